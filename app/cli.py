@@ -1,0 +1,179 @@
+"""``ros2-classroom``: serve the dashboard, run or list catalog nodes.
+
+Errors a user can cause (unknown node, busy port, bad domain id) print one
+clear line and exit non-zero; they never show a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ipaddress
+import os
+import signal
+import socket
+import sys
+import threading
+import time
+
+from app import catalog
+from app.dds import configure_this_process, validate_domain_id
+
+EXIT_USAGE = 2
+
+
+class CliError(Exception):
+    """A problem the user can fix; printed as one line."""
+
+
+def _domain_id(text: str) -> int:
+    try:
+        return validate_domain_id(int(text))
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _port(text: str) -> int:
+    try:
+        port = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a port number: {text!r}") from None
+    if not 1 <= port <= 65535:
+        raise argparse.ArgumentTypeError(f"port must be 1-65535, got {port}")
+    return port
+
+
+def _is_loopback(host: str) -> bool:
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+def _check_port_free(host: str, port: int) -> None:
+    # viser silently moves to the next port when ours is taken; say so instead.
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        try:
+            probe.bind((host, port))
+        except OSError as exc:
+            raise CliError(
+                f"port {port} on {host} is already in use ({exc.strerror}); "
+                f"stop the other program or pick another port with --port"
+            ) from None
+
+
+def cmd_serve(args: argparse.Namespace) -> int:
+    if not _is_loopback(args.host):
+        raise CliError(
+            f"refusing to serve on {args.host}: the dashboard can start processes, so it "
+            "only listens on this machine (127.0.0.1)"
+        )
+    configure_this_process(domain_id=args.domain_id, network=args.network)
+    _check_port_free(args.host, args.port)
+
+    # Heavy imports only for the command that needs them.
+    import viser
+
+    from app.dashboard import Dashboard
+    from app.ros_runtime import RosRuntime
+    from app.supervisor import Supervisor
+
+    stop_requested = threading.Event()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda *_: stop_requested.set())
+
+    server = viser.ViserServer(host=args.host, port=args.port, verbose=False)
+    if server.get_port() != args.port:
+        server.stop()
+        raise CliError(f"port {args.port} on {args.host} became busy; pick another with --port")
+    runtime = RosRuntime()
+    supervisor = Supervisor(os.environ)
+    dashboard = Dashboard(server, runtime, supervisor)
+    dashboard.start()
+    domain = os.environ.get("ROS_DOMAIN_ID", "0")
+    scope = "network (opt-in)" if args.network else "loopback only"
+    print(
+        f"ROS 2 Classroom is ready: http://{args.host}:{args.port}  "
+        f"(ROS domain {domain}, DDS {scope}). Press Ctrl+C to stop.",
+        flush=True,
+    )
+    stop_requested.wait()
+    print("Shutting down…", flush=True)
+    started = time.monotonic()
+    dashboard.stop()
+    runtime.shutdown()
+    supervisor.shutdown(timeout=2.5)
+    server.stop()
+    print(f"Stopped in {time.monotonic() - started:.1f} s.", flush=True)
+    return 0
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    entry = catalog.lookup(args.node)
+    configure_this_process(domain_id=args.domain_id, network=args.network)
+    argv = [sys.executable, "-m", f"nodes.{entry.module}", *entry.argv_tail()]
+    extra = list(args.ros_args)
+    if extra:
+        if extra[0] != "--ros-args":
+            raise CliError("extra arguments must follow --ros-args, as with `ros2 run`")
+        argv += extra[1:] if entry.ros_args else extra
+    # Replace this process, as `ros2 run` does: Ctrl+C goes straight to the node.
+    os.execv(sys.executable, argv)
+    return 0  # not reached
+
+
+def cmd_list(args: argparse.Namespace) -> int:
+    width = max(len(name) for name in catalog.names())
+    print("Catalog nodes (ros2-classroom run <name>):")
+    for entry in catalog.ENTRIES:
+        print(f"  {entry.name:<{width}}  {entry.summary}")
+    print("\nLaunch groups:")
+    for group in catalog.GROUPS:
+        print(f"  {group.name:<{width}}  {group.summary}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="ros2-classroom", description="A browser-based teaching dashboard for ROS 2 Jazzy."
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    def dds_options(p: argparse.ArgumentParser) -> None:
+        p.add_argument(
+            "--domain-id",
+            type=_domain_id,
+            default=None,
+            help="ROS_DOMAIN_ID to use (default: $ROS_DOMAIN_ID or 0)",
+        )
+        p.add_argument(
+            "--network",
+            action="store_true",
+            help="let DDS use the network cards to reach other machines (default: loopback only)",
+        )
+
+    serve = sub.add_parser("serve", help="start the dashboard web server")
+    serve.add_argument("--host", default="127.0.0.1", help="address to listen on")
+    serve.add_argument("--port", type=_port, default=8080, help="port to listen on")
+    dds_options(serve)
+    serve.set_defaults(func=cmd_serve)
+
+    run = sub.add_parser("run", help="run one catalog node in the foreground, like `ros2 run`")
+    run.add_argument("node", help="catalog name (see `ros2-classroom list`)")
+    run.add_argument("ros_args", nargs=argparse.REMAINDER, help="--ros-args ...")
+    dds_options(run)
+    run.set_defaults(func=cmd_run)
+
+    lst = sub.add_parser("list", help="print the node catalog")
+    lst.set_defaults(func=cmd_list)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except (CliError, catalog.UnknownNodeError, ValueError) as exc:
+        print(f"ros2-classroom: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE

@@ -1,0 +1,74 @@
+"""Wires the web server, the ROS runtime, the supervisor and the panels. Nothing else."""
+
+from __future__ import annotations
+
+import logging
+import os
+import threading
+
+import viser
+from std_msgs.msg import String
+
+from app.graph import GraphSnapshot, snapshot
+from app.panels import Panel
+from app.panels.echo_panel import EchoPanel
+from app.panels.graph_panel import GraphPanel
+from app.panels.nodes_panel import NodesPanel
+from app.ros_runtime import RosRuntime
+from app.supervisor import Supervisor
+from app.topic_tap import TopicTap
+
+log = logging.getLogger(__name__)
+
+UI_PERIOD_SEC = 0.2  # panels refresh at 5 Hz
+
+
+class Dashboard:
+    def __init__(self, server: viser.ViserServer, runtime: RosRuntime, supervisor: Supervisor):
+        self.server = server
+        self.runtime = runtime
+        self.supervisor = supervisor
+        self._stop = threading.Event()
+        self.graph = GraphSnapshot()
+        self._chatter = TopicTap(runtime.node, "/chatter", String)
+        self._panels: list[Panel] = self._build_gui()
+        self._ui_thread = threading.Thread(target=self._ui_loop, name="ui-refresh", daemon=True)
+
+    def _build_gui(self) -> list[Panel]:
+        gui = self.server.gui
+        gui.configure_theme(
+            titlebar_content=None, control_width="large", show_share_button=False
+        )
+        self.server.scene.configure_environment_map(None)  # avoids a stall in software WebGL
+        self.server.scene.add_grid("/grid", width=4.0, height=4.0, cell_size=0.25)
+        self.server.scene.add_frame("/world", axes_length=0.3, axes_radius=0.01)
+        gui.add_markdown(
+            "## ROS 2 Classroom\n"
+            f"Domain id **{os.environ.get('ROS_DOMAIN_ID', '0')}** · "
+            "this dashboard is the ROS node `/classroom_dashboard`."
+        )
+        tabs = gui.add_tab_group()
+        with tabs.add_tab("Nodes", viser.Icon.CPU):
+            nodes = NodesPanel(gui, self.supervisor)
+        with tabs.add_tab("Graph", viser.Icon.SITEMAP):
+            graph = GraphPanel(gui)
+        with tabs.add_tab("Echo", viser.Icon.MESSAGE):
+            echo = EchoPanel(gui, self._chatter)
+        return [nodes, graph, echo]
+
+    def start(self) -> None:
+        self._ui_thread.start()
+
+    def _ui_loop(self) -> None:
+        while not self._stop.wait(UI_PERIOD_SEC):
+            try:
+                self.graph = snapshot(self.runtime.node)
+                self.supervisor.note_visible_nodes(self.graph.nodes)
+                for panel in self._panels:
+                    panel.refresh(self.graph)
+            except Exception:  # a panel bug must not freeze every other panel
+                log.exception("UI refresh failed")
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._ui_thread.join(timeout=2.0)

@@ -1,0 +1,89 @@
+"""Nodes panel: the catalog with Start / Stop / Restart, state and a live log tail."""
+
+from __future__ import annotations
+
+import threading
+
+import viser
+
+from app.catalog import ENTRIES, UnknownNodeError, lookup
+from app.graph import GraphSnapshot
+from app.panels import MarkdownView, code_block
+from app.supervisor import ACTIVE_STATES, NodeState, NodeStatus, Supervisor
+
+_STATE_ICONS = {
+    NodeState.STARTING: "◐",
+    NodeState.RUNNING: "●",
+    NodeState.STOPPING: "◑",
+    NodeState.STOPPED: "○",
+    NodeState.EXITED: "✓",
+    NodeState.CRASHED: "✗",
+}
+LOG_TAIL_LINES = 14
+
+
+class NodesPanel:
+    def __init__(self, gui: viser.GuiApi, supervisor: Supervisor) -> None:
+        self._supervisor = supervisor
+        self._overview = MarkdownView(gui)
+        self._selector = gui.add_dropdown(
+            "Catalog node",
+            [entry.name for entry in ENTRIES],
+            initial_value=ENTRIES[0].name,
+            hint="Pick a tutorial node to start, stop or inspect",
+        )
+        self._details = MarkdownView(gui)
+        self._start = gui.add_button("Start", icon=viser.Icon.PLAYER_PLAY, color="green")
+        self._stop = gui.add_button("Stop", icon=viser.Icon.PLAYER_STOP, color="red")
+        self._restart = gui.add_button("Restart", icon=viser.Icon.REFRESH)
+        self._message = MarkdownView(gui)
+        self._log = MarkdownView(gui)
+        self._start.on_click(lambda _: self._act(self._do_start))
+        self._stop.on_click(lambda _: self._act(self._do_stop))
+        self._restart.on_click(lambda _: self._act(self._do_restart))
+        self._selector.on_update(lambda _: self.refresh(None))
+
+    # Button actions never block the viser callback thread for long: a stop
+    # escalates in the supervisor's own thread.
+    def _act(self, action) -> None:
+        name = self._selector.value
+        try:
+            self._message.show(action(name))
+        except (UnknownNodeError, RuntimeError, OSError) as exc:
+            self._message.show(f"⚠️ {exc}")
+        self.refresh(None)
+
+    def _do_start(self, name: str) -> str:
+        status = self._supervisor.start(name)
+        return f"Started **{name}** (pid {status.pid})."
+
+    def _do_stop(self, name: str) -> str:
+        self._supervisor.stop(name)
+        return f"Stopping **{name}** (Ctrl+C, as in a terminal)…"
+
+    def _do_restart(self, name: str) -> str:
+        threading.Thread(target=self._supervisor.restart, args=(name,), daemon=True).start()
+        return f"Restarting **{name}**…"
+
+    def refresh(self, graph: GraphSnapshot | None) -> None:
+        statuses = self._supervisor.statuses()
+        rows = ["| node | state |", "|---|---|"]
+        for entry in ENTRIES:
+            status = statuses.get(entry.name, NodeStatus(entry.name, NodeState.STOPPED))
+            rows.append(f"| {entry.name} | {_STATE_ICONS[status.state]} {status.describe()} |")
+        self._overview.show("\n".join(rows))
+
+        name = self._selector.value
+        entry = lookup(name)
+        status = statuses.get(name, NodeStatus(name, NodeState.STOPPED))
+        self._details.show(
+            f"**{name}**: {entry.summary}\n\n"
+            f"State: {_STATE_ICONS[status.state]} **{status.describe()}**\n\n"
+            f"In a terminal: `{entry.ros2_run_command()}`"
+        )
+        active = status.state in ACTIVE_STATES
+        self._start.disabled = active
+        self._stop.disabled = not active
+        lines = self._supervisor.output(name, last=LOG_TAIL_LINES)
+        dropped = f"\n\n_{status.dropped_lines} older lines dropped_" if status.dropped_lines else ""
+        self._log.show(f"Log of **{name}**:\n\n" + code_block(lines) + dropped)

@@ -1,0 +1,44 @@
+"""The dashboard's own ROS participant: one context, one node, one executor thread.
+
+``rclpy`` is initialised on the calling (main) thread with its signal
+handlers off (the CLI owns SIGINT/SIGTERM); the observer node
+``/classroom_dashboard`` is spun by one MultiThreadedExecutor in one thread.
+Everything else in the dashboard creates its subscriptions and clients on
+``runtime.node`` and never spins it.
+"""
+
+from __future__ import annotations
+
+import threading
+
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
+
+DASHBOARD_NODE_NAME = "classroom_dashboard"
+
+
+class RosRuntime:
+    def __init__(self, node_name: str = DASHBOARD_NODE_NAME, *, threads: int = 4) -> None:
+        self.context = Context()
+        rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO)
+        self.node = Node(node_name, context=self.context)
+        self.executor = MultiThreadedExecutor(num_threads=threads, context=self.context)
+        self.executor.add_node(self.node)
+        self._thread = threading.Thread(target=self._spin, name="ros-executor", daemon=True)
+        self._thread.start()
+
+    def _spin(self) -> None:
+        try:
+            self.executor.spin()
+        except (ExternalShutdownException, KeyboardInterrupt):
+            pass
+
+    def shutdown(self, timeout: float = 2.0) -> None:
+        """Executor first, then the node, then the context."""
+        self.executor.shutdown(timeout_sec=timeout)
+        self._thread.join(timeout)
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)

@@ -1,0 +1,295 @@
+"""The supervisor: sole owner of the tutorial node processes.
+
+Each catalog node runs as ``python -m nodes.<module> --ros-args ...`` in its
+own process group, as ``ros2 run`` would start it. Stopping escalates
+SIGINT -> SIGTERM -> SIGKILL with timeouts; every child is reaped. Children
+get a parent-death signal, so they end even when the dashboard is killed with
+SIGKILL. Output is kept in a bounded buffer per node.
+
+Threads: children are spawned from one long-lived thread (the parent-death
+signal is tied to the *thread* that forked), each child has one reader thread
+that also reaps it, and stops escalate in short-lived threads. All state
+lives in ``_Process`` objects guarded by one lock.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from collections import deque
+from collections.abc import Callable, Iterable, Mapping
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass
+from enum import Enum
+
+from app import PROJECT_ROOT
+from app.catalog import CatalogEntry, lookup
+
+_PR_SET_PDEATHSIG = 1
+_libc = ctypes.CDLL(None, use_errno=True)
+
+
+class NodeState(str, Enum):
+    STARTING = "starting"  # process spawned, ROS node not yet seen in the graph
+    RUNNING = "running"
+    STOPPING = "stopping"
+    STOPPED = "stopped"  # stopped on request
+    EXITED = "exited"  # ended on its own with exit code 0 (e.g. a client)
+    CRASHED = "crashed"  # ended on its own with a non-zero code or a signal
+
+
+ACTIVE_STATES = frozenset({NodeState.STARTING, NodeState.RUNNING, NodeState.STOPPING})
+
+
+@dataclass(frozen=True)
+class NodeStatus:
+    """A snapshot of one catalog node's process, safe to hand to any thread."""
+
+    name: str
+    state: NodeState
+    pid: int | None = None
+    exit_code: int | None = None
+    started_at: float | None = None
+    ended_at: float | None = None
+    dropped_lines: int = 0
+
+    @property
+    def active(self) -> bool:
+        return self.state in ACTIVE_STATES
+
+    def describe(self) -> str:
+        """Readable state, e.g. 'crashed (exit code 1)' or 'killed by SIGKILL'."""
+        if self.state in (NodeState.CRASHED, NodeState.STOPPED, NodeState.EXITED):
+            if self.exit_code is not None and self.exit_code < 0:
+                try:
+                    sig = signal.Signals(-self.exit_code).name
+                except ValueError:
+                    sig = f"signal {-self.exit_code}"
+                return f"{self.state.value} (killed by {sig})"
+            if self.exit_code is not None:
+                return f"{self.state.value} (exit code {self.exit_code})"
+        if self.state in ACTIVE_STATES and self.pid is not None:
+            return f"{self.state.value} (pid {self.pid})"
+        return self.state.value
+
+
+class _Process:
+    """Book-keeping for one child; mutated only under the supervisor's lock."""
+
+    def __init__(self, entry: CatalogEntry, popen: subprocess.Popen[bytes], max_lines: int):
+        self.entry = entry
+        self.popen = popen
+        self.state = NodeState.STARTING
+        self.stop_requested = False
+        self.started_at = time.time()
+        self.ended_at: float | None = None
+        self.exit_code: int | None = None
+        self.output: deque[str] = deque(maxlen=max_lines)
+        self.dropped_lines = 0
+        self.done = threading.Event()
+
+    def status(self) -> NodeStatus:
+        return NodeStatus(
+            self.entry.name,
+            self.state,
+            self.popen.pid,
+            self.exit_code,
+            self.started_at,
+            self.ended_at,
+            self.dropped_lines,
+        )
+
+
+def _set_parent_death_signal() -> None:
+    """Runs in the child between fork and exec: die with the dashboard."""
+    _libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
+
+
+class Supervisor:
+    """Starts, stops and watches catalog nodes. Thread-safe."""
+
+    MAX_LINE_CHARS = 2000
+
+    def __init__(
+        self,
+        env: Mapping[str, str],
+        *,
+        max_log_lines: int = 400,
+        sigint_timeout: float = 3.0,
+        sigterm_timeout: float = 2.0,
+        on_change: Callable[[NodeStatus], None] | None = None,
+    ) -> None:
+        self._env = dict(env)
+        self._env.setdefault("PYTHONUNBUFFERED", "1")
+        self._env.setdefault("RCUTILS_COLORIZED_OUTPUT", "0")
+        self._max_log_lines = max_log_lines
+        self._timeouts = (sigint_timeout, sigterm_timeout)
+        self._on_change = on_change
+        self._lock = threading.Lock()
+        self._procs: dict[str, _Process] = {}
+        self._spawner = ThreadPoolExecutor(max_workers=1, thread_name_prefix="supervisor-spawn")
+        self._closed = False
+
+    # -- queries -----------------------------------------------------------
+
+    def status(self, name: str) -> NodeStatus:
+        lookup(name)  # unknown names are an error, not "stopped"
+        with self._lock:
+            proc = self._procs.get(name)
+            return proc.status() if proc else NodeStatus(name, NodeState.STOPPED)
+
+    def statuses(self) -> dict[str, NodeStatus]:
+        with self._lock:
+            return {name: proc.status() for name, proc in self._procs.items()}
+
+    def output(self, name: str, last: int | None = None) -> list[str]:
+        with self._lock:
+            proc = self._procs.get(name)
+            lines = list(proc.output) if proc else []
+        return lines[-last:] if last else lines
+
+    # -- control -----------------------------------------------------------
+
+    def start(self, name: str, extra_ros_args: Iterable[str] = ()) -> NodeStatus:
+        """Start a catalog node (no-op if it is already active)."""
+        entry = lookup(name)
+        with self._lock:
+            if self._closed:
+                raise RuntimeError("the supervisor is shutting down")
+            current = self._procs.get(name)
+            if current and current.state in ACTIVE_STATES:
+                return current.status()
+        status = self._spawner.submit(self._spawn, entry, tuple(extra_ros_args)).result()
+        self._notify(status)
+        return status
+
+    def stop(self, name: str) -> Future[NodeStatus]:
+        """Ask a node to stop; the future resolves once it has been reaped."""
+        lookup(name)
+        future: Future[NodeStatus] = Future()
+        with self._lock:
+            proc = self._procs.get(name)
+            if proc is None or proc.state not in ACTIVE_STATES:
+                future.set_result(proc.status() if proc else NodeStatus(name, NodeState.STOPPED))
+                return future
+            proc.stop_requested = True
+            proc.state = NodeState.STOPPING
+            status = proc.status()
+        self._notify(status)
+        threading.Thread(
+            target=self._escalate_stop, args=(proc, future), name=f"stop-{name}", daemon=True
+        ).start()
+        return future
+
+    def restart(self, name: str) -> NodeStatus:
+        self.stop(name).result()
+        return self.start(name)
+
+    def note_visible_nodes(self, node_names: Iterable[str]) -> None:
+        """Called with the graph's node names: a STARTING node seen there is RUNNING."""
+        seen = set(node_names)
+        changed = []
+        with self._lock:
+            for proc in self._procs.values():
+                if proc.state is NodeState.STARTING and proc.entry.node_name in seen:
+                    proc.state = NodeState.RUNNING
+                    changed.append(proc.status())
+        for status in changed:
+            self._notify(status)
+
+    def shutdown(self, timeout: float = 4.0) -> None:
+        """Stop every child in parallel and reap them all."""
+        with self._lock:
+            self._closed = True
+            names = [n for n, p in self._procs.items() if p.state in ACTIVE_STATES]
+        futures = [self.stop(name) for name in names]
+        deadline = time.monotonic() + timeout
+        for future in futures:
+            try:
+                future.result(timeout=max(0.1, deadline - time.monotonic()))
+            except TimeoutError:
+                pass
+        with self._lock:
+            leftovers = [p for p in self._procs.values() if not p.done.is_set()]
+        for proc in leftovers:  # out of time: no child may outlive us
+            self._signal_group(proc, signal.SIGKILL)
+            proc.done.wait(1.0)
+        self._spawner.shutdown(wait=True)
+
+    # -- internals ---------------------------------------------------------
+
+    def _spawn(self, entry: CatalogEntry, extra_ros_args: tuple[str, ...]) -> NodeStatus:
+        argv = [sys.executable, "-m", f"nodes.{entry.module}", *entry.argv_tail()]
+        if extra_ros_args:
+            argv += ([] if entry.ros_args else ["--ros-args"]) + list(extra_ros_args)
+        popen = subprocess.Popen(
+            argv,
+            cwd=PROJECT_ROOT,
+            env=self._env,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,  # own process group: signals reach the whole node
+            preexec_fn=_set_parent_death_signal,
+        )
+        proc = _Process(entry, popen, self._max_log_lines)
+        with self._lock:
+            self._procs[entry.name] = proc
+        threading.Thread(
+            target=self._read_and_reap, args=(proc,), name=f"output-{entry.name}", daemon=True
+        ).start()
+        return proc.status()
+
+    def _read_and_reap(self, proc: _Process) -> None:
+        assert proc.popen.stdout is not None
+        for raw in proc.popen.stdout:
+            line = raw.decode("utf-8", errors="replace").rstrip("\n")
+            if len(line) > self.MAX_LINE_CHARS:
+                line = line[: self.MAX_LINE_CHARS] + " …(line cut)"
+            with self._lock:
+                if len(proc.output) == proc.output.maxlen:
+                    proc.dropped_lines += 1
+                proc.output.append(line)
+        code = proc.popen.wait()
+        with self._lock:
+            proc.exit_code = code
+            proc.ended_at = time.time()
+            if proc.stop_requested:
+                proc.state = NodeState.STOPPED
+            else:
+                proc.state = NodeState.EXITED if code == 0 else NodeState.CRASHED
+            status = proc.status()
+        proc.done.set()
+        self._notify(status)
+
+    def _escalate_stop(self, proc: _Process, future: Future[NodeStatus]) -> None:
+        # SIGINT is Ctrl+C: rclpy nodes leave spin and shut down cleanly, so
+        # they also leave the ROS graph at once instead of after a lease timeout.
+        for sig, timeout in zip((signal.SIGINT, signal.SIGTERM), self._timeouts, strict=True):
+            self._signal_group(proc, sig)
+            if proc.done.wait(timeout):
+                break
+        else:
+            self._signal_group(proc, signal.SIGKILL)
+            proc.done.wait()
+        with self._lock:
+            status = proc.status()
+        future.set_result(status)
+
+    @staticmethod
+    def _signal_group(proc: _Process, sig: signal.Signals) -> None:
+        if proc.done.is_set():
+            return  # reaped: its process-group id may already belong to someone else
+        try:
+            os.killpg(proc.popen.pid, sig)
+        except (ProcessLookupError, PermissionError):
+            pass  # already gone
+
+    def _notify(self, status: NodeStatus) -> None:
+        if self._on_change is not None:
+            self._on_change(status)

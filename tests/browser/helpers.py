@@ -1,0 +1,22 @@
+"""Selectors that work on viser's page (see DESIGN.md section 6)."""
+
+from __future__ import annotations
+
+from playwright.sync_api import Page, expect
+
+
+def open_tab(page: Page, name: str) -> None:
+    page.get_by_role("tab", name=name).click()
+
+
+def choose(page: Page, label: str, option: str) -> None:
+    page.get_by_label(label).click()
+    page.get_by_role("option", name=option, exact=True).click()
+
+
+def click(page: Page, button: str) -> None:
+    page.get_by_role("button", name=button, exact=True).click()
+
+
+def expect_text(page: Page, text: str, timeout: float = 20_000) -> None:
+    expect(page.get_by_text(text).first).to_be_visible(timeout=timeout)

@@ -1,0 +1,56 @@
+"""A learner's first minutes: start talker and listener, watch, stop."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+from playwright.sync_api import expect
+
+from tests.browser.helpers import choose, click, expect_text, open_tab
+
+pytestmark = [pytest.mark.browser, pytest.mark.ros]
+
+
+def start(page, name: str) -> None:
+    open_tab(page, "Nodes")
+    choose(page, "Catalog node", name)
+    click(page, "Start")
+    expect_text(page, "Started")
+
+
+def test_start_watch_and_stop_talker_and_listener(page):
+    start(page, "talker")
+    start(page, "listener")
+
+    open_tab(page, "Echo")
+    expect(page.get_by_text(re.compile(r"data: 'Hello World: \d+'")).first).to_be_visible(
+        timeout=30_000
+    )
+
+    open_tab(page, "Graph")
+    expect_text(page, "/listener")
+    expect_text(page, "/talker")
+
+    for name in ("talker", "listener"):
+        open_tab(page, "Nodes")
+        choose(page, "Catalog node", name)
+        click(page, "Stop")
+        expect_text(page, "stopped (exit code 0)")
+
+    open_tab(page, "Graph")
+    graph = page.get_by_text("ros2 node list").locator("xpath=ancestor::div[1]")
+    expect(page.get_by_text("/talker", exact=True)).to_have_count(0, timeout=15_000)
+    expect(page.get_by_text("/listener", exact=True)).to_have_count(0, timeout=15_000)
+    assert graph is not None
+
+
+def test_crashed_node_shows_exit_code_and_restarts(page):
+    start(page, "crashing_node")
+    expect_text(page, "crashed (exit code 1)", timeout=30_000)
+    expect_text(page, "simulated bug")
+    click(page, "Restart")
+    expect_text(page, "Restarting")
+    expect(page.get_by_text(re.compile(r"(starting|running) \(pid \d+\)")).first).to_be_visible(
+        timeout=15_000
+    )

@@ -1,0 +1,159 @@
+"""Shared fixtures: private DDS domain per test, a probe node, the dashboard, a browser."""
+
+from __future__ import annotations
+
+import itertools
+import os
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+
+from app import PROJECT_ROOT
+from app.dds import configure_dds_env
+
+ARTIFACTS = PROJECT_ROOT / "test-artifacts"
+_domain_ids = itertools.count(1 + os.getpid() % 50)
+
+
+def in_private_netns() -> bool:
+    return [name for _, name in socket.if_nameindex()] == ["lo"]
+
+
+def wait_until(
+    predicate: Callable[[], object], timeout: float = 15.0, interval: float = 0.05, what: str = ""
+) -> object:
+    """Poll until ``predicate()`` is truthy; fail the test with ``what`` on timeout."""
+    deadline = time.monotonic() + timeout
+    while True:
+        value = predicate()
+        if value:
+            return value
+        if time.monotonic() > deadline:
+            pytest.fail(f"timed out after {timeout:.0f} s waiting for {what or predicate}")
+        time.sleep(interval)
+
+
+@pytest.fixture
+def ros_env(monkeypatch: pytest.MonkeyPatch) -> dict[str, str]:
+    """A fresh ROS domain on loopback for one test; fails (never skips) outside the netns."""
+    if not in_private_netns():
+        pytest.fail(
+            "DDS tests must run inside a private network namespace with only loopback: "
+            "run them with `make test` (tests/run.py)"
+        )
+    domain = next(_domain_ids) % 100 + 1
+    env = dict(os.environ)
+    configure_dds_env(env, domain_id=domain, network=False)
+    for key in ("ROS_DOMAIN_ID", "FASTRTPS_DEFAULT_PROFILES_FILE", "RMW_IMPLEMENTATION"):
+        monkeypatch.setenv(key, env[key])
+    monkeypatch.delenv("ROS_AUTOMATIC_DISCOVERY_RANGE", raising=False)
+    return env
+
+
+@pytest.fixture
+def probe(ros_env):
+    """A ROS node in the test process, spun in its own thread, to observe over DDS."""
+    from app.ros_runtime import RosRuntime
+
+    runtime = RosRuntime("test_probe", threads=2)
+    yield runtime
+    runtime.shutdown()
+
+
+@pytest.fixture
+def supervisor(ros_env):
+    from app.supervisor import Supervisor
+
+    sup = Supervisor(ros_env)
+    yield sup
+    sup.shutdown()
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+class DashboardProcess:
+    """``ros2-classroom serve`` as a real child process."""
+
+    def __init__(self, env: dict[str, str], port: int, extra: list[str] | None = None):
+        self.port = port
+        self.url = f"http://127.0.0.1:{port}"
+        self.log_path = ARTIFACTS / f"dashboard-{port}.log"
+        ARTIFACTS.mkdir(exist_ok=True)
+        self._log = open(self.log_path, "wb")  # noqa: SIM115 - closed in stop()
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "app", "serve", "--port", str(port), *(extra or [])],
+            cwd=PROJECT_ROOT,
+            env={**env, "PYTHONUNBUFFERED": "1"},
+            stdout=self._log,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,
+        )
+        wait_until(self._ready, timeout=40, interval=0.2, what="the dashboard to serve")
+
+    def _ready(self) -> bool:
+        if self.proc.poll() is not None:
+            pytest.fail(f"dashboard exited early ({self.proc.returncode}):\n{self.log()}")
+        return "is ready" in self.log()
+
+    def log(self) -> str:
+        return Path(self.log_path).read_text(errors="replace")
+
+    def stop(self, timeout: float = 10.0) -> int:
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(timeout)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+        self._log.close()
+        return self.proc.returncode
+
+
+@pytest.fixture
+def dashboard(ros_env) -> Iterator[DashboardProcess]:
+    dash = DashboardProcess(ros_env, free_port())
+    yield dash
+    dash.stop()
+
+
+@pytest.fixture(scope="session")
+def browser():
+    from playwright.sync_api import sync_playwright
+
+    executable = "/usr/bin/chromium"
+    if not Path(executable).exists():
+        pytest.fail("Debian's chromium is missing: `make test` installs it (apt-get install chromium)")
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(
+            executable_path=executable,
+            args=[
+                "--no-sandbox",
+                "--disable-dev-shm-usage",
+                "--disable-background-networking",
+                "--disable-component-update",
+                "--no-first-run",
+            ],
+        )
+        yield browser
+        browser.close()
+
+
+@pytest.fixture
+def page(browser, dashboard, request):
+    context = browser.new_context(viewport={"width": 1400, "height": 900})
+    page = context.new_page()
+    page.goto(dashboard.url)
+    yield page
+    ARTIFACTS.mkdir(exist_ok=True)
+    page.screenshot(path=str(ARTIFACTS / f"{request.node.name}.png"))
+    context.close()

@@ -1,0 +1,132 @@
+"""The supervisor runs real node processes on a private DDS domain."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+
+import psutil
+import pytest
+from std_msgs.msg import String
+
+from app import PROJECT_ROOT
+from app.supervisor import NodeState
+from app.topic_tap import TopicTap
+from tests.conftest import wait_until
+
+pytestmark = pytest.mark.ros
+
+
+def test_talker_and_listener_talk_over_dds(supervisor, probe):
+    tap = TopicTap(probe.node, "/chatter", String)
+    supervisor.start("talker")
+    supervisor.start("listener")
+    wait_until(lambda: tap.count >= 3, what="/chatter messages at the probe")
+    assert tap.recent()[-1][1].data.startswith("Hello World: ")
+    wait_until(
+        lambda: any("I heard" in line for line in supervisor.output("listener")),
+        what="the listener to log what it heard",
+    )
+    nodes = wait_until(
+        lambda: {"/talker", "/listener"} <= set(_node_names(probe)) and _node_names(probe),
+        what="both nodes in the graph",
+    )
+    assert "/talker" in nodes
+
+
+def test_stop_is_clean_and_leaves_the_graph(supervisor, probe):
+    supervisor.start("talker")
+    wait_until(lambda: "/talker" in _node_names(probe), what="/talker in the graph")
+    supervisor.note_visible_nodes(_node_names(probe))
+    assert supervisor.status("talker").state is NodeState.RUNNING
+    pid = supervisor.status("talker").pid
+    status = supervisor.stop("talker").result(timeout=10)
+    assert status.state is NodeState.STOPPED
+    assert status.exit_code == 0, supervisor.output("talker")  # SIGINT handled cleanly
+    assert not psutil.pid_exists(pid) or psutil.Process(pid).status() == psutil.STATUS_ZOMBIE
+    wait_until(lambda: "/talker" not in _node_names(probe), timeout=5, what="/talker to leave")
+
+
+def test_crash_is_reported_with_exit_code_and_restart_works(supervisor):
+    supervisor.start("crashing_node")
+    status = wait_until(
+        lambda: (s := supervisor.status("crashing_node")).state is NodeState.CRASHED and s,
+        timeout=30,
+        what="crashing_node to crash",
+    )
+    assert status.exit_code == 1
+    assert status.describe() == "crashed (exit code 1)"
+    assert any("simulated bug" in line for line in supervisor.output("crashing_node"))
+    restarted = supervisor.restart("crashing_node")
+    assert restarted.state is NodeState.STARTING and restarted.pid != status.pid
+
+
+def test_stubborn_process_is_escalated_to_sigkill(ros_env):
+    from app.supervisor import Supervisor
+
+    sup = Supervisor(ros_env, sigint_timeout=0.5, sigterm_timeout=0.5)
+    try:
+        sup.start("talker")
+        wait_until(lambda: sup.output("talker"), what="talker output")
+        pid = sup.status("talker").pid
+        # Make the node ignore Ctrl+C and SIGTERM, as a hung program would.
+        os.kill(pid, signal.SIGSTOP)
+        status = sup.stop("talker").result(timeout=10)
+        assert status.state is NodeState.STOPPED
+        assert status.exit_code == -signal.SIGKILL
+    finally:
+        sup.shutdown()
+
+
+def test_output_buffer_is_bounded(ros_env):
+    from app.supervisor import Supervisor
+
+    sup = Supervisor(ros_env, max_log_lines=5)
+    try:
+        sup.start("talker")
+        wait_until(lambda: sup.status("talker").dropped_lines > 0, what="old lines to drop")
+        assert len(sup.output("talker")) == 5
+    finally:
+        sup.shutdown()
+
+
+def test_no_child_survives_a_sigkilled_dashboard(ros_env):
+    """The supervisor's owner dies by SIGKILL with three nodes running: none survives."""
+    script = textwrap.dedent(
+        """
+        import os, sys, time
+        from app.supervisor import Supervisor
+        sup = Supervisor(os.environ)
+        for name in ("talker", "listener", "listener2"):
+            print(sup.start(name).pid, flush=True)
+        time.sleep(600)
+        """
+    )
+    owner = subprocess.Popen(
+        [sys.executable, "-c", script],
+        cwd=PROJECT_ROOT,
+        env=ros_env,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    pids = [int(owner.stdout.readline()) for _ in range(3)]
+    assert all(psutil.pid_exists(pid) for pid in pids)
+    owner.kill()
+    owner.wait()
+    wait_until(
+        lambda: not any(_alive(pid) for pid in pids), timeout=10, what="every child to end"
+    )
+
+
+def _alive(pid: int) -> bool:
+    try:
+        return psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        return False
+
+
+def _node_names(probe) -> list[str]:
+    return [f"{ns.rstrip('/')}/{n}" for n, ns in probe.node.get_node_names_and_namespaces()]
