@@ -60,6 +60,8 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         "/crashing_node",
         "Crashes on purpose after 3 s, to show how failures are reported.",
     ),
+    # --- core tutorial nodes (issue 3): add entries below this line ---
+    # --- perception and manipulation nodes (issue 5): add entries below this line ---
 )
 
 GROUPS: tuple[LaunchGroup, ...] = (
@@ -68,6 +70,8 @@ GROUPS: tuple[LaunchGroup, ...] = (
         "talker + listener + listener2 on /chatter",
         ("talker", "listener", "listener2"),
     ),
+    # --- core tutorial groups (issue 3): add groups below this line ---
+    # --- perception groups (issue 5): add groups below this line ---
 )
 
 _BY_NAME = {entry.name: entry for entry in ENTRIES}
