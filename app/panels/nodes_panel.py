@@ -6,7 +6,7 @@ import threading
 
 import viser
 
-from app.catalog import ENTRIES, UnknownNodeError, lookup
+from app.catalog import ENTRIES, GROUPS, UnknownNodeError, lookup, lookup_group
 from app.graph import GraphSnapshot
 from app.panels import MarkdownView, code_block
 from app.supervisor import ACTIVE_STATES, NodeState, NodeStatus, Supervisor
@@ -38,6 +38,16 @@ class NodesPanel:
         self._restart = gui.add_button("Restart", icon=viser.Icon.REFRESH)
         self._message = MarkdownView(gui)
         self._log = MarkdownView(gui)
+        gui.add_markdown("**Launch groups**: several nodes at once, as a launch file would.")
+        self._group_selector = gui.add_dropdown(
+            "Launch group", [group.name for group in GROUPS], initial_value=GROUPS[0].name
+        )
+        self._group_details = MarkdownView(gui)
+        self._start_group = gui.add_button("Start group", icon=viser.Icon.PLAYER_PLAY)
+        self._stop_group = gui.add_button("Stop group", icon=viser.Icon.PLAYER_STOP)
+        self._start_group.on_click(lambda _: self._act_on_group(self._supervisor.start, "Started"))
+        self._stop_group.on_click(lambda _: self._act_on_group(self._supervisor.stop, "Stopping"))
+        self._group_selector.on_update(lambda _: self.refresh(None))
         self._start.on_click(lambda _: self._act(self._do_start))
         self._stop.on_click(lambda _: self._act(self._do_stop))
         self._restart.on_click(lambda _: self._act(self._do_restart))
@@ -49,6 +59,16 @@ class NodesPanel:
         name = self._selector.value
         try:
             self._message.show(action(name))
+        except (UnknownNodeError, RuntimeError, OSError) as exc:
+            self._message.show(f"⚠️ {exc}")
+        self.refresh(None)
+
+    def _act_on_group(self, action, verb: str) -> None:
+        group = lookup_group(self._group_selector.value)
+        try:
+            for member in group.members:
+                action(member)
+            self._message.show(f"{verb} group **{group.name}**: {', '.join(group.members)}.")
         except (UnknownNodeError, RuntimeError, OSError) as exc:
             self._message.show(f"⚠️ {exc}")
         self.refresh(None)
@@ -84,6 +104,10 @@ class NodesPanel:
         active = status.state in ACTIVE_STATES
         self._start.disabled = active
         self._stop.disabled = not active
+        group = lookup_group(self._group_selector.value)
+        self._group_details.show(
+            f"{group.summary}. In a terminal: `ros2 launch tutorial_nodes {group.name}.launch.py`"
+        )
         lines = self._supervisor.output(name, last=LOG_TAIL_LINES)
         dropped = f"\n\n_{status.dropped_lines} older lines dropped_" if status.dropped_lines else ""
         self._log.show(f"Log of **{name}**:\n\n" + code_block(lines) + dropped)
