@@ -26,9 +26,9 @@ class EchoPanel:
         ]
         rate = self._tap.rate_hz()
         rate_text = f"{rate:.1f} Hz" if rate else "no messages lately"
-        header = (
-            f"`ros2 topic echo {self._tap.topic}` · {self._tap.count} received · {rate_text}"
+        header = f"`ros2 topic echo {self._tap.topic}` · {self._tap.count} received · {rate_text}"
+        publishers = (
+            graph.topic(self._tap.topic).publishers if graph and graph.topic(self._tap.topic) else 0
         )
-        publishers = graph.topic(self._tap.topic).publishers if graph and graph.topic(self._tap.topic) else 0
         hint = "" if publishers else "\n\n_No publisher on this topic: start **talker**._"
         self._view.show(header + hint + "\n\n" + code_block(lines, "(waiting for messages)"))

@@ -109,5 +109,7 @@ class NodesPanel:
             f"{group.summary}. In a terminal: `ros2 launch tutorial_nodes {group.name}.launch.py`"
         )
         lines = self._supervisor.output(name, last=LOG_TAIL_LINES)
-        dropped = f"\n\n_{status.dropped_lines} older lines dropped_" if status.dropped_lines else ""
+        dropped = (
+            f"\n\n_{status.dropped_lines} older lines dropped_" if status.dropped_lines else ""
+        )
         self._log.show(f"Log of **{name}**:\n\n" + code_block(lines) + dropped)

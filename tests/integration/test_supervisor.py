@@ -116,9 +116,7 @@ def test_no_child_survives_a_sigkilled_dashboard(ros_env):
     assert all(psutil.pid_exists(pid) for pid in pids)
     owner.kill()
     owner.wait()
-    wait_until(
-        lambda: not any(_alive(pid) for pid in pids), timeout=10, what="every child to end"
-    )
+    wait_until(lambda: not any(_alive(pid) for pid in pids), timeout=10, what="every child to end")
 
 
 def _alive(pid: int) -> bool:
