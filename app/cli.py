@@ -14,6 +14,7 @@ import socket
 import sys
 import threading
 import time
+from pathlib import Path
 
 from app import catalog
 from app.dds import configure_this_process, validate_domain_id
@@ -76,9 +77,11 @@ def cmd_serve(args: argparse.Namespace) -> int:
     import viser
 
     from app.dashboard import Dashboard
+    from app.lessons.progress import DEFAULT_DIR, ProgressStore
     from app.ros_runtime import RosRuntime
     from app.supervisor import Supervisor
 
+    progress = ProgressStore(args.learner, args.progress_dir or DEFAULT_DIR)
     stop_requested = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: stop_requested.set())
@@ -89,7 +92,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         raise CliError(f"port {args.port} on {args.host} became busy; pick another with --port")
     runtime = RosRuntime()
     supervisor = Supervisor(os.environ)
-    dashboard = Dashboard(server, runtime, supervisor)
+    dashboard = Dashboard(server, runtime, supervisor, progress)
     dashboard.start()
     domain = os.environ.get("ROS_DOMAIN_ID", "0")
     scope = "network (opt-in)" if args.network else "loopback only"
@@ -156,6 +159,13 @@ def build_parser() -> argparse.ArgumentParser:
     serve = sub.add_parser("serve", help="start the dashboard web server")
     serve.add_argument("--host", default="127.0.0.1", help="address to listen on")
     serve.add_argument("--port", type=_port, default=8080, help="port to listen on")
+    serve.add_argument("--learner", default="default", help="whose lesson progress to keep")
+    serve.add_argument(
+        "--progress-dir",
+        type=Path,
+        default=None,
+        help="where progress is saved (default var/progress)",
+    )
     dds_options(serve)
     serve.set_defaults(func=cmd_serve)
 

@@ -10,9 +10,13 @@ import viser
 from std_msgs.msg import String
 
 from app.graph import GraphSnapshot, snapshot
+from app.lessons.live import LessonRuntime
+from app.lessons.progress import ProgressStore
+from app.lessons.schema import load_course
 from app.panels import Panel
 from app.panels.echo_panel import EchoPanel
 from app.panels.graph_panel import GraphPanel
+from app.panels.lessons_panel import LessonsPanel
 from app.panels.nodes_panel import NodesPanel
 from app.ros_runtime import RosRuntime
 from app.supervisor import Supervisor
@@ -24,10 +28,18 @@ UI_PERIOD_SEC = 0.2  # panels refresh at 5 Hz
 
 
 class Dashboard:
-    def __init__(self, server: viser.ViserServer, runtime: RosRuntime, supervisor: Supervisor):
+    def __init__(
+        self,
+        server: viser.ViserServer,
+        runtime: RosRuntime,
+        supervisor: Supervisor,
+        progress: ProgressStore,
+    ):
         self.server = server
         self.runtime = runtime
         self.supervisor = supervisor
+        self.progress = progress
+        self.lessons = LessonRuntime(runtime.node, supervisor)
         self._stop = threading.Event()
         self.graph = GraphSnapshot()
         self._chatter = TopicTap(runtime.node, "/chatter", String)
@@ -36,9 +48,7 @@ class Dashboard:
 
     def _build_gui(self) -> list[Panel]:
         gui = self.server.gui
-        gui.configure_theme(
-            titlebar_content=None, control_width="large", show_share_button=False
-        )
+        gui.configure_theme(titlebar_content=None, control_width="large", show_share_button=False)
         self.server.scene.configure_environment_map(None)  # avoids a stall in software WebGL
         self.server.scene.add_grid("/grid", width=4.0, height=4.0, cell_size=0.25)
         self.server.scene.add_frame("/world", axes_length=0.3, axes_radius=0.01)
@@ -48,13 +58,15 @@ class Dashboard:
             "this dashboard is the ROS node `/classroom_dashboard`."
         )
         tabs = gui.add_tab_group()
+        with tabs.add_tab("Lessons", viser.Icon.SCHOOL):
+            lessons = LessonsPanel(gui, load_course(), self.lessons, self.progress)
         with tabs.add_tab("Nodes", viser.Icon.CPU):
             nodes = NodesPanel(gui, self.supervisor)
         with tabs.add_tab("Graph", viser.Icon.SITEMAP):
             graph = GraphPanel(gui)
         with tabs.add_tab("Echo", viser.Icon.MESSAGE):
             echo = EchoPanel(gui, self._chatter)
-        return [nodes, graph, echo]
+        return [lessons, nodes, graph, echo]
 
     def start(self) -> None:
         self._ui_thread.start()
@@ -64,6 +76,7 @@ class Dashboard:
             try:
                 self.graph = snapshot(self.runtime.node)
                 self.supervisor.note_visible_nodes(self.graph.nodes)
+                self.lessons.graph = self.graph
                 for panel in self._panels:
                     panel.refresh(self.graph)
             except Exception:  # a panel bug must not freeze every other panel

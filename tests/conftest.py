@@ -120,8 +120,13 @@ class DashboardProcess:
 
 
 @pytest.fixture
-def dashboard(ros_env) -> Iterator[DashboardProcess]:
-    dash = DashboardProcess(ros_env, free_port())
+def progress_dir(tmp_path) -> Path:
+    return tmp_path / "progress"
+
+
+@pytest.fixture
+def dashboard(ros_env, progress_dir) -> Iterator[DashboardProcess]:
+    dash = DashboardProcess(ros_env, free_port(), ["--progress-dir", str(progress_dir)])
     yield dash
     dash.stop()
 

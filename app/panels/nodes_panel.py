@@ -60,7 +60,7 @@ class NodesPanel:
         try:
             self._message.show(action(name))
         except (UnknownNodeError, RuntimeError, OSError) as exc:
-            self._message.show(f"⚠️ {exc}")
+            self._message.show(f"⚠ {exc}")
         self.refresh(None)
 
     def _act_on_group(self, action, verb: str) -> None:
@@ -70,7 +70,7 @@ class NodesPanel:
                 action(member)
             self._message.show(f"{verb} group **{group.name}**: {', '.join(group.members)}.")
         except (UnknownNodeError, RuntimeError, OSError) as exc:
-            self._message.show(f"⚠️ {exc}")
+            self._message.show(f"⚠ {exc}")
         self.refresh(None)
 
     def _do_start(self, name: str) -> str:

@@ -1,0 +1,97 @@
+"""A learner's progress on disk, written atomically so a crash never loses it.
+
+Each save writes a temporary file in the same directory, fsyncs it and renames
+it over the old one (``os.replace`` is atomic on POSIX), then fsyncs the
+directory. A SIGKILL at any moment leaves either the old or the new file. A
+file that is corrupt anyway (edited by hand, disk trouble) is moved aside, not
+deleted, and the learner starts fresh with a clear message.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import tempfile
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+from app import PROJECT_ROOT
+
+DEFAULT_DIR = PROJECT_ROOT / "var" / "progress"
+_NAME = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
+
+
+class ProgressStore:
+    def __init__(self, learner: str = "default", directory: Path = DEFAULT_DIR) -> None:
+        if not _NAME.match(learner):
+            raise ValueError("learner names use letters, digits, '-' and '_' (1-64 characters)")
+        self.path = directory / f"{learner}.json"
+        self.warning = ""
+        self._lock = threading.Lock()
+        self._data = self._load()
+
+    def _load(self) -> dict[str, Any]:
+        try:
+            data = json.loads(self.path.read_text(encoding="utf-8"))
+            if not isinstance(data, dict) or not isinstance(data.get("lessons"), dict):
+                raise ValueError("unexpected layout")
+            return data
+        except FileNotFoundError:
+            return {"version": 1, "lessons": {}}
+        except (ValueError, UnicodeDecodeError) as exc:
+            aside = self.path.with_suffix(f".corrupt-{int(time.time())}.json")
+            os.replace(self.path, aside)
+            self.warning = f"Progress file was unreadable ({exc}); kept it as {aside.name}."
+            return {"version": 1, "lessons": {}}
+
+    def lesson(self, lesson_id: str) -> dict[str, Any]:
+        with self._lock:
+            entry = self._data["lessons"].get(lesson_id, {})
+            return {"step": int(entry.get("step", 0)), "passed": list(entry.get("passed", []))}
+
+    def current_lesson(self) -> str | None:
+        with self._lock:
+            return self._data.get("current")
+
+    def set_position(self, lesson_id: str, step: int) -> None:
+        with self._lock:
+            entry = self._data["lessons"].setdefault(lesson_id, {"step": 0, "passed": []})
+            entry["step"] = step
+            self._data["current"] = lesson_id
+            self._save()
+
+    def mark_passed(self, lesson_id: str, step: int) -> bool:
+        """Record a passed step; returns True when this is news."""
+        with self._lock:
+            entry = self._data["lessons"].setdefault(lesson_id, {"step": step, "passed": []})
+            if step in entry["passed"]:
+                return False
+            entry["passed"] = sorted({*entry["passed"], step})
+            self._save()
+            return True
+
+    def reset(self) -> None:
+        with self._lock:
+            self._data = {"version": 1, "lessons": {}}
+            self._save()
+
+    def _save(self) -> None:
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=".progress-", dir=self.path.parent)
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8") as handle:
+                json.dump(self._data, handle, indent=1, sort_keys=True)
+                handle.flush()
+                os.fsync(handle.fileno())
+            os.replace(tmp, self.path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+        dir_fd = os.open(self.path.parent, os.O_RDONLY)
+        try:
+            os.fsync(dir_fd)
+        finally:
+            os.close(dir_fd)

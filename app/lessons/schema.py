@@ -1,0 +1,222 @@
+"""Lesson files: ``lessons/NN_slug/lesson.toml`` plus Markdown, validated at load.
+
+A broken lesson gives a ``LessonError`` naming the file and the field; the
+loader keeps the rest of the course. Lessons are data only: the actions and
+check kinds they may name are fixed here and implemented in ``app.lessons``.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    import tomli as tomllib  # type: ignore[no-redef]
+
+from app import PROJECT_ROOT
+
+LESSONS_DIR = PROJECT_ROOT / "lessons"
+_DIR_PATTERN = re.compile(r"^(\d{2})_[a-z0-9_]+$")
+
+# kind -> (required fields, optional fields)
+ACTION_FIELDS: dict[str, tuple[set[str], set[str]]] = {
+    "start": ({"node"}, {"label"}),
+    "stop": ({"node"}, {"label"}),
+    "start_group": ({"group"}, {"label"}),
+    "stop_group": ({"group"}, {"label"}),
+    "lifecycle": ({"node", "transition"}, {"label"}),
+    "set_param": ({"node", "name", "value"}, {"label"}),
+    "call_service": ({"service", "type", "request"}, {"label"}),
+    "send_goal": ({"action", "type", "goal"}, {"label", "cancel_after_feedback"}),
+    "open_panel": ({"panel"}, {"label"}),
+}
+CHECK_FIELDS: dict[str, tuple[set[str], set[str]]] = {
+    "node_running": ({"node"}, set()),
+    "node_absent": ({"node"}, set()),
+    "topic_messages": ({"topic", "type", "at_least"}, {"field", "contains"}),
+    "topic_rate": ({"topic", "type", "min_hz", "max_hz"}, set()),
+    "topic_subscribers": ({"topic", "at_least"}, set()),
+    "log_contains": ({"node", "text"}, {"at_least"}),
+    "lifecycle_state": ({"node", "state"}, set()),
+    "parameter_equals": ({"node", "name", "value"}, set()),
+    "service_returns": ({"service", "type", "request", "field", "equals"}, set()),
+    "action_result": ({"action", "status"}, set()),
+    "pointcloud_points": ({"topic", "at_least"}, set()),
+    "arm_reached": ({"tolerance"}, set()),
+    "interface_exists": ({"type"}, set()),
+    "quiz": ({"question", "options", "answer"}, set()),
+}
+PANELS = {"Nodes", "Graph", "Echo", "Console", "Topics", "Services", "Actions", "Parameters",
+          "Lifecycle", "Logs", "Scene", "Lessons"}  # fmt: skip
+
+
+class LessonError(ValueError):
+    """A lesson file that does not follow the schema; the message names file and field."""
+
+
+@dataclass(frozen=True)
+class Spec:
+    """An action or a check: its kind and its validated fields."""
+
+    kind: str
+    fields: dict[str, Any]
+
+    def __getitem__(self, key: str) -> Any:
+        return self.fields[key]
+
+    def get(self, key: str, default: Any = None) -> Any:
+        return self.fields.get(key, default)
+
+    @property
+    def key(self) -> str:
+        """Stable identity, used to remember answers and results."""
+        return self.kind + ":" + ",".join(f"{k}={self.fields[k]}" for k in sorted(self.fields))
+
+
+@dataclass(frozen=True)
+class Step:
+    title: str
+    text: str  # Markdown
+    command: str = ""  # the `ros2 ...` command for the same step
+    actions: tuple[Spec, ...] = ()
+    checks: tuple[Spec, ...] = ()
+
+
+@dataclass(frozen=True)
+class Lesson:
+    id: str  # directory name, e.g. "02_first_node"
+    unit: int
+    title: str
+    summary: str
+    goals: tuple[str, ...]
+    steps: tuple[Step, ...]
+    code: tuple[str, ...] = ()  # project-relative source files shown beside the text
+    path: Path = field(default=LESSONS_DIR, compare=False)
+
+
+@dataclass(frozen=True)
+class Course:
+    lessons: tuple[Lesson, ...]
+    errors: tuple[str, ...] = ()
+
+    def lesson(self, lesson_id: str) -> Lesson | None:
+        return next((lesson for lesson in self.lessons if lesson.id == lesson_id), None)
+
+
+def _require(table: dict, key: str, kind: type | tuple[type, ...], where: str) -> Any:
+    if key not in table:
+        raise LessonError(f"{where}: missing field '{key}'")
+    value = table[key]
+    if not isinstance(value, kind) or isinstance(value, bool) and kind is not bool:
+        names = kind.__name__ if isinstance(kind, type) else " or ".join(k.__name__ for k in kind)
+        raise LessonError(f"{where}: field '{key}' must be {names}, got {type(value).__name__}")
+    return value
+
+
+def _spec(raw: Any, table: dict[str, tuple[set[str], set[str]]], where: str) -> Spec:
+    if not isinstance(raw, dict):
+        raise LessonError(f"{where}: must be a table, got {type(raw).__name__}")
+    kind = _require(raw, "kind", str, where)
+    if kind not in table:
+        raise LessonError(f"{where}: unknown kind '{kind}' (known: {', '.join(sorted(table))})")
+    required, optional = table[kind]
+    fields = {k: v for k, v in raw.items() if k != "kind"}
+    missing = required - fields.keys()
+    if missing:
+        raise LessonError(f"{where}: kind '{kind}' needs field '{sorted(missing)[0]}'")
+    unknown = fields.keys() - required - optional
+    if unknown:
+        raise LessonError(f"{where}: kind '{kind}' has unknown field '{sorted(unknown)[0]}'")
+    if kind == "open_panel" and fields["panel"] not in PANELS:
+        raise LessonError(f"{where}: unknown panel '{fields['panel']}'")
+    if kind == "quiz" and fields["answer"] not in fields["options"]:
+        raise LessonError(f"{where}: quiz answer must be one of its options")
+    return Spec(kind, fields)
+
+
+def _inside(base: Path, relative: str, where: str) -> Path:
+    """Resolve a path from a lesson file, refusing any that leaves ``base``."""
+    candidate = (base / relative).resolve()
+    if not candidate.is_relative_to(base.resolve()):
+        raise LessonError(f"{where}: path '{relative}' leaves {base.name}/")
+    if not candidate.is_file():
+        raise LessonError(f"{where}: file '{relative}' does not exist")
+    return candidate
+
+
+def load_lesson(directory: Path) -> Lesson:
+    toml_path = directory / "lesson.toml"
+    where = f"{directory.name}/lesson.toml"
+    try:
+        data = tomllib.loads(toml_path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise LessonError(f"{where}: file missing") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise LessonError(f"{where}: not valid TOML ({exc})") from None
+    unit = _require(data, "unit", int, where)
+    title = _require(data, "title", str, where)
+    summary = _require(data, "summary", str, where)
+    goals = _require(data, "goals", list, where)
+    if not all(isinstance(goal, str) for goal in goals):
+        raise LessonError(f"{where}: field 'goals' must be a list of strings")
+    code = _require(data, "code", list, where) if "code" in data else []
+    for i, source in enumerate(code):
+        if not isinstance(source, str):
+            raise LessonError(f"{where}: code[{i}] must be a string")
+        _inside(PROJECT_ROOT, source, f"{where}: code[{i}]")
+    raw_steps = _require(data, "steps", list, where)
+    if not raw_steps:
+        raise LessonError(f"{where}: field 'steps' must list at least one step")
+    steps = []
+    for i, raw in enumerate(raw_steps):
+        step_where = f"{where}: steps[{i}]"
+        if not isinstance(raw, dict):
+            raise LessonError(f"{step_where}: must be a table")
+        text_file = _require(raw, "text", str, step_where)
+        text = _inside(directory, text_file, f"{step_where}.text").read_text(encoding="utf-8")
+        actions = [
+            _spec(a, ACTION_FIELDS, f"{step_where}.actions[{j}]")
+            for j, a in enumerate(_require(raw, "actions", list, step_where))
+        ] if "actions" in raw else []  # fmt: skip
+        checks = [
+            _spec(c, CHECK_FIELDS, f"{step_where}.checks[{j}]")
+            for j, c in enumerate(_require(raw, "checks", list, step_where))
+        ] if "checks" in raw else []  # fmt: skip
+        command = _require(raw, "command", str, step_where) if "command" in raw else ""
+        steps.append(
+            Step(
+                title=_require(raw, "title", str, step_where),
+                text=text,
+                command=command,
+                actions=tuple(actions),
+                checks=tuple(checks),
+            )
+        )
+    return Lesson(
+        id=directory.name,
+        unit=unit,
+        title=title,
+        summary=summary,
+        goals=tuple(goals),
+        steps=tuple(steps),
+        code=tuple(code),
+        path=directory,
+    )
+
+
+def load_course(root: Path = LESSONS_DIR) -> Course:
+    """Every valid lesson under ``root``, sorted by directory; errors for the rest."""
+    lessons: list[Lesson] = []
+    errors: list[str] = []
+    for directory in sorted(p for p in root.iterdir() if p.is_dir()) if root.is_dir() else []:
+        if not _DIR_PATTERN.match(directory.name):
+            continue
+        try:
+            lessons.append(load_lesson(directory))
+        except LessonError as exc:
+            errors.append(str(exc))
+    return Course(tuple(lessons), tuple(errors))

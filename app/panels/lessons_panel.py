@@ -1,0 +1,171 @@
+"""Lessons panel: course outline, the current step, its buttons, live checks, Back/Next."""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+import viser
+
+from app import PROJECT_ROOT
+from app.graph import GraphSnapshot
+from app.lessons.live import FAIL, PASS, LessonRuntime
+from app.lessons.progress import ProgressStore
+from app.lessons.schema import Course, Lesson
+from app.panels import MarkdownView
+
+_MARKS = {PASS: "✓", FAIL: "✗", "waiting": "…"}
+_CHOOSE = "(choose an answer)"
+
+
+def _label(lesson: Lesson) -> str:
+    return f"{lesson.unit:02d} · {lesson.title}"
+
+
+class LessonsPanel:
+    def __init__(
+        self, gui: viser.GuiApi, course: Course, live: LessonRuntime, progress: ProgressStore
+    ) -> None:
+        self._gui = gui
+        self._course = course
+        self._live = live
+        self._progress = progress
+        self._lock = threading.RLock()
+        self._dynamic: list[Any] = []
+        by_label = {_label(lesson): lesson for lesson in course.lessons}
+        self._by_label = by_label
+        self._outline = MarkdownView(gui)
+        if not course.lessons:
+            self._outline.show("No lessons could be loaded.\n\n" + "\n".join(course.errors))
+            return
+        current = course.lesson(progress.current_lesson() or "") or course.lessons[0]
+        self._selector = gui.add_dropdown("Lesson", list(by_label), initial_value=_label(current))
+        self._header = MarkdownView(gui)
+        self._text = MarkdownView(gui)
+        self._command = MarkdownView(gui)
+        self._actions = gui.add_folder("Do this step")
+        self._checks = MarkdownView(gui)
+        self._message = MarkdownView(gui)
+        self._back = gui.add_button("Back", icon=viser.Icon.ARROW_LEFT)
+        self._next = gui.add_button("Next", icon=viser.Icon.ARROW_RIGHT)
+        with gui.add_folder("Source code", expand_by_default=False):
+            self._code = MarkdownView(gui)
+        self._reset = gui.add_button("Reset my progress", color="gray")
+        self._lesson = current
+        self._step = min(progress.lesson(current.id)["step"], len(current.steps) - 1)
+        self._selector.on_update(lambda _: self._select(by_label[self._selector.value], 0))
+        self._back.on_click(lambda _: self._select(self._lesson, self._step - 1))
+        self._next.on_click(lambda _: self._go_next())
+        self._reset.on_click(lambda _: self._do_reset())
+        self._select(current, self._step)
+
+    # -- navigation --------------------------------------------------------
+
+    def _go_next(self) -> None:
+        if self._step + 1 < len(self._lesson.steps):
+            self._select(self._lesson, self._step + 1)
+            return
+        index = self._course.lessons.index(self._lesson)
+        if index + 1 < len(self._course.lessons):
+            following = self._course.lessons[index + 1]
+            self._selector.value = _label(following)  # triggers _select via on_update
+
+    def _do_reset(self) -> None:
+        self._progress.reset()
+        self._message.show("Progress reset.")
+        self._select(self._lesson, 0)
+
+    def _select(self, lesson: Lesson, step: int) -> None:
+        with self._lock:
+            step = max(0, min(step, len(lesson.steps) - 1))
+            self._lesson, self._step = lesson, step
+            self._progress.set_position(lesson.id, step)
+            current = lesson.steps[step]
+            goals = "\n".join(f"- {goal}" for goal in lesson.goals)
+            self._header.show(
+                f"### {lesson.title}\n{lesson.summary}\n\n**Goals**\n{goals}\n\n"
+                f"**Step {step + 1} of {len(lesson.steps)}: {current.title}**"
+            )
+            self._text.show(current.text)
+            self._command.show(f"In a terminal: `{current.command}`" if current.command else "")
+            self._code.show(self._source_listing(lesson))
+            self._message.show("")
+            self._rebuild_step_widgets()
+            self._back.disabled = step == 0
+        self.refresh(None)
+
+    def _source_listing(self, lesson: Lesson) -> str:
+        parts = []
+        for relative in lesson.code:
+            text = (PROJECT_ROOT / relative).read_text(encoding="utf-8")
+            parts.append(f"`{relative}`\n```python\n{text}\n```")
+        return "\n\n".join(parts) or "(this lesson shows no source file)"
+
+    def _rebuild_step_widgets(self) -> None:
+        for handle in self._dynamic:
+            handle.remove()
+        self._dynamic = []
+        step = self._lesson.steps[self._step]
+        with self._actions:
+            for action in step.actions:
+                label = action.get("label") or f"{action.kind.replace('_', ' ')}"
+                button = self._gui.add_button(label, icon=viser.Icon.PLAYER_PLAY)
+                button.on_click(lambda _, a=action: self._perform(a))
+                self._dynamic.append(button)
+            for check in step.checks:
+                if check.kind != "quiz":
+                    continue
+                chosen = self._live.quiz_answers.get(check.key, _CHOOSE)
+                quiz = self._gui.add_dropdown(
+                    check["question"], [_CHOOSE, *check["options"]], initial_value=chosen
+                )
+                quiz.on_update(lambda _, c=check, q=quiz: self._answer(c, q.value))
+                self._dynamic.append(quiz)
+            if not self._dynamic:
+                self._dynamic.append(self._gui.add_markdown("_Nothing to click: read on._"))
+
+    def _perform(self, action) -> None:
+        try:
+            self._message.show(self._live.perform(action))
+        except Exception as exc:  # shown to the learner, never a traceback
+            self._message.show(f"⚠ {exc}")
+
+    def _answer(self, check, value: str) -> None:
+        if value == _CHOOSE:
+            self._live.quiz_answers.pop(check.key, None)
+        else:
+            self._live.quiz_answers[check.key] = value
+
+    # -- live part ---------------------------------------------------------
+
+    def refresh(self, graph: GraphSnapshot | None) -> None:
+        if not self._course.lessons:
+            return
+        with self._lock:
+            lesson, index = self._lesson, self._step
+            step = lesson.steps[index]
+            results = [(check, self._live.evaluate(check)) for check in step.checks]
+            if results and all(result.state == PASS for _, result in results):
+                self._progress.mark_passed(lesson.id, index)
+            lines = [
+                f"- {_MARKS[result.state]} **{result.state}**: {result.reason}"
+                for _, result in results
+            ]
+            passed = set(self._progress.lesson(lesson.id)["passed"])
+            status = "✓ step done" if index in passed else ""
+            self._checks.show(
+                ("**Checks** " + status + "\n\n" + "\n".join(lines)) if lines else status
+            )
+            self._outline.show(self._outline_text(lesson))
+
+    def _outline_text(self, current: Lesson) -> str:
+        rows = []
+        for lesson in self._course.lessons:
+            passed = len(self._progress.lesson(lesson.id)["passed"])
+            total = len(lesson.steps)
+            mark = "✓" if passed >= total else f"{passed}/{total}"
+            title = f"**{lesson.title}**" if lesson is current else lesson.title
+            rows.append(f"| {lesson.unit} | {title} | {mark} |")
+        warning = f"⚠ {self._progress.warning}\n\n" if self._progress.warning else ""
+        errors = "".join(f"\n\n⚠ {error}" for error in self._course.errors)
+        return warning + "| unit | lesson | done |\n|---|---|---|\n" + "\n".join(rows) + errors
