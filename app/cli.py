@@ -137,6 +137,17 @@ def cmd_list(args: argparse.Namespace) -> int:
     return 0
 
 
+ROS2_GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface")
+
+
+def cmd_ros2(args: argparse.Namespace) -> int:
+    """One ros2-like verb (see app/ros2cli), in a fresh short-lived ROS participant."""
+    configure_this_process(domain_id=args.domain_id, network=args.network)
+    from app.ros2cli.cli import main as ros2_main
+
+    return ros2_main([args.group, *args.words])
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="ros2-classroom", description="A browser-based teaching dashboard for ROS 2 Jazzy."
@@ -177,6 +188,13 @@ def build_parser() -> argparse.ArgumentParser:
 
     lst = sub.add_parser("list", help="print the node catalog")
     lst.set_defaults(func=cmd_list)
+
+    # ros2-like verbs (app/ros2cli): `ros2-classroom topic list -t` is `ros2 topic list -t`.
+    for group in ROS2_GROUPS:
+        verb = sub.add_parser(group, help=f"like `ros2 {group} ...`", add_help=False)
+        dds_options(verb)
+        verb.add_argument("words", nargs=argparse.REMAINDER, help="verb and its arguments")
+        verb.set_defaults(func=cmd_ros2, group=group)
     return parser
 
 

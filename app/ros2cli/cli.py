@@ -1,0 +1,40 @@
+"""The command-line face: ``ros2-classroom topic list -t`` and friends.
+
+A short-lived rclpy participant (a hidden node, as ros2cli's daemon is) is
+created only for verbs that need the graph; Ctrl+C stops a streaming verb
+(echo, hz, pub -r) cleanly.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import threading
+
+from app.ros2cli.common import CLI_LIMITS, VerbContext
+from app.ros2cli.parser import needs_ros, run_argv
+
+
+def _print(line: str) -> None:
+    print(line, flush=True)
+
+
+def main(argv: list[str]) -> int:
+    """Run one verb; the caller has already configured DDS for this process."""
+    cancel = threading.Event()
+    if not needs_ros(argv):
+        return run_argv(
+            VerbContext(node=None, write=_print, limits=CLI_LIMITS), argv, "ros2-classroom"
+        )  # type: ignore[arg-type]
+    from app.ros_runtime import RosRuntime
+
+    runtime = RosRuntime(f"_ros2_classroom_cli_{os.getpid()}", threads=2)
+    ctx = VerbContext(node=runtime.node, write=_print, limits=CLI_LIMITS, cancel=cancel)
+    try:
+        return run_argv(ctx, argv, "ros2-classroom")
+    except KeyboardInterrupt:
+        cancel.set()
+        return 130
+    finally:
+        runtime.shutdown()
+        sys.stdout.flush()

@@ -1,0 +1,165 @@
+"""`ros2 node`, `ros2 service`, `ros2 action`: what is on the graph, and talking to it."""
+
+from __future__ import annotations
+
+from rclpy.action import (
+    get_action_client_names_and_types_by_node,
+    get_action_names_and_types,
+    get_action_server_names_and_types_by_node,
+)
+
+from app.ros2cli.calls import GoalRun, action_type_of, call_service, send_goal
+from app.ros2cli.common import (
+    ACTION_MARKER,
+    Ros2Error,
+    VerbContext,
+    all_nodes,
+    node_fqn,
+    require_node,
+)
+from app.ros2cli.convert import from_yaml, import_type, message_repr, to_yaml
+
+# ------------------------------------------------------------------- node
+
+
+def node_list(ctx: VerbContext, all_: bool = False, count: bool = False) -> int:
+    names = all_nodes(ctx.node, include_hidden=all_)
+    if count:
+        ctx.write(str(len(names)))
+        return 0
+    for name in names:
+        ctx.write(name)
+    return 0
+
+
+def _visible(pairs: list[tuple[str, list[str]]]) -> list[tuple[str, list[str]]]:
+    return sorted((n, t) for n, t in pairs if ACTION_MARKER not in n)
+
+
+def node_info(ctx: VerbContext, fqn: str) -> int:
+    name, namespace = require_node(ctx, fqn)
+    node = ctx.node
+    sections = [
+        ("Subscribers", _visible(node.get_subscriber_names_and_types_by_node(name, namespace))),
+        ("Publishers", _visible(node.get_publisher_names_and_types_by_node(name, namespace))),
+        ("Service Servers", _visible(node.get_service_names_and_types_by_node(name, namespace))),
+        ("Service Clients", _visible(node.get_client_names_and_types_by_node(name, namespace))),
+        ("Action Servers", get_action_server_names_and_types_by_node(node, name, namespace)),
+        ("Action Clients", get_action_client_names_and_types_by_node(node, name, namespace)),
+    ]
+    ctx.write(node_fqn(name, namespace))
+    for title, entries in sections:
+        ctx.write(f"  {title}:")
+        for entry, types in sorted(entries):
+            ctx.write(f"    {entry}: {', '.join(types)}")
+    return 0
+
+
+# ---------------------------------------------------------------- service
+
+
+def service_list(ctx: VerbContext, show_types: bool = False, count: bool = False) -> int:
+    services = _visible(ctx.node.get_service_names_and_types())
+    if count:
+        ctx.write(str(len(services)))
+        return 0
+    for name, types in services:
+        ctx.write(f"{name} [{', '.join(types)}]" if show_types else name)
+    return 0
+
+
+def service_type(ctx: VerbContext, name: str) -> int:
+    types = dict(ctx.node.get_service_names_and_types()).get(name)
+    if not types:
+        raise Ros2Error(f"unknown service '{name}' (see `ros2 service list`)")
+    for type_text in types:
+        ctx.write(type_text)
+    return 0
+
+
+def service_call(ctx: VerbContext, name: str, type_text: str, values: str = "") -> int:
+    srv_type = import_type(type_text, "srv")
+    request = from_yaml(srv_type.Request, values)
+    ctx.write(f"requester: making request: {message_repr(request)}")
+    ctx.write("")
+    response = call_service(ctx, name, srv_type, request)
+    ctx.write("response:")
+    ctx.write(message_repr(response))
+    ctx.write("")
+    return 0
+
+
+# ----------------------------------------------------------------- action
+
+
+def action_list(ctx: VerbContext, show_types: bool = False, count: bool = False) -> int:
+    actions = sorted(get_action_names_and_types(ctx.node))
+    if count:
+        ctx.write(str(len(actions)))
+        return 0
+    for name, types in actions:
+        ctx.write(f"{name} [{', '.join(types)}]" if show_types else name)
+    return 0
+
+
+def action_info(ctx: VerbContext, name: str, show_types: bool = False) -> int:
+    action_type = action_type_of(ctx, name)
+    if action_type is None:
+        raise Ros2Error(f"unknown action '{name}' (see `ros2 action list`)")
+    clients, servers = [], []
+    for fqn in all_nodes(ctx.node, include_hidden=True):
+        node_name, namespace = fqn.rsplit("/", 1)[1], fqn.rsplit("/", 1)[0] or "/"
+        try:
+            srv = get_action_server_names_and_types_by_node(ctx.node, node_name, namespace)
+            cli = get_action_client_names_and_types_by_node(ctx.node, node_name, namespace)
+        except Exception:  # the node left the graph between the two calls
+            continue
+        if any(a == name for a, _t in srv):
+            servers.append(fqn)
+        if any(a == name for a, _t in cli):
+            clients.append(fqn)
+    suffix = f" [{action_type}]" if show_types else ""
+    ctx.write(f"Action: {name}")
+    ctx.write(f"Action clients: {len(clients)}")
+    for fqn in clients:
+        ctx.write(f"    {fqn}{suffix}")
+    ctx.write(f"Action servers: {len(servers)}")
+    for fqn in servers:
+        ctx.write(f"    {fqn}{suffix}")
+    return 0
+
+
+def _indented(text: str, spaces: int = 4) -> str:
+    return "\n".join(" " * spaces + line for line in text.splitlines())
+
+
+def action_send_goal(
+    ctx: VerbContext, name: str, type_text: str, values: str = "", feedback: bool = False
+) -> int:
+    action_cls = import_type(type_text, "action")
+    goal = from_yaml(action_cls.Goal, values)
+    run = GoalRun(name, type_text, goal)
+    ctx.write("Waiting for an action server to become available...")
+    ctx.write("Sending goal:")
+    ctx.write(_indented(to_yaml(goal), 5))
+    ctx.write("")
+
+    def on_accepted(run: GoalRun) -> None:
+        ctx.write(f"Goal accepted with ID: {run.goal_id}")
+        ctx.write("")
+
+    def on_feedback(message) -> None:
+        if feedback:
+            ctx.write("Feedback:")
+            ctx.write(_indented(to_yaml(message)))
+            ctx.write("")
+
+    send_goal(ctx, run, on_feedback, on_accepted)
+    if run.status == "REJECTED":
+        ctx.write("Goal was rejected.")
+        return 1
+    ctx.write("Result:")
+    ctx.write(_indented(to_yaml(run.result)))
+    ctx.write("")
+    ctx.write(f"Goal finished with status: {run.status}")
+    return 0 if run.status == "SUCCEEDED" else 1
