@@ -1,0 +1,52 @@
+"""minimal_node: the smallest useful ROS 2 node, written as a class.
+
+Every ROS 2 Python program in this course grows from this skeleton:
+
+1. ``rclpy.init()`` connects the process to ROS (it reads ``--ros-args``);
+2. a class derived from ``rclpy.node.Node`` gets its name in
+   ``super().__init__("minimal_node")`` and sets up everything it needs in its
+   constructor, here one timer;
+3. ``rclpy.spin(node)`` hands control to ROS, which calls our callbacks when
+   there is work: here ``on_timer`` five times a second (a 0.2 s period);
+4. on Ctrl+C (SIGINT) or SIGTERM the spin ends, the node is destroyed and ROS
+   is shut down, in that order.
+
+ROS concepts shown
+- a node is an object; its timers, publishers and so on are attributes;
+- ``create_timer(period_sec, callback)``;
+- ``get_logger().info(...)``: a log line on the console and on /rosout.
+
+Compare it with ``minimal_node_procedural``, the same node without a class.
+Try it: ``ros2-classroom run minimal_node`` and ``ros2 node list``.
+"""
+
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+
+TIMER_PERIOD_SEC = 0.2  # 5 Hz
+
+
+class MinimalNode(Node):
+    def __init__(self) -> None:
+        super().__init__("minimal_node")
+        self.timer = self.create_timer(TIMER_PERIOD_SEC, self.on_timer)
+
+    def on_timer(self) -> None:
+        self.get_logger().info("Hello ROS2")
+
+
+def main(args=None) -> None:
+    rclpy.init(args=args)
+    node = MinimalNode()
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass  # Ctrl+C (SIGINT) or SIGTERM: leave quietly
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == "__main__":
+    main()
