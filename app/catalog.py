@@ -61,6 +61,121 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         "Crashes on purpose after 3 s, to show how failures are reported.",
     ),
     # --- core tutorial nodes (issue 3): add entries below this line ---
+    CatalogEntry(
+        "minimal_node",
+        "minimal_node",
+        "/minimal_node",
+        'The smallest OOP node: logs "Hello ROS2" from a 5 Hz timer.',
+    ),
+    CatalogEntry(
+        "minimal_node_procedural",
+        "minimal_node_procedural",
+        "/minimal_node_procedural",
+        "The same minimal node written without a class, for comparison.",
+    ),
+    CatalogEntry(
+        "add_two_ints_server",
+        "add_two_ints_server",
+        "/add_two_ints_server",
+        "Offers the /add_two_ints service (AddTwoInts: a + b -> sum).",
+    ),
+    CatalogEntry(
+        "add_two_ints_client",
+        "add_two_ints_client",
+        "/add_two_ints_client",
+        "Waits for /add_two_ints, asks for 2 + 3, prints the sum and exits.",
+        args=("2", "3"),
+    ),
+    CatalogEntry(
+        "fibonacci_action_server",
+        "fibonacci_action_server",
+        "/fibonacci_action_server",
+        "Offers the /fibonacci action: feedback per step, cancel, range 0..46, newest goal wins.",
+    ),
+    CatalogEntry(
+        "fibonacci_action_client",
+        "fibonacci_action_client",
+        "/fibonacci_action_client",
+        "Sends a /fibonacci goal of order 10, prints feedback and the result, exits.",
+        args=("10",),
+    ),
+    CatalogEntry(
+        "lifecycle_talker",
+        "lifecycle_talker",
+        "/lifecycle_talker",
+        "A lifecycle node: publishes on /lifecycle_chatter only while active.",
+    ),
+    CatalogEntry(
+        "lifecycle_talker_failing",
+        "lifecycle_talker",
+        "/lifecycle_talker",
+        "The lifecycle talker with fail_on:=activate: activation fails on purpose.",
+        ros_args=("-p", "fail_on:=activate"),
+    ),
+    CatalogEntry(
+        "parameters_node",
+        "parameters_node",
+        "/parameters_node",
+        "Publishes a greeting on /greeting; rate, text and case are live parameters.",
+    ),
+    CatalogEntry(
+        "qos_talker",
+        "qos_talker",
+        "/qos_talker",
+        "Publishes on /qos_chatter, reliable + volatile (QoS set by parameters).",
+    ),
+    CatalogEntry(
+        "qos_talker_best_effort",
+        "qos_talker",
+        "/qos_talker_best_effort",
+        "The QoS talker as a best-effort publisher: reliable listeners reject it.",
+        ros_args=("-r", "__node:=qos_talker_best_effort", "-p", "reliability:=best_effort"),
+    ),
+    CatalogEntry(
+        "qos_talker_transient_local",
+        "qos_talker",
+        "/qos_talker_transient_local",
+        "The QoS talker keeping its last 10 messages for late-joining subscribers.",
+        ros_args=("-r", "__node:=qos_talker_transient_local", "-p", "durability:=transient_local"),
+    ),
+    CatalogEntry(
+        "qos_listener",
+        "qos_listener",
+        "/qos_listener",
+        "Subscribes to /qos_chatter as reliable; logs incompatible-QoS events.",
+    ),
+    CatalogEntry(
+        "qos_listener_best_effort",
+        "qos_listener",
+        "/qos_listener_best_effort",
+        "The QoS listener as best-effort: compatible with every talker.",
+        ros_args=("-r", "__node:=qos_listener_best_effort", "-p", "reliability:=best_effort"),
+    ),
+    CatalogEntry(
+        "qos_listener_transient_local",
+        "qos_listener",
+        "/qos_listener_transient_local",
+        "The QoS listener asking for transient-local history (late joiner).",
+        ros_args=(
+            "-r",
+            "__node:=qos_listener_transient_local",
+            "-p",
+            "durability:=transient_local",
+        ),
+    ),
+    CatalogEntry(
+        "executor_demo",
+        "executor_demo",
+        "/executor_demo",
+        "A slow callback starves a fast one under the single-threaded executor.",
+    ),
+    CatalogEntry(
+        "executor_demo_multi",
+        "executor_demo",
+        "/executor_demo_multi",
+        "The executor demo on a multi-threaded executor with callback groups: no starvation.",
+        ros_args=("-r", "__node:=executor_demo_multi", "-p", "executor:=multi"),
+    ),
     # --- perception and manipulation nodes (issue 5): add entries below this line ---
 )
 
@@ -71,6 +186,36 @@ GROUPS: tuple[LaunchGroup, ...] = (
         ("talker", "listener", "listener2"),
     ),
     # --- core tutorial groups (issue 3): add groups below this line ---
+    LaunchGroup(
+        "minimal_nodes",
+        "the OOP and the procedural minimal node side by side",
+        ("minimal_node", "minimal_node_procedural"),
+    ),
+    LaunchGroup(
+        "add_two_ints",
+        "the /add_two_ints server and a client that asks for 2 + 3",
+        ("add_two_ints_server", "add_two_ints_client"),
+    ),
+    LaunchGroup(
+        "fibonacci",
+        "the /fibonacci action server and a client sending order 10",
+        ("fibonacci_action_server", "fibonacci_action_client"),
+    ),
+    LaunchGroup(
+        "qos_mismatch",
+        "a best-effort talker and a reliable listener: incompatible QoS, reported",
+        ("qos_talker_best_effort", "qos_listener"),
+    ),
+    LaunchGroup(
+        "qos_compatible",
+        "a reliable talker and a best-effort listener: compatible, messages flow",
+        ("qos_talker", "qos_listener_best_effort"),
+    ),
+    LaunchGroup(
+        "executor_comparison",
+        "the executor demo on a single- and a multi-threaded executor, side by side",
+        ("executor_demo", "executor_demo_multi"),
+    ),
     # --- perception groups (issue 5): add groups below this line ---
 )
 
