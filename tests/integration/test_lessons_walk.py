@@ -1,0 +1,117 @@
+"""Walk every lesson with the same code the lesson buttons use, on real nodes.
+
+Each step's actions are performed in order, quizzes are answered, and every
+check of the step must pass. A second test shows that every kind of check can
+also fail: a check that cannot fail is a defect.
+"""
+
+from __future__ import annotations
+
+import threading
+
+import pytest
+
+from app.graph import snapshot
+from app.lessons.live import FAIL, PASS, LessonRuntime
+from app.lessons.schema import CHECK_FIELDS, Spec, load_course
+from tests.conftest import wait_until
+
+pytestmark = pytest.mark.ros
+COURSE = load_course()
+
+
+@pytest.fixture
+def dashboard_node(ros_env):
+    """The same ROS node the dashboard has, so graph checks see the same names."""
+    from app.ros_runtime import RosRuntime
+
+    runtime = RosRuntime()
+    yield runtime.node
+    runtime.shutdown()
+
+
+@pytest.fixture
+def live(dashboard_node, supervisor):
+    runtime = LessonRuntime(dashboard_node, supervisor)
+    stop = threading.Event()
+
+    def watch_graph() -> None:  # what the dashboard's UI loop does
+        while not stop.wait(0.2):
+            runtime.graph = snapshot(dashboard_node)
+            supervisor.note_visible_nodes(runtime.graph.nodes)
+
+    thread = threading.Thread(target=watch_graph, daemon=True)
+    thread.start()
+    yield runtime
+    stop.set()
+    thread.join()
+
+
+@pytest.mark.parametrize("lesson", COURSE.lessons, ids=lambda lesson: lesson.id)
+def test_every_step_of_the_lesson_passes_on_real_nodes(live, lesson):
+    for index, step in enumerate(lesson.steps):
+        for action in step.actions:
+            if action.kind == "send_goal" or action.kind.startswith("call"):
+                wait_until(
+                    lambda a=action: _server_ready(live, a),
+                    timeout=20,
+                    what=f"the server for {action.key}",
+                )
+            live.perform(action)
+        for check in step.checks:
+            if check.kind == "quiz":
+                live.quiz_answers[check.key] = check["answer"]
+        for check in step.checks:
+            wait_until(
+                lambda c=check: live.evaluate(c).state == PASS,
+                timeout=45,
+                interval=0.2,
+                what=f"{lesson.id} step {index + 1} check {check.key}: "
+                f"{live.evaluate(check).reason}",
+            )
+
+
+def _server_ready(live: LessonRuntime, action: Spec) -> bool:
+    names = {name for name, _ in live.node.get_service_names_and_types()}
+    if action.kind == "send_goal":
+        return f"{action['action']}/_action/send_goal" in names
+    return action["service"] in names
+
+
+FAILING_CHECKS = [
+    Spec("node_running", {"node": "/nobody_here"}),
+    Spec("node_absent", {"node": "/classroom_dashboard"}),
+    Spec("topic_messages", {"topic": "/silent", "type": "std_msgs/msg/String", "at_least": 1}),
+    Spec(
+        "topic_rate", {"topic": "/silent", "type": "std_msgs/msg/String", "min_hz": 1, "max_hz": 2}
+    ),
+    Spec("topic_subscribers", {"topic": "/silent", "at_least": 1}),
+    Spec("log_contains", {"node": "talker", "text": "never said"}),
+    Spec("lifecycle_state", {"node": "/nobody_here", "state": "active"}),
+    Spec("parameter_equals", {"node": "/nobody_here", "name": "x", "value": 1}),
+    Spec(
+        "service_returns",
+        {
+            "service": "/none",
+            "type": "std_srvs/srv/Trigger",
+            "request": {},
+            "field": "success",
+            "equals": True,
+        },
+    ),  # fmt: skip
+    Spec("action_result", {"action": "/nowhere", "status": "succeeded"}),
+    Spec("pointcloud_points", {"topic": "/no_cloud", "at_least": 1}),
+    Spec("arm_reached", {"tolerance": 0.01}),
+    Spec("interface_exists", {"type": "no_such_pkg/msg/Nothing"}),
+    Spec("quiz", {"question": "2+2?", "options": ["3", "4"], "answer": "4"}),
+]
+
+
+def test_every_check_kind_can_fail(live):
+    assert {spec.kind for spec in FAILING_CHECKS} == set(CHECK_FIELDS)
+    live.quiz_answers[FAILING_CHECKS[-1].key] = "3"
+    wait_until(lambda: live.graph.has_node("/classroom_dashboard"), what="our node in the graph")
+    for spec in FAILING_CHECKS:
+        result = live.evaluate(spec)
+        assert result.state == FAIL, (spec.kind, result)
+        assert result.reason, spec.kind

@@ -1,0 +1,69 @@
+"""Progress survives a SIGKILL mid-write and a corrupt file is set aside, not lost."""
+
+from __future__ import annotations
+
+import json
+import random
+import signal
+import subprocess
+import sys
+import time
+
+from app import PROJECT_ROOT
+from app.lessons.progress import ProgressStore
+
+
+def test_round_trip_and_reset(tmp_path):
+    store = ProgressStore("ada", tmp_path)
+    store.set_position("02_first_node", 2)
+    assert store.mark_passed("02_first_node", 1)
+    assert not store.mark_passed("02_first_node", 1)
+    again = ProgressStore("ada", tmp_path)
+    assert again.lesson("02_first_node") == {"step": 2, "passed": [1]}
+    assert again.current_lesson() == "02_first_node"
+    again.reset()
+    assert ProgressStore("ada", tmp_path).lesson("02_first_node") == {"step": 0, "passed": []}
+
+
+def test_sigkill_during_writes_never_leaves_a_broken_file(tmp_path):
+    writer = (
+        "import sys; from pathlib import Path; from app.lessons.progress import ProgressStore\n"
+        "s = ProgressStore('kid', Path(sys.argv[1])); s.set_position('start', 0)\n"
+        "print('ready', flush=True)\n"
+        "i = 0\n"
+        "while True:\n"
+        "    i += 1; s.set_position(f'lesson_{i % 50}', i); s.mark_passed('big' * 200, i)\n"
+    )
+    rng = random.Random(7)
+    for _ in range(12):
+        proc = subprocess.Popen(
+            [sys.executable, "-c", writer, str(tmp_path)],
+            cwd=PROJECT_ROOT,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+        assert proc.stdout.readline().strip() == "ready"
+        time.sleep(rng.uniform(0.0, 0.15))
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()
+        data = json.loads((tmp_path / "kid.json").read_text())  # always whole
+        assert isinstance(data["lessons"], dict)
+        store = ProgressStore("kid", tmp_path)
+        assert store.warning == ""
+
+
+def test_corrupt_file_is_moved_aside_with_a_warning(tmp_path):
+    (tmp_path / "bob.json").write_text("{ not json")
+    store = ProgressStore("bob", tmp_path)
+    assert "unreadable" in store.warning
+    kept = list(tmp_path.glob("bob.corrupt-*.json"))
+    assert len(kept) == 1 and kept[0].read_text() == "{ not json"
+    store.set_position("01_ros2_and_dds", 1)
+    assert ProgressStore("bob", tmp_path).lesson("01_ros2_and_dds")["step"] == 1
+
+
+def test_learner_name_cannot_be_a_path(tmp_path):
+    import pytest
+
+    with pytest.raises(ValueError, match="learner names"):
+        ProgressStore("../../etc/passwd", tmp_path)
