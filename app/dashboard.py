@@ -18,6 +18,7 @@ from app.panels.echo_panel import EchoPanel
 from app.panels.graph_panel import GraphPanel
 from app.panels.lessons_panel import LessonsPanel
 from app.panels.nodes_panel import NodesPanel
+from app.panels.scene_panel import ScenePanel
 from app.ros_runtime import RosRuntime
 from app.supervisor import Supervisor
 from app.topic_tap import TopicTap
@@ -66,7 +67,9 @@ class Dashboard:
             graph = GraphPanel(gui)
         with tabs.add_tab("Echo", viser.Icon.MESSAGE):
             echo = EchoPanel(gui, self._chatter)
-        return [lessons, nodes, graph, echo]
+        with tabs.add_tab("3D view", viser.Icon.CUBE):
+            scene = ScenePanel(self.server, self.runtime.node)
+        return [lessons, nodes, graph, echo, scene]
 
     def start(self) -> None:
         self._ui_thread.start()

@@ -1,0 +1,209 @@
+"""3D view panel: pick what the scene draws, see how much of it arrives, edit the camera pose.
+
+The scene layers (``app/scene``) draw from their own worker threads; this
+panel only owns the controls and the status text, and refreshes them from
+the dashboard's UI thread a few times a second.
+"""
+
+from __future__ import annotations
+
+import math
+
+import viser
+from rclpy.node import Node
+
+from app.graph import GraphSnapshot
+from app.panels import MarkdownView, code_block
+from app.scene import topic_picker as picker
+from app.scene import transforms as tf
+from app.scene.arm import ArmLayer
+from app.scene.camera_params import CameraParamSync
+from app.scene.frames import CameraPose, FrameTree
+from app.scene.images import ImageLayer
+from app.scene.markers import MarkerLayer
+from app.scene.plots import JointPlot
+from app.scene.pointclouds import PointCloudLayer
+from app.scene.stamped import StampedLayer
+
+INTRO = (
+    "The **3D view** draws live topics, as rviz does. Drag to orbit, scroll to zoom. "
+    "Axes are red = x, green = y, blue = z."
+)
+
+
+class _TopicRow:
+    """A dropdown offering only topics of some types, plus a liveness note under it."""
+
+    def __init__(self, gui: viser.GuiApi, label: str, types: tuple[str, ...], hint: str) -> None:
+        self.types = types
+        self._options: tuple[str, ...] = (picker.NONE,)
+        self.dropdown = gui.add_dropdown(label, self._options, initial_value=picker.NONE, hint=hint)
+        self.note = MarkdownView(gui)
+
+    def refresh_options(self, graph: GraphSnapshot | None) -> None:
+        opts = tuple(picker.options(graph, self.types, self.dropdown.value))
+        if opts != self._options:
+            self._options = opts
+            self.dropdown.options = opts
+
+
+class ScenePanel:
+    def __init__(self, server: viser.ViserServer, node: Node) -> None:
+        gui, scene = server.gui, server.scene
+        self._server = server
+        MarkdownView(gui, INTRO)
+        # Start close to the robot: the arm, the camera and a table-top cloud fill the view.
+        server.initial_camera.position = (1.3, -1.4, 1.1)
+        server.initial_camera.look_at = (0.25, 0.0, 0.25)
+        self.frames = FrameTree(scene)
+        self.clouds = PointCloudLayer(node, server)
+        self.markers = MarkerLayer(node, server)
+        self.stamped = StampedLayer(node, server)
+
+        with gui.add_folder("Point cloud"):
+            self._cloud_row = _TopicRow(
+                gui, "Cloud topic", picker.CLOUD_TYPES, "sensor_msgs/msg/PointCloud2 topics"
+            )
+            self._budget = gui.add_slider(
+                "Point budget",
+                min=10_000,
+                max=1_000_000,
+                step=10_000,
+                initial_value=self.clouds.budget,
+                hint="Bigger clouds are thinned to this many points before they go to the browser",
+            )
+            self._cloud_status = MarkdownView(gui)
+        with gui.add_folder("Camera image"):
+            self._image_row = _TopicRow(
+                gui, "Image topic", picker.IMAGE_TYPES, "sensor_msgs/msg/Image topics"
+            )
+            self.images = ImageLayer(node, gui, self.frames)
+            self._image_on_frustum = gui.add_checkbox("Image on the 3D camera", False)
+            self._image_info = MarkdownView(gui)
+        with gui.add_folder("Markers"):
+            self._marker_row = _TopicRow(
+                gui,
+                "Marker topic",
+                picker.MARKER_TYPES,
+                "visualization_msgs Marker or MarkerArray topics",
+            )
+            self._marker_info = MarkdownView(gui)
+        with gui.add_folder("Robot arm"):
+            self._joint_row = _TopicRow(
+                gui, "Joint topic", picker.JOINT_TYPES, "sensor_msgs/msg/JointState topics"
+            )
+            self.plot = JointPlot(gui)
+            self.arm = ArmLayer(node, server, on_joints=self.plot.add)
+            self._arm_info = MarkdownView(gui)
+        with gui.add_folder("Camera ↔ base transform", expand_by_default=False):
+            MarkdownView(
+                gui,
+                "Where the camera sits on the robot. Points seen by the camera are moved "
+                "into `base_link` by this 4×4 matrix: **p_base = T · p_camera**.",
+            )
+            self._gizmo = gui.add_checkbox("Edit with a gizmo in 3D", False)
+            pose = self.frames.pose
+            self._sliders = {
+                "x": gui.add_slider("x (m)", -1.0, 1.0, 0.01, pose.x),
+                "y": gui.add_slider("y (m)", -1.0, 1.0, 0.01, pose.y),
+                "z": gui.add_slider("z (m)", 0.0, 1.5, 0.01, pose.z),
+                "roll": gui.add_slider("roll (°)", -180.0, 180.0, 1.0, math.degrees(pose.roll)),
+                "pitch": gui.add_slider("pitch (°)", -90.0, 90.0, 1.0, math.degrees(pose.pitch)),
+                "yaw": gui.add_slider("yaw (°)", -180.0, 180.0, 1.0, math.degrees(pose.yaw)),
+            }
+            self._matrix = MarkdownView(gui)
+            self._param_status = MarkdownView(gui)
+        self._stamped_info = MarkdownView(gui)
+
+        self.params = CameraParamSync(node)
+        self._syncing_sliders = False
+        self.clouds.on_drawn = lambda _status: self._cloud_status.show(self.clouds.describe())
+        self._wire()
+        self._show_matrix(self.frames.pose)
+
+    def _wire(self) -> None:
+        self._cloud_row.dropdown.on_update(
+            lambda _: self.clouds.select(self._cloud_row.dropdown.value)
+        )
+        self._budget.on_update(lambda _: setattr(self.clouds, "budget", int(self._budget.value)))
+        self._image_row.dropdown.on_update(
+            lambda _: self.images.select(self._image_row.dropdown.value)
+        )
+        self._image_on_frustum.on_update(
+            lambda _: self.images.show_on_frustum(self._image_on_frustum.value)
+        )
+        self._marker_row.dropdown.on_update(
+            lambda _: self.markers.select(self._marker_row.dropdown.value)
+        )
+        self._joint_row.dropdown.on_update(lambda _: self._select_joints())
+        self._gizmo.on_update(lambda _: self.frames.show_gizmo(self._gizmo.value))
+        for slider in self._sliders.values():
+            slider.on_update(lambda _: self._on_slider())
+        self.frames.on_change(self._on_pose_changed)
+
+    def _select_joints(self) -> None:
+        self.plot.clear()
+        self.arm.select(self._joint_row.dropdown.value)
+
+    def _on_slider(self) -> None:
+        if self._syncing_sliders:
+            return
+        v = {k: float(s.value) for k, s in self._sliders.items()}
+        pose = CameraPose(
+            v["x"],
+            v["y"],
+            v["z"],
+            math.radians(v["roll"]),
+            math.radians(v["pitch"]),
+            math.radians(v["yaw"]),
+        )
+        self.frames.set_pose(pose, "sliders")
+
+    def _on_pose_changed(self, pose: CameraPose, source: str) -> None:
+        if source == "gizmo":  # keep the sliders in step without echoing back
+            self._syncing_sliders = True
+            try:
+                for key, slider in self._sliders.items():
+                    value = getattr(pose, key)
+                    slider.value = round(
+                        math.degrees(value) if key in ("roll", "pitch", "yaw") else value, 2
+                    )
+            finally:
+                self._syncing_sliders = False
+        self._show_matrix(pose)
+        self.params.push(pose)
+
+    def _show_matrix(self, pose: CameraPose) -> None:
+        x, y, z, w = tf.wxyz_to_ros(pose.wxyz)
+        self._matrix.show(
+            "**T** (camera in base_link):\n\n"
+            + code_block(tf.format_matrix(pose.matrix()).splitlines())
+            + f"\n\nquaternion (ROS order x, y, z, w): ({x:.3f}, {y:.3f}, {z:.3f}, {w:.3f})"
+        )
+
+    def refresh(self, graph: GraphSnapshot | None) -> None:
+        rows = (
+            (self._cloud_row, self.clouds.worker, self.clouds.topic),
+            (self._image_row, self.images.worker, self.images.topic),
+            (self._marker_row, self.markers.worker, self.markers.topic),
+            (self._joint_row, self.arm.worker, self.arm.topic),
+        )
+        for row, worker, topic in rows:
+            row.refresh_options(graph)
+            received, _drawn, rate, since = worker.stats()
+            note = picker.liveness_note(graph, topic, received, since)
+            if not note and rate:
+                note = f"{rate:.1f} Hz received"
+            row.note.show(note)
+        self._cloud_status.show(self.clouds.describe())
+        self._image_info.show(self.images.info)
+        self._marker_info.show(self.markers.describe())
+        self._arm_info.show(self.arm.describe())
+        self.plot.flush()
+        self.stamped.refresh(graph)
+        self._stamped_info.show(self.stamped.describe())
+        self._param_status.show(self.params.status)
+
+    def close(self) -> None:
+        for layer in (self.clouds, self.images, self.markers, self.arm, self.stamped, self.params):
+            layer.close()

@@ -1,0 +1,85 @@
+"""Show one sensor_msgs/Image topic in a panel image, and optionally on the camera frustum.
+
+Images are converted and jpeg-encoded in a worker thread at most a few times a
+second (a browser panel needs no 30 Hz), downscaled first so each frame is
+a few tens of kilobytes.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+import numpy as np
+import viser
+from rclpy.node import Node
+from sensor_msgs.msg import Image
+
+from app.scene.frames import FrameTree
+from app.scene.image_codec import ImageFormatError, downscale, image_to_rgb
+from app.scene.latest import LatestWorker
+from app.scene.pointclouds import SENSOR_QOS
+from app.scene.topic_picker import NONE
+
+MAX_HZ = 10.0
+PANEL_WIDTH = 480
+FRUSTUM_WIDTH = 160
+
+
+class ImageLayer:
+    def __init__(
+        self, node: Node, gui: viser.GuiApi, frames: FrameTree, *, label: str = "Camera image"
+    ) -> None:
+        self._node = node
+        self._frames = frames
+        self._lock = threading.Lock()
+        self._topic = NONE
+        self._subscription: Any = None
+        self.on_frustum = False
+        self.info = ""
+        self.frames_shown = 0
+        blank = np.full((48, 64, 3), 235, dtype=np.uint8)  # placeholder until a frame arrives
+        self.handle = gui.add_image(blank, label=label, format="jpeg", jpeg_quality=80)
+        self.worker = LatestWorker("image", self._draw, MAX_HZ)
+
+    @property
+    def topic(self) -> str:
+        return self._topic
+
+    def select(self, topic: str) -> None:
+        with self._lock:
+            if topic == self._topic:
+                return
+            old, self._subscription = self._subscription, None
+            self._topic = topic
+            self.info = ""
+        if old is not None:
+            self._node.destroy_subscription(old)
+        self.worker.reset()
+        if topic != NONE:
+            sub = self._node.create_subscription(Image, topic, self.worker.offer, SENSOR_QOS)
+            with self._lock:
+                self._subscription = sub
+
+    def show_on_frustum(self, enabled: bool) -> None:
+        self.on_frustum = enabled
+        if not enabled:
+            self._frames.frustum.image = None
+
+    def _draw(self, msg: Image) -> None:
+        try:
+            rgb = image_to_rgb(msg)
+        except (ImageFormatError, ValueError) as exc:
+            self.info = f"⚠️ {exc}"
+            return
+        self.handle.image = np.ascontiguousarray(downscale(rgb, PANEL_WIDTH))
+        if self.on_frustum:
+            frustum = self._frames.frustum
+            frustum.aspect = msg.width / max(1, msg.height)
+            frustum.image = np.ascontiguousarray(downscale(rgb, FRUSTUM_WIDTH))
+        self.frames_shown += 1
+        self.info = f"{msg.width}×{msg.height} `{msg.encoding}` · frame `{msg.header.frame_id}`"
+
+    def close(self) -> None:
+        self.select(NONE)
+        self.worker.stop()

@@ -1,0 +1,157 @@
+"""Draw one PointCloud2 topic the learner picks, throttled and under a point budget.
+
+The subscription callback only hands the message to a :class:`LatestWorker`;
+decoding (numpy, a few ms for 100k points) and the viser update run in the
+worker thread. The cloud node is created once per frame and then updated in
+place (``handle.points``/``handle.colors``), never re-added per message.
+"""
+
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass
+from typing import Any
+
+import viser
+from rclpy.node import Node
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import PointCloud2
+
+from app.scene.cloud_codec import CloudFormatError, decode_cloud
+from app.scene.frames import scene_path_for_frame
+from app.scene.latest import LatestWorker
+from app.scene.topic_picker import NONE
+
+DEFAULT_BUDGET = 200_000
+MAX_HZ = 30.0  # above the 20 Hz a typical depth camera publishes, so none is skipped
+
+# Best effort, newest only: works with reliable and best-effort publishers
+# alike and never makes a fast publisher wait for the dashboard.
+SENSOR_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT)
+
+
+@dataclass(frozen=True)
+class CloudStatus:
+    topic: str
+    total: int = 0
+    shown: int = 0
+    budget: int = DEFAULT_BUDGET
+    colour_source: str = ""
+    frame_id: str = ""
+    frame_known: bool = True
+    stamp: str = ""
+    error: str = ""
+
+
+class PointCloudLayer:
+    def __init__(self, node: Node, server: viser.ViserServer, *, point_size: float = 0.01) -> None:
+        self._node = node
+        self._server = server
+        self._point_size = point_size
+        self._lock = threading.Lock()
+        self._topic = NONE
+        self._subscription: Any = None
+        self._handle: viser.PointCloudHandle | None = None
+        self._handle_path = ""
+        self.budget = DEFAULT_BUDGET
+        self._status = CloudStatus(NONE)
+        self.worker = LatestWorker("cloud", self._draw, MAX_HZ)
+
+    @property
+    def topic(self) -> str:
+        return self._topic
+
+    @property
+    def status(self) -> CloudStatus:
+        with self._lock:
+            return self._status
+
+    def select(self, topic: str) -> None:
+        """Follow ``topic`` (or nothing, for "(none)"): one subscription at a time."""
+        with self._lock:
+            if topic == self._topic:
+                return
+            old, self._subscription = self._subscription, None
+            self._topic = topic
+            self._status = CloudStatus(topic, budget=self.budget)
+        if old is not None:
+            self._node.destroy_subscription(old)
+        self.worker.reset()
+        if topic != NONE:
+            sub = self._node.create_subscription(PointCloud2, topic, self.worker.offer, SENSOR_QOS)
+            with self._lock:
+                self._subscription = sub
+        else:
+            self._remove_handle()
+
+    def _remove_handle(self) -> None:
+        if self._handle is not None:
+            self._handle.remove()
+            self._handle = None
+            self._handle_path = ""
+
+    def _draw(self, msg: PointCloud2) -> None:
+        budget = self.budget
+        stamp = f"{msg.header.stamp.sec}.{msg.header.stamp.nanosec:09d}"
+        try:
+            cloud = decode_cloud(msg, budget)
+        except CloudFormatError as exc:
+            with self._lock:
+                self._status = CloudStatus(self._topic, budget=budget, error=str(exc))
+            return
+        parent, known = scene_path_for_frame(msg.header.frame_id, self._topic)
+        path = f"{parent}/cloud"
+        if self._handle is not None and self._handle_path == path:
+            with self._server.atomic():
+                self._handle.points = cloud.points
+                self._handle.colors = cloud.colors
+        else:
+            self._remove_handle()
+            self._handle = self._server.scene.add_point_cloud(
+                path,
+                points=cloud.points,
+                colors=cloud.colors,
+                point_size=self._point_size,
+                point_shape="square",
+                point_shading="flat",
+            )
+            self._handle_path = path
+        with self._lock:
+            self._status = CloudStatus(
+                self._topic,
+                total=cloud.total,
+                shown=cloud.shown,
+                budget=budget,
+                colour_source=cloud.colour_source,
+                frame_id=msg.header.frame_id,
+                frame_known=known,
+                stamp=stamp,
+            )
+        if self.on_drawn is not None:
+            self.on_drawn(self.status)
+
+    on_drawn: Any = None  # set by the panel: refresh the status line right after a draw
+
+    def describe(self) -> str:
+        """Markdown for the panel: how many points, which budget, colouring, frame."""
+        s = self.status
+        if s.topic == NONE:
+            return ""
+        if s.error:
+            return f"⚠️ cannot draw `{s.topic}`: {s.error}"
+        if not s.total:
+            return ""
+        cut = (
+            f"showing **{s.shown:,}** of {s.total:,} points (budget {s.budget:,}: every "
+            f"{-(-s.total // s.shown) if s.shown else 1}th point)"
+            if s.shown < s.total and s.total > s.budget
+            else f"**{s.shown:,}** points (budget {s.budget:,})"
+        )
+        frame = f"frame `{s.frame_id or '(empty)'}`"
+        if not s.frame_known:
+            frame += " (unknown here: drawn at base_link)"
+        return f"{cut} · colour: {s.colour_source} · {frame} · stamp {s.stamp}"
+
+    def close(self) -> None:
+        self.select(NONE)
+        self.worker.stop()

@@ -1,0 +1,108 @@
+"""Stamped points and poses (PointStamped, PoseStamped) drawn in their own frame.
+
+Every such topic on the graph is followed automatically (up to a limit): the
+coordinate-transform lesson publishes the same object in the camera frame
+and in the base frame, and when the camera pose is right the two spheres
+coincide in the 3D view.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+import viser
+from geometry_msgs.msg import PointStamped, PoseStamped
+from rclpy.node import Node
+
+from app.graph import GraphSnapshot
+from app.scene import topic_picker as picker
+from app.scene.frames import scene_path_for_frame
+from app.scene.latest import LatestWorker
+from app.scene.transforms import ros_to_wxyz
+
+MAX_TOPICS = 8
+_COLOURS = ((230, 50, 50), (50, 120, 230), (40, 170, 60), (200, 120, 20), (150, 60, 200))
+
+
+def _leaf(topic: str) -> str:
+    return "".join(ch if ch.isalnum() else "_" for ch in topic.strip("/")) or "topic"
+
+
+class _Follower:
+    def __init__(self, layer: StampedLayer, topic: str, is_pose: bool, colour) -> None:
+        self.topic = topic
+        self.is_pose = is_pose
+        self.colour = colour
+        self.handle: Any = None
+        self.label: Any = None
+        self.path = ""
+        self.last = ""
+        self.worker = LatestWorker(f"stamped{_leaf(topic)}", self._draw, 10.0)
+        self._layer = layer
+        msg_type = PoseStamped if is_pose else PointStamped
+        self.subscription = layer.node.create_subscription(msg_type, topic, self.worker.offer, 10)
+
+    def _draw(self, msg: Any) -> None:
+        parent, known = scene_path_for_frame(msg.header.frame_id, self.topic)
+        path = f"{parent}/stamped/{_leaf(self.topic)}"
+        if self.is_pose:
+            p, o = msg.pose.position, msg.pose.orientation
+            position, wxyz = (p.x, p.y, p.z), ros_to_wxyz(o.x, o.y, o.z, o.w)
+        else:
+            p = msg.point
+            position, wxyz = (p.x, p.y, p.z), (1.0, 0.0, 0.0, 0.0)
+        scene = self._layer.scene
+        if path != self.path:
+            if self.handle is not None:
+                self.handle.remove()
+            if self.is_pose:
+                self.handle = scene.add_frame(path, axes_length=0.1, axes_radius=0.005)
+            else:
+                self.handle = scene.add_icosphere(path, radius=0.025, color=self.colour)
+            scene.add_label(f"{path}/label", self.topic, position=(0.0, 0.0, 0.05))
+            self.path = path
+        self.handle.position = position
+        self.handle.wxyz = wxyz
+        where = "" if known else " (unknown frame: drawn at base_link)"
+        self.last = (
+            f"`{self.topic}` ({p.x:+.3f}, {p.y:+.3f}, {p.z:+.3f}) m in "
+            f"`{msg.header.frame_id or '(empty)'}`{where}"
+        )
+
+    def close(self) -> None:
+        self._layer.node.destroy_subscription(self.subscription)
+        self.worker.stop()
+        if self.handle is not None:
+            self.handle.remove()
+
+
+class StampedLayer:
+    def __init__(self, node: Node, server: viser.ViserServer) -> None:
+        self.node = node
+        self.scene = server.scene
+        self._lock = threading.Lock()
+        self._followers: dict[str, _Follower] = {}
+
+    def refresh(self, graph: GraphSnapshot | None) -> None:
+        """Follow every new stamped point/pose topic (UI thread)."""
+        points = picker.drawable_topics(graph, picker.POINT_TYPES)
+        poses = picker.drawable_topics(graph, picker.POSE_TYPES)
+        for topic, is_pose in [(t, False) for t in points] + [(t, True) for t in poses]:
+            if topic in self._followers or len(self._followers) >= MAX_TOPICS:
+                continue
+            colour = _COLOURS[len(self._followers) % len(_COLOURS)]
+            self._followers[topic] = _Follower(self, topic, is_pose, colour)
+
+    def describe(self) -> str:
+        lines = [f.last for f in self._followers.values() if f.last]
+        if not lines:
+            return ""
+        return "**Stamped points and poses** (drawn in their frame):\n\n" + "\n".join(
+            f"- {line}" for line in lines
+        )
+
+    def close(self) -> None:
+        for follower in self._followers.values():
+            follower.close()
+        self._followers.clear()

@@ -1,0 +1,109 @@
+"""The 3D view: a learner picks a cloud, an image and a joint topic and sees them live."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from playwright.sync_api import expect
+from sensor_msgs.msg import Image, JointState, PointCloud2
+
+from app.scene.cloud_codec import encode_cloud
+from app.scene.image_codec import rgb_to_image_msg
+from tests.browser.helpers import open_tab
+from tests.browser.scene_helpers import (
+    Repeater,
+    now_stamp,
+    synthetic_cloud_points,
+    wait_scene_points,
+    world_position,
+)
+
+pytestmark = [pytest.mark.browser, pytest.mark.ros]
+
+CLOUD_POINTS = 50_000
+# src of the image under the "Camera image" label once it shows a picture (not the blank one).
+CAMERA_IMAGE_SRC_JS = """() => {
+  const label = [...document.querySelectorAll('p')].find((e) => e.textContent === 'Camera image');
+  const img = label && label.parentElement && label.parentElement.querySelector('img');
+  return img && img.naturalWidth === 160 ? img.src : null;
+}"""
+
+
+def pick(page, label: str, topic: str) -> None:
+    """Choose ``topic`` once the dashboard has discovered it (the graph refreshes at 5 Hz)."""
+    page.get_by_label(label).click()
+    option = page.get_by_role("option", name=topic, exact=True)
+    for _ in range(60):
+        if option.count():
+            option.click()
+            return
+        page.keyboard.press("Escape")
+        page.wait_for_timeout(500)
+        page.get_by_label(label).click()
+    raise AssertionError(f"{topic} never appeared in {label}")
+
+
+def test_point_cloud_image_and_arm_show_up_live(page, probe):
+    node = probe.node
+    pts, colours = synthetic_cloud_points(CLOUD_POINTS)
+    cloud_pub = node.create_publisher(PointCloud2, "/test/cloud", 1)
+    image_pub = node.create_publisher(Image, "/test/camera/image", 1)
+    joint_pub = node.create_publisher(JointState, "/test/joint_states", 10)
+
+    def cloud(i: int) -> PointCloud2:
+        return encode_cloud(pts, colours, frame_id="base_link", stamp=now_stamp())
+
+    def image(i: int) -> Image:
+        rgb = np.zeros((120, 160, 3), np.uint8)
+        rgb[:, :, 0] = (i * 40) % 256  # the red channel changes with every frame
+        rgb[40:80, 60:100] = (30, 200, 60)
+        return rgb_to_image_msg(rgb, "bgr8")
+
+    def joints(i: int) -> JointState:
+        msg = JointState()
+        msg.name = ["base_yaw", "shoulder_pitch", "elbow_pitch", "wrist_pitch"]
+        t = i * 0.1
+        msg.position = [math.sin(t), 0.6 + 0.3 * math.sin(t), -1.0, -0.8]
+        return msg
+
+    repeaters = [
+        Repeater(cloud_pub, cloud, 0.2),
+        Repeater(image_pub, image, 0.2),
+        Repeater(joint_pub, joints, 0.05),
+    ]
+    try:
+        open_tab(page, "3D view")
+        pick(page, "Cloud topic", "/test/cloud")
+        shown = wait_scene_points(page, "/base_link/cloud", CLOUD_POINTS, timeout_ms=40_000)
+        assert shown == CLOUD_POINTS
+        expect(page.get_by_text(f"{CLOUD_POINTS:,} points").first).to_be_visible(timeout=10_000)
+
+        pick(page, "Image topic", "/test/camera/image")
+        first = page.wait_for_function(CAMERA_IMAGE_SRC_JS, polling=100, timeout=20_000)
+        first_src = first.json_value()
+        page.wait_for_function(
+            f"(old) => {{ const src = ({CAMERA_IMAGE_SRC_JS})(); return src && src !== old; }}",
+            arg=first_src,
+            polling=100,
+            timeout=20_000,
+        )
+        expect(page.get_by_text("160×120").first).to_be_visible(timeout=10_000)
+
+        pick(page, "Joint topic", "/test/joint_states")
+        start = world_position(page, "/base_link/arm/joint4")
+        page.wait_for_function(
+            "([name, old]) => { const o = window.__viserMutable.nodeRefFromName[name];"
+            " if (!o) return false; o.updateWorldMatrix(true, false);"
+            " const e = o.matrixWorld.elements;"
+            " return Math.hypot(e[12]-old[0], e[13]-old[1], e[14]-old[2]) > 0.02; }",
+            arg=["/base_link/arm/joint4", start],
+            polling=100,
+            timeout=20_000,
+        )
+        page.get_by_text("Robot arm").first.scroll_into_view_if_needed()
+        expect(page.get_by_text("gripper at").first).to_be_visible(timeout=10_000)
+    finally:
+        for r in repeaters:
+            r.stop()
