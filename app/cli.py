@@ -137,6 +137,18 @@ def cmd_list(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_launch(args: argparse.Namespace) -> int:
+    """Run a launch group in the foreground (app/launch.py), or print its launch file."""
+    from app.launch import launch_file_text, launch_in_foreground
+
+    if args.print_launch_file:
+        print(launch_file_text(args.group), end="")
+        return 0
+    catalog.lookup_group(args.group)
+    configure_this_process(domain_id=args.domain_id, network=args.network)
+    return launch_in_foreground(args.group, os.environ)
+
+
 ROS2_GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface")
 
 
@@ -188,6 +200,14 @@ def build_parser() -> argparse.ArgumentParser:
 
     lst = sub.add_parser("list", help="print the node catalog")
     lst.set_defaults(func=cmd_list)
+
+    launch = sub.add_parser("launch", help="start a launch group, like `ros2 launch`")
+    launch.add_argument("group", help="launch group name (see `ros2-classroom list`)")
+    launch.add_argument(
+        "--print", dest="print_launch_file", action="store_true", help="print its launch file"
+    )
+    dds_options(launch)
+    launch.set_defaults(func=cmd_launch)
 
     # ros2-like verbs (app/ros2cli): `ros2-classroom topic list -t` is `ros2 topic list -t`.
     for group in ROS2_GROUPS:
