@@ -143,7 +143,25 @@ def to_yaml(msg: Any, *, max_items: int | None = 32) -> str:
     plain = to_plain(msg, max_items=max_items)
     if not plain:
         return "{}"
-    return yaml.safe_dump(plain, sort_keys=False, default_flow_style=None, width=100).rstrip()
+    return dump_yaml(plain)
+
+
+class _Dumper(yaml.SafeDumper):
+    """Block-style mappings (as ros2 prints them), lists of plain values on one line."""
+
+
+def _represent_list(dumper: yaml.SafeDumper, data: list) -> Any:
+    flat = all(not isinstance(v, dict | list) for v in data)
+    return dumper.represent_sequence("tag:yaml.org,2002:seq", data, flow_style=flat)
+
+
+_Dumper.add_representer(list, _represent_list)
+
+
+def dump_yaml(value: Any) -> str:
+    return yaml.dump(
+        value, Dumper=_Dumper, sort_keys=False, default_flow_style=False, width=100
+    ).rstrip()
 
 
 def field_value(msg: Any, path: str) -> Any:

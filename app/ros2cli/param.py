@@ -15,6 +15,7 @@ from rcl_interfaces.srv import (
 
 from app.ros2cli.calls import call_service
 from app.ros2cli.common import Ros2Error, VerbContext, all_nodes, node_fqn, require_node
+from app.ros2cli.convert import dump_yaml
 
 _TYPE_WORDS = {
     ParameterType.PARAMETER_BOOL: ("Boolean value is", "bool_value"),
@@ -187,7 +188,7 @@ def dump_dict(ctx: VerbContext, fqn: str) -> dict[str, Any]:
 
 
 def param_dump(ctx: VerbContext, fqn: str) -> int:
-    text = yaml.safe_dump(dump_dict(ctx, fqn), sort_keys=True, default_flow_style=None)
+    text = dump_yaml(dump_dict(ctx, fqn))
     for line in text.rstrip().splitlines():
         ctx.write(line)
     return 0

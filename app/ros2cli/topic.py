@@ -26,6 +26,7 @@ from rclpy.serialization import deserialize_message
 from app.ros2cli.common import ACTION_MARKER, Ros2Error, VerbContext
 from app.ros2cli.convert import (
     ConversionError,
+    dump_yaml,
     field_value,
     from_yaml,
     import_type,
@@ -76,6 +77,13 @@ def matching_qos(node: Node, topic: str, depth: int = 10) -> QoSProfile:
         durability=DurabilityPolicy.TRANSIENT_LOCAL if transient else DurabilityPolicy.VOLATILE,
     )
 
+
+MEASURE_QOS = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST,
+    depth=100,
+    reliability=ReliabilityPolicy.BEST_EFFORT,
+    durability=DurabilityPolicy.VOLATILE,
+)
 
 # ---------------------------------------------------------------- monitor
 
@@ -328,15 +336,14 @@ def echo(
 
 def _field_text(value: Any) -> str:
     if isinstance(value, dict | list):
-        import yaml
-
-        return yaml.safe_dump(value, sort_keys=False, default_flow_style=None).rstrip()
+        return dump_yaml(value)
     return str(value)
 
 
 def _measure(ctx: VerbContext, topic: str, type_text: str | None, window: int, report) -> int:
     msg_type = resolve_type(ctx, topic, type_text)
-    monitor = TopicMonitor(ctx.node, topic, msg_type, window=window, keep=1)
+    # Best effort, as ros2 hz/bw subscribe: measuring must not slow a reliable publisher.
+    monitor = TopicMonitor(ctx.node, topic, msg_type, window=window, keep=1, qos=MEASURE_QOS)
     deadline = _deadline(ctx)
     reported = False
     try:

@@ -1,0 +1,86 @@
+"""node/topic/service/action verbs against real catalog nodes, outputs checked."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+from tests.integration.conftest import one_error_line
+
+pytestmark = pytest.mark.ros
+
+
+def test_node_topic_service_and_action_verbs(supervisor, ros2):
+    for name in ("talker", "add_two_ints_server", "fibonacci_action_server"):
+        supervisor.start(name)
+
+    out = ros2.until(
+        "ros2 node list",
+        lambda o: all(
+            n in o for n in ("/talker", "/add_two_ints_server", "/fibonacci_action_server")
+        ),
+    )
+    assert "/test_probe" in out.splitlines()
+
+    out = ros2.until("node info /talker", "/chatter: std_msgs/msg/String")
+    assert out.splitlines()[0] == "/talker"
+    publishers = out.split("  Publishers:")[1].split("  Service Servers:")[0]
+    assert "/chatter: std_msgs/msg/String" in publishers
+    assert "/talker/get_parameters: rcl_interfaces/srv/GetParameters" in out
+
+    out = ros2.until("topic list -t", "/chatter [std_msgs/msg/String]")
+    assert "/rosout [rcl_interfaces/msg/Log]" in out.splitlines()
+
+    out = ros2.until("topic info /chatter --verbose", "Node name: talker")
+    assert "Type: std_msgs/msg/String" in out
+    assert "Publisher count: 1" in out
+    assert "Endpoint type: PUBLISHER" in out
+    assert "  Reliability: RELIABLE" in out
+    assert "  Durability: VOLATILE" in out
+
+    code, lines = ros2("ros2 topic echo /chatter --once")
+    assert code == 0
+    assert re.fullmatch(r"data: 'Hello World: \d+'", lines[0]), lines
+    assert lines[1] == "---"
+    code, lines = ros2("topic echo /chatter --field data")
+    numbers = [
+        int(m.group(1)) for line in lines if (m := re.fullmatch(r"Hello World: (\d+)", line))
+    ]
+    assert len(numbers) == 3 and numbers == sorted(numbers), lines  # bounded: 3 messages
+
+    out = ros2.until("service list -t", "/add_two_ints [tutorial_interfaces/srv/AddTwoInts]")
+    code, lines = ros2("service type /add_two_ints")
+    assert lines == ["tutorial_interfaces/srv/AddTwoInts"]
+    code, lines = ros2(
+        "ros2 service call /add_two_ints tutorial_interfaces/srv/AddTwoInts '{a: 2, b: 40}'"
+    )
+    assert code == 0, lines
+    assert lines[0] == (
+        "requester: making request: tutorial_interfaces.srv.AddTwoInts_Request(a=2, b=40)"
+    )
+    assert "response:" in lines
+    assert "tutorial_interfaces.srv.AddTwoInts_Response(sum=42)" in lines
+
+    ros2.until("action list -t", "/fibonacci [tutorial_interfaces/action/Fibonacci]")
+    out = ros2.until("action info /fibonacci", "Action servers: 1")
+    assert "    /fibonacci_action_server" in out.splitlines()
+    assert "Action clients: 0" in out
+
+    code, lines = ros2("param set /fibonacci_action_server step_period 0.05")
+    assert lines == ["Set parameter successful"]
+    code, lines = ros2(
+        "ros2 action send_goal /fibonacci tutorial_interfaces/action/Fibonacci "
+        '"{order: 6}" --feedback'
+    )
+    out = "\n".join(lines)
+    assert code == 0, out
+    assert re.search(r"Goal accepted with ID: [0-9a-f]{32}", out)
+    assert out.count("Feedback:") >= 3
+    assert "partial_sequence: [0, 1, 1]" in out
+    assert "    sequence: [0, 1, 1, 2, 3, 5, 8]" in lines
+    assert lines[-1] == "Goal finished with status: SUCCEEDED"
+
+    code, lines = ros2("ros2 node info /nobody")
+    assert code == 1
+    assert "not on the graph" in one_error_line(lines)
