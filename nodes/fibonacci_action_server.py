@@ -33,7 +33,6 @@ ROS concepts shown
 """
 
 import threading
-import time
 
 import rclpy
 from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor
@@ -60,6 +59,7 @@ class FibonacciActionServer(Node):
         )
         self.goal_lock = threading.Lock()  # guards current_goal and goal state changes
         self.current_goal: ServerGoalHandle | None = None
+        self.shutting_down = threading.Event()  # set by main() on Ctrl+C or SIGTERM
         self.action_server = ActionServer(
             self,
             Fibonacci,
@@ -103,7 +103,9 @@ class FibonacciActionServer(Node):
         self.get_logger().info(f"Executing goal: order {order}")
         self.send_feedback(goal_handle, sequence)
         while len(sequence) < order + 1:
-            time.sleep(self.get_parameter("step_period").value)
+            # Like time.sleep(step_period), but wakes at once when the node shuts down.
+            if self.shutting_down.wait(self.get_parameter("step_period").value):
+                return self.abandon_goal(goal_handle, sequence)
             with self.goal_lock:
                 if not goal_handle.is_active:
                     self.get_logger().info(f"Goal aborted by a newer goal after {sequence}")
@@ -121,6 +123,16 @@ class FibonacciActionServer(Node):
         self.get_logger().info(f"Goal succeeded: {sequence}")
         return Fibonacci.Result(sequence=sequence)
 
+    def abandon_goal(self, goal_handle: ServerGoalHandle, sequence: list[int]) -> Fibonacci.Result:
+        """The node is shutting down: end the goal as ABORTED if ROS still lets us."""
+        with self.goal_lock:
+            if goal_handle.is_active:
+                try:
+                    goal_handle.abort()
+                except Exception:  # after SIGTERM the context is gone: nothing can be sent
+                    pass
+        return Fibonacci.Result(sequence=sequence)
+
     def send_feedback(self, goal_handle: ServerGoalHandle, sequence: list[int]) -> None:
         goal_handle.publish_feedback(Fibonacci.Feedback(partial_sequence=sequence))
         self.get_logger().info(f"Feedback: {sequence}")
@@ -136,6 +148,7 @@ def main(args=None) -> None:
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
+        node.shutting_down.set()  # a goal still executing stops at once
         executor.shutdown()
         node.destroy_node()
         rclpy.try_shutdown()

@@ -161,6 +161,13 @@ def test_fibonacci_feedback_result_rejection_cancel_and_preemption(supervisor, p
     assert any("Feedback: [0, 1, 1, 2]" in line for line in out), out
     assert any(f"Result (SUCCEEDED): {fib(10)}" in line for line in out), out
 
+    # Ctrl+C while a goal executes: the server still stops cleanly.
+    running = ProbeGoal(client, 40)
+    wait_until(lambda: len(running.feedback) >= 2, what="a goal running before the stop")
+    stopped = supervisor.stop("fibonacci_action_server").result(timeout=20)
+    assert stopped.exit_code == 0, supervisor.output("fibonacci_action_server", last=20)
+    assert not output_has(supervisor, "fibonacci_action_server", "Traceback")
+
 
 # -- lifecycle -----------------------------------------------------------------
 
@@ -345,3 +352,5 @@ def test_executor_demo_single_thread_starves_multi_thread_does_not(supervisor, p
     assert multi_rate >= 2 * single_rate
     wait_for_output(supervisor, "executor_demo", "[single] fast timer")
     wait_for_output(supervisor, "executor_demo_multi", "[multi] fast timer")
+    for name in ("executor_demo", "executor_demo_multi"):  # even mid slow callback
+        assert supervisor.stop(name).result(timeout=20).exit_code == 0, supervisor.output(name)
