@@ -1,0 +1,68 @@
+"""A learner completes lessons by clicking only; progress survives reloads and restarts."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from playwright.sync_api import expect
+
+from app.lessons.schema import load_course
+from tests.browser.helpers import choose, click, expect_text, open_tab
+from tests.conftest import DashboardProcess, free_port
+
+pytestmark = [pytest.mark.browser, pytest.mark.ros]
+COURSE = load_course()
+
+
+def lesson_label(lesson) -> str:
+    return f"{lesson.unit:02d} · {lesson.title}"
+
+
+def complete_by_clicking(page, lesson) -> None:
+    open_tab(page, "Lessons")
+    choose(page, "Lesson", lesson_label(lesson))
+    for index, step in enumerate(lesson.steps):
+        expect_text(page, f"Step {index + 1} of {len(lesson.steps)}: {step.title}")
+        for action in step.actions:
+            click(page, action.get("label") or action.kind.replace("_", " "))
+            page.wait_for_timeout(300)  # a learner reads the result before the next click
+        for check in step.checks:
+            if check.kind == "quiz":
+                choose(page, check["question"], check["answer"])
+        expect(page.get_by_text("✓ step done")).to_be_visible(timeout=45_000)
+        if index + 1 < len(lesson.steps):
+            click(page, "Next")
+
+
+def done_cells(page):
+    return page.get_by_role("cell", name="✓", exact=True)
+
+
+@pytest.mark.parametrize("lesson_id", ["02_first_node", "03_topics"])
+def test_complete_a_lesson_and_keep_progress(page, dashboard, ros_env, progress_dir, lesson_id):
+    lesson = COURSE.lesson(lesson_id)
+    complete_by_clicking(page, lesson)
+    expect(done_cells(page)).to_have_count(1, timeout=10_000)
+
+    saved = json.loads((progress_dir / "default.json").read_text())
+    assert sorted(saved["lessons"][lesson_id]["passed"]) == list(range(len(lesson.steps)))
+
+    page.reload()
+    open_tab(page, "Lessons")
+    expect(done_cells(page)).to_have_count(1, timeout=15_000)
+
+    dashboard.stop()
+    restarted = DashboardProcess(ros_env, free_port(), ["--progress-dir", str(progress_dir)])
+    try:
+        page.goto(restarted.url)
+        open_tab(page, "Lessons")
+        expect(done_cells(page)).to_have_count(1, timeout=15_000)
+        expect_text(page, lesson.title)
+    finally:
+        restarted.stop()
+
+
+@pytest.mark.skipif(COURSE.lesson("09_lifecycle") is None, reason="no lifecycle lesson yet")
+def test_complete_the_lifecycle_lesson_by_clicking_transitions(page):
+    complete_by_clicking(page, COURSE.lesson("09_lifecycle"))
