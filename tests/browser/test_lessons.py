@@ -63,6 +63,5 @@ def test_complete_a_lesson_and_keep_progress(page, dashboard, ros_env, progress_
         restarted.stop()
 
 
-@pytest.mark.skipif(COURSE.lesson("09_lifecycle") is None, reason="no lifecycle lesson yet")
 def test_complete_the_lifecycle_lesson_by_clicking_transitions(page):
     complete_by_clicking(page, COURSE.lesson("09_lifecycle"))
