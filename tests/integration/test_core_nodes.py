@@ -275,7 +275,7 @@ def test_parameters_node_accepts_and_rejects_changes(supervisor, probe):
     )
     time.sleep(2.5)
     rate = tap.rate_hz(window_sec=2.0)
-    assert rate is not None and 6.0 <= rate <= 13.0, rate
+    assert rate is not None and 5.0 <= rate <= 16.0, rate  # was 2 Hz
     assert set_parameters(probe, "/parameters_node", shout=True)[0].successful
     wait_until(
         lambda: tap.recent()[-1][1].data.startswith("BONJOUR FROM PARAMETERS_NODE #"),
@@ -320,19 +320,24 @@ def test_qos_mismatch_is_reported_and_compatible_pairs_talk(supervisor, probe):
 def test_qos_transient_local_history_reaches_a_late_joiner(supervisor, probe):
     supervisor.start("qos_talker_transient_local")
     wait_for_output(supervisor, "qos_talker_transient_local", 'Publishing: "QoS message 3"')
-    late = TopicTap(
-        probe.node,
-        "/qos_chatter",
-        String,
-        qos=QoSProfile(
-            depth=10,
-            reliability=ReliabilityPolicy.RELIABLE,
-            durability=DurabilityPolicy.TRANSIENT_LOCAL,
-        ),
+    # Two late joiners at the same moment: only the transient-local one gets old messages.
+    history = QoSProfile(
+        depth=10,
+        reliability=ReliabilityPolicy.RELIABLE,
+        durability=DurabilityPolicy.TRANSIENT_LOCAL,
     )
-    wait_until(lambda: late.count >= 1, timeout=DISCOVERY_TIMEOUT, what="history for a late joiner")
-    first = int(late.recent()[0][1].data.rsplit(" ", 1)[1])
-    assert first <= 3, f"the first message a late joiner got was #{first}, not an old one"
+    late = TopicTap(probe.node, "/qos_chatter", String, qos=history)
+    fresh = TopicTap(probe.node, "/qos_chatter", String, qos=10)
+    wait_until(
+        lambda: late.count >= 1 and fresh.count >= 1,
+        timeout=DISCOVERY_TIMEOUT,
+        what="messages for both late joiners",
+    )
+
+    def first_number(tap: TopicTap) -> int:
+        return int(tap.recent()[0][1].data.rsplit(" ", 1)[1])
+
+    assert first_number(late) < first_number(fresh), (first_number(late), first_number(fresh))
 
 
 # -- executors -----------------------------------------------------------------
@@ -347,9 +352,9 @@ def test_executor_demo_single_thread_starves_multi_thread_does_not(supervisor, p
     wait_until(lambda: single.count >= 3 and multi.count >= 3, timeout=40, what="rate reports")
     single_rate = single.recent()[-1][1].data
     multi_rate = multi.recent()[-1][1].data
-    assert multi_rate >= 7.0, multi_rate
-    assert single_rate <= 5.0, single_rate
-    assert multi_rate >= 2 * single_rate
+    assert multi_rate >= 6.0, multi_rate  # about 10 Hz: nothing blocks the fast timer
+    assert single_rate <= 5.0, single_rate  # about 3 Hz: starved by the slow callback
+    assert multi_rate >= 1.5 * single_rate
     wait_for_output(supervisor, "executor_demo", "[single] fast timer")
     wait_for_output(supervisor, "executor_demo_multi", "[multi] fast timer")
     for name in ("executor_demo", "executor_demo_multi"):  # even mid slow callback
