@@ -64,3 +64,11 @@ def test_qos_profile_from_parameter_values():
         profile_from_names("reliable", "forever", 10)
     with pytest.raises(ValueError, match="depth"):
         profile_from_names("reliable", "volatile", 0)
+
+
+def test_executor_demo_rate_measure():
+    from nodes.executor_demo import rate_hz
+
+    assert rate_hz([]) == 0.0 and rate_hz([1.0]) == 0.0
+    assert rate_hz([0.0, 0.1, 0.2, 0.3, 0.4]) == pytest.approx(10.0)
+    assert rate_hz([0.0, 0.05, 1.0, 1.05, 2.0]) == pytest.approx(2.0)  # starved: bursts
