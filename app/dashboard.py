@@ -14,11 +14,16 @@ from app.lessons.live import LessonRuntime
 from app.lessons.progress import ProgressStore
 from app.lessons.schema import load_course
 from app.panels import Panel
+from app.panels.actions_panel import ActionsPanel
+from app.panels.console_panel import ConsolePanel
 from app.panels.echo_panel import EchoPanel
 from app.panels.graph_panel import GraphPanel
 from app.panels.lessons_panel import LessonsPanel
+from app.panels.lifecycle_panel import LifecyclePanel
+from app.panels.logs_panel import LogsPanel, RosoutLog
 from app.panels.nodes_panel import NodesPanel
 from app.panels.scene_panel import ScenePanel
+from app.panels.services_panel import ServicesPanel
 from app.ros_runtime import RosRuntime
 from app.supervisor import Supervisor
 from app.topic_tap import TopicTap
@@ -69,7 +74,24 @@ class Dashboard:
             echo = EchoPanel(gui, self._chatter)
         with tabs.add_tab("3D view", viser.Icon.CUBE):
             scene = ScenePanel(self.server, self.runtime.node)
-        return [lessons, nodes, graph, echo, scene]
+        ros_panels = self._build_ros_panels(tabs)
+        return [lessons, nodes, graph, echo, scene, *ros_panels]
+
+    def _build_ros_panels(self, tabs: viser.GuiTabGroupHandle) -> list[Panel]:
+        """The ros2 command line and rqt, in the browser (issue 4)."""
+        gui, node = self.server.gui, self.runtime.node
+        rosout = RosoutLog(node)
+        with tabs.add_tab("Console", viser.Icon.TERMINAL):
+            console = ConsolePanel(gui, node)
+        with tabs.add_tab("Services", viser.Icon.ARROWS_EXCHANGE):
+            services = ServicesPanel(gui, node)
+        with tabs.add_tab("Actions", viser.Icon.ROCKET):
+            actions = ActionsPanel(gui, node)
+        with tabs.add_tab("Lifecycle", viser.Icon.PROGRESS):
+            lifecycle = LifecyclePanel(gui, node, rosout)
+        with tabs.add_tab("Logs", viser.Icon.FILE_TEXT):
+            logs = LogsPanel(gui, rosout)
+        return [console, services, actions, lifecycle, logs]
 
     def start(self) -> None:
         self._ui_thread.start()

@@ -1,0 +1,103 @@
+"""Helpers the ROS panels share: background jobs and forms generated from message types.
+
+viser runs callbacks on its own thread pool; ROS requests wait on futures.
+A click therefore starts a short-lived worker thread (``run_job``) that calls
+the same ros2cli functions the console uses; the callback returns at once.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from collections.abc import Callable
+from typing import Any
+
+import viser
+
+from app.ros2cli.common import Ros2Error
+from app.ros2cli.convert import ConversionError, fill_from_form, leaf_fields, type_name
+
+log = logging.getLogger(__name__)
+
+
+def run_job(work: Callable[[], None], on_error: Callable[[str], None]) -> threading.Thread:
+    """Run ``work`` off the callback thread; any failure reaches ``on_error`` as one line."""
+
+    def body() -> None:
+        try:
+            work()
+        except Ros2Error as exc:
+            on_error(str(exc))
+        except Exception as exc:  # never a traceback in the page; keep it in the log
+            log.exception("panel job failed")
+            on_error(f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}")
+
+    thread = threading.Thread(target=body, name="panel-job", daemon=True)
+    thread.start()
+    return thread
+
+
+class MessageForm:
+    """Widgets for every leaf field of a message class, inside one folder.
+
+    Numbers get number inputs, booleans checkboxes, text text inputs; lists
+    and deeply nested parts are typed as YAML. ``message()`` builds the
+    message or raises one ConversionError line.
+    """
+
+    MAX_FIELDS = 24
+
+    def __init__(self, gui: viser.GuiApi, cls: type, title: str) -> None:
+        self.cls = cls
+        self._folder = gui.add_folder(title)
+        self._widgets: dict[str, tuple[str, Any]] = {}
+        fields = leaf_fields(cls)
+        with self._folder:
+            if not fields:
+                gui.add_markdown("_(no fields)_")
+            if len(fields) > self.MAX_FIELDS:
+                self._yaml = gui.add_text("YAML", "{}", hint=f"fields of {type_name(cls)}")
+                return
+            self._yaml = None
+            for path, ros_type, kind in fields:
+                label = f"{path} ({ros_type})"
+                if kind == "bool":
+                    widget = gui.add_checkbox(label, False)
+                elif kind == "int":
+                    widget = gui.add_number(label, 0, step=1)
+                elif kind == "float":
+                    widget = gui.add_number(label, 0.0, step=0.01)
+                elif kind == "yaml":
+                    widget = gui.add_text(label, "", hint="YAML, e.g. [1, 2, 3]")
+                else:
+                    widget = gui.add_text(label, "")
+                self._widgets[path] = (kind, widget)
+
+    def values(self) -> dict[str, Any]:
+        return {path: widget.value for path, (_kind, widget) in self._widgets.items()}
+
+    def message(self) -> Any:
+        if self._yaml is not None:
+            from app.ros2cli.convert import from_yaml
+
+            return from_yaml(self.cls, self._yaml.value)
+        values = self.values()
+        for path, (kind, _w) in self._widgets.items():
+            if kind == "int" and isinstance(values[path], float):
+                if not values[path].is_integer():
+                    raise ConversionError(f"field '{path}' needs a whole number")
+                values[path] = int(values[path])
+        return fill_from_form(self.cls, values)
+
+    def remove(self) -> None:
+        self._folder.remove()
+
+
+def yaml_inline(msg: Any) -> str:
+    """A message as '{a: 1, b: 2}' for the equivalent ros2 command line."""
+    import yaml
+
+    from app.ros2cli.convert import to_plain
+
+    text = yaml.safe_dump(to_plain(msg), default_flow_style=True, width=10_000).strip()
+    return "'" + text.replace("'", "'\"'\"'") + "'"

@@ -1,0 +1,97 @@
+"""Smoke tests of the ros2 panels: lifecycle clicks, an action goal, a service form, the console."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+from playwright.sync_api import expect
+
+from tests.browser.helpers import choose, click, expect_text, open_tab
+
+pytestmark = [pytest.mark.browser, pytest.mark.ros]
+
+
+def start(page, name: str) -> None:
+    open_tab(page, "Nodes")
+    choose(page, "Catalog node", name)
+    click(page, "Start")
+    expect_text(page, "Started")
+
+
+def field(page, label: str):
+    """The input next to a viser label (viser's label `for` does not point at the input)."""
+    text = page.get_by_text(label, exact=True).locator("visible=true").first
+    return text.locator("xpath=ancestor::div[contains(@class,'mantine-Flex-root')][1]//input")
+
+
+def expect_regex(page, pattern: str, timeout: float = 30_000) -> None:
+    """Some visible text matches (hidden tabs hold logs with the same words)."""
+    found = page.get_by_text(re.compile(pattern)).locator("visible=true").first
+    expect(found).to_be_visible(timeout=timeout)
+
+
+def expect_shown(page, text: str, timeout: float = 30_000) -> None:
+    expect_regex(page, re.escape(text), timeout)
+
+
+def test_console_runs_ros2_topic_list(page):
+    open_tab(page, "Console")
+    field(page, "Command").fill("ros2 topic list -t")
+    click(page, "Run")
+    expect_shown(page, "/rosout [rcl_interfaces/msg/Log]")
+    expect_shown(page, "[exit code 0]")
+    field(page, "Command").fill("ros2 topic echo /nowhere")
+    click(page, "Run")
+    expect_shown(page, "error: topic '/nowhere' is not on the graph")
+
+
+def test_lifecycle_walk_changes_state_and_rate(page):
+    start(page, "lifecycle_talker")
+    open_tab(page, "Lifecycle")
+    expect_regex(page, r"Current state of /lifecycle_talker: unconfigured")
+    activate = page.get_by_role("button", name="activate", exact=True)
+    expect(activate).to_be_disabled()
+    steps = [
+        ("configure", "inactive"),
+        ("activate", "active"),
+        ("deactivate", "inactive"),
+        ("cleanup", "unconfigured"),
+        ("shutdown", "finalized"),
+    ]
+    for transition, state in steps:
+        button = page.get_by_role("button", name=transition, exact=True)
+        expect(button).to_be_enabled(timeout=20_000)
+        button.click()
+        expect_regex(page, rf"Current state of /lifecycle_talker: {state}\b")
+        expect_shown(page, f"ros2 lifecycle set /lifecycle_talker {transition}")
+        if state == "active":
+            expect_regex(page, r"/lifecycle_chatter: \d+\.\d Hz")
+            expect_regex(page, r"on_activate")  # the node's own log line
+        if transition == "deactivate":
+            expect_regex(page, r"/lifecycle_chatter: silent", timeout=20_000)
+    for transition in ("configure", "activate", "cleanup"):
+        expect(page.get_by_role("button", name=transition, exact=True)).to_be_disabled()
+
+
+def test_fibonacci_goal_feedback_then_result(page):
+    start(page, "fibonacci_action_server")
+    open_tab(page, "Actions")
+    expect_shown(page, "Type: tutorial_interfaces/action/Fibonacci", timeout=30_000)
+    field(page, "order (int32)").fill("6")
+    click(page, "Send goal")
+    expect_regex(page, r"Feedback \([1-9]\d* received\)")
+    expect_regex(page, r"Status: EXECUTING")
+    expect_shown(page, "Status: SUCCEEDED", timeout=40_000)
+    expect_shown(page, "sequence: [0, 1, 1, 2, 3, 5, 8]")
+
+
+def test_add_two_ints_from_the_form(page):
+    start(page, "add_two_ints_server")
+    open_tab(page, "Services")
+    expect_shown(page, "Type: tutorial_interfaces/srv/AddTwoInts", timeout=30_000)
+    field(page, "a (int64)").fill("20")
+    field(page, "b (int64)").fill("22")
+    click(page, "Call")
+    expect_shown(page, "AddTwoInts_Response(sum=42)")
+    expect_shown(page, "ros2 service call /add_two_ints tutorial_interfaces/srv/AddTwoInts")
