@@ -31,6 +31,9 @@ def lifecycle_nodes(ctx: VerbContext) -> list[str]:
 
 
 def _target(ctx: VerbContext, fqn: str) -> str:
+    target = fqn if fqn.startswith("/") else "/" + fqn
+    if target in lifecycle_nodes(ctx):
+        return target  # its services are visible even before its name is discovered
     name, namespace = require_node(ctx, fqn)
     target = node_fqn(name, namespace)
     if target not in lifecycle_nodes(ctx):
