@@ -177,6 +177,48 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         ros_args=("-r", "__node:=executor_demo_multi", "-p", "executor:=multi"),
     ),
     # --- perception and manipulation nodes (issue 5): add entries below this line ---
+    CatalogEntry(
+        "camera_publisher",
+        "camera_publisher",
+        "/camera_publisher",
+        "A pretend camera: an object's position on /pos_in_cam_frame (camera frame).",
+    ),
+    CatalogEntry(
+        "coordinate_transform",
+        "coordinate_transform",
+        "/coordinate_transform",
+        "Camera frame to robot base frame with a configurable camera pose.",
+    ),
+    CatalogEntry(
+        "robotic_arm",
+        "robotic_arm",
+        "/robotic_arm",
+        "A 4-joint arm: inverse kinematics, /joint_states, /end_effector_pose, /arm_status.",
+    ),
+    CatalogEntry(
+        "image_publisher",
+        "image_publisher",
+        "/image_publisher",
+        "Camera images (bgr8) on /camera/image_raw: a synthetic scene with a moving red ball.",
+    ),
+    CatalogEntry(
+        "object_detector",
+        "object_detector",
+        "/object_detector",
+        "Finds the red ball with OpenCV; annotated image and its position in the camera frame.",
+    ),
+    CatalogEntry(
+        "video_publisher",
+        "video_publisher",
+        "/video_publisher",
+        "Frames on /cam/image_raw from a camera looping through a textured room.",
+    ),
+    CatalogEntry(
+        "slam_node",
+        "slam_node",
+        "/slam_node",
+        "Monocular SLAM: map points, camera trajectory and tracked features.",
+    ),
 )
 
 GROUPS: tuple[LaunchGroup, ...] = (
@@ -217,6 +259,21 @@ GROUPS: tuple[LaunchGroup, ...] = (
         ("executor_demo", "executor_demo_multi"),
     ),
     # --- perception groups (issue 5): add groups below this line ---
+    LaunchGroup(
+        "camera_to_arm",
+        "camera_publisher + coordinate_transform + robotic_arm: pick and place",
+        ("camera_publisher", "coordinate_transform", "robotic_arm"),
+    ),
+    LaunchGroup(
+        "image_pipeline",
+        "image_publisher + object_detector: find a ball in camera images",
+        ("image_publisher", "object_detector"),
+    ),
+    LaunchGroup(
+        "slam",
+        "video_publisher + slam_node: monocular SLAM on a synthetic room",
+        ("video_publisher", "slam_node"),
+    ),
 )
 
 _BY_NAME = {entry.name: entry for entry in ENTRIES}
