@@ -20,6 +20,7 @@ from sensor_msgs.msg import JointState
 from app.scene import transforms as tf
 from app.scene.frames import BASE_PATH
 from app.scene.latest import LatestWorker
+from app.scene.qos import SCENE_CALLBACK_GROUP
 from app.scene.topic_picker import NONE
 from nodes.common.arm_kinematics import JOINT_NAMES, link_points
 
@@ -107,7 +108,9 @@ class ArmLayer:
             self._node.destroy_subscription(old)
         self.worker.reset()
         if topic != NONE:
-            sub = self._node.create_subscription(JointState, topic, self.worker.offer, 10)
+            sub = self._node.create_subscription(
+                JointState, topic, self.worker.offer, 10, callback_group=SCENE_CALLBACK_GROUP
+            )
             with self._lock:
                 self._subscription = sub
 

@@ -15,6 +15,7 @@ from rclpy.node import Node
 
 from app.scene.frames import CameraPose
 from app.scene.latest import LatestWorker
+from app.scene.qos import SCENE_CALLBACK_GROUP
 
 TARGET_NODE = "/coordinate_transform"
 # CameraPose field -> parameter name on the node
@@ -44,7 +45,9 @@ class CameraParamSync:
     def __init__(self, node: Node, target: str = TARGET_NODE) -> None:
         self._node = node
         self._target = target
-        self._client = node.create_client(SetParameters, f"{target}/set_parameters")
+        self._client = node.create_client(
+            SetParameters, f"{target}/set_parameters", callback_group=SCENE_CALLBACK_GROUP
+        )
         self._lock = threading.Lock()
         self.status = ""
         self._worker = LatestWorker("camera-params", self._send, 3.0)

@@ -18,7 +18,7 @@ from sensor_msgs.msg import Image
 from app.scene.frames import FrameTree
 from app.scene.image_codec import ImageFormatError, downscale, image_to_rgb
 from app.scene.latest import LatestWorker
-from app.scene.pointclouds import SENSOR_QOS
+from app.scene.qos import SCENE_CALLBACK_GROUP, newest_only_qos
 from app.scene.topic_picker import NONE
 
 MAX_HZ = 10.0
@@ -57,7 +57,13 @@ class ImageLayer:
             self._node.destroy_subscription(old)
         self.worker.reset()
         if topic != NONE:
-            sub = self._node.create_subscription(Image, topic, self.worker.offer, SENSOR_QOS)
+            sub = self._node.create_subscription(
+                Image,
+                topic,
+                self.worker.offer,
+                newest_only_qos(self._node, topic),
+                callback_group=SCENE_CALLBACK_GROUP,
+            )
             with self._lock:
                 self._subscription = sub
 

@@ -20,6 +20,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 from app.scene.frames import scene_path_for_frame
 from app.scene.latest import LatestWorker
 from app.scene.marker_plan import Plan, Shape, plan_marker, scene_name
+from app.scene.qos import SCENE_CALLBACK_GROUP
 from app.scene.topic_picker import NONE
 
 MAX_HZ = 15.0
@@ -78,7 +79,9 @@ class MarkerLayer:
             types = dict(self._node.get_topic_names_and_types()).get(topic, [])
             type_name = types[0] if types else "visualization_msgs/msg/MarkerArray"
         msg_type = Marker if type_name.endswith("/Marker") else MarkerArray
-        sub = self._node.create_subscription(msg_type, topic, self._on_message, 10)
+        sub = self._node.create_subscription(
+            msg_type, topic, self._on_message, 10, callback_group=SCENE_CALLBACK_GROUP
+        )
         with self._lock:
             self._subscription = sub
 

@@ -14,20 +14,16 @@ from typing import Any
 
 import viser
 from rclpy.node import Node
-from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import PointCloud2
 
 from app.scene.cloud_codec import CloudFormatError, decode_cloud
 from app.scene.frames import scene_path_for_frame
 from app.scene.latest import LatestWorker
+from app.scene.qos import SCENE_CALLBACK_GROUP, newest_only_qos
 from app.scene.topic_picker import NONE
 
 DEFAULT_BUDGET = 200_000
 MAX_HZ = 30.0  # above the 20 Hz a typical depth camera publishes, so none is skipped
-
-# Best effort, newest only: works with reliable and best-effort publishers
-# alike and never makes a fast publisher wait for the dashboard.
-SENSOR_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT)
 
 
 @dataclass(frozen=True)
@@ -44,7 +40,7 @@ class CloudStatus:
 
 
 class PointCloudLayer:
-    def __init__(self, node: Node, server: viser.ViserServer, *, point_size: float = 0.01) -> None:
+    def __init__(self, node: Node, server: viser.ViserServer, *, point_size: float = 0.004) -> None:
         self._node = node
         self._server = server
         self._point_size = point_size
@@ -78,7 +74,13 @@ class PointCloudLayer:
             self._node.destroy_subscription(old)
         self.worker.reset()
         if topic != NONE:
-            sub = self._node.create_subscription(PointCloud2, topic, self.worker.offer, SENSOR_QOS)
+            sub = self._node.create_subscription(
+                PointCloud2,
+                topic,
+                self.worker.offer,
+                newest_only_qos(self._node, topic),
+                callback_group=SCENE_CALLBACK_GROUP,
+            )
             with self._lock:
                 self._subscription = sub
         else:

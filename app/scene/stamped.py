@@ -19,6 +19,7 @@ from app.graph import GraphSnapshot
 from app.scene import topic_picker as picker
 from app.scene.frames import scene_path_for_frame
 from app.scene.latest import LatestWorker
+from app.scene.qos import SCENE_CALLBACK_GROUP
 from app.scene.transforms import ros_to_wxyz
 
 MAX_TOPICS = 8
@@ -41,7 +42,9 @@ class _Follower:
         self.worker = LatestWorker(f"stamped{_leaf(topic)}", self._draw, 10.0)
         self._layer = layer
         msg_type = PoseStamped if is_pose else PointStamped
-        self.subscription = layer.node.create_subscription(msg_type, topic, self.worker.offer, 10)
+        self.subscription = layer.node.create_subscription(
+            msg_type, topic, self.worker.offer, 10, callback_group=SCENE_CALLBACK_GROUP
+        )
 
     def _draw(self, msg: Any) -> None:
         parent, known = scene_path_for_frame(msg.header.frame_id, self.topic)

@@ -1,0 +1,493 @@
+"""Benchmark: PointCloud2 -> headless Chromium, the dashboard against a minimal baseline.
+
+For 100k and 1M points at 10 and 20 Hz this publishes clouds from a ROS node
+and measures, inside the browser, how many distinct frames arrive per second
+and how long each took from ``publish()`` to the page (p50, p95):
+
+- **dashboard**: the real ``ros2-classroom serve`` process with the 3D view
+  following the topic (decode, decimate to the point budget, viser update).
+  A frame counts when the panel's status line with that frame's
+  ``header.stamp`` reaches the page's main thread; it is sent right after the
+  points, in order, so the points have arrived by then.
+- **baseline**: the least a browser view can do: one rclpy subscriber, the
+  same numpy decode, and one websocket send of the same points (float16 +
+  rgb, as viser sends them) to a bare page, no throttle, no scene.
+
+Both subscribe best effort, newest only. The clock is the wall clock shared by
+all processes on this machine. Run it inside the loopback-only namespace:
+``.venv/bin/python tests/run.py --bench cloud_to_browser``. The last line
+printed is one JSON object with every figure.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import http
+import json
+import os
+import socket
+import statistics
+import struct
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+CHROMIUM = "/usr/bin/chromium"
+DASH_TOPIC = "/bench/cloud_dash"
+BASE_TOPIC = "/bench/cloud_base"
+CASES = ((100_000, 10), (100_000, 20), (1_000_000, 10), (1_000_000, 20))
+WARMUP_SEC = 1.5
+MEASURE_SEC = 3.0
+ROUNDS = 2
+TAIL_SEC = 0.8
+
+# The dashboard page: time-stamp every message batch viser's websocket worker
+# hands to the main thread, and pick out the cloud status line's stamp.
+DASHBOARD_PROBE_JS = r"""
+window.__frames = [];
+const OrigWorker = window.Worker;
+window.Worker = class extends OrigWorker {
+  constructor(...args) {
+    super(...args);
+    this.addEventListener('message', (event) => {
+      const data = event.data;
+      if (!data || data.type !== 'message_batch') return;
+      const t = performance.timeOrigin + performance.now();
+      for (const m of data.messages) {
+        if (m.type !== 'GuiUpdateMessage' || !m.updates) continue;
+        for (const v of Object.values(m.updates)) {
+          if (typeof v !== 'string') continue;
+          const r = /stamp (\d+)\.(\d{9})/.exec(v);
+          if (r) window.__frames.push([r[1], r[2], t]);
+        }
+      }
+    });
+  }
+};
+"""
+
+BASELINE_PAGE = """<!doctype html><html><body><p id="s">baseline</p><script>
+window.__frames = []; window.__ready = false;
+const ws = new WebSocket('ws://' + location.host + '/ws');
+ws.binaryType = 'arraybuffer';
+ws.onopen = () => { window.__ready = true; };
+ws.onmessage = (event) => {
+  const t = performance.timeOrigin + performance.now();
+  const view = new DataView(event.data);
+  const sec = view.getUint32(0, true), nsec = view.getUint32(4, true), n = view.getUint32(8, true);
+  const points = new Uint16Array(event.data, 16, n * 3);   // float16 x, y, z
+  const colours = new Uint8Array(event.data, 16 + n * 6, n * 3);
+  const nsecText = String(nsec).padStart(9, '0');
+  window.__frames.push([String(sec), nsecText, t, points.length + colours.length]);
+};
+</script></body></html>"""
+
+
+# --------------------------------------------------------------------------- baseline server
+
+
+def serve_baseline(port: int) -> None:
+    """Subscriber + websocket server in one process: the minimal cloud-to-browser path."""
+    import websockets.asyncio.server as ws_server
+    from sensor_msgs.msg import PointCloud2
+    from websockets.datastructures import Headers
+    from websockets.http11 import Response
+
+    from app.ros_runtime import RosRuntime
+    from app.scene.cloud_codec import decode_cloud
+    from app.scene.qos import newest_only_qos
+
+    runtime = RosRuntime("bench_baseline", threads=2)
+    # Subscribe once the publisher is known, as the dashboard's picker does.
+    deadline = time.monotonic() + 20
+    while not runtime.node.get_publishers_info_by_topic(BASE_TOPIC):
+        if time.monotonic() > deadline:
+            raise SystemExit(f"no publisher on {BASE_TOPIC}")
+        time.sleep(0.1)
+    loop = asyncio.new_event_loop()
+    wake = asyncio.Event()
+    latest: list[Any] = [None]
+    lock = threading.Lock()
+    clients: set[Any] = set()
+
+    counts = {"received": 0, "sent": 0}
+
+    def on_cloud(msg: PointCloud2) -> None:
+        counts["received"] += 1
+        with lock:
+            latest[0] = msg
+        loop.call_soon_threadsafe(wake.set)
+
+    runtime.node.create_subscription(
+        PointCloud2, BASE_TOPIC, on_cloud, newest_only_qos(runtime.node, BASE_TOPIC)
+    )
+
+    def process_request(connection, request):
+        if request.path == "/":
+            body = BASELINE_PAGE.encode()
+            headers = Headers([("Content-Type", "text/html"), ("Content-Length", str(len(body)))])
+            return Response(http.HTTPStatus.OK, "OK", headers, body)
+        return None
+
+    async def handler(connection) -> None:
+        clients.add(connection)
+        try:
+            await connection.wait_closed()
+        finally:
+            clients.discard(connection)
+
+    async def sender() -> None:
+        while True:
+            await wake.wait()
+            wake.clear()
+            with lock:
+                msg, latest[0] = latest[0], None
+            if msg is None:
+                continue
+            cloud = decode_cloud(msg)  # the same numpy decode, every point
+            head = struct.pack(
+                "<IIII", msg.header.stamp.sec, msg.header.stamp.nanosec, cloud.shown, 0
+            )
+            payload = b"".join(
+                (head, cloud.points.astype(np.float16).tobytes(), cloud.colors.tobytes())
+            )
+            counts["sent"] += 1
+            for connection in list(clients):
+                try:
+                    await connection.send(payload)
+                except Exception:
+                    clients.discard(connection)
+
+    async def amain() -> None:
+        async with ws_server.serve(
+            handler, "127.0.0.1", port, process_request=process_request, max_size=None
+        ):
+            print("BASELINE READY", flush=True)
+
+            async def report() -> None:  # diagnostics in the baseline's log
+                while True:
+                    await asyncio.sleep(2.0)
+                    print(f"received {counts['received']} sent {counts['sent']}", flush=True)
+
+            await asyncio.gather(sender(), report())
+
+    try:
+        loop.run_until_complete(amain())
+    except KeyboardInterrupt:
+        pass
+    finally:
+        runtime.shutdown()
+
+
+# --------------------------------------------------------------------------- the benchmark
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+def wait_for_line(proc: subprocess.Popen, log: Path, text: str, timeout: float) -> None:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if text in log.read_text(errors="replace"):
+            return
+        if proc.poll() is not None:
+            raise SystemExit(f"{log.name}: exited early:\n{log.read_text(errors='replace')}")
+        time.sleep(0.1)
+    raise SystemExit(f"{log.name}: not ready after {timeout:.0f} s")
+
+
+def start(argv: list[str], log: Path, ready: str) -> subprocess.Popen:
+    proc = subprocess.Popen(
+        argv,
+        cwd=ROOT,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+        stdout=log.open("wb"),
+        stderr=subprocess.STDOUT,
+        start_new_session=True,
+    )
+    wait_for_line(proc, log, ready, 60.0)
+    return proc
+
+
+def stop(proc: subprocess.Popen) -> None:
+    if proc.poll() is None:
+        proc.terminate()
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+class CloudPublisher:
+    """Pre-built clouds (the decode side is what we measure); only the stamp changes."""
+
+    def __init__(self) -> None:
+        from rclpy.qos import QoSProfile, ReliabilityPolicy
+        from sensor_msgs.msg import PointCloud2
+
+        from app.ros_runtime import RosRuntime
+        from app.scene.cloud_codec import encode_cloud
+
+        self.runtime = RosRuntime("bench_cloud_publisher", threads=1)
+        qos = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
+        node = self.runtime.node
+        self.publishers = {
+            t: node.create_publisher(PointCloud2, t, qos) for t in (DASH_TOPIC, BASE_TOPIC)
+        }
+        rng = np.random.default_rng(7)
+        self.messages = {}
+        for size, _hz in CASES:
+            if size in self.messages:
+                continue
+            pts = rng.uniform(-1.0, 1.0, size=(size, 3)).astype(np.float32)
+            pts[:, 2] = np.abs(pts[:, 2]) * 0.5
+            cols = rng.integers(0, 255, size=(size, 3), dtype=np.uint8)
+            self.messages[size] = encode_cloud(pts, cols, frame_id="base_link")
+
+    def run(self, topic: str, size: int, hz: float, duration: float) -> list[tuple[int, int]]:
+        """Publish at ``hz`` for ``duration`` s; returns the (sec, nanosec) stamps sent."""
+        pub, msg = self.publishers[topic], self.messages[size]
+        period = 1.0 / hz
+        sent: list[tuple[int, int]] = []
+        start_t = time.perf_counter()
+        k = 0
+        while True:
+            due = start_t + k * period
+            now = time.perf_counter()
+            if due - start_t >= duration:
+                break
+            if due > now:
+                time.sleep(due - now)
+            wall = time.time_ns()
+            msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(wall, 1_000_000_000)
+            pub.publish(msg)
+            sent.append((msg.header.stamp.sec, msg.header.stamp.nanosec))
+            k += 1
+        return sent
+
+    def close(self) -> None:
+        self.runtime.shutdown()
+
+
+def window_arrivals(frames: list[list[Any]], sent: list[tuple[int, int]]) -> dict[int, float]:
+    """First page arrival (ms) of each stamp published inside the measuring window."""
+    t0 = sent[0][0] * 1e9 + sent[0][1]
+    lo, hi = t0 + WARMUP_SEC * 1e9, t0 + (WARMUP_SEC + MEASURE_SEC) * 1e9
+    window = {s[0] * 1_000_000_000 + s[1] for s in sent}
+    window = {s for s in window if lo <= s < hi}
+    first_arrival: dict[int, float] = {}
+    for frame in frames:
+        stamp = int(frame[0]) * 1_000_000_000 + int(frame[1])
+        if stamp in window and stamp not in first_arrival:
+            first_arrival[stamp] = float(frame[2])
+    return first_arrival
+
+
+def summarise(rounds: list[dict[int, float]], published: list[int]) -> dict[str, float]:
+    """Pool several rounds: delivered fps and publish-to-page latency percentiles."""
+    latencies = sorted(t - s / 1e6 for r in rounds for s, t in r.items())
+    seconds = MEASURE_SEC * len(rounds)
+    fps = sum(len(r) for r in rounds) / seconds
+    result = {"fps": round(fps, 2), "published_fps": round(sum(published) / seconds, 2)}
+    if not latencies:
+        return {**result, "p50_ms": float("nan"), "p95_ms": float("nan")}
+    p95 = latencies[min(len(latencies) - 1, int(round(0.95 * (len(latencies) - 1))))]
+    return {
+        **result,
+        "p50_ms": round(statistics.median(latencies), 1),
+        "p95_ms": round(p95, 1),
+    }
+
+
+def measure_round(
+    browser,
+    url: str,
+    init_js: str | None,
+    ready_js: str,
+    publisher: CloudPublisher,
+    topic: str,
+    size: int,
+    hz: float,
+) -> tuple[dict[int, float], int]:
+    """One fresh page, one burst of clouds: (arrivals in the window, clouds published in it)."""
+    context = browser.new_context(viewport={"width": 1280, "height": 800})
+    try:
+        page = context.new_page()
+        if init_js:
+            page.add_init_script(init_js)
+        page.goto(url)
+        page.wait_for_function(ready_js, polling=100, timeout=30_000)
+        page.wait_for_timeout(1000)  # let the initial scene replay settle
+        sent = publisher.run(topic, size, hz, WARMUP_SEC + MEASURE_SEC)
+        page.wait_for_timeout(TAIL_SEC * 1000)
+        frames = page.evaluate("window.__frames")
+        in_window = round(MEASURE_SEC * hz)
+        return window_arrivals(frames, sent), in_window
+    finally:
+        context.close()
+
+
+def pick_cloud_topic(browser, url: str) -> None:
+    """Once, like a learner: 3D view tab, Cloud topic dropdown, our topic."""
+    context = browser.new_context(viewport={"width": 1280, "height": 800})
+    try:
+        page = context.new_page()
+        page.goto(url)
+        page.get_by_role("tab", name="3D view").click()
+        deadline = time.monotonic() + 30
+        while True:
+            page.get_by_label("Cloud topic").click()
+            option = page.get_by_role("option", name=DASH_TOPIC, exact=True)
+            if option.count():
+                option.click()
+                break
+            if time.monotonic() > deadline:
+                raise SystemExit(f"the dashboard never listed {DASH_TOPIC}")
+            page.keyboard.press("Escape")
+            page.wait_for_timeout(500)
+        page.wait_for_timeout(500)
+    finally:
+        context.close()
+
+
+def run_bench(cases: tuple[tuple[int, int], ...]) -> dict[str, Any]:
+    from playwright.sync_api import sync_playwright
+
+    from app.dds import configure_this_process
+
+    if [name for _, name in socket.if_nameindex()] != ["lo"]:
+        raise SystemExit(
+            "run this inside the loopback-only namespace: "
+            ".venv/bin/python tests/run.py --bench cloud_to_browser"
+        )
+    configure_this_process(domain_id=60 + os.getpid() % 30, network=False)
+    variant = os.environ.get("BENCH_DDS", "")
+    if variant:
+        from app.dds import LOOPBACK_PROFILE, PROFILE_VAR
+
+        xml = LOOPBACK_PROFILE.read_text()
+        if "buffers" in variant:
+            xml = xml.replace(
+                "<maxInitialPeersRange>",
+                "<sendBufferSize>4194304</sendBufferSize>"
+                "<receiveBufferSize>4194304</receiveBufferSize><maxInitialPeersRange>",
+            )
+        if "shm" in variant:
+            xml = xml.replace(
+                "  </transport_descriptors>",
+                "    <transport_descriptor><transport_id>classroom_shm</transport_id>"
+                "<type>SHM</type><segment_size>33554432</segment_size></transport_descriptor>\n"
+                "  </transport_descriptors>",
+            ).replace(
+                "<transport_id>classroom_loopback_udp</transport_id>\n      </userTransports>",
+                "<transport_id>classroom_loopback_udp</transport_id>\n"
+                "        <transport_id>classroom_shm</transport_id>\n      </userTransports>",
+            )
+        custom = ROOT / "test-artifacts" / "bench-dds.xml"
+        custom.parent.mkdir(exist_ok=True)
+        custom.write_text(xml)
+        os.environ[PROFILE_VAR] = str(custom)
+    logs = ROOT / "test-artifacts"
+    logs.mkdir(exist_ok=True)
+    dash_port, base_port = free_port(), free_port()
+    py = sys.executable
+    dashboard = start(
+        [py, "-m", "app", "serve", "--port", str(dash_port)],
+        logs / "bench-dashboard.log",
+        "is ready",
+    )
+    publisher = CloudPublisher()  # first: the baseline subscribes once it sees it
+    baseline = start(
+        [py, "-m", "bench.cloud_to_browser", "--serve-baseline", str(base_port)],
+        logs / "bench-baseline.log",
+        "BASELINE READY",
+    )
+    results: dict[str, Any] = {}
+    try:
+        with sync_playwright() as pw:
+            browser = pw.chromium.launch(
+                executable_path=CHROMIUM, args=["--no-sandbox", "--disable-dev-shm-usage"]
+            )
+            dash_url, base_url = f"http://127.0.0.1:{dash_port}", f"http://127.0.0.1:{base_port}/"
+            pick_cloud_topic(browser, dash_url)
+            for size, hz in cases:
+                label = f"{size // 1000}k" if size < 1_000_000 else f"{size // 1_000_000}M"
+                key = f"{label}_{hz}hz"
+                rounds: dict[str, list[dict[int, float]]] = {"baseline": [], "dashboard": []}
+                published: list[int] = []
+                for _ in range(ROUNDS):  # alternate, so a load spike hits both alike
+                    for name, url, init_js, ready_js, topic in (
+                        ("baseline", base_url, None, "window.__ready === true", BASE_TOPIC),
+                        (
+                            "dashboard",
+                            dash_url,
+                            DASHBOARD_PROBE_JS,
+                            "window.__viserMutable !== undefined",
+                            DASH_TOPIC,
+                        ),
+                    ):
+                        arrivals, count = measure_round(
+                            browser, url, init_js, ready_js, publisher, topic, size, hz
+                        )
+                        rounds[name].append(arrivals)
+                        if name == "dashboard":
+                            published.append(count)
+                base = summarise(rounds["baseline"], published)
+                dash = summarise(rounds["dashboard"], published)
+                for name, res in (("baseline", base), ("dashboard", dash)):
+                    results[f"{name}_fps_{key}"] = res["fps"]
+                    results[f"{name}_p50_ms_{key}"] = res["p50_ms"]
+                    results[f"{name}_p95_ms_{key}"] = res["p95_ms"]
+                results[f"published_fps_{key}"] = dash["published_fps"]
+                results[f"fps_ratio_{key}"] = (
+                    round(dash["fps"] / base["fps"], 2) if base["fps"] else None
+                )
+                print(
+                    f"{label:>4} points @ {hz:2d} Hz | published {dash['published_fps']:5.1f} fps"
+                    f" | baseline {base['fps']:5.1f} fps p50 {base['p50_ms']:7.1f} ms"
+                    f" p95 {base['p95_ms']:7.1f} ms | dashboard {dash['fps']:5.1f} fps"
+                    f" p50 {dash['p50_ms']:7.1f} ms p95 {dash['p95_ms']:7.1f} ms",
+                    flush=True,
+                )
+            browser.close()
+    finally:
+        publisher.close()
+        stop(baseline)
+        stop(dashboard)
+    results["dashboard_point_budget"] = 200_000
+    if "dashboard_fps_100k_20hz" in results:
+        results["aim_met_100k_20hz"] = bool(
+            results["dashboard_p95_ms_100k_20hz"] < 100
+            and results["fps_ratio_100k_20hz"] is not None
+            and results["fps_ratio_100k_20hz"] >= 0.8
+        )
+    return results
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m bench cloud_to_browser")
+    parser.add_argument("--serve-baseline", type=int, metavar="PORT", help=argparse.SUPPRESS)
+    parser.add_argument("--quick", action="store_true", help="only 100k points at 20 Hz")
+    args = parser.parse_args(argv)
+    if args.serve_baseline:
+        serve_baseline(args.serve_baseline)
+        return 0
+    cases = ((100_000, 20),) if args.quick else CASES
+    results = run_bench(cases)
+    print(json.dumps(results, sort_keys=True))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
