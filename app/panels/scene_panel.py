@@ -32,19 +32,48 @@ INTRO = (
 
 
 class _TopicRow:
-    """A dropdown offering only topics of some types, plus a liveness note under it."""
+    """A dropdown offering only topics of some types, plus a liveness note under it.
 
-    def __init__(self, gui: viser.GuiApi, label: str, types: tuple[str, ...], hint: str) -> None:
+    Until the learner picks something, the row follows the first suitable topic
+    by itself (``preferred`` names first), so starting a node is enough to see it.
+    """
+
+    def __init__(
+        self,
+        gui: viser.GuiApi,
+        label: str,
+        types: tuple[str, ...],
+        hint: str,
+        preferred: tuple[str, ...] = (),
+    ) -> None:
         self.types = types
+        self.preferred = preferred
+        self.chosen_by_learner = False
+        self._setting = False
         self._options: tuple[str, ...] = (picker.NONE,)
         self.dropdown = gui.add_dropdown(label, self._options, initial_value=picker.NONE, hint=hint)
         self.note = MarkdownView(gui)
+
+    def on_pick(self, select) -> None:
+        def handle(_event: object) -> None:
+            if not self._setting:
+                self.chosen_by_learner = True
+            select(self.dropdown.value)
+
+        self.dropdown.on_update(handle)
 
     def refresh_options(self, graph: GraphSnapshot | None) -> None:
         opts = tuple(picker.options(graph, self.types, self.dropdown.value))
         if opts != self._options:
             self._options = opts
             self.dropdown.options = opts
+        if not self.chosen_by_learner and self.dropdown.value == picker.NONE and len(opts) > 1:
+            choice = next((t for t in self.preferred if t in opts), opts[1])
+            self._setting = True
+            try:
+                self.dropdown.value = choice
+            finally:
+                self._setting = False
 
 
 class ScenePanel:
@@ -62,7 +91,11 @@ class ScenePanel:
 
         with gui.add_folder("Point cloud"):
             self._cloud_row = _TopicRow(
-                gui, "Cloud topic", picker.CLOUD_TYPES, "sensor_msgs/msg/PointCloud2 topics"
+                gui,
+                "Cloud topic",
+                picker.CLOUD_TYPES,
+                "sensor_msgs/msg/PointCloud2 topics",
+                ("/cam/map_points",),
             )
             self._budget = gui.add_slider(
                 "Point budget",
@@ -75,7 +108,11 @@ class ScenePanel:
             self._cloud_status = MarkdownView(gui)
         with gui.add_folder("Camera image"):
             self._image_row = _TopicRow(
-                gui, "Image topic", picker.IMAGE_TYPES, "sensor_msgs/msg/Image topics"
+                gui,
+                "Image topic",
+                picker.IMAGE_TYPES,
+                "sensor_msgs/msg/Image topics",
+                ("/object_detection/output", "/camera/image_raw", "/cam/feature_ext_viz"),
             )
             self.images = ImageLayer(node, gui, self.frames)
             self._image_on_frustum = gui.add_checkbox("Image on the 3D camera", False)
@@ -86,11 +123,16 @@ class ScenePanel:
                 "Marker topic",
                 picker.MARKER_TYPES,
                 "visualization_msgs Marker or MarkerArray topics",
+                ("/cam/camera_pose",),
             )
             self._marker_info = MarkdownView(gui)
         with gui.add_folder("Robot arm"):
             self._joint_row = _TopicRow(
-                gui, "Joint topic", picker.JOINT_TYPES, "sensor_msgs/msg/JointState topics"
+                gui,
+                "Joint topic",
+                picker.JOINT_TYPES,
+                "sensor_msgs/msg/JointState topics",
+                ("/joint_states",),
             )
             self.plot = JointPlot(gui)
             self.arm = ArmLayer(node, server, on_joints=self.plot.add)
@@ -122,28 +164,22 @@ class ScenePanel:
         self._show_matrix(self.frames.pose)
 
     def _wire(self) -> None:
-        self._cloud_row.dropdown.on_update(
-            lambda _: self.clouds.select(self._cloud_row.dropdown.value)
-        )
+        self._cloud_row.on_pick(self.clouds.select)
+        self._image_row.on_pick(self.images.select)
+        self._marker_row.on_pick(self.markers.select)
+        self._joint_row.on_pick(self._select_joints)
         self._budget.on_update(lambda _: setattr(self.clouds, "budget", int(self._budget.value)))
-        self._image_row.dropdown.on_update(
-            lambda _: self.images.select(self._image_row.dropdown.value)
-        )
         self._image_on_frustum.on_update(
             lambda _: self.images.show_on_frustum(self._image_on_frustum.value)
         )
-        self._marker_row.dropdown.on_update(
-            lambda _: self.markers.select(self._marker_row.dropdown.value)
-        )
-        self._joint_row.dropdown.on_update(lambda _: self._select_joints())
         self._gizmo.on_update(lambda _: self.frames.show_gizmo(self._gizmo.value))
         for slider in self._sliders.values():
             slider.on_update(lambda _: self._on_slider())
         self.frames.on_change(self._on_pose_changed)
 
-    def _select_joints(self) -> None:
+    def _select_joints(self, topic: str) -> None:
         self.plot.clear()
-        self.arm.select(self._joint_row.dropdown.value)
+        self.arm.select(topic)
 
     def _on_slider(self) -> None:
         if self._syncing_sliders:

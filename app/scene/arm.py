@@ -91,7 +91,7 @@ class ArmLayer:
             )
             for i in range(len(pts))
         ]
-        scene.add_label(f"{ARM_PATH}/label", "arm", position=(0.0, -0.1, 0.02))
+        scene.add_label(f"{ARM_PATH}/label", "arm", position=(0.0, 0.0, 0.16))
         self.worker = LatestWorker("arm", self._draw, MAX_HZ)
 
     @property

@@ -16,6 +16,7 @@ import numpy as np
 import viser
 
 from app.scene import transforms as tf
+from nodes.coordinate_transform import DEFAULT_CAMERA_POSE
 
 BASE_PATH = "/base_link"
 CAMERA_PATH = "/base_link/camera"
@@ -46,16 +47,20 @@ def scene_path_for_frame(frame_id: str, topic: str = "") -> tuple[str, bool]:
     return BASE_PATH, False
 
 
+# The coordinate_transform node's own defaults, so the 3D view starts where the node does.
+_NODE_DEFAULT = DEFAULT_CAMERA_POSE
+
+
 @dataclass(frozen=True)
 class CameraPose:
-    """Pose of the camera frame in base_link: translation in metres, RPY in radians."""
+    """Pose of the camera (optical) frame in base_link: metres, and fixed-axis RPY in radians."""
 
-    x: float = 0.4
-    y: float = 0.0
-    z: float = 0.6
-    roll: float = -2.3
-    pitch: float = 0.0
-    yaw: float = -1.5708
+    x: float = _NODE_DEFAULT["camera_x"]
+    y: float = _NODE_DEFAULT["camera_y"]
+    z: float = _NODE_DEFAULT["camera_z"]
+    roll: float = _NODE_DEFAULT["camera_roll"]
+    pitch: float = _NODE_DEFAULT["camera_pitch"]
+    yaw: float = _NODE_DEFAULT["camera_yaw"]
 
     @property
     def wxyz(self) -> tuple[float, float, float, float]:
@@ -95,7 +100,12 @@ class FrameTree:
         )
         scene.add_label(f"{CAMERA_PATH}/label", "camera", position=(0.0, -0.06, 0.0))
         self.frustum = scene.add_camera_frustum(
-            f"{CAMERA_PATH}/frustum", fov=1.0, aspect=4 / 3, scale=0.12, color=(40, 90, 200)
+            f"{CAMERA_PATH}/frustum",
+            fov=1.0,
+            aspect=4 / 3,
+            scale=0.1,
+            thickness=0.004,
+            color=(40, 90, 200),
         )
         self.gizmo = scene.add_transform_controls(
             "/camera_pose_gizmo",

@@ -26,6 +26,15 @@ DEFAULT_BUDGET = 200_000
 MAX_HZ = 30.0  # above the 20 Hz a typical depth camera publishes, so none is skipped
 
 
+def point_size_for(count: int) -> float:
+    """Metres per point: a sparse SLAM map needs fat points, a dense depth cloud thin ones."""
+    if count < 5_000:
+        return 0.02
+    if count < 50_000:
+        return 0.01
+    return 0.004
+
+
 @dataclass(frozen=True)
 class CloudStatus:
     topic: str
@@ -40,10 +49,9 @@ class CloudStatus:
 
 
 class PointCloudLayer:
-    def __init__(self, node: Node, server: viser.ViserServer, *, point_size: float = 0.004) -> None:
+    def __init__(self, node: Node, server: viser.ViserServer) -> None:
         self._node = node
         self._server = server
-        self._point_size = point_size
         self._lock = threading.Lock()
         self._topic = NONE
         self._subscription: Any = None
@@ -103,17 +111,20 @@ class PointCloudLayer:
             return
         parent, known = scene_path_for_frame(msg.header.frame_id, self._topic)
         path = f"{parent}/cloud"
+        size = point_size_for(cloud.shown)
         if self._handle is not None and self._handle_path == path:
             with self._server.atomic():
                 self._handle.points = cloud.points
                 self._handle.colors = cloud.colors
+                if self._handle.point_size != size:
+                    self._handle.point_size = size
         else:
             self._remove_handle()
             self._handle = self._server.scene.add_point_cloud(
                 path,
                 points=cloud.points,
                 colors=cloud.colors,
-                point_size=self._point_size,
+                point_size=size,
                 point_shape="square",
                 point_shading="flat",
             )
