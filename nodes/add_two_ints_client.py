@@ -69,9 +69,10 @@ def main(args=None) -> None:
         print(f"add_two_ints_client: error: {exc}\n{USAGE}", file=sys.stderr)
         raise SystemExit(EXIT_USAGE) from None
 
-    rclpy.init(args=args)
-    node = AddTwoIntsClient()
+    node = None
     try:
+        rclpy.init(args=args)
+        node = AddTwoIntsClient()
         node.wait_for_server()
         future = node.send_request(a, b)
         rclpy.spin_until_future_complete(node, future)
@@ -80,7 +81,9 @@ def main(args=None) -> None:
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        node.destroy_node()
+        # Ctrl+C can arrive before the node exists: clean up only what was made.
+        if node is not None:
+            node.destroy_node()
         rclpy.try_shutdown()
 
 

@@ -63,14 +63,17 @@ class CameraPublisher(Node):
 
 
 def main(args=None) -> None:
-    rclpy.init(args=args)
-    node = CameraPublisher()
+    node = None
     try:
+        rclpy.init(args=args)
+        node = CameraPublisher()
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        node.destroy_node()
+        # Ctrl+C can arrive before the node exists: clean up only what was made.
+        if node is not None:
+            node.destroy_node()
         rclpy.try_shutdown()
 
 

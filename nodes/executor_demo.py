@@ -117,22 +117,24 @@ class ExecutorDemo(Node):
 
 
 def main(args=None) -> None:
-    rclpy.init(args=args)
+    node = executor = None
     try:
+        rclpy.init(args=args)
         node = ExecutorDemo()
-    except ValueError as exc:
-        print(f"executor_demo: error: {exc}", file=sys.stderr)
-        rclpy.try_shutdown()
-        raise SystemExit(EXIT_BAD_PARAMETER) from None
-    executor = node.make_executor()
-    executor.add_node(node)
-    try:
+        executor = node.make_executor()
+        executor.add_node(node)
         executor.spin()
+    except ValueError as exc:  # an unknown executor kind
+        print(f"executor_demo: error: {exc}", file=sys.stderr)
+        raise SystemExit(EXIT_BAD_PARAMETER) from None
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        executor.shutdown()
-        node.destroy_node()
+        # Ctrl+C can arrive at any point of start-up: clean up only what was made.
+        if executor is not None:
+            executor.shutdown()
+        if node is not None:
+            node.destroy_node()
         rclpy.try_shutdown()
 
 

@@ -96,17 +96,20 @@ def main(args=None) -> None:
         print(f"fibonacci_action_client: error: {exc}\n{USAGE}", file=sys.stderr)
         raise SystemExit(EXIT_USAGE) from None
 
-    rclpy.init(args=args)
-    node = FibonacciActionClient()
+    node = None
     succeeded = False
     try:
+        rclpy.init(args=args)
+        node = FibonacciActionClient()
         node.send_goal(order)
         rclpy.spin_until_future_complete(node, node.done)
         succeeded = bool(node.done.result())
     except (KeyboardInterrupt, ExternalShutdownException):
         succeeded = True  # stopped on request: not a failure
     finally:
-        node.destroy_node()
+        # Ctrl+C can arrive before the node exists: clean up only what was made.
+        if node is not None:
+            node.destroy_node()
         rclpy.try_shutdown()
     if not succeeded:
         raise SystemExit(1)

@@ -139,18 +139,23 @@ class FibonacciActionServer(Node):
 
 
 def main(args=None) -> None:
-    rclpy.init(args=args)
-    node = FibonacciActionServer()
-    executor = MultiThreadedExecutor()
-    executor.add_node(node)
+    node = executor = None
     try:
+        rclpy.init(args=args)
+        node = FibonacciActionServer()
+        executor = MultiThreadedExecutor()
+        executor.add_node(node)
         executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        node.shutting_down.set()  # a goal still executing stops at once
-        executor.shutdown()
-        node.destroy_node()
+        # Ctrl+C can arrive at any point of start-up: clean up only what was made.
+        if node is not None:
+            node.shutting_down.set()  # a goal still executing stops at once
+        if executor is not None:
+            executor.shutdown()
+        if node is not None:
+            node.destroy_node()
         rclpy.try_shutdown()
 
 

@@ -23,14 +23,17 @@ class Listener(Node):
 
 
 def main(args=None) -> None:
-    rclpy.init(args=args)
-    node = Listener()
+    node = None
     try:
+        rclpy.init(args=args)
+        node = Listener()
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        node.destroy_node()
+        # Ctrl+C can arrive before the node exists: clean up only what was made.
+        if node is not None:
+            node.destroy_node()
         rclpy.try_shutdown()
 
 

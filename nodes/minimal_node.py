@@ -37,14 +37,17 @@ class MinimalNode(Node):
 
 
 def main(args=None) -> None:
-    rclpy.init(args=args)
-    node = MinimalNode()
+    node = None
     try:
+        rclpy.init(args=args)
+        node = MinimalNode()
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass  # Ctrl+C (SIGINT) or SIGTERM: leave quietly
     finally:
-        node.destroy_node()
+        # Ctrl+C can arrive before the node exists: clean up only what was made.
+        if node is not None:
+            node.destroy_node()
         rclpy.try_shutdown()
 
 

@@ -21,19 +21,22 @@ TIMER_PERIOD_SEC = 0.2  # 5 Hz
 
 
 def main(args=None) -> None:
-    rclpy.init(args=args)
-    node = rclpy.create_node("minimal_node_procedural")
-
-    def on_timer() -> None:
-        node.get_logger().info("Hello ROS2")
-
-    node.create_timer(TIMER_PERIOD_SEC, on_timer)
+    node = None
     try:
+        rclpy.init(args=args)
+        node = rclpy.create_node("minimal_node_procedural")
+
+        def on_timer() -> None:
+            node.get_logger().info("Hello ROS2")
+
+        node.create_timer(TIMER_PERIOD_SEC, on_timer)
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        node.destroy_node()
+        # Ctrl+C can arrive before the node exists: clean up only what was made.
+        if node is not None:
+            node.destroy_node()
         rclpy.try_shutdown()
 
 

@@ -67,19 +67,20 @@ class QosListener(Node):
 
 
 def main(args=None) -> None:
-    rclpy.init(args=args)
+    node = None
     try:
+        rclpy.init(args=args)
         node = QosListener()
-    except ValueError as exc:
-        print(f"qos_listener: error: {exc}", file=sys.stderr)
-        rclpy.try_shutdown()
-        raise SystemExit(EXIT_BAD_PARAMETER) from None
-    try:
         rclpy.spin(node)
+    except ValueError as exc:  # a QoS parameter with an unknown value
+        print(f"qos_listener: error: {exc}", file=sys.stderr)
+        raise SystemExit(EXIT_BAD_PARAMETER) from None
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        node.destroy_node()
+        # Ctrl+C can arrive before the node exists: clean up only what was made.
+        if node is not None:
+            node.destroy_node()
         rclpy.try_shutdown()
 
 

@@ -33,14 +33,17 @@ class Talker(Node):
 
 
 def main(args=None) -> None:
-    rclpy.init(args=args)
-    node = Talker()
+    node = None
     try:
+        rclpy.init(args=args)
+        node = Talker()
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass  # Ctrl+C (SIGINT) or SIGTERM: leave quietly
     finally:
-        node.destroy_node()
+        # Ctrl+C can arrive before the node exists: clean up only what was made.
+        if node is not None:
+            node.destroy_node()
         rclpy.try_shutdown()
 
 

@@ -96,14 +96,17 @@ class VideoPublisher(Node):
 
 
 def main(args=None) -> None:
-    rclpy.init(args=args)
-    node = VideoPublisher()
+    node = None
     try:
+        rclpy.init(args=args)
+        node = VideoPublisher()
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        node.destroy_node()
+        # Ctrl+C can arrive before the node exists: clean up only what was made.
+        if node is not None:
+            node.destroy_node()
         rclpy.try_shutdown()
 
 
