@@ -8,11 +8,15 @@ created only for verbs that need the graph; Ctrl+C stops a streaming verb
 from __future__ import annotations
 
 import os
+import signal
 import sys
 import threading
 
 from app.ros2cli.common import CLI_LIMITS, VerbContext
 from app.ros2cli.parser import needs_ros, run_argv
+
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+EXIT_INTERRUPTED = 130
 
 
 def _print(line: str) -> None:
@@ -28,13 +32,16 @@ def main(argv: list[str]) -> int:
         )  # type: ignore[arg-type]
     from app.ros_runtime import RosRuntime
 
+    # Ctrl+C (or SIGTERM) asks the running verb to stop at its next wait, so it
+    # always cleans up (subscriptions, publishers) instead of dying mid-call.
+    previous = {sig: signal.signal(sig, lambda *_: cancel.set()) for sig in STOP_SIGNALS}
     runtime = RosRuntime(f"_ros2_classroom_cli_{os.getpid()}", threads=2)
     ctx = VerbContext(node=runtime.node, write=_print, limits=CLI_LIMITS, cancel=cancel)
     try:
-        return run_argv(ctx, argv, "ros2-classroom")
-    except KeyboardInterrupt:
-        cancel.set()
-        return 130
+        code = run_argv(ctx, argv, "ros2-classroom")
+        return EXIT_INTERRUPTED if cancel.is_set() else code
     finally:
         runtime.shutdown()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
         sys.stdout.flush()

@@ -40,7 +40,8 @@ class Limits:
 
 
 CONSOLE_LIMITS = Limits(max_messages=10, max_seconds=5.0, action_timeout=30.0)
-CLI_LIMITS = Limits(discovery_wait=3.0)
+CLI_LIMITS = Limits(discovery_wait=4.0)
+MIN_DISCOVERY_SEC = 1.5
 
 
 @dataclass
@@ -112,18 +113,31 @@ def require_node(ctx: VerbContext, fqn: str) -> tuple[str, str]:
     """The (name, namespace) of a node on the graph, or one clear error."""
     if not fqn.startswith("/"):
         fqn = "/" + fqn
-    if fqn not in all_nodes(ctx.node, include_hidden=True):
+    if not wait_for_graph(ctx, lambda: fqn in all_nodes(ctx.node, include_hidden=True)):
         raise Ros2Error(f"node '{fqn}' is not on the graph (see `ros2 node list`)")
     return split_node_name(fqn)
+
+
+def wait_for_graph(ctx: VerbContext, present: Callable[[], bool]) -> bool:
+    """True once ``present()``; a fresh CLI node keeps looking for ``discovery_wait`` s."""
+    deadline = time.monotonic() + ctx.limits.discovery_wait
+    while not present():
+        if time.monotonic() >= deadline:
+            return False
+        ctx.sleep(0.1)
+    return True
 
 
 def settle_discovery(ctx: VerbContext) -> None:
     """A brand-new node sees the graph piece by piece: wait until it stops changing."""
     if ctx.limits.discovery_wait <= 0:
         return
-    deadline = time.monotonic() + ctx.limits.discovery_wait
+    # Participants are found before their endpoints: insist on a minimum look
+    # (as `ros2 ... --no-daemon` spins a while) and then on a quiet second.
+    started = time.monotonic()
+    deadline = started + ctx.limits.discovery_wait
     last: tuple[int, int, int] | None = None
-    stable_since = time.monotonic()
+    stable_since = started
     while time.monotonic() < deadline:
         node = ctx.node
         now = (
@@ -133,7 +147,11 @@ def settle_discovery(ctx: VerbContext) -> None:
         )
         if now != last:
             last, stable_since = now, time.monotonic()
-        elif now[0] > 1 and time.monotonic() - stable_since > 0.8:
+        elif (
+            now[0] > 1
+            and time.monotonic() - started > MIN_DISCOVERY_SEC
+            and time.monotonic() - stable_since > 1.0
+        ):
             return
         ctx.sleep(0.1)
 

@@ -23,7 +23,7 @@ from rclpy.qos import (
 )
 from rclpy.serialization import deserialize_message
 
-from app.ros2cli.common import ACTION_MARKER, Ros2Error, VerbContext
+from app.ros2cli.common import ACTION_MARKER, Ros2Error, VerbContext, wait_for_graph
 from app.ros2cli.convert import (
     ConversionError,
     dump_yaml,
@@ -50,6 +50,7 @@ def resolve_type(ctx: VerbContext, topic: str, given: str | None) -> type:
     """The message class for ``topic``: the given type, else the one on the graph."""
     if given:
         return import_type(given, "msg")
+    wait_for_graph(ctx, lambda: topic in topic_types(ctx.node, include_hidden=True))
     types = topic_types(ctx.node, include_hidden=True).get(topic)
     if not types:
         raise Ros2Error(

@@ -108,9 +108,14 @@ def test_cli_face_and_topic_hz_within_two_percent(ros_env, ros2):
         code, lines = ros2("topic bw /rate_probe", Limits(max_seconds=2.5))
         assert re.search(r"B/s from \d+ messages", "\n".join(lines)), lines
 
-        done = cli(ros_env, "topic", "list", "-t")
-        assert done.returncode == 0, done.stderr
-        assert "/rate_probe [std_msgs/msg/Float64]" in done.stdout.splitlines()
+        # A fresh process discovers the graph as it goes (ros2 without its daemon
+        # too): allow a second look when the machine is busy.
+        for _attempt in range(3):
+            done = cli(ros_env, "topic", "list", "-t")
+            assert done.returncode == 0, done.stderr
+            if "/rate_probe [std_msgs/msg/Float64]" in done.stdout.splitlines():
+                break
+        assert "/rate_probe [std_msgs/msg/Float64]" in done.stdout.splitlines(), done.stdout
         done = cli(ros_env, "topic", "echo", "/rate_probe", "--once")
         assert done.stdout.splitlines()[:2] == ["data: 1.5", "---"], done.stdout
         done = cli(ros_env, "service", "call", "/nope", "std_srvs/srv/Trigger", "{}")
@@ -121,7 +126,8 @@ def test_cli_face_and_topic_hz_within_two_percent(ros_env, ros2):
         publisher.send_signal(signal.SIGINT)
         output, _ = publisher.communicate(timeout=15)
     assert "publishing #1: std_msgs.msg.Float64(data=1.5)" in output
-    assert publisher.returncode in (0, 1, 130), output
+    assert publisher.returncode == 130, output  # stopped by Ctrl+C, cleanly
+    assert "(stopped)" in output
     assert "Traceback" not in output
 
 
