@@ -6,8 +6,10 @@ import math
 
 import numpy as np
 import pytest
+from geometry_msgs.msg import Point
 from playwright.sync_api import expect
 from sensor_msgs.msg import Image, JointState, PointCloud2
+from visualization_msgs.msg import Marker, MarkerArray
 
 from app.scene.cloud_codec import encode_cloud
 from app.scene.image_codec import rgb_to_image_msg
@@ -19,10 +21,14 @@ from tests.browser.scene_helpers import (
     wait_scene_points,
     world_position,
 )
+from tests.conftest import ARTIFACTS
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
 CLOUD_POINTS = 50_000
+# A scene node is mounted (labels register their name with a null object).
+HAS_NODE_JS = "(n) => !!window.__viserMutable && (n in window.__viserMutable.nodeRefFromName)"
+GONE_JS = "(n) => !!window.__viserMutable && !window.__viserMutable.nodeRefFromName[n]"
 # src of the image under the "Camera image" label once it shows a picture (not the blank one).
 CAMERA_IMAGE_SRC_JS = """() => {
   const label = [...document.querySelectorAll('p')].find((e) => e.textContent === 'Camera image');
@@ -102,8 +108,59 @@ def test_point_cloud_image_and_arm_show_up_live(page, probe):
             polling=100,
             timeout=20_000,
         )
-        page.get_by_text("Robot arm").first.scroll_into_view_if_needed()
         expect(page.get_by_text("gripper at").first).to_be_visible(timeout=10_000)
+        page.screenshot(path=str(ARTIFACTS / "scene-live-probe.png"))
     finally:
         for r in repeaters:
             r.stop()
+
+
+def _marker(kind: int, mid: int, action: int = Marker.ADD) -> Marker:
+    m = Marker()
+    m.header.frame_id = "base_link"
+    m.ns, m.id, m.type, m.action = "demo", mid, kind, action
+    m.pose.position.x, m.pose.position.y, m.pose.position.z = -0.3, 0.1 * mid, 0.2
+    m.pose.orientation.w = 1.0
+    m.scale.x = m.scale.y = m.scale.z = 0.08
+    m.color.r, m.color.g, m.color.a = 0.9, 0.3, 1.0
+    if kind == Marker.LINE_STRIP:
+        m.scale.x = 0.01
+        m.points = [Point(x=0.1 * i, y=0.0, z=0.05 * i) for i in range(5)]
+    m.text = "hello marker"
+    return m
+
+
+def test_markers_add_modify_and_delete(page, probe):
+    pub = probe.node.create_publisher(MarkerArray, "/test/markers", 10)
+    kinds = (Marker.SPHERE, Marker.CUBE, Marker.ARROW, Marker.LINE_STRIP, Marker.TEXT_VIEW_FACING)
+    state = {"delete_cube": False}
+
+    def markers(i: int) -> MarkerArray:
+        arr = MarkerArray()
+        arr.markers = [_marker(k, n) for n, k in enumerate(kinds)]
+        if state["delete_cube"]:
+            arr.markers[1] = _marker(Marker.CUBE, 1, Marker.DELETE)
+        return arr
+
+    repeater = Repeater(pub, markers, 0.2)
+    try:
+        open_tab(page, "3D view")
+        pick(page, "Marker topic", "/test/markers")
+        page.wait_for_function(
+            HAS_NODE_JS, arg="/base_link/markers/demo_0", polling=100, timeout=30_000
+        )
+        for n in range(len(kinds)):
+            page.wait_for_function(
+                HAS_NODE_JS, arg=f"/base_link/markers/demo_{n}", polling=100, timeout=30_000
+            )
+        expect(page.get_by_text("Markers shown:").first).to_be_visible(timeout=10_000)
+        state["delete_cube"] = True
+        page.wait_for_function(
+            GONE_JS,
+            arg="/base_link/markers/demo_1",
+            polling=100,
+            timeout=20_000,
+        )
+        assert page.evaluate(HAS_NODE_JS, "/base_link/markers/demo_0")
+    finally:
+        repeater.stop()
