@@ -53,6 +53,7 @@ class PointCloudLayer:
         self._node = node
         self._server = server
         self._lock = threading.Lock()
+        self._draw_lock = threading.Lock()  # the handle: worker draws, viser thread removes
         self._topic = NONE
         self._subscription: Any = None
         self._handle: viser.PointCloudHandle | None = None
@@ -95,12 +96,24 @@ class PointCloudLayer:
             self._remove_handle()
 
     def _remove_handle(self) -> None:
+        with self._draw_lock:
+            self._remove_handle_locked()
+
+    def _remove_handle_locked(self) -> None:
         if self._handle is not None:
             self._handle.remove()
             self._handle = None
             self._handle_path = ""
 
     def _draw(self, msg: PointCloud2) -> None:
+        with self._draw_lock:
+            self._draw_locked(msg)
+        if self.on_drawn is not None:
+            self.on_drawn(self.status)
+
+    def _draw_locked(self, msg: PointCloud2) -> None:
+        if self._topic == NONE:  # unpicked while this message waited
+            return
         budget = self.budget
         stamp = f"{msg.header.stamp.sec}.{msg.header.stamp.nanosec:09d}"
         try:
@@ -119,7 +132,7 @@ class PointCloudLayer:
                 if self._handle.point_size != size:
                     self._handle.point_size = size
         else:
-            self._remove_handle()
+            self._remove_handle_locked()
             self._handle = self._server.scene.add_point_cloud(
                 path,
                 points=cloud.points,
@@ -140,8 +153,6 @@ class PointCloudLayer:
                 frame_known=known,
                 stamp=stamp,
             )
-        if self.on_drawn is not None:
-            self.on_drawn(self.status)
 
     on_drawn: Any = None  # set by the panel: refresh the status line right after a draw
 
