@@ -17,6 +17,10 @@ Both subscribe best effort, newest only. The clock is the wall clock shared by
 all processes on this machine. Run it inside the loopback-only namespace:
 ``.venv/bin/python tests/run.py --bench cloud_to_browser``. The last line
 printed is one JSON object with every figure.
+
+``BENCH_DDS=buffers`` (or ``shm``, or ``buffers+shm``) runs everything with a
+variant of the loopback DDS profile (4 MB UDP socket buffers; a shared-memory
+transport), to see how much of the cost is the DDS transport itself.
 """
 
 from __future__ import annotations
