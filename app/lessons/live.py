@@ -21,6 +21,7 @@ from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import GetParameters, SetParameters
 from rclpy.action import ActionClient
 from rclpy.node import Node
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 from app import catalog
 from app.graph import GraphSnapshot
@@ -30,13 +31,13 @@ from app.topic_tap import TopicTap
 
 PASS, FAIL, WAITING = "pass", "fail", "waiting"
 RECALL_PERIOD_SEC = 1.0
-TRANSITIONS = {
-    "configure": Transition.TRANSITION_CONFIGURE,
-    "cleanup": Transition.TRANSITION_CLEANUP,
-    "activate": Transition.TRANSITION_ACTIVATE,
-    "deactivate": Transition.TRANSITION_DEACTIVATE,
-    "shutdown": Transition.TRANSITION_INACTIVE_SHUTDOWN,
-}
+ACTION_SERVER_WAIT_SEC = 3.0
+# Transitions are sent by label: the node picks the one valid from its current
+# state ("shutdown" exists from unconfigured, inactive and active).
+TRANSITIONS = ("configure", "cleanup", "activate", "deactivate", "shutdown")
+# Best effort hears reliable and best-effort publishers alike (camera images
+# are usually best effort); a reliable tap would hear only the former.
+TAP_QOS = QoSProfile(depth=50, reliability=ReliabilityPolicy.BEST_EFFORT)
 
 
 @dataclass(frozen=True)
@@ -121,7 +122,9 @@ class LessonRuntime:
         with self._lock:
             key = (topic, type_name)
             if key not in self._taps:
-                self._taps[key] = TopicTap(self.node, topic, import_interface(type_name))
+                self._taps[key] = TopicTap(
+                    self.node, topic, import_interface(type_name), qos=TAP_QOS
+                )
             return self._taps[key]
 
     def _client(self, service: str, srv_type: type) -> Any:
@@ -150,6 +153,8 @@ class LessonRuntime:
     def perform(self, action: Spec) -> str:
         """Do one step action; returns a one-line message for the page."""
         kind = action.kind
+        with self._lock:
+            self._calls.clear()  # answers from before this action may be stale now
         if kind == "start":
             status = self.supervisor.start(action["node"])
             message = f"Started {action['node']} (pid {status.pid})."
@@ -170,8 +175,7 @@ class LessonRuntime:
             if transition not in TRANSITIONS:
                 raise ValueError(f"unknown lifecycle transition {transition!r}")
             client = self._client(f"{action['node']}/change_state", ChangeState)
-            request = ChangeState.Request()
-            request.transition.id = TRANSITIONS[transition]
+            request = ChangeState.Request(transition=Transition(label=transition))
             client.call_async(request)
             message = f"Asked {action['node']} to {transition}."
         elif kind == "set_param":
@@ -201,7 +205,8 @@ class LessonRuntime:
             if client is None:
                 client = ActionClient(self.node, action_type, name)
                 self._action_clients[(name, type_name)] = client
-        if not client.server_is_ready():
+        # A new client may not have discovered the server yet: wait briefly.
+        if not client.wait_for_server(timeout_sec=ACTION_SERVER_WAIT_SEC):
             raise RuntimeError(f"no action server on {name}: start it first")
         cancel_after = action.get("cancel_after_feedback")
         feedback: list[Any] = []
