@@ -106,6 +106,9 @@ class ScenePanel:
                 hint="Bigger clouds are thinned to this many points before they go to the browser",
             )
             self._cloud_status = MarkdownView(gui)
+            self._frame_cloud = gui.add_button(
+                "Look at the cloud", icon=viser.Icon.FOCUS_2, hint="Move the 3D camera to it"
+            )
         with gui.add_folder("Camera image"):
             self._image_row = _TopicRow(
                 gui,
@@ -168,6 +171,7 @@ class ScenePanel:
         self._image_row.on_pick(self.images.select)
         self._marker_row.on_pick(self.markers.select)
         self._joint_row.on_pick(self._select_joints)
+        self._frame_cloud.on_click(lambda _: self.clouds.frame_in_view(self.frames.to_world))
         self._budget.on_update(lambda _: setattr(self.clouds, "budget", int(self._budget.value)))
         self._image_on_frustum.on_update(
             lambda _: self.images.show_on_frustum(self._image_on_frustum.value)

@@ -138,6 +138,13 @@ class FrameTree:
         for listener in self._listeners:
             listener(pose, source)
 
+    def to_world(self, path: str, point) -> tuple[float, float, float]:
+        """A point given in the frame drawn at scene ``path``, in world coordinates."""
+        p = np.asarray(point, dtype=np.float64).reshape(1, 3)
+        if path == CAMERA_PATH:
+            p = tf.apply(self.pose.matrix(), p)
+        return tuple(float(v) for v in p[0])
+
     def show_gizmo(self, visible: bool) -> None:
         self.gizmo.visible = visible
 

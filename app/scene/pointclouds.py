@@ -12,6 +12,7 @@ import threading
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
 import viser
 from rclpy.node import Node
 from sensor_msgs.msg import PointCloud2
@@ -46,6 +47,8 @@ class CloudStatus:
     frame_known: bool = True
     stamp: str = ""
     error: str = ""
+    centre: tuple[float, float, float] = (0.0, 0.0, 0.0)  # in the cloud's frame
+    radius: float = 0.0  # half the bounding-box diagonal, metres
 
 
 class PointCloudLayer:
@@ -124,6 +127,11 @@ class PointCloudLayer:
             return
         parent, known = scene_path_for_frame(msg.header.frame_id, self._topic)
         path = f"{parent}/cloud"
+        centre, radius = (0.0, 0.0, 0.0), 0.0
+        if cloud.shown:
+            lo, hi = cloud.points.min(axis=0), cloud.points.max(axis=0)
+            centre = tuple(float(v) for v in (lo + hi) / 2)
+            radius = float(np.linalg.norm(hi - lo)) / 2
         size = point_size_for(cloud.shown)
         if self._handle is not None and self._handle_path == path:
             with self._server.atomic():
@@ -147,6 +155,8 @@ class PointCloudLayer:
                 self._topic,
                 total=cloud.total,
                 shown=cloud.shown,
+                centre=centre,
+                radius=radius,
                 budget=budget,
                 colour_source=cloud.colour_source,
                 frame_id=msg.header.frame_id,
@@ -155,6 +165,20 @@ class PointCloudLayer:
             )
 
     on_drawn: Any = None  # set by the panel: refresh the status line right after a draw
+
+    def frame_in_view(self, world_from_frame) -> bool:
+        """Point every browser's camera at the cloud; False when nothing is drawn yet."""
+        s = self.status
+        if not s.shown or self._handle is None:
+            return False
+        centre = world_from_frame(self._handle_path.rsplit("/", 1)[0], s.centre)
+        distance = max(1.5 * s.radius, 0.5)
+        eye = np.asarray(centre) + distance * np.array([1.0, -1.0, 0.8])
+        for client in self._server.get_clients().values():
+            with client.atomic():
+                client.camera.position = tuple(float(v) for v in eye)
+                client.camera.look_at = tuple(float(v) for v in centre)
+        return True
 
     def describe(self) -> str:
         """Markdown for the panel: how many points, which budget, colouring, frame."""

@@ -72,6 +72,7 @@ def test_slam_chain_draws_map_trajectory_and_camera_image(page):
     page.wait_for_function(
         HAS_NODE_JS, arg="/base_link/markers/trajectory_0", polling=100, timeout=30_000
     )
+    page.get_by_label("Image on the 3D camera").check()
     first = page.wait_for_function(IMAGE_SRC_JS, polling=200, timeout=30_000).json_value()
     page.wait_for_function(
         f"(old) => {{ const s = ({IMAGE_SRC_JS})(); return s && s !== old; }}",
@@ -79,3 +80,14 @@ def test_slam_chain_draws_map_trajectory_and_camera_image(page):
         polling=200,
         timeout=30_000,
     )
+    # One click brings the (far away, sparse) SLAM map into view.
+    before = page.evaluate("() => window.__viserMutable.camera.position.toArray()")
+    page.get_by_role("button", name="Look at the cloud").click()
+    page.wait_for_function(
+        "(old) => { const p = window.__viserMutable.camera.position;"
+        " return Math.hypot(p.x - old[0], p.y - old[1], p.z - old[2]) > 0.05; }",
+        arg=before,
+        polling=100,
+        timeout=10_000,
+    )
+    page.wait_for_timeout(500)
