@@ -27,11 +27,6 @@ def drawable_topics(graph: GraphSnapshot | None, types: tuple[str, ...]) -> list
     return sorted(t.name for t in graph.topics if any(ty in types for ty in t.types))
 
 
-def topic_type(graph: GraphSnapshot | None, topic: str) -> str | None:
-    info = graph.topic(topic) if graph else None
-    return info.types[0] if info and info.types else None
-
-
 def options(graph: GraphSnapshot | None, types: tuple[str, ...], current: str) -> list[str]:
     """Dropdown choices: "(none)", every drawable topic, and the current pick even if gone."""
     found = drawable_topics(graph, types)
