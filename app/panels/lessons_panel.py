@@ -34,9 +34,8 @@ class LessonsPanel:
         self._dynamic: list[Any] = []
         by_label = {_label(lesson): lesson for lesson in course.lessons}
         self._by_label = by_label
-        self._outline = MarkdownView(gui)
         if not course.lessons:
-            self._outline.show("No lessons could be loaded.\n\n" + "\n".join(course.errors))
+            gui.add_markdown("No lessons could be loaded.\n\n" + "\n".join(course.errors))
             return
         current = course.lesson(progress.current_lesson() or "") or course.lessons[0]
         self._selector = gui.add_dropdown("Lesson", list(by_label), initial_value=_label(current))
@@ -48,9 +47,11 @@ class LessonsPanel:
         self._message = MarkdownView(gui)
         self._back = gui.add_button("Back", icon=viser.Icon.ARROW_LEFT)
         self._next = gui.add_button("Next", icon=viser.Icon.ARROW_RIGHT)
-        with gui.add_folder("Source code", expand_by_default=False):
+        with gui.add_folder("Source code of this lesson's nodes", expand_by_default=False):
             self._code = MarkdownView(gui)
-        self._reset = gui.add_button("Reset my progress", color="gray")
+        with gui.add_folder("Course outline", expand_by_default=False):
+            self._outline = MarkdownView(gui)
+            self._reset = gui.add_button("Reset my progress", color="gray")
         self._lesson = current
         self._step = min(progress.lesson(current.id)["step"], len(current.steps) - 1)
         self._selector.on_update(lambda _: self._select(by_label[self._selector.value], 0))

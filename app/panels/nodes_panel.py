@@ -8,6 +8,7 @@ import viser
 
 from app.catalog import ENTRIES, GROUPS, UnknownNodeError, lookup, lookup_group
 from app.graph import GraphSnapshot
+from app.launch import launch_file_text
 from app.panels import MarkdownView, code_block
 from app.supervisor import ACTIVE_STATES, NodeState, NodeStatus, Supervisor
 
@@ -25,7 +26,6 @@ LOG_TAIL_LINES = 14
 class NodesPanel:
     def __init__(self, gui: viser.GuiApi, supervisor: Supervisor) -> None:
         self._supervisor = supervisor
-        self._overview = MarkdownView(gui)
         self._selector = gui.add_dropdown(
             "Catalog node",
             [entry.name for entry in ENTRIES],
@@ -38,13 +38,16 @@ class NodesPanel:
         self._restart = gui.add_button("Restart", icon=viser.Icon.REFRESH)
         self._message = MarkdownView(gui)
         self._log = MarkdownView(gui)
-        gui.add_markdown("**Launch groups**: several nodes at once, as a launch file would.")
-        self._group_selector = gui.add_dropdown(
-            "Launch group", [group.name for group in GROUPS], initial_value=GROUPS[0].name
-        )
-        self._group_details = MarkdownView(gui)
-        self._start_group = gui.add_button("Start group", icon=viser.Icon.PLAYER_PLAY)
-        self._stop_group = gui.add_button("Stop group", icon=viser.Icon.PLAYER_STOP)
+        with gui.add_folder("Launch groups"):
+            gui.add_markdown("Several nodes at once, as a Python launch file would start them.")
+            self._group_selector = gui.add_dropdown(
+                "Launch group", [group.name for group in GROUPS], initial_value=GROUPS[0].name
+            )
+            self._start_group = gui.add_button("Start group", icon=viser.Icon.PLAYER_PLAY)
+            self._stop_group = gui.add_button("Stop group", icon=viser.Icon.PLAYER_STOP)
+            self._group_details = MarkdownView(gui)
+        with gui.add_folder("All catalog nodes"):
+            self._overview = MarkdownView(gui)
         self._start_group.on_click(lambda _: self._act_on_group(self._supervisor.start, "Started"))
         self._stop_group.on_click(lambda _: self._act_on_group(self._supervisor.stop, "Stopping"))
         self._group_selector.on_update(lambda _: self.refresh(None))
@@ -106,7 +109,9 @@ class NodesPanel:
         self._stop.disabled = not active
         group = lookup_group(self._group_selector.value)
         self._group_details.show(
-            f"{group.summary}. In a terminal: `ros2 launch tutorial_nodes {group.name}.launch.py`"
+            f"{group.summary}.\n\nIn a terminal: `ros2 launch tutorial_nodes "
+            f"{group.name}.launch.py`, where the launch file says:\n\n"
+            f"```python\n{launch_file_text(group)}\n```"
         )
         lines = self._supervisor.output(name, last=LOG_TAIL_LINES)
         dropped = (
