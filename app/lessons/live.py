@@ -8,7 +8,6 @@ check that needs a service answer issues ``call_async`` and reports
 
 from __future__ import annotations
 
-import importlib
 import math
 import threading
 import time
@@ -26,6 +25,8 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 from app import catalog
 from app.graph import GraphSnapshot
 from app.lessons.schema import Spec
+from app.ros2cli.common import Ros2Error
+from app.ros2cli.convert import fill, import_type
 from app.supervisor import Supervisor
 from app.topic_tap import TopicTap
 
@@ -44,31 +45,6 @@ TAP_QOS = QoSProfile(depth=50, reliability=ReliabilityPolicy.BEST_EFFORT)
 class CheckResult:
     state: str  # pass | fail | waiting
     reason: str = ""
-
-
-def import_interface(name: str) -> type:
-    """'pkg/msg/Name' (or 'pkg/Name' for a message) -> the generated Python class."""
-    parts = name.split("/")
-    if len(parts) == 2:
-        parts = [parts[0], "msg", parts[1]]
-    if len(parts) != 3 or parts[1] not in ("msg", "srv", "action") or not all(parts):
-        raise ValueError(f"not an interface type name: {name!r} (expected pkg/msg/Name)")
-    try:
-        return getattr(importlib.import_module(f"{parts[0]}.{parts[1]}"), parts[2])
-    except (ImportError, AttributeError):
-        raise ValueError(f"unknown interface type: {name}") from None
-
-
-def fill(msg: Any, values: dict[str, Any]) -> Any:
-    """Set fields of ``msg`` from a (possibly nested) dict."""
-    for key, value in values.items():
-        if key not in msg.get_fields_and_field_types():
-            raise ValueError(f"{type(msg).__name__} has no field '{key}'")
-        if isinstance(value, dict):
-            fill(getattr(msg, key), value)
-        else:
-            setattr(msg, key, value)
-    return msg
 
 
 def _parameter_value(value: ParameterValue) -> Any:
@@ -122,9 +98,7 @@ class LessonRuntime:
         with self._lock:
             key = (topic, type_name)
             if key not in self._taps:
-                self._taps[key] = TopicTap(
-                    self.node, topic, import_interface(type_name), qos=TAP_QOS
-                )
+                self._taps[key] = TopicTap(self.node, topic, import_type(type_name), qos=TAP_QOS)
             return self._taps[key]
 
     def _client(self, service: str, srv_type: type) -> Any:
@@ -184,8 +158,8 @@ class LessonRuntime:
             client.call_async(SetParameters.Request(parameters=[param]))
             message = f"Set {action['name']} = {action['value']!r} on {action['node']}."
         elif kind == "call_service":
-            srv_type = import_interface(action["type"])
-            request = fill(srv_type.Request(), action["request"])
+            srv_type = import_type(action["type"])
+            request = fill(srv_type.Request, action["request"])
             self._client(action["service"], srv_type).call_async(request)
             message = f"Called {action['service']}."
         elif kind == "send_goal":
@@ -199,7 +173,7 @@ class LessonRuntime:
 
     def _send_goal(self, action: Spec) -> str:
         name, type_name = action["action"], action["type"]
-        action_type = import_interface(type_name)
+        action_type = import_type(type_name)
         with self._lock:
             client = self._action_clients.get((name, type_name))
             if client is None:
@@ -233,7 +207,7 @@ class LessonRuntime:
             handle_box.append(handle)
             handle.get_result_async().add_done_callback(on_result)
 
-        goal = fill(action_type.Goal(), action["goal"])
+        goal = fill(action_type.Goal, action["goal"])
         client.send_goal_async(goal, feedback_callback=on_feedback).add_done_callback(on_goal)
         return f"Sent a goal to {name}."
 
@@ -242,7 +216,7 @@ class LessonRuntime:
     def evaluate(self, check: Spec) -> CheckResult:
         try:
             return getattr(self, f"_check_{check.kind}")(check)
-        except (ValueError, RuntimeError, catalog.UnknownNodeError) as exc:
+        except (Ros2Error, ValueError, RuntimeError, catalog.UnknownNodeError) as exc:
             return CheckResult(FAIL, str(exc))
 
     def _check_node_running(self, c: Spec) -> CheckResult:
@@ -337,10 +311,10 @@ class LessonRuntime:
         return CheckResult(FAIL, f"{c['name']} = {value!r}, expected {expected!r}")
 
     def _check_service_returns(self, c: Spec) -> CheckResult:
-        srv_type = import_interface(c["type"])
+        srv_type = import_type(c["type"])
         if not self._client(c["service"], srv_type).service_is_ready():
             return CheckResult(FAIL, f"no server for {c['service']}")
-        request = fill(srv_type.Request(), c["request"])
+        request = fill(srv_type.Request, c["request"])
         response = self._poll_service(c.key, c["service"], srv_type, request)
         if response is None:
             return CheckResult(WAITING, f"calling {c['service']}")
@@ -388,7 +362,7 @@ class LessonRuntime:
         return CheckResult(WAITING, f"the gripper is {error * 1000:.0f} mm from the target")
 
     def _check_interface_exists(self, c: Spec) -> CheckResult:
-        import_interface(c["type"])  # raises ValueError -> fail with the reason
+        import_type(c["type"])  # an unknown type raises -> fail with the reason
         return CheckResult(PASS, f"{c['type']} is installed")
 
     def _check_quiz(self, c: Spec) -> CheckResult:
