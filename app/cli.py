@@ -64,18 +64,31 @@ def _check_port_free(host: str, port: int) -> None:
             ) from None
 
 
-def cmd_serve(args: argparse.Namespace) -> int:
-    if not _is_loopback(args.host):
+def _access_token(args: argparse.Namespace) -> str | None:
+    """Beyond loopback only with --allow-remote, and then always with a token."""
+    from app.access import AccessError, check_token, new_token
+
+    if not _is_loopback(args.host) and not args.allow_remote:
         raise CliError(
             f"refusing to serve on {args.host}: the dashboard can start processes, so it "
-            "only listens on this machine (127.0.0.1)"
+            "only listens on this machine (127.0.0.1) unless you add --allow-remote "
+            "(which also requires an access token)"
         )
+    if not (args.allow_remote or args.token):
+        return None
+    try:
+        return check_token(args.token) if args.token else new_token()
+    except AccessError as exc:
+        raise CliError(str(exc)) from None
+
+
+def cmd_serve(args: argparse.Namespace) -> int:
+    token = _access_token(args)
     configure_this_process(domain_id=args.domain_id, network=args.network)
     _check_port_free(args.host, args.port)
 
     # Heavy imports only for the command that needs them.
-    import viser
-
+    from app.access import make_server
     from app.dashboard import Dashboard
     from app.lessons.progress import DEFAULT_DIR, ProgressStore
     from app.ros_runtime import RosRuntime
@@ -86,7 +99,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: stop_requested.set())
 
-    server = viser.ViserServer(host=args.host, port=args.port, verbose=False)
+    server, _gate = make_server(args.host, args.port, token)
     if server.get_port() != args.port:
         server.stop()
         raise CliError(f"port {args.port} on {args.host} became busy; pick another with --port")
@@ -96,8 +109,9 @@ def cmd_serve(args: argparse.Namespace) -> int:
     dashboard.start()
     domain = os.environ.get("ROS_DOMAIN_ID", "0")
     scope = "network (opt-in)" if args.network else "loopback only"
+    query = f"/?token={token}" if token else ""
     print(
-        f"ROS 2 Classroom is ready: http://{args.host}:{args.port}  "
+        f"ROS 2 Classroom is ready: http://{args.host}:{args.port}{query}  "
         f"(ROS domain {domain}, DDS {scope}). Press Ctrl+C to stop.",
         flush=True,
     )
@@ -182,6 +196,16 @@ def build_parser() -> argparse.ArgumentParser:
     serve = sub.add_parser("serve", help="start the dashboard web server")
     serve.add_argument("--host", default="127.0.0.1", help="address to listen on")
     serve.add_argument("--port", type=_port, default=8080, help="port to listen on")
+    serve.add_argument(
+        "--allow-remote",
+        action="store_true",
+        help="allow a --host other than loopback; every browser then needs the access token",
+    )
+    serve.add_argument(
+        "--token",
+        default=os.environ.get("CLASSROOM_TOKEN"),
+        help="access token (default: $CLASSROOM_TOKEN, else a random one printed with the URL)",
+    )
     serve.add_argument("--learner", default="default", help="whose lesson progress to keep")
     serve.add_argument(
         "--progress-dir",

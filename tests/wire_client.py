@@ -1,0 +1,134 @@
+"""A bare viser websocket client for tests: many at once, cheap, and able to send anything.
+
+A headless Chromium page costs hundreds of MB; this client speaks viser's
+wire format directly (zstd-compressed msgpack frames in, plain msgpack out),
+keeps the GUI state it is sent (labels, values, markdown) and counts what
+arrives, so load tests can run ten of them and fuzz tests can send values a
+real page never would.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections import Counter
+from typing import Any
+
+import msgspec
+import viser
+import zstandard
+from websockets.exceptions import ConnectionClosed
+from websockets.sync.client import ClientConnection, connect
+
+
+def decode_frame(frame: bytes) -> list[dict[str, Any]]:
+    """One server->client frame: [raw size][compressed size][zstd msgpack][binary tail]."""
+    raw_size = int.from_bytes(frame[:8], "little")
+    packed_size = int.from_bytes(frame[8:16], "little")
+    inner = zstandard.ZstdDecompressor().decompress(
+        frame[16 : 16 + packed_size], max_output_size=raw_size
+    )
+    return list(msgspec.msgpack.decode(inner)["messages"])
+
+
+class WireClient:
+    """Connects, reads every frame in a thread, and keeps the GUI state it was sent."""
+
+    def __init__(self, url: str, *, headers: dict[str, str] | None = None) -> None:
+        self.url = url.replace("http://", "ws://", 1)
+        self.ws: ClientConnection = connect(
+            self.url,
+            subprotocols=[f"viser-v{viser.__version__}"],  # type: ignore[list-item]
+            additional_headers=headers or {},
+            max_size=None,
+            open_timeout=10,
+        )
+        self.lock = threading.Lock()
+        self.gui: dict[str, dict[str, Any]] = {}  # uuid -> {"type", "props"...}
+        self.counts: Counter[str] = Counter()
+        self.frames = 0
+        self.bytes = 0
+        self.last_frame_at = 0.0
+        self.closed_reason: str | None = None
+        self._reader = threading.Thread(target=self._read, name="wire-reader", daemon=True)
+        self._reader.start()
+        # viser counts a client as connected (and runs its clicks) only after
+        # the first camera report, which a page sends as soon as it renders.
+        self.send(
+            {
+                "type": "ViewerCameraMessage",
+                "wxyz": (1.0, 0.0, 0.0, 0.0),
+                "position": (3.0, 3.0, 3.0),
+                "fov": 1.0,
+                "near": 0.01,
+                "far": 1000.0,
+                "image_height": 900,
+                "image_width": 1400,
+                "look_at": (0.0, 0.0, 0.0),
+                "up_direction": (0.0, 0.0, 1.0),
+            }
+        )
+
+    def _read(self) -> None:
+        try:
+            for frame in self.ws:
+                assert isinstance(frame, bytes)
+                messages = decode_frame(frame)
+                with self.lock:
+                    self.frames += 1
+                    self.bytes += len(frame)
+                    self.last_frame_at = time.monotonic()
+                    for message in messages:
+                        self._apply(message)
+        except ConnectionClosed as exc:
+            self.closed_reason = str(exc)
+        except Exception as exc:  # noqa: BLE001 - reported, then the test fails on it
+            self.closed_reason = f"{type(exc).__name__}: {exc}"
+
+    def _apply(self, message: dict[str, Any]) -> None:
+        kind = message.get("type", "?")
+        self.counts[kind] += 1
+        uuid = message.get("uuid")
+        if kind.startswith("Gui") and "props" in message and uuid:
+            self.gui[uuid] = {"type": kind, **dict(message["props"])}
+            if "value" in message:
+                self.gui[uuid]["value"] = message["value"]
+        elif kind == "GuiUpdateMessage" and uuid in self.gui:
+            self.gui[uuid].update(message.get("updates", {}))
+        elif kind == "GuiRemoveMessage" and uuid:
+            self.gui.pop(uuid, None)
+
+    # -- queries -------------------------------------------------------------
+
+    def find(self, label: str, kind: str | None = None) -> str | None:
+        with self.lock:
+            for uuid, props in self.gui.items():
+                if props.get("label") == label and (kind is None or props["type"] == kind):
+                    return uuid
+        return None
+
+    def markdown(self) -> str:
+        with self.lock:
+            return "\n".join(str(p["_markdown"]) for p in self.gui.values() if "_markdown" in p)
+
+    def value(self, uuid: str) -> Any:
+        with self.lock:
+            return self.gui[uuid].get("value")
+
+    # -- actions -------------------------------------------------------------
+
+    def send(self, message: dict[str, Any]) -> None:
+        self.ws.send(msgspec.msgpack.encode(message))
+
+    def set_value(self, uuid: str, value: Any) -> None:
+        """What a page sends when a widget changes (or a button is clicked: True)."""
+        self.send({"type": "GuiUpdateMessage", "uuid": uuid, "updates": {"value": value}})
+
+    def click(self, label: str) -> None:
+        uuid = self.find(label, "GuiButtonMessage")
+        assert uuid, f"no button {label!r}"
+        self.set_value(uuid, True)
+
+    def close(self) -> None:
+        self.ws.close()
+        self._reader.join(timeout=5)
