@@ -241,7 +241,7 @@ class CloudPublisher:
         from sensor_msgs.msg import PointCloud2
 
         from app.ros_runtime import RosRuntime
-        from app.scene.cloud_codec import encode_cloud
+        from nodes.common.pointcloud import xyz_to_pointcloud2 as encode_cloud
 
         self.runtime = RosRuntime("bench_cloud_publisher", threads=1)
         qos = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)

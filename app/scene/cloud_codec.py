@@ -6,31 +6,20 @@ straight over the message's buffer, so decoding 100k points costs a few
 milliseconds. Decimation happens on the view (a larger stride) before any
 copy. Works on the rclpy message or any object with the same attributes.
 
-(The perception nodes have their own ``nodes/common/pointcloud.py``; this one
-also does colouring and decimation for drawing.)
+The perception nodes' ``nodes/common/pointcloud.py`` reads whole clouds and
+builds them (``xyz_to_pointcloud2``); this module adds what drawing needs:
+decimation before any copy, and colouring by rgb, intensity or height.
 """
 
 from __future__ import annotations
 
-import array
 import math
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-# sensor_msgs/PointField datatype constants -> numpy dtype
-POINTFIELD_DTYPES: dict[int, np.dtype] = {
-    1: np.dtype(np.int8),
-    2: np.dtype(np.uint8),
-    3: np.dtype(np.int16),
-    4: np.dtype(np.uint16),
-    5: np.dtype(np.int32),
-    6: np.dtype(np.uint32),
-    7: np.dtype(np.float32),
-    8: np.dtype(np.float64),
-}
-FLOAT32 = 7
+from nodes.common.pointcloud import POINTFIELD_DTYPES
 
 # A small perceptual colour ramp (dark blue -> teal -> yellow) for intensity
 # and height; 5 stops interpolated in numpy.
@@ -140,48 +129,3 @@ def decode_cloud(msg: Any, budget: int | None = None) -> DecodedCloud:
     if colors is None:
         colors = colour_ramp(points[:, 2])
     return DecodedCloud(points, colors, total, colour_source)
-
-
-def encode_cloud(
-    points: np.ndarray,
-    colors: np.ndarray | None = None,
-    *,
-    frame_id: str = "base_link",
-    stamp: tuple[int, int] = (0, 0),
-    intensity: np.ndarray | None = None,
-) -> Any:
-    """A PointCloud2 with float32 x, y, z (+ packed rgb or intensity), built in bulk.
-
-    Used by tests, the benchmark and synthetic demo publishers.
-    """
-    from sensor_msgs.msg import PointCloud2, PointField
-
-    pts = np.asarray(points, dtype=np.float32).reshape(-1, 3)
-    names = ["x", "y", "z"]
-    extra: np.ndarray | None = None
-    if colors is not None:
-        c = np.asarray(colors, dtype=np.uint32).reshape(-1, 3)
-        extra = ((c[:, 0] << 16) | (c[:, 1] << 8) | c[:, 2]).view(np.float32)
-        names.append("rgb")
-    elif intensity is not None:
-        extra = np.asarray(intensity, dtype=np.float32).reshape(-1)
-        names.append("intensity")
-    block = np.empty((pts.shape[0], len(names)), dtype=np.float32)
-    block[:, :3] = pts
-    if extra is not None:
-        block[:, 3] = extra
-    msg = PointCloud2()
-    msg.header.frame_id = frame_id
-    msg.header.stamp.sec, msg.header.stamp.nanosec = int(stamp[0]), int(stamp[1])
-    msg.height = 1
-    msg.width = int(pts.shape[0])
-    msg.fields = [
-        PointField(name=name, offset=4 * i, datatype=FLOAT32, count=1)
-        for i, name in enumerate(names)
-    ]
-    msg.is_bigendian = False
-    msg.point_step = 4 * len(names)
-    msg.row_step = msg.point_step * msg.width
-    msg.is_dense = True
-    msg.data = array.array("B", block.tobytes())
-    return msg

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 # sensor_msgs/PointField datatype constants -> numpy
-_DATATYPES = {
+POINTFIELD_DTYPES = {
     1: np.dtype(np.int8),
     2: np.dtype(np.uint8),
     3: np.dtype(np.int16),
@@ -35,7 +35,7 @@ def fields_to_dtype(fields, point_step: int, is_bigendian: bool = False) -> np.d
     order = ">" if is_bigendian else "<"
     names, formats, offsets = [], [], []
     for field in fields:
-        base = _DATATYPES.get(int(field.datatype))
+        base = POINTFIELD_DTYPES.get(int(field.datatype))
         if base is None:
             raise ValueError(f"field {field.name!r} has unknown datatype {field.datatype}")
         count = max(1, int(field.count))

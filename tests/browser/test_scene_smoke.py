@@ -6,13 +6,14 @@ import math
 
 import numpy as np
 import pytest
+from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Point
 from playwright.sync_api import expect
 from sensor_msgs.msg import Image, JointState, PointCloud2
 from visualization_msgs.msg import Marker, MarkerArray
 
-from app.scene.cloud_codec import encode_cloud
 from app.scene.image_codec import rgb_to_image_msg
+from nodes.common.pointcloud import xyz_to_pointcloud2
 from tests.browser.helpers import open_tab
 from tests.browser.scene_helpers import (
     Repeater,
@@ -59,7 +60,10 @@ def test_point_cloud_image_and_arm_show_up_live(page, probe):
     joint_pub = node.create_publisher(JointState, "/test/joint_states", 10)
 
     def cloud(i: int) -> PointCloud2:
-        return encode_cloud(pts, colours, frame_id="base_link", stamp=now_stamp())
+        sec, nanosec = now_stamp()
+        return xyz_to_pointcloud2(
+            pts, colours, frame_id="base_link", stamp=Time(sec=sec, nanosec=nanosec)
+        )
 
     def image(i: int) -> Image:
         rgb = np.zeros((120, 160, 3), np.uint8)

@@ -11,8 +11,8 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import PointCloud2
 
 from app.ros_runtime import RosRuntime
-from app.scene.cloud_codec import encode_cloud
 from app.scene.pointclouds import PointCloudLayer
+from nodes.common.pointcloud import xyz_to_pointcloud2 as encode_cloud
 from tests.conftest import free_port, wait_until
 
 pytestmark = [pytest.mark.ros]

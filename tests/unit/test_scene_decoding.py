@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 from sensor_msgs.msg import PointCloud2, PointField
 
-from app.scene.cloud_codec import CloudFormatError, decode_cloud, encode_cloud
+from app.scene.cloud_codec import CloudFormatError, decode_cloud
 from app.scene.image_codec import ImageFormatError, image_to_rgb, rgb_to_image_msg
 from nodes.common.pointcloud import xyz_to_pointcloud2
+from nodes.common.pointcloud import xyz_to_pointcloud2 as encode_cloud
 
 
 def test_xyz_and_packed_rgb_round_trip():
