@@ -62,6 +62,12 @@ ENTRIES: tuple[CatalogEntry, ...] = (
     ),
     # --- core tutorial nodes (issue 3): add entries below this line ---
     CatalogEntry(
+        "flood_node",
+        "flood_node",
+        "/flood_node",
+        "Misbehaves on purpose: 2000 messages/s on /chatter, each one logged.",
+    ),
+    CatalogEntry(
         "minimal_node",
         "minimal_node",
         "/minimal_node",

@@ -126,6 +126,34 @@ def cmd_serve(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_classroom(args: argparse.Namespace) -> int:
+    """N isolated learner dashboards (app/classroom.py); URLs printed, Ctrl+C stops all."""
+    from app import classroom
+    from app.lessons.progress import DEFAULT_DIR
+
+    if not _is_loopback(args.host) and not args.allow_remote:
+        raise CliError(
+            f"refusing to serve on {args.host}: add --allow-remote (each learner then gets "
+            "an access token in their URL)"
+        )
+    learners = classroom.plan(
+        args.learners,
+        base_port=args.base_port,
+        base_domain=args.base_domain_id,
+        progress_root=args.progress_dir or DEFAULT_DIR / "classroom",
+        tokens=args.allow_remote,
+    )
+    for learner in learners:
+        _check_port_free(args.host, learner.port)
+    chosen = (("--allow-remote", args.allow_remote), ("--network", args.network))
+    flags = tuple(flag for flag, on in chosen if on)
+    stop_requested = threading.Event()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda *_: stop_requested.set())
+    room = classroom.Classroom(learners, os.environ, host=args.host, serve_flags=flags)
+    return classroom.run(room, stop_requested, lambda line: print(line, flush=True))
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     entry = catalog.lookup(args.node)
     configure_this_process(domain_id=args.domain_id, network=args.network)
@@ -215,6 +243,22 @@ def build_parser() -> argparse.ArgumentParser:
     )
     dds_options(serve)
     serve.set_defaults(func=cmd_serve)
+
+    room = sub.add_parser("classroom", help="start N isolated learner dashboards")
+    room.add_argument("--learners", type=int, required=True, help="how many learners")
+    room.add_argument("--base-port", type=_port, default=8080, help="first learner's port")
+    room.add_argument(
+        "--base-domain-id", type=_domain_id, default=10, help="first learner's ROS domain id"
+    )
+    room.add_argument("--host", default="127.0.0.1", help="address to listen on")
+    room.add_argument(
+        "--allow-remote", action="store_true", help="serve other machines (tokens per learner)"
+    )
+    room.add_argument(
+        "--progress-dir", type=Path, default=None, help="parent of each learner's progress"
+    )
+    room.add_argument("--network", action="store_true", help="let DDS use the network cards")
+    room.set_defaults(func=cmd_classroom)
 
     run = sub.add_parser("run", help="run one catalog node in the foreground, like `ros2 run`")
     run.add_argument("node", help="catalog name (see `ros2-classroom list`)")

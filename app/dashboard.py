@@ -102,10 +102,13 @@ class Dashboard:
                 self.graph = snapshot(self.runtime.node)
                 self.supervisor.note_visible_nodes(self.graph.nodes)
                 self.lessons.graph = self.graph
-                for panel in self._panels:
+            except Exception:  # the graph may be unreadable for a moment: keep the panels going
+                log.exception("graph snapshot failed")
+            for panel in self._panels:
+                try:
                     panel.refresh(self.graph)
-            except Exception:  # a panel bug must not freeze every other panel
-                log.exception("UI refresh failed")
+                except Exception:  # one panel's bug (or a forged widget value) freezes no other
+                    log.exception("refresh of %s failed", type(panel).__name__)
 
     def stop(self) -> None:
         self._stop.set()

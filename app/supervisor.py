@@ -128,10 +128,12 @@ class Supervisor:
         self._env.setdefault("PYTHONUNBUFFERED", "1")
         self._env.setdefault("RCUTILS_COLORIZED_OUTPUT", "0")
         self._max_log_lines = max_log_lines
+        self.max_log_lines = max_log_lines
         self._timeouts = (sigint_timeout, sigterm_timeout)
         self._on_change = on_change
         self._lock = threading.Lock()
         self._procs: dict[str, _Process] = {}
+        self._ended: deque[NodeStatus] = deque(maxlen=500)  # who ended, newest last
         self._spawner = ThreadPoolExecutor(max_workers=1, thread_name_prefix="supervisor-spawn")
         self._closed = False
 
@@ -146,6 +148,29 @@ class Supervisor:
     def statuses(self) -> dict[str, NodeStatus]:
         with self._lock:
             return {name: proc.status() for name, proc in self._procs.items()}
+
+    def ended(self) -> list[NodeStatus]:
+        """Every process that has ended and been reaped (pid, exit code), newest last."""
+        with self._lock:
+            return list(self._ended)
+
+    def stale_in_graph(self, node_names: Iterable[str]) -> dict[str, NodeStatus]:
+        """Catalog nodes whose process is gone but whose name the graph still lists.
+
+        A node killed without a clean exit stays in DDS discovery until its
+        lease runs out (about 20 s with Fast DDS); the panel says so instead
+        of showing a dead node as alive.
+        """
+        seen = set(node_names)
+        with self._lock:
+            active_names = {p.entry.node_name for p in self._procs.values() if not p.done.is_set()}
+            return {
+                name: proc.status()
+                for name, proc in self._procs.items()
+                if proc.done.is_set()
+                and proc.entry.node_name in seen
+                and proc.entry.node_name not in active_names
+            }
 
     def output(self, name: str, last: int | None = None) -> list[str]:
         with self._lock:
@@ -264,6 +289,7 @@ class Supervisor:
             else:
                 proc.state = NodeState.EXITED if code == 0 else NodeState.CRASHED
             status = proc.status()
+            self._ended.append(status)
         proc.done.set()
         self._notify(status)
 

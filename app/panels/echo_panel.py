@@ -11,6 +11,7 @@ from app.panels import MarkdownView, code_block
 from app.topic_tap import TopicTap
 
 SHOWN_MESSAGES = 10
+FAST_HZ = 50.0
 
 
 class EchoPanel:
@@ -26,6 +27,8 @@ class EchoPanel:
         ]
         rate = self._tap.rate_hz()
         rate_text = f"{rate:.1f} Hz" if rate else "no messages lately"
+        if rate and rate > FAST_HZ:  # say so: most messages scroll by unseen
+            rate_text += f" · ⚠ too fast to read: showing only the newest {SHOWN_MESSAGES}"
         header = f"`ros2 topic echo {self._tap.topic}` · {self._tap.count} received · {rate_text}"
         publishers = (
             graph.topic(self._tap.topic).publishers if graph and graph.topic(self._tap.topic) else 0

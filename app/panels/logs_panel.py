@@ -35,6 +35,7 @@ class RosoutLog:
         )
         self._sub = node.create_subscription(Log, "/rosout", self._on_log, qos)
         self.total = 0
+        self.keep = keep
 
     def _on_log(self, record: Log) -> None:
         with self._lock:
@@ -74,11 +75,18 @@ class LogsPanel:
             if current not in options:
                 options.append(current)
             self._node.options = options
-        level = next(k for k, v in LEVELS.items() if v == self._level.value)
+        # The value comes from the browser; an unknown one means "everything".
+        level = next((k for k, v in LEVELS.items() if v == self._level.value), 0)
         node = None if self._node.value == ALL_NODES else self._node.value
         lines = [format_record(r) for r in self._log.records(node, level, last=40)]
         where = f" --ros-args (node {node})" if node else ""
+        dropped = self._log.total - self._log.keep
+        note = (
+            f" · ⚠ {dropped} older records dropped, the newest {self._log.keep} kept"
+            if dropped > 0
+            else ""
+        )
         self._view.show(
-            f"`/rosout` · {self._log.total} records seen{where}\n\n"
+            f"`/rosout` · {self._log.total} records seen{where}{note}\n\n"
             + code_block(lines, "(no log records yet)")
         )

@@ -21,6 +21,17 @@ _STATE_ICONS = {
     NodeState.CRASHED: "✗",
 }
 LOG_TAIL_LINES = 14
+_ENTRY_NAMES = frozenset(entry.name for entry in ENTRIES)
+_GROUP_NAMES = frozenset(group.name for group in GROUPS)
+STALE_NOTE = " · ⚠ still listed in the ROS graph until its DDS lease expires (about 20 s)"
+
+
+def _notes(status: NodeStatus, stale: bool) -> str:
+    """What the state alone hides: a dead node the graph still lists, lost log lines."""
+    notes = STALE_NOTE if stale else ""
+    if status.dropped_lines:
+        notes += f" · dropping log lines ({status.dropped_lines} so far)"
+    return notes
 
 
 class NodesPanel:
@@ -67,8 +78,8 @@ class NodesPanel:
         self.refresh(None)
 
     def _act_on_group(self, action, verb: str) -> None:
-        group = lookup_group(self._group_selector.value)
         try:
+            group = lookup_group(self._group_selector.value)
             for member in group.members:
                 action(member)
             self._message.show(f"{verb} group **{group.name}**: {', '.join(group.members)}.")
@@ -88,12 +99,24 @@ class NodesPanel:
         threading.Thread(target=self._supervisor.restart, args=(name,), daemon=True).start()
         return f"Restarting **{name}**…"
 
+    def _valid_selection(self) -> None:
+        """Dropdown values come from the browser: anything outside the catalog is reset."""
+        if self._selector.value not in _ENTRY_NAMES:
+            self._selector.value = ENTRIES[0].name
+        if self._group_selector.value not in _GROUP_NAMES:
+            self._group_selector.value = GROUPS[0].name
+
     def refresh(self, graph: GraphSnapshot | None) -> None:
+        self._valid_selection()
         statuses = self._supervisor.statuses()
+        stale = self._supervisor.stale_in_graph(graph.nodes) if graph is not None else {}
         rows = ["| node | state |", "|---|---|"]
         for entry in ENTRIES:
             status = statuses.get(entry.name, NodeStatus(entry.name, NodeState.STOPPED))
-            rows.append(f"| {entry.name} | {_STATE_ICONS[status.state]} {status.describe()} |")
+            rows.append(
+                f"| {entry.name} | {_STATE_ICONS[status.state]} {status.describe()}"
+                f"{_notes(status, entry.name in stale)} |"
+            )
         self._overview.show("\n".join(rows))
 
         name = self._selector.value
@@ -101,7 +124,8 @@ class NodesPanel:
         status = statuses.get(name, NodeStatus(name, NodeState.STOPPED))
         self._details.show(
             f"**{name}**: {entry.summary}\n\n"
-            f"State: {_STATE_ICONS[status.state]} **{status.describe()}**\n\n"
+            f"State: {_STATE_ICONS[status.state]} **{status.describe()}**"
+            f"{_notes(status, name in stale)}\n\n"
             f"In a terminal: `{entry.ros2_run_command()}`"
         )
         active = status.state in ACTIVE_STATES
@@ -115,6 +139,9 @@ class NodesPanel:
         )
         lines = self._supervisor.output(name, last=LOG_TAIL_LINES)
         dropped = (
-            f"\n\n_{status.dropped_lines} older lines dropped_" if status.dropped_lines else ""
+            f"\n\n_⚠ output is faster than the buffer keeps: {status.dropped_lines} older "
+            f"lines dropped, the last {self._supervisor.max_log_lines} kept_"
+            if status.dropped_lines
+            else ""
         )
         self._log.show(f"Log of **{name}**:\n\n" + code_block(lines) + dropped)

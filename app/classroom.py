@@ -1,0 +1,211 @@
+"""Classroom mode: one command, N isolated learner dashboards.
+
+Each learner gets a whole ``ros2-classroom serve`` process of their own: own
+port, own ROS domain id (so nobody's nodes show up in anybody else's graph),
+own learner name and progress directory. Isolation comes from DDS domains
+and separate processes, not from new machinery. The children die with this
+process (parent-death signal) and are stopped in parallel on Ctrl+C.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+from app import PROJECT_ROOT
+from app.dds import MAX_DOMAIN_ID
+
+_PR_SET_PDEATHSIG = 1
+_libc = ctypes.CDLL(None, use_errno=True)
+READY_TIMEOUT_SEC = 90.0
+MAX_LEARNERS = 40
+
+
+@dataclass(frozen=True)
+class Learner:
+    name: str
+    port: int
+    domain_id: int
+    progress_dir: Path
+    token: str | None = None
+
+    def url(self, host: str) -> str:
+        shown = "127.0.0.1" if host in ("0.0.0.0", "localhost") else host
+        query = f"/?token={self.token}" if self.token else ""
+        return f"http://{shown}:{self.port}{query}"
+
+
+def plan(
+    learners: int,
+    *,
+    base_port: int,
+    base_domain: int,
+    progress_root: Path,
+    tokens: bool = False,
+) -> list[Learner]:
+    """Who gets which port, domain and directory; raises ValueError on an impossible plan."""
+    from app.access import new_token
+
+    if not 1 <= learners <= MAX_LEARNERS:
+        raise ValueError(f"--learners must be 1-{MAX_LEARNERS}, got {learners}")
+    if base_port + learners - 1 > 65535:
+        raise ValueError(f"ports {base_port}..{base_port + learners - 1} do not all exist")
+    if not 0 <= base_domain or base_domain + learners - 1 > MAX_DOMAIN_ID:
+        raise ValueError(
+            f"domain ids {base_domain}..{base_domain + learners - 1} must lie in 0..{MAX_DOMAIN_ID}"
+        )
+    return [
+        Learner(
+            name=f"learner{i + 1}",
+            port=base_port + i,
+            domain_id=base_domain + i,
+            progress_dir=progress_root / f"learner{i + 1}",
+            token=new_token() if tokens else None,
+        )
+        for i in range(learners)
+    ]
+
+
+def _die_with_parent() -> None:
+    """Runs in each child between fork and exec: end when the classroom command ends."""
+    _libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
+
+
+class Classroom:
+    """The learner dashboards as child processes; start, watch, stop."""
+
+    def __init__(
+        self,
+        learners: list[Learner],
+        env: Mapping[str, str],
+        *,
+        host: str = "127.0.0.1",
+        serve_flags: tuple[str, ...] = (),
+        log_dir: Path | None = None,
+    ) -> None:
+        self.learners = learners
+        self.host = host
+        self._env = dict(env)
+        self._flags = serve_flags
+        self._log_dir = log_dir
+        self._procs: dict[str, subprocess.Popen[bytes]] = {}
+        self._ready: dict[str, threading.Event] = {}
+
+    def start(self) -> None:
+        for learner in self.learners:
+            argv = [
+                sys.executable, "-m", "app", "serve",
+                "--host", self.host,
+                "--port", str(learner.port),
+                "--domain-id", str(learner.domain_id),
+                "--learner", learner.name,
+                "--progress-dir", str(learner.progress_dir),
+                *self._flags,
+            ]  # fmt: skip
+            env = {**self._env, "PYTHONUNBUFFERED": "1"}
+            env.pop("CLASSROOM_TOKEN", None)
+            if learner.token:  # through the environment: a token on argv shows in `ps`
+                env["CLASSROOM_TOKEN"] = learner.token
+            proc = subprocess.Popen(
+                argv,
+                cwd=PROJECT_ROOT,
+                env=env,
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,  # Ctrl+C reaches us; we stop them in order
+                preexec_fn=_die_with_parent,
+            )
+            self._procs[learner.name] = proc
+            self._ready[learner.name] = threading.Event()
+            threading.Thread(
+                target=self._pump, args=(learner, proc), name=f"log-{learner.name}", daemon=True
+            ).start()
+
+    def _pump(self, learner: Learner, proc: subprocess.Popen[bytes]) -> None:
+        """Copy a child's output to its log file and notice when it is ready."""
+        assert proc.stdout is not None
+        log = None
+        if self._log_dir is not None:
+            self._log_dir.mkdir(parents=True, exist_ok=True)
+            log = open(self._log_dir / f"{learner.name}.log", "ab")  # noqa: SIM115
+        try:
+            for raw in proc.stdout:
+                if log is not None:
+                    log.write(raw)
+                    log.flush()
+                if b"is ready" in raw:
+                    self._ready[learner.name].set()
+        finally:
+            if log is not None:
+                log.close()
+
+    def wait_ready(self, timeout: float = READY_TIMEOUT_SEC) -> list[str]:
+        """Names of learners whose dashboard failed to come up in time (empty: all ready)."""
+        deadline = time.monotonic() + timeout
+        failed = []
+        for learner in self.learners:
+            while not self._ready[learner.name].wait(0.2):
+                if self._procs[learner.name].poll() is not None or time.monotonic() > deadline:
+                    failed.append(learner.name)
+                    break
+        return failed
+
+    def ended(self) -> dict[str, int]:
+        """Learner dashboards that have exited, with their exit codes."""
+        return {name: p.returncode for name, p in self._procs.items() if p.poll() is not None}
+
+    def pids(self) -> dict[str, int]:
+        return {name: proc.pid for name, proc in self._procs.items()}
+
+    def stop(self, timeout: float = 10.0) -> None:
+        """SIGTERM to all at once (each stops its own nodes), SIGKILL what remains."""
+        for proc in self._procs.values():
+            if proc.poll() is None:
+                proc.send_signal(signal.SIGTERM)
+        deadline = time.monotonic() + timeout
+        for proc in self._procs.values():
+            try:
+                proc.wait(max(0.1, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                os.killpg(proc.pid, signal.SIGKILL)
+                proc.wait()
+
+
+def run(
+    classroom: Classroom,
+    stop_requested: threading.Event,
+    say: Callable[[str], None] = print,
+) -> int:
+    """Start everyone, print the URLs, report dashboards that end, stop on request."""
+    classroom.start()
+    failed = classroom.wait_ready()
+    if failed:
+        say(f"ros2-classroom: error: could not start the dashboard of {', '.join(failed)}")
+        classroom.stop()
+        return 1
+    width = max(len(learner.name) for learner in classroom.learners)
+    say(f"Classroom is ready: {len(classroom.learners)} learners, each isolated.")
+    for learner in classroom.learners:
+        say(
+            f"  {learner.name:<{width}}  {learner.url(classroom.host)}  "
+            f"(ROS domain {learner.domain_id}, progress in {learner.progress_dir})"
+        )
+    say("Press Ctrl+C to stop every dashboard.")
+    reported: set[str] = set()
+    while not stop_requested.wait(0.5):
+        for name, code in classroom.ended().items():
+            if name not in reported:
+                reported.add(name)
+                say(f"  {name}'s dashboard ended (exit code {code}); the others keep running")
+    say("Stopping the classroom…")
+    classroom.stop()
+    return 0
