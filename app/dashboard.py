@@ -22,8 +22,10 @@ from app.panels.lessons_panel import LessonsPanel
 from app.panels.lifecycle_panel import LifecyclePanel
 from app.panels.logs_panel import LogsPanel, RosoutLog
 from app.panels.nodes_panel import NodesPanel
+from app.panels.parameters_panel import ParametersPanel
 from app.panels.scene_panel import ScenePanel
 from app.panels.services_panel import ServicesPanel
+from app.panels.topics_panel import TopicsPanel
 from app.ros_runtime import RosRuntime
 from app.supervisor import Supervisor
 from app.topic_tap import TopicTap
@@ -69,7 +71,7 @@ class Dashboard:
         with tabs.add_tab("Nodes", viser.Icon.CPU):
             nodes = NodesPanel(gui, self.supervisor)
         with tabs.add_tab("Graph", viser.Icon.SITEMAP):
-            graph = GraphPanel(gui)
+            graph = GraphPanel(gui, self.runtime.node)
         with tabs.add_tab("Echo", viser.Icon.MESSAGE):
             echo = EchoPanel(gui, self._chatter)
         with tabs.add_tab("3D view", viser.Icon.CUBE):
@@ -81,6 +83,10 @@ class Dashboard:
         """The ros2 command line and rqt, in the browser (issue 4)."""
         gui, node = self.server.gui, self.runtime.node
         rosout = RosoutLog(node)
+        with tabs.add_tab("Topics", viser.Icon.LIST_DETAILS):
+            topics = TopicsPanel(gui, node)
+        with tabs.add_tab("Parameters", viser.Icon.ADJUSTMENTS):
+            parameters = ParametersPanel(gui, node, rosout)
         with tabs.add_tab("Console", viser.Icon.TERMINAL):
             console = ConsolePanel(gui, node)
         with tabs.add_tab("Services", viser.Icon.ARROWS_EXCHANGE):
@@ -91,7 +97,7 @@ class Dashboard:
             lifecycle = LifecyclePanel(gui, node, rosout)
         with tabs.add_tab("Logs", viser.Icon.FILE_TEXT):
             logs = LogsPanel(gui, rosout)
-        return [console, services, actions, lifecycle, logs]
+        return [topics, parameters, console, services, actions, lifecycle, logs]
 
     def start(self) -> None:
         self._ui_thread.start()

@@ -1,20 +1,88 @@
-"""Graph panel: the nodes and topics on the live ROS graph (`ros2 node list`, `ros2 topic list`)."""
+"""Graph panel: nodes, topics, services and actions in one picture, edges with live rates.
+
+rqt_graph shows no services or actions; this picture does. Who publishes,
+subscribes, serves or calls what is asked per node (as `ros2 node info`
+does) once a second; rates come from a ``RateBoard`` of best-effort raw
+subscriptions on the topics in the picture only. The text lists below
+(`ros2 node list`, `ros2 topic list -t`) stay for copying names.
+"""
 
 from __future__ import annotations
 
+import logging
+import time
+
 import viser
+from rclpy.action import (
+    get_action_client_names_and_types_by_node,
+    get_action_server_names_and_types_by_node,
+)
+from rclpy.node import Node
 
 from app.graph import GraphSnapshot
 from app.panels import MarkdownView
+from app.panels.graph_svg import (
+    NodeEndpoints,
+    graph_picture,
+    legend_html,
+    render_svg,
+    topics_to_measure,
+)
+from app.panels.rates import RateBoard, rate_text
+from app.ros2cli.common import split_node_name
+
+log = logging.getLogger(__name__)
+
+PICTURE_PERIOD_SEC = 1.0
+
+
+def _first_types(pairs: list[tuple[str, list[str]]]) -> dict[str, str]:
+    return {name: types[0] for name, types in pairs if types}
+
+
+def node_endpoints(node: Node, fqn: str) -> NodeEndpoints | None:
+    """One node's endpoints from the local graph cache; None if it just vanished."""
+    name, namespace = split_node_name(fqn)
+    try:
+        return NodeEndpoints(
+            fqn,
+            _first_types(node.get_publisher_names_and_types_by_node(name, namespace)),
+            _first_types(node.get_subscriber_names_and_types_by_node(name, namespace)),
+            _first_types(node.get_service_names_and_types_by_node(name, namespace)),
+            _first_types(node.get_client_names_and_types_by_node(name, namespace)),
+            _first_types(get_action_server_names_and_types_by_node(node, name, namespace)),
+            _first_types(get_action_client_names_and_types_by_node(node, name, namespace)),
+        )
+    except Exception:  # noqa: BLE001 - the node left between listing and asking
+        return None
 
 
 class GraphPanel:
-    def __init__(self, gui: viser.GuiApi) -> None:
+    def __init__(self, gui: viser.GuiApi, node: Node | None = None) -> None:
+        self._node = node
+        self._rates = RateBoard(node) if node is not None else None
+        self._last_picture = 0.0
+        self._svg = ""
+        if node is not None:
+            with gui.add_folder("Options", expand_by_default=False):
+                self._show_quiet = gui.add_checkbox(
+                    "Show /rosout, /parameter_events, parameter services", False
+                )
+                self._show_self = gui.add_checkbox("Show this dashboard's own node", False)
+                self._live = gui.add_checkbox("Live rates", True)
+                self._heavy = gui.add_checkbox(
+                    "Rates of images and clouds too",
+                    False,
+                    hint="Large messages cost bandwidth even when only counted",
+                )
+            gui.add_html(legend_html())
+            self._picture = gui.add_html(render_svg([], []))
         self._view = MarkdownView(gui, "Waiting for the first look at the graph…")
 
     def refresh(self, graph: GraphSnapshot | None) -> None:
         if graph is None:
             return
+        self._refresh_picture(graph)
         parts = [f"**Nodes ({len(graph.nodes)})** · `ros2 node list`", ""]
         parts += [f"- `{name}`" for name in graph.nodes] or ["- (none)"]
         parts += ["", f"**Topics ({len(graph.topics)})** · `ros2 topic list -t`", ""]
@@ -24,4 +92,35 @@ class GraphPanel:
                 f"| `{topic.name}` | {', '.join(topic.types)} "
                 f"| {topic.publishers} | {topic.subscribers} |"
             )
+        if graph.services or graph.actions:
+            parts += ["", f"**Actions ({len(graph.actions)})** · `ros2 action list`", ""]
+            parts += [f"- `{name}`" for name in graph.actions] or ["- (none)"]
         self._view.show("\n".join(parts))
+
+    def _refresh_picture(self, graph: GraphSnapshot) -> None:
+        node, rates = self._node, self._rates
+        if node is None or rates is None:
+            return
+        now = time.monotonic()
+        if now - self._last_picture < PICTURE_PERIOD_SEC:
+            return
+        self._last_picture = now
+        own = node.get_fully_qualified_name()
+        endpoints = [
+            found
+            for fqn in graph.nodes
+            if (self._show_self.value or fqn != own)
+            and (found := node_endpoints(node, fqn)) is not None
+        ]
+        quiet = self._show_quiet.value
+        if self._live.value:
+            shape = graph_picture(endpoints, show_quiet=quiet)
+            rates.watch(topics_to_measure(shape, endpoints, heavy_too=self._heavy.value))
+        else:
+            rates.watch({})
+        labels = {topic: rate_text(rates.rate(topic)) for topic in rates.watched()}
+        vertices, edges = graph_picture(endpoints, labels, show_quiet=quiet)
+        svg = render_svg(vertices, edges)
+        if svg != self._svg:
+            self._svg = svg
+            self._picture.content = svg

@@ -1,0 +1,79 @@
+"""Live topic rates for the panels, measured cheaply.
+
+One best-effort raw ``TopicMonitor`` per watched topic: best effort so a
+reliable publisher is never slowed by us, raw so an image or a point cloud is
+counted, never deserialized. The set of watched topics is capped, and
+changed only when the caller's wish list changes.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+
+from rclpy.node import Node
+
+from app.ros2cli.convert import ConversionError, import_type
+from app.ros2cli.topic import MEASURE_QOS, TopicMonitor
+
+log = logging.getLogger(__name__)
+
+MAX_WATCHED = 30
+RATE_WINDOW_SEC = 3.0
+
+
+class RateBoard:
+    """Rates of a changing set of topics; ``watch`` from one thread, ``rate`` from any."""
+
+    def __init__(self, node: Node, limit: int = MAX_WATCHED) -> None:
+        self._node = node
+        self._limit = limit
+        self._lock = threading.Lock()
+        self._monitors: dict[str, tuple[str, TopicMonitor]] = {}
+
+    def watch(self, topics: dict[str, str]) -> None:
+        """Measure exactly these topics (name -> type), at most ``limit`` of them."""
+        wanted = dict(sorted(topics.items())[: self._limit])
+        with self._lock:
+            stale = [t for t, (kind, _m) in self._monitors.items() if wanted.get(t) != kind]
+            dropped = [self._monitors.pop(t)[1] for t in stale]
+            missing = [t for t in wanted if t not in self._monitors]
+        for monitor in dropped:
+            monitor.close()
+        for topic in missing:
+            try:
+                msg_type = import_type(wanted[topic], "msg")
+            except ConversionError:
+                continue  # a type this environment does not have: no rate, no crash
+            monitor = TopicMonitor(self._node, topic, msg_type, window=200, keep=1, qos=MEASURE_QOS)
+            with self._lock:
+                self._monitors[topic] = (wanted[topic], monitor)
+
+    def watched(self) -> list[str]:
+        with self._lock:
+            return sorted(self._monitors)
+
+    def rate(self, topic: str, window_sec: float = RATE_WINDOW_SEC) -> float | None:
+        """Messages per second over the last few seconds; 0.0 when silent, None if unwatched."""
+        with self._lock:
+            entry = self._monitors.get(topic)
+        if entry is None:
+            return None
+        stats = entry[1].rate(window_sec=window_sec)
+        return stats.rate if stats else 0.0
+
+    def close(self) -> None:
+        with self._lock:
+            monitors = [m for _kind, m in self._monitors.values()]
+            self._monitors = {}
+        for monitor in monitors:
+            monitor.close()
+
+
+def rate_text(rate: float | None) -> str:
+    """'2.0 Hz', 'silent', or '' when not measured."""
+    if rate is None:
+        return ""
+    if rate <= 0:
+        return "silent"
+    return f"{rate:.1f} Hz" if rate < 100 else f"{rate:.0f} Hz"

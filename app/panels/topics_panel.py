@@ -1,0 +1,413 @@
+"""Topics panel: every topic with its counts; echo, hz, bw, a plot and a publish form for one.
+
+One ``TopicMonitor`` (app.ros2cli, the same one behind `ros2 topic echo/hz/bw`)
+watches the selected topic as raw bytes; messages are deserialized here only
+when new ones arrived, at most ``KEEP`` per refresh, so a fast or large topic
+costs little. Publishing reuses the generated ``MessageForm``: once (after
+waiting briefly for subscribers to match, as `ros2 topic pub --once` does) or
+at a rate from a timer on the dashboard's node, never blocking a callback.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from collections import deque
+from typing import Any
+
+import numpy as np
+import viser
+import viser.uplot as uplot
+from rclpy.node import Node
+from rclpy.timer import Timer
+
+from app.graph import GraphSnapshot
+from app.panels import MarkdownView, code_block
+from app.panels.ros_tools import MessageForm, run_job, yaml_inline
+from app.ros2cli import Ros2Error
+from app.ros2cli.convert import (
+    ConversionError,
+    field_value,
+    import_type,
+    leaf_fields,
+    to_yaml,
+    type_name,
+)
+from app.ros2cli.topic import TopicMonitor, matching_qos
+
+NONE = "(pick a topic)"
+NO_FIELD = "(no field)"
+KEEP = 10  # raw messages the monitor keeps; also the most deserialized per refresh
+SHOWN_MESSAGES = 3
+ECHO_LINES = 36  # fewer messages are shown when each is long
+PLOT_WINDOW_SEC = 30.0
+PLOT_SAMPLES = 600
+STATS_WINDOW_SEC = 5.0
+COUNTS_PERIOD_SEC = 1.0
+MATCH_WAIT_SEC = 3.0
+MAX_RATE_HZ = 100.0
+
+
+def numeric_fields(cls: type) -> list[str]:
+    """Paths of the number fields of a message type, nested ones too ('linear.x')."""
+    return [path for path, _ros, kind in leaf_fields(cls) if kind in ("int", "float")]
+
+
+def preferred_field(cls: type) -> str:
+    """The field a learner most likely wants to see first: a float, else any number."""
+    fields = leaf_fields(cls)
+    for kind in ("float", "int"):
+        found = next((path for path, _ros, k in fields if k == kind), None)
+        if found:
+            return found
+    return NO_FIELD
+
+
+def plot_value(msg: Any, path: str) -> float | None:
+    """The number at ``path`` as a float, or None when it is not a finite number."""
+    try:
+        value = field_value(msg, path)
+    except ConversionError:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return None
+    value = float(value)
+    return value if math.isfinite(value) else None
+
+
+def others_count(infos: list[Any], own_name: str, own_namespace: str) -> int:
+    """Endpoints not belonging to this dashboard (its own taps would confuse a learner)."""
+    return sum(1 for i in infos if (i.node_name, i.node_namespace) != (own_name, own_namespace))
+
+
+class TopicsPanel:
+    def __init__(self, gui: viser.GuiApi, node: Node) -> None:
+        self._gui = gui
+        self._node = node
+        self._lock = threading.RLock()
+        self._types: dict[str, str] = {}
+        self._counts: dict[str, tuple[int, int]] = {}
+        self._counts_at = 0.0
+        self._topic: str | None = None
+        self._monitor: TopicMonitor | None = None
+        self._seen = 0
+        self._latest: deque[tuple[float, Any]] = deque(maxlen=SHOWN_MESSAGES)
+        self._samples: deque[tuple[float, float]] = deque(maxlen=PLOT_SAMPLES)
+        self._plot_dirty = False
+        self._plot_path = ""
+        self._publisher: Any = None
+        self._timer: Timer | None = None
+        self._sent = 0
+        self._pub_message = ""
+
+        gui.add_markdown(
+            "Every topic on the graph. Counts leave out this dashboard's own "
+            "subscriptions (`ros2 topic list -t`, `ros2 topic info <topic>`)."
+        )
+        self._table = MarkdownView(gui, "")
+        self._selector = gui.add_dropdown("Topic", [NONE], initial_value=NONE)
+        self._info = MarkdownView(gui, "")
+        with gui.add_folder("Echo", expand_by_default=True):
+            self._stats = MarkdownView(gui, "")
+            self._echo = MarkdownView(gui, "")
+        with gui.add_folder("Plot", expand_by_default=True):
+            self._field = gui.add_dropdown("Field to plot", [NO_FIELD], initial_value=NO_FIELD)
+            self._plot_note = MarkdownView(gui, "")
+            self._plot = gui.add_uplot(
+                (np.zeros(0), np.zeros(0)),
+                (uplot.Series(label="t (s)"), uplot.Series(label="value", stroke="#1c7ed6")),
+                scales={"x": uplot.Scale(time=False)},
+                height=200,
+                visible=False,
+            )
+        with gui.add_folder("Publish", expand_by_default=True):
+            self._form_slot = gui.add_folder("Message", expand_by_default=True)
+            self._form: MessageForm | None = None
+            self._rate = gui.add_number("Rate (Hz)", 1.0, min=0.1, max=MAX_RATE_HZ, step=0.1)
+            self._once = gui.add_button("Publish once", icon=viser.Icon.SEND, disabled=True)
+            self._start = gui.add_button(
+                "Publish at rate", icon=viser.Icon.PLAYER_PLAY, disabled=True
+            )
+            self._stop = gui.add_button(
+                "Stop publishing", icon=viser.Icon.PLAYER_STOP, disabled=True
+            )
+            self._pub_view = MarkdownView(gui, "")
+        self._selector.on_update(lambda _: self._select(self._selector.value))
+        self._field.on_update(lambda _: self._clear_plot())
+        self._once.on_click(lambda _: self._publish_once())
+        self._start.on_click(lambda _: self._publish_at_rate())
+        self._stop.on_click(lambda _: self._stop_publishing())
+
+    # --- selection -------------------------------------------------------------
+
+    def _select(self, topic: str) -> None:
+        """Called from viser callbacks and the UI thread: one switch at a time."""
+        with self._lock:
+            chosen = None if topic == NONE else topic
+            type_text = self._types.get(chosen or "")
+            current = self._monitor.msg_type if self._monitor else None
+            if chosen == self._topic and (
+                type_text is None or (current and type_name(current) == type_text)
+            ):
+                return
+            self._stop_publishing()
+            self._drop_publisher()
+            if self._monitor is not None:
+                self._monitor.close()
+                self._monitor = None
+            if self._form is not None:
+                self._form.remove()
+                self._form = None
+            self._topic, self._seen = chosen, 0
+            self._latest.clear()
+            self._pub_message = ""
+            fields: list[str] = []
+            cls = None
+            if chosen and type_text:
+                try:
+                    cls = import_type(type_text, "msg")
+                except ConversionError as exc:
+                    self._pub_message = f"⚠️ {exc}"
+            if chosen and cls is not None:
+                qos = matching_qos(self._node, chosen, depth=KEEP)
+                self._monitor = TopicMonitor(self._node, chosen, cls, keep=KEEP, qos=qos)
+                fields = numeric_fields(cls)
+                with self._form_slot:
+                    self._form = MessageForm(self._gui, cls, type_text or "")
+            self._field.options = [NO_FIELD, *fields]
+            self._field.value = preferred_field(cls) if cls is not None else NO_FIELD
+            self._clear_plot()
+            for button in (self._once, self._start):
+                button.disabled = self._form is None
+
+    def _clear_plot(self) -> None:
+        with self._lock:
+            self._samples.clear()
+            self._plot_dirty = True
+
+    # --- publishing ------------------------------------------------------------
+
+    def _message(self) -> Any | None:
+        form = self._form
+        if form is None:
+            return None
+        try:
+            return form.message()
+        except Ros2Error as exc:
+            self._pub_message = f"⚠️ {exc}"
+            return None
+
+    def _ensure_publisher(self) -> Any:
+        with self._lock:
+            if self._publisher is None and self._monitor is not None:
+                self._publisher = self._node.create_publisher(
+                    self._monitor.msg_type, self._monitor.topic, 10
+                )
+            return self._publisher
+
+    def _drop_publisher(self) -> None:
+        with self._lock:
+            publisher, self._publisher = self._publisher, None
+        if publisher is not None:
+            self._node.destroy_publisher(publisher)
+
+    def _publish_once(self) -> None:
+        msg, topic, type_text = self._message(), self._topic, self._types.get(self._topic or "")
+        if msg is None or topic is None:
+            return
+        command = f"ros2 topic pub --once {topic} {type_text} {yaml_inline(msg)}"
+        self._pub_message = f"`{command}`\n\nwaiting for subscribers to match…"
+
+        def work() -> None:
+            publisher = self._ensure_publisher()
+            if publisher is None:
+                return
+            # A fresh publisher is matched to subscribers after discovery: wait for
+            # them (bounded) so a reliable listener does not miss the one message.
+            deadline = time.monotonic() + MATCH_WAIT_SEC
+            while time.monotonic() < deadline and publisher.get_subscription_count() < (
+                self._node.count_subscribers(topic)
+            ):
+                time.sleep(0.05)
+            publisher.publish(msg)
+            self._pub_message = f"`{command}`\n\npublished 1 message"
+
+        run_job(work, lambda text: setattr(self, "_pub_message", f"`{command}`\n\n⚠️ {text}"))
+
+    def _publish_at_rate(self) -> None:
+        msg, topic, type_text = self._message(), self._topic, self._types.get(self._topic or "")
+        rate = float(self._rate.value)
+        if msg is None or topic is None:
+            return
+        if not 0 < rate <= MAX_RATE_HZ:
+            self._pub_message = f"⚠️ the rate must be between 0.1 and {MAX_RATE_HZ:g} Hz"
+            return
+        self._stop_publishing()
+        publisher = self._ensure_publisher()
+        if publisher is None:
+            return
+        command = f"ros2 topic pub -r {rate:g} {topic} {type_text} {yaml_inline(msg)}"
+        self._sent = 0
+
+        def on_timer() -> None:
+            publisher.publish(msg)
+            self._sent += 1
+
+        with self._lock:
+            self._timer = self._node.create_timer(1.0 / rate, on_timer)
+            self._pub_message = f"`{command}`"
+        self._stop.disabled = False
+
+    def _stop_publishing(self) -> None:
+        with self._lock:
+            timer, self._timer = self._timer, None
+        if timer is not None:
+            self._node.destroy_timer(timer)
+            self._pub_message += f"\n\nstopped after {self._sent} messages"
+        self._stop.disabled = True
+
+    # --- refresh ---------------------------------------------------------------
+
+    def refresh(self, graph: GraphSnapshot | None) -> None:
+        if graph is not None:
+            self._refresh_list(graph)
+        with self._lock:
+            monitor, topic = self._monitor, self._topic
+            fresh = self._take_fresh(monitor)
+        self._show_topic(topic, monitor, fresh)
+        self._show_plot()
+        with self._lock:
+            text, timer = self._pub_message, self._timer
+        if timer is not None:
+            text += f"\n\npublishing: {self._sent} sent so far"
+        self._pub_view.show(text)
+
+    def _refresh_list(self, graph: GraphSnapshot) -> None:
+        types = {t.name: t.types[0] for t in graph.topics if t.types}
+        now = time.monotonic()
+        if types != self._types or now - self._counts_at > COUNTS_PERIOD_SEC:
+            self._counts_at = now
+            node = self._node
+            me = (node.get_name(), node.get_namespace())
+            self._counts = {
+                topic: (
+                    others_count(node.get_publishers_info_by_topic(topic), *me),
+                    others_count(node.get_subscriptions_info_by_topic(topic), *me),
+                )
+                for topic in types
+            }
+        rows = ["| topic | type | publishers | subscribers |", "|---|---|---|---|"]
+        for topic, type_text in sorted(types.items()):
+            pubs, subs = self._counts.get(topic, (0, 0))
+            rows.append(f"| `{topic}` | {type_text} | {pubs} | {subs} |")
+        self._table.show("\n".join(rows))
+        if types != self._types:
+            self._types = types
+            options = [NONE, *sorted(types)]
+            current = self._selector.value
+            if current not in options:
+                options.append(current)  # keep a vanished topic selected: it may come back
+            self._selector.options = options
+            self._selector.value = current
+            self._select(current)
+
+    def _take_fresh(self, monitor: TopicMonitor | None) -> list[tuple[float, Any]]:
+        """New messages since the last refresh (at most KEEP), fed to echo and the plot."""
+        if monitor is None or monitor.count == self._seen:
+            return []
+        fresh = monitor.messages_since(self._seen)
+        self._seen = monitor.count
+        self._latest.extend(fresh)
+        path = self._field.value
+        if path != NO_FIELD:
+            for stamp, msg in fresh:
+                value = plot_value(msg, path)
+                if value is not None:
+                    self._samples.append((stamp, value))
+                    self._plot_dirty = True
+        return fresh
+
+    def _show_topic(self, topic: str | None, monitor: TopicMonitor | None, fresh: list) -> None:
+        if topic is None:
+            self._info.show("_Pick a topic to echo, measure, plot or publish on it._")
+            self._stats.show("")
+            self._echo.show("")
+            return
+        type_text = self._types.get(topic)
+        pubs, subs = self._counts.get(topic, (0, 0))
+        if type_text is None:
+            self._info.show(f"`{topic}` is not on the graph right now.")
+        else:
+            self._info.show(
+                f"`{topic}` · type `{type_text}` · {pubs} publisher{'s' * (pubs != 1)}, "
+                f"{subs} subscriber{'s' * (subs != 1)} · `ros2 topic info {topic} -v`"
+            )
+        if monitor is None:
+            return
+        rate = monitor.rate(window_sec=STATS_WINDOW_SEC)
+        band = monitor.bandwidth(window_sec=STATS_WINDOW_SEC)
+        hz = f"**{rate.rate:.2f} Hz**" if rate else ("silent" if monitor.count else "waiting…")
+        bw = (
+            f"**{band.ros2_text().splitlines()[0]}**"
+            if band
+            else ("silent" if monitor.count else "waiting…")
+        )
+        self._stats.show(
+            f"Rate: {hz} · `ros2 topic hz {topic}`\n\n"
+            f"Bandwidth: {bw} · `ros2 topic bw {topic}`\n\n"
+            f"Messages received: {monitor.count}"
+        )
+        if fresh or not self._latest:
+            with self._lock:
+                latest = list(self._latest)
+            shown: list[str] = []
+            for _stamp, msg in reversed(latest):
+                text = to_yaml(msg) + "\n---"
+                if shown and sum(t.count("\n") + 1 for t in shown) + text.count("\n") > ECHO_LINES:
+                    break
+                shown.insert(0, text)
+            self._echo.show(
+                f"Latest messages · `ros2 topic echo {topic}`\n\n"
+                + code_block(shown, f"(no message on {topic} yet)")
+            )
+
+    def _show_plot(self) -> None:
+        path = self._field.value
+        topic = self._topic
+        if topic is None or path == NO_FIELD:
+            cls = self._monitor.msg_type if self._monitor else None
+            self._plot_note.show(
+                f"`{type_name(cls)}` has no number field to plot."
+                if cls and not numeric_fields(cls)
+                else ""
+            )
+            if self._plot.visible:
+                self._plot.visible = False
+            return
+        with self._lock:
+            if not self._plot_dirty:
+                return
+            self._plot_dirty = False
+            samples = list(self._samples)
+        if samples:
+            end = samples[-1][0]
+            samples = [s for s in samples if end - s[0] <= PLOT_WINDOW_SEC]
+        note = f"{len(samples)} samples of `{path}`"
+        if samples:
+            note += f", latest {samples[-1][1]:.4g}"
+        self._plot_note.show(f"{note} · `ros2 topic echo {topic} --field {path}`")
+        if len(samples) < 2:
+            return
+        start = samples[0][0]
+        t = np.array([s[0] - start for s in samples])
+        y = np.array([s[1] for s in samples])
+        if path != self._plot_path:
+            self._plot_path = path
+            self._plot.series = (
+                uplot.Series(label="t (s)"),
+                uplot.Series(label=path, stroke="#1c7ed6", width=2),
+            )
+        self._plot.data = (t, y)
+        if not self._plot.visible:
+            self._plot.visible = True

@@ -1,0 +1,153 @@
+"""Smoke tests of the Topics, Parameters and Graph panels against real catalog nodes."""
+
+from __future__ import annotations
+
+import re
+import time
+
+import pytest
+from playwright.sync_api import Page, expect
+from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+from tests.browser.helpers import click, expect_text, open_tab
+
+pytestmark = [pytest.mark.browser, pytest.mark.ros]
+
+
+def start(page: Page, name: str) -> None:
+    open_tab(page, "Nodes")
+    choose(page, "Catalog node", name)
+    click(page, "Start")
+    expect_text(page, f"Started {name}")
+
+
+def stop(page: Page, name: str) -> None:
+    open_tab(page, "Nodes")
+    choose(page, "Catalog node", name)
+    click(page, "Stop")
+    expect_text(page, f"Stopping {name}")
+
+
+def choose(page: Page, label: str, option: str, timeout: float = 30.0) -> None:
+    """Pick a dropdown option that may be listed only once discovery has found it."""
+    dropdown = page.get_by_label(label).locator("visible=true").first
+    wanted = page.get_by_role("option", name=option, exact=True)
+    deadline = time.monotonic() + timeout
+    while True:
+        dropdown.click()
+        try:
+            wanted.wait_for(timeout=1_500)
+            break
+        except PlaywrightTimeout:
+            page.keyboard.press("Escape")  # not listed yet: close, let the panel refresh
+            if time.monotonic() > deadline:
+                pytest.fail(f"option {option!r} never appeared in {label!r}")
+            page.wait_for_timeout(500)
+    wanted.click()
+
+
+def field(page: Page, label: str):
+    """The visible text or number input on a viser row labelled ``label``."""
+    exact = re.compile(rf"^{re.escape(label)}$")
+    text = page.locator("label").filter(has_text=exact).locator("visible=true").first
+    row = text.locator("xpath=ancestor::div[contains(@class,'mantine-Flex-root')][1]")
+    return row.locator("input:not([type=hidden])").first
+
+
+def visible_text(page: Page, pattern: str):
+    return page.get_by_text(re.compile(pattern)).locator("visible=true").first
+
+
+def expect_regex(page: Page, pattern: str, timeout: float = 30_000) -> None:
+    expect(visible_text(page, pattern)).to_be_visible(timeout=timeout)
+
+
+def test_topics_echo_hz_publish_and_plot(page):
+    start(page, "talker")
+    start(page, "camera_publisher")
+    open_tab(page, "Topics")
+    choose(page, "Topic", "/chatter")
+    expect_regex(page, r"data: 'Hello World: \d+'")
+    expect_regex(page, r"Rate: [12]\.\d\d Hz")
+    expect_regex(page, r"Bandwidth: \d+\.\d\d B/s")
+    expect_regex(page, r"std_msgs/msg/String has no number field to plot")
+    expect_regex(page, r"ros2 topic echo /chatter")
+
+    field(page, "data (string)").fill("Hello from the browser")
+    click(page, "Publish once")
+    expect_regex(page, r"published 1 message")
+    expect_regex(page, r"ros2 topic pub --once /chatter std_msgs/msg/String")
+    expect_regex(page, r"^data: Hello from the browser$|data: Hello from the browser\n")
+
+    field(page, "Rate (Hz)").fill("10")
+    click(page, "Publish at rate")
+    expect_regex(page, r"publishing: ([3-9]|\d\d+) sent so far")
+    click(page, "Stop publishing")
+    expect_regex(page, r"stopped after \d+ messages")
+
+    choose(page, "Topic", "/pos_in_cam_frame")
+    expect(page.get_by_label("Field to plot").locator("visible=true").first).to_have_value(
+        "point.x", timeout=20_000
+    )
+    expect_regex(page, r"([5-9]|\d\d+) samples of point\.x, latest -?\d")
+    plot = page.locator(".uplot canvas").locator("visible=true")
+    expect(plot.first).to_be_visible(timeout=10_000)
+    # uPlot lays out one x tick label per grid step: the axis has numbers, so data arrived.
+    expect(page.locator(".uplot .u-axis").first).to_be_visible()
+
+
+def test_parameters_set_rate_and_refused_greeting(page):
+    start(page, "parameters_node")
+    open_tab(page, "Parameters")
+    choose(page, "Node", "/parameters_node")
+    set_rate = page.get_by_role("button", name="Set publish_rate_hz", exact=True)
+    expect(set_rate).to_be_visible(timeout=30_000)
+    expect_regex(page, r"publish_rate_hz \(double, 0\.1 to 20\)")
+    expect_regex(page, r"/greeting: [12]\.\d Hz")
+
+    rate = field(page, "publish_rate_hz")
+    rate.fill("5")
+    rate.press("Enter")
+    set_rate.click()
+    expect_regex(page, r"ros2 param set /parameters_node publish_rate_hz 5\.0")
+    expect_regex(page, r"Set parameter successful")
+    expect_regex(page, r"/greeting: (4\.[5-9]|5\.[0-4]) Hz", timeout=30_000)
+
+    field(page, "greeting").fill("")
+    click(page, "Set greeting")
+    expect_regex(page, r"Set parameter failed: greeting must not be empty")
+
+
+def test_graph_shows_services_actions_and_rates(page):
+    for name in ("talker", "add_two_ints_server", "fibonacci_action_server"):
+        start(page, name)
+    open_tab(page, "Graph")
+
+    def vertex(kind: str, name: str):
+        return page.locator(f'svg.ros-graph g.rg-vertex[data-kind="{kind}"][data-name="{name}"]')
+
+    for kind, name in (
+        ("node", "/add_two_ints_server"),
+        ("service", "/add_two_ints"),
+        ("node", "/fibonacci_action_server"),
+        ("action", "/fibonacci"),
+        ("node", "/talker"),
+        ("topic", "/chatter"),
+    ):
+        expect(vertex(kind, name)).to_have_count(1, timeout=30_000)
+    edge = page.locator('svg.ros-graph path.rg-edge[data-source="/talker"][data-target="/chatter"]')
+    expect(edge).to_have_count(1)
+    expect(
+        page.locator("svg.ros-graph text.rg-rate", has_text=re.compile(r"[12]\.\d Hz")).first
+    ).to_be_visible(timeout=30_000)
+
+    for name in ("add_two_ints_server", "fibonacci_action_server"):
+        stop(page, name)
+    open_tab(page, "Graph")
+    for kind, name in (
+        ("node", "/add_two_ints_server"),
+        ("service", "/add_two_ints"),
+        ("action", "/fibonacci"),
+    ):
+        expect(vertex(kind, name)).to_have_count(0, timeout=30_000)
+    expect(vertex("node", "/talker")).to_have_count(1)
