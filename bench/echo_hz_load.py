@@ -1,0 +1,324 @@
+"""Benchmark: echo and hz of 11 busy topics in the dashboard, against plain subscribers.
+
+A publisher process sends 10 topics of small messages (``std_msgs/Int64``) at
+1 kHz each and one 640x480 RGB ``sensor_msgs/Image`` at 30 Hz. Then, in turn
+and over the same kind of window:
+
+- **baseline**: one plain rclpy subscriber process per topic (11 processes),
+  a callback that only notes the arrival time;
+- **dashboard**: the dashboard as ``serve`` builds it (viser server, ROS
+  runtime, supervisor, every panel) plus, on its own node, one
+  ``TopicMonitor`` per topic (the raw subscription behind the dashboard's
+  echo and hz) and a 5 Hz view that deserializes each topic's latest message,
+  renders it as ``ros2 topic echo`` YAML and its rate as ``ros2 topic hz``
+  into a markdown handle.
+
+Both subscribe with the dashboard's measuring QoS (best effort, depth 100).
+Figures: received messages per second (dashboard / baseline), and the hz each
+shows against the rate actually published in the window (the error, in %).
+
+Run: ``.venv/bin/python tests/run.py --bench echo_hz_load [--seconds S]``.
+The last line printed is one JSON object.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+from bench._common import (
+    LOGS,
+    configure_dds,
+    rate_from_stamps,
+    ratio,
+    require_private_netns,
+    rounded,
+    spawn,
+    stop,
+    wait_for_text,
+)
+
+SMALL_TOPICS = tuple(f"/bench/load_{k}" for k in range(10))
+IMAGE_TOPIC = "/bench/image"
+SMALL_HZ = 1000.0
+IMAGE_HZ = 30.0
+WARMUP_SEC = 6.0
+
+
+def _types() -> tuple[type, type]:
+    from sensor_msgs.msg import Image
+    from std_msgs.msg import Int64
+
+    return Int64, Image
+
+
+def _measure_qos() -> Any:
+    from app.ros2cli.topic import MEASURE_QOS
+
+    return MEASURE_QOS
+
+
+# ------------------------------------------------------------------ child processes
+
+
+def publisher_main(out: Path) -> None:
+    """Publish until SIGINT; then write the monotonic time of every 1 kHz tick and image."""
+    import rclpy
+    from rclpy.node import Node
+
+    Int64, Image = _types()
+    rclpy.init()
+    node = Node("bench_load_publisher")
+    small = [node.create_publisher(Int64, t, 10) for t in SMALL_TOPICS]
+    image_pub = node.create_publisher(Image, IMAGE_TOPIC, 10)
+    image = Image(height=480, width=640, encoding="rgb8", step=640 * 3)
+    image.data = bytes(640 * 480 * 3)
+    msg = Int64()
+    ticks: list[float] = []
+    images: list[float] = []
+    stopping = threading.Event()
+    signal.signal(signal.SIGINT, lambda *_: stopping.set())
+    print("PUBLISHER READY", flush=True)
+    start = time.monotonic()
+    k = 0
+    next_image = start
+    while not stopping.is_set():
+        due = start + k / SMALL_HZ
+        now = time.monotonic()
+        if due > now:
+            time.sleep(due - now)
+        msg.data = k
+        for pub in small:
+            pub.publish(msg)
+        ticks.append(time.monotonic())
+        k += 1
+        if ticks[-1] >= next_image:
+            image_pub.publish(image)
+            images.append(time.monotonic())
+            next_image += 1.0 / IMAGE_HZ
+    out.write_text(json.dumps({"ticks": ticks, "images": images}))
+    node.destroy_node()
+    rclpy.try_shutdown()
+
+
+def baseline_main(topic: str, t0: float, t1: float, out: Path) -> None:
+    """One plain subscriber: note arrival times, keep those inside [t0, t1]."""
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+
+    Int64, Image = _types()
+    rclpy.init()
+    node = Node(f"bench_plain_{topic.rsplit('/', 1)[-1]}")
+    stamps: list[float] = []
+    node.create_subscription(
+        Image if topic == IMAGE_TOPIC else Int64,
+        topic,
+        lambda _msg: stamps.append(time.monotonic()),
+        _measure_qos(),
+    )
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    while time.monotonic() < t1 + 0.2:
+        executor.spin_once(timeout_sec=0.05)
+    inside = [s for s in stamps if t0 <= s <= t1]
+    out.write_text(
+        json.dumps({"topic": topic, "count": len(inside), "hz": rate_from_stamps(inside)})
+    )
+    executor.shutdown()
+    node.destroy_node()
+    rclpy.try_shutdown()
+
+
+def dashboard_main(t0: float, t1: float, out: Path) -> None:
+    """The dashboard as `serve` builds it, plus echo + hz views of every load topic."""
+    import viser
+
+    from app.dashboard import Dashboard
+    from app.lessons.progress import ProgressStore
+    from app.panels import MarkdownView, code_block
+    from app.ros2cli.convert import to_yaml
+    from app.ros2cli.topic import TopicMonitor
+    from app.ros_runtime import RosRuntime
+    from app.supervisor import Supervisor
+
+    Int64, Image = _types()
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    runtime = RosRuntime()
+    supervisor = Supervisor({})
+    dashboard = Dashboard(server, runtime, supervisor, ProgressStore("bench", LOGS / "bench-p"))
+    dashboard.start()
+    topics = [*SMALL_TOPICS, IMAGE_TOPIC]
+    monitors = {
+        t: TopicMonitor(
+            runtime.node, t, Image if t == IMAGE_TOPIC else Int64, qos=_measure_qos(), keep=10
+        )
+        for t in topics
+    }
+    views = {t: MarkdownView(server.gui) for t in topics}
+    readings: dict[str, dict[str, float]] = {}
+    stop_views = threading.Event()
+
+    def show() -> None:  # the echo + hz views, 5 Hz as the panels refresh
+        while not stop_views.wait(0.2):
+            for topic, monitor in monitors.items():
+                latest = monitor.message()
+                stats = monitor.rate(window_sec=2.0)
+                text = f"`ros2 topic hz {topic}`: " + (stats.ros2_text() if stats else "-")
+                if latest is not None:
+                    text += "\n\n" + code_block(to_yaml(latest[1]).splitlines())
+                views[topic].show(text)
+
+    viewer = threading.Thread(target=show, daemon=True)
+    viewer.start()
+    print("DASHBOARD SIDE READY", flush=True)
+    time.sleep(max(0.0, t0 - time.monotonic()))
+    before = {t: m.count for t, m in monitors.items()}
+    time.sleep(max(0.0, t1 - time.monotonic()))
+    after = {t: m.count for t, m in monitors.items()}
+    shown = {t: m.rate(window_sec=t1 - t0) for t, m in monitors.items()}
+    for topic in topics:
+        readings[topic] = {
+            "count": after[topic] - before[topic],
+            "hz": shown[topic].rate if shown[topic] else float("nan"),
+        }
+    out.write_text(json.dumps(readings))
+    stop_views.set()
+    viewer.join(1.0)
+    dashboard.stop()
+    for monitor in monitors.values():
+        monitor.close()
+    runtime.shutdown()
+    supervisor.shutdown()
+    server.stop()
+
+
+# ------------------------------------------------------------------ orchestration
+
+
+def _window(seconds: float) -> tuple[float, float]:
+    t0 = time.monotonic() + WARMUP_SEC
+    return t0, t0 + seconds
+
+
+def _published(pub_data: dict[str, list[float]], t0: float, t1: float) -> dict[str, float]:
+    ticks = [t for t in pub_data["ticks"] if t0 <= t <= t1]
+    images = [t for t in pub_data["images"] if t0 <= t <= t1]
+    span = t1 - t0
+    rates = {t: len(ticks) / span for t in SMALL_TOPICS}
+    rates[IMAGE_TOPIC] = len(images) / span
+    return rates
+
+
+def _child(argv: list[str], log: str) -> tuple[subprocess.Popen, Path]:
+    return spawn([sys.executable, "-m", "bench.echo_hz_load", *argv], log)
+
+
+def run(seconds: float) -> dict[str, Any]:
+    require_private_netns("echo_hz_load")
+    configure_dds(50)
+    LOGS.mkdir(exist_ok=True)
+    pub_out = LOGS / "bench-load-published.json"
+    publisher, pub_log = _child(["--publisher", str(pub_out)], "bench-load-publisher.log")
+    results: dict[str, dict[str, Any]] = {}
+    windows: dict[str, tuple[float, float]] = {}
+    try:
+        wait_for_text(publisher, pub_log, "PUBLISHER READY", 30)
+        # Baseline: one plain subscriber process per topic.
+        t0, t1 = windows["baseline"] = _window(seconds)
+        procs = []
+        for k, topic in enumerate([*SMALL_TOPICS, IMAGE_TOPIC]):
+            out = LOGS / f"bench-load-plain-{k}.json"
+            args = ["--baseline", topic, f"{t0!r}", f"{t1!r}", str(out)]
+            procs.append((_child(args, f"bench-load-plain-{k}.log")[0], out))
+        results["baseline"] = {}
+        for proc, out in procs:
+            proc.wait(timeout=WARMUP_SEC + seconds + 30)
+            data = json.loads(out.read_text())
+            results["baseline"][data["topic"]] = data
+        # Dashboard: one process, every topic.
+        t0, t1 = windows["dashboard"] = _window(seconds)
+        out = LOGS / "bench-load-dashboard.json"
+        proc, log = _child(
+            ["--dashboard-side", f"{t0!r}", f"{t1!r}", str(out)], "bench-load-dashboard.log"
+        )
+        proc.wait(timeout=WARMUP_SEC + seconds + 30)
+        if proc.returncode != 0:
+            raise SystemExit(f"dashboard side failed:\n{log.read_text(errors='replace')}")
+        results["dashboard"] = json.loads(out.read_text())
+    finally:
+        stop(publisher)
+    pub_data = json.loads(pub_out.read_text())
+    figures: dict[str, Any] = {"seconds": seconds}
+    totals = {}
+    errors: dict[str, list[float]] = {"baseline": [], "dashboard": []}
+    for side in ("baseline", "dashboard"):
+        t0, t1 = windows[side]
+        published = _published(pub_data, t0, t1)
+        got = results[side]
+        totals[side] = sum(got[t]["count"] for t in published) / (t1 - t0)
+        for topic, rate in published.items():
+            hz = got[topic]["hz"]
+            error = abs(hz - rate) / rate * 100 if rate and hz == hz else float("nan")
+            errors[side].append(error)
+            key = "image" if topic == IMAGE_TOPIC else "small"
+            figures.setdefault(f"{side}_{key}_received_hz", []).append(
+                got[topic]["count"] / (t1 - t0)
+            )
+        figures[f"{side}_published_per_s"] = sum(published.values())
+        figures[f"{side}_received_per_s"] = totals[side]
+    for side in ("baseline", "dashboard"):
+        for key in ("small", "image"):
+            values = figures.pop(f"{side}_{key}_received_hz")
+            figures[f"{side}_{key}_received_hz"] = sum(values) / len(values)
+        figures[f"{side}_hz_error_percent"] = max(errors[side])
+    figures["echo_ratio"] = ratio(totals["dashboard"], totals["baseline"])
+    figures["hz_error_percent"] = figures["dashboard_hz_error_percent"]
+    return figures
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m bench echo_hz_load")
+    parser.add_argument("--seconds", type=float, default=5.0)
+    parser.add_argument("--publisher", type=Path, help=argparse.SUPPRESS)
+    parser.add_argument("--baseline", nargs=4, help=argparse.SUPPRESS)
+    parser.add_argument("--dashboard-side", nargs=3, help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.publisher:
+        publisher_main(args.publisher)
+        return 0
+    if args.baseline:
+        topic, t0, t1, out = args.baseline
+        baseline_main(topic, float(t0), float(t1), Path(out))
+        return 0
+    if args.dashboard_side:
+        t0, t1, out = args.dashboard_side
+        dashboard_main(float(t0), float(t1), Path(out))
+        return 0
+    f = run(args.seconds)
+    for side in ("baseline", "dashboard"):
+        print(
+            f"{side:9s}: published {f[f'{side}_published_per_s']:7.0f} msg/s, received "
+            f"{f[f'{side}_received_per_s']:7.0f} msg/s (small topics "
+            f"{f[f'{side}_small_received_hz']:.0f} Hz each, image "
+            f"{f[f'{side}_image_received_hz']:.1f} Hz), worst hz error "
+            f"{f[f'{side}_hz_error_percent']:.1f} %"
+        )
+    f["aim_met"] = bool(f["echo_ratio"] >= 0.9 and f["hz_error_percent"] <= 1.0)
+    print(
+        f"received ratio dashboard/plain {f['echo_ratio']:.2f}x (aim >= 0.9), dashboard hz "
+        f"error {f['hz_error_percent']:.1f} % (aim <= 1 %)"
+    )
+    print(json.dumps(rounded(f, 2), sort_keys=True))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
