@@ -1,0 +1,313 @@
+"""Run every benchmark with short settings and write bench/results/summary.md.
+
+``make bench`` (``python tests/run.py --bench``) runs this inside the
+loopback-only namespace. Each benchmark runs as its own ``python -m bench
+NAME`` process; its last output line (one JSON object) is collected. The
+Markdown table, with the machine and the date, goes to
+``bench/results/summary.md``; the last line printed is one JSON object with
+the headline figures.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import math
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from bench._common import ROOT, machine, require_private_netns
+
+RESULTS = ROOT / "bench" / "results" / "summary.md"
+
+# (benchmark, short arguments); optional ones are skipped when their module is absent.
+RUNS: tuple[tuple[str, list[str]], ...] = (
+    ("start_to_visible", ["--trials", "5"]),
+    ("echo_hz_load", ["--seconds", "5"]),
+    ("click_to_effect", ["--repeats", "4"]),
+    ("idle_cost", ["--seconds", "8"]),
+    ("startup", ["--rounds", "2"]),
+    ("cloud_to_browser", ["--quick"]),
+    ("slam_accuracy", ["--frames", "120"]),
+)
+
+# (figure, benchmark, key ("a|b" shows both), unit, aim text, aim test)
+ROWS: tuple[tuple[str, str, str, str, str, Any], ...] = (
+    (
+        "Node start → visible, dashboard p50",
+        "start_to_visible",
+        "start_dashboard_p50_ms",
+        "ms",
+        "",
+        None,
+    ),
+    (
+        "Node start → visible, plain observer p50",
+        "start_to_visible",
+        "start_baseline_p50_ms",
+        "ms",
+        "",
+        None,
+    ),
+    (
+        "Node start → visible, ratio",
+        "start_to_visible",
+        "start_ratio",
+        "x",
+        "≤ 1.2",
+        lambda v: v <= 1.2,
+    ),
+    (
+        "Node start → visible, extra over observer",
+        "start_to_visible",
+        "start_extra_ms",
+        "ms",
+        "< 150",
+        lambda v: v < 150,
+    ),
+    (
+        "Node stop → gone, dashboard p50",
+        "start_to_visible",
+        "stop_to_gone_s",
+        "s",
+        "< 1",
+        lambda v: v < 1.0,
+    ),
+    ("Node stop → gone, plain observer p50", "start_to_visible", "stop_baseline_s", "s", "", None),
+    (
+        "Echo+hz load: received, dashboard",
+        "echo_hz_load",
+        "dashboard_received_per_s",
+        "msg/s",
+        "",
+        None,
+    ),
+    (
+        "Echo+hz load: received, plain subscribers",
+        "echo_hz_load",
+        "baseline_received_per_s",
+        "msg/s",
+        "",
+        None,
+    ),
+    (
+        "Echo+hz load: received ratio",
+        "echo_hz_load",
+        "echo_ratio",
+        "x",
+        "≥ 0.9",
+        lambda v: v >= 0.9,
+    ),
+    (
+        "Echo+hz load: worst hz error, dashboard",
+        "echo_hz_load",
+        "hz_error_percent",
+        "%",
+        "≤ 1",
+        lambda v: v <= 1.0,
+    ),
+    (
+        "Echo+hz load: worst hz error, plain",
+        "echo_hz_load",
+        "baseline_hz_error_percent",
+        "%",
+        "",
+        None,
+    ),
+    (
+        "Lifecycle click → state shown p50 / p95",
+        "click_to_effect",
+        "lifecycle_p50_ms|lifecycle_p95_ms",
+        "ms",
+        "",
+        None,
+    ),
+    (
+        "Service submit → response shown p50 / p95",
+        "click_to_effect",
+        "service_p50_ms|service_p95_ms",
+        "ms",
+        "",
+        None,
+    ),
+    (
+        "Click → effect, all clicks p50",
+        "click_to_effect",
+        "click_p50_ms",
+        "ms",
+        "< 150",
+        lambda v: v < 150,
+    ),
+    (
+        "Same ROS calls from plain rclpy p50 (lifecycle / service)",
+        "click_to_effect",
+        "baseline_lifecycle_p50_ms|baseline_service_p50_ms",
+        "ms",
+        "",
+        None,
+    ),
+    (
+        "Idle CPU, dashboard + 1 browser",
+        "idle_cost",
+        "idle_cpu_dashboard_percent",
+        "% core",
+        "",
+        None,
+    ),
+    ("Idle CPU, plain rclpy node", "idle_cost", "idle_cpu_plain_percent", "% core", "", None),
+    (
+        "Idle CPU above plain node",
+        "idle_cost",
+        "idle_cpu_delta_percent",
+        "% core",
+        "≤ 5",
+        lambda v: v <= 5.0,
+    ),
+    (
+        "Idle memory RSS (dashboard / plain)",
+        "idle_cost",
+        "idle_rss_dashboard_mb|idle_rss_plain_mb",
+        "MB",
+        "",
+        None,
+    ),
+    ("serve → first page ready p50", "startup", "startup_page_s", "s", "", None),
+    ("bare viser+rclpy app → page ready p50", "startup", "startup_baseline_page_s", "s", "", None),
+    ("Start-up ratio", "startup", "startup_ratio", "x", "", None),
+    (
+        "Cloud 100k @ 20 Hz: fps dashboard / baseline",
+        "cloud_to_browser",
+        "dashboard_fps_100k_20hz|baseline_fps_100k_20hz",
+        "fps",
+        "",
+        None,
+    ),
+    (
+        "Cloud 100k @ 20 Hz: p95 latency dashboard",
+        "cloud_to_browser",
+        "dashboard_p95_ms_100k_20hz",
+        "ms",
+        "< 100",
+        lambda v: v < 100,
+    ),
+    ("SLAM ATE (synthetic loop)", "slam_accuracy", "ate_percent", "% of path", "", None),
+    ("SLAM speed", "slam_accuracy", "fps", "frames/s", "", None),
+)
+
+HEADLINE = {
+    "start_ratio": ("start_to_visible", "start_ratio"),
+    "start_extra_ms": ("start_to_visible", "start_extra_ms"),
+    "stop_to_gone_s": ("start_to_visible", "stop_to_gone_s"),
+    "echo_ratio": ("echo_hz_load", "echo_ratio"),
+    "hz_error_percent": ("echo_hz_load", "hz_error_percent"),
+    "click_p50_ms": ("click_to_effect", "click_p50_ms"),
+    "click_p95_ms": ("click_to_effect", "click_p95_ms"),
+    "idle_cpu_delta_percent": ("idle_cost", "idle_cpu_delta_percent"),
+    "startup_page_s": ("startup", "startup_page_s"),
+}
+
+
+def last_json(output: str) -> dict[str, Any] | None:
+    """The last line of ``output`` that parses as a JSON object, if any."""
+    for line in reversed(output.strip().splitlines()):
+        line = line.strip()
+        if line.startswith("{"):
+            try:
+                value = json.loads(line)
+            except json.JSONDecodeError:
+                continue
+            if isinstance(value, dict):
+                return value
+    return None
+
+
+def run_one(name: str, args: list[str]) -> tuple[dict[str, Any] | None, float]:
+    print(f"\n== {name} {' '.join(args)}", flush=True)
+    t0 = time.monotonic()
+    proc = subprocess.run(
+        [sys.executable, "-m", "bench", name, *args],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    elapsed = time.monotonic() - t0
+    lines = proc.stdout.strip().splitlines()
+    print("\n".join(lines[-8:]), flush=True)
+    if proc.returncode != 0:
+        print(f"(failed with code {proc.returncode})\n{proc.stderr[-2000:]}", flush=True)
+    return last_json(proc.stdout), elapsed
+
+
+def cell(figures: dict[str, Any], key: str) -> tuple[str, float | None]:
+    parts, first = [], None
+    for k in key.split("|"):
+        value = figures.get(k)
+        if isinstance(value, int | float) and not (isinstance(value, float) and math.isnan(value)):
+            parts.append(f"{value:.3g}" if abs(value) < 10 else f"{value:.0f}")
+            first = value if first is None else first
+        else:
+            parts.append("–")
+    return " / ".join(parts), first
+
+
+def markdown(results: dict[str, dict[str, Any]], times: dict[str, float]) -> str:
+    m = machine()
+    lines = [
+        "# Benchmark summary",
+        "",
+        f"Date: {datetime.datetime.now().astimezone().strftime('%Y-%m-%d %H:%M %Z')}  ",
+        f"Machine: {m['cores']} cores, {m['ram_gb']} GB RAM, {m['cpu_model']}; "
+        f"Python {m['python']}; {m['os']}  ",
+        "Command: `make bench` (short settings; each benchmark alone takes more samples). "
+        "Dashboard and baseline are measured in the same run; ratios matter, "
+        "absolute times on a shared machine are noise.",
+        "",
+        "| figure | value | unit | aim | met |",
+        "|---|---|---|---|---|",
+    ]
+    for label, bench, key, unit, aim, test in ROWS:
+        if bench not in results:
+            continue
+        text, value = cell(results[bench], key)
+        met = "" if test is None or value is None else ("yes" if test(value) else "**no**")
+        lines.append(f"| {label} | {text} | {unit} | {aim} | {met} |")
+    lines += ["", "Wall time per benchmark: "]
+    lines[-1] += ", ".join(f"{name} {sec:.0f} s" for name, sec in times.items())
+    return "\n".join(lines) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m bench summary")
+    parser.add_argument("--only", nargs="*", help="run only these benchmarks")
+    parser.add_argument("--no-write", action="store_true", help="do not write summary.md")
+    args = parser.parse_args(argv)
+    require_private_netns("")
+    here = Path(__file__).parent
+    results: dict[str, dict[str, Any]] = {}
+    times: dict[str, float] = {}
+    for name, bench_args in RUNS:
+        if args.only and name not in args.only:
+            continue
+        if not (here / f"{name}.py").exists():
+            continue
+        figures, times[name] = run_one(name, bench_args)
+        if figures is not None:
+            results[name] = figures
+    text = markdown(results, times)
+    print("\n" + text)
+    if not args.no_write:
+        RESULTS.parent.mkdir(parents=True, exist_ok=True)
+        RESULTS.write_text(text)
+        print(f"written to {RESULTS.relative_to(ROOT)}")
+    headline = {key: results.get(b, {}).get(k) for key, (b, k) in HEADLINE.items()}
+    print(json.dumps(headline, sort_keys=True))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
