@@ -37,6 +37,7 @@ def _notes(status: NodeStatus, stale: bool) -> str:
 class NodesPanel:
     def __init__(self, gui: viser.GuiApi, supervisor: Supervisor) -> None:
         self._supervisor = supervisor
+        self._one_action = threading.Lock()
         self._selector = gui.add_dropdown(
             "Catalog node",
             [entry.name for entry in ENTRIES],
@@ -69,22 +70,26 @@ class NodesPanel:
 
     # Button actions never block the viser callback thread for long: a stop
     # escalates in the supervisor's own thread.
+    # One click at a time: a Stop that overtook a half-done group Start would
+    # miss the members started after it, and leave them running.
     def _act(self, action) -> None:
-        name = self._selector.value
-        try:
-            self._message.show(action(name))
-        except (UnknownNodeError, RuntimeError, OSError) as exc:
-            self._message.show(f"⚠ {exc}")
+        with self._one_action:
+            name = self._selector.value
+            try:
+                self._message.show(action(name))
+            except (UnknownNodeError, RuntimeError, OSError) as exc:
+                self._message.show(f"⚠ {exc}")
         self.refresh(None)
 
     def _act_on_group(self, action, verb: str) -> None:
-        try:
-            group = lookup_group(self._group_selector.value)
-            for member in group.members:
-                action(member)
-            self._message.show(f"{verb} group **{group.name}**: {', '.join(group.members)}.")
-        except (UnknownNodeError, RuntimeError, OSError) as exc:
-            self._message.show(f"⚠ {exc}")
+        with self._one_action:
+            try:
+                group = lookup_group(self._group_selector.value)
+                for member in group.members:
+                    action(member)
+                self._message.show(f"{verb} group **{group.name}**: {', '.join(group.members)}.")
+            except (UnknownNodeError, RuntimeError, OSError) as exc:
+                self._message.show(f"⚠ {exc}")
         self.refresh(None)
 
     def _do_start(self, name: str) -> str:
