@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import json
 import signal
 import time
 
 import psutil
 import pytest
 
+from app.lessons.progress import ProgressStore
 from tests.browser.helpers import choose, click, expect_text, open_tab
 from tests.conftest import wait_until
 
@@ -35,7 +37,11 @@ def _gone(pids: list[int]) -> bool:
     return not any(alive(pid) for pid in pids)
 
 
-def test_sigkill_of_the_dashboard_leaves_no_node_running(page, dashboard):
+def test_sigkill_of_the_dashboard_leaves_no_node_running(page, dashboard, progress_dir):
+    # The first lesson's first check passes at once: the progress file is being written.
+    saved = progress_dir / "default.json"
+    wait_until(saved.exists, what="the progress file")
+    before = json.loads(saved.read_text())
     start_chatter_group(page)
     children = wait_until(
         lambda: len(kids := node_processes(dashboard.proc.pid)) >= 3 and kids,
@@ -45,6 +51,10 @@ def test_sigkill_of_the_dashboard_leaves_no_node_running(page, dashboard):
     dashboard.proc.send_signal(signal.SIGKILL)
     dashboard.proc.wait()
     wait_until(lambda: _gone(pids), timeout=10, what="every node process to end")
+    after = ProgressStore("default", progress_dir)  # intact: no warning, nothing lost
+    assert after.warning == ""
+    for lesson, entry in before["lessons"].items():
+        assert set(entry["passed"]) <= set(after.lesson(lesson)["passed"])
 
 
 def test_sigterm_shuts_down_in_order_within_five_seconds(page, dashboard):
