@@ -5,6 +5,7 @@ from __future__ import annotations
 import logging
 import os
 import threading
+import time
 
 import viser
 from std_msgs.msg import String
@@ -23,6 +24,7 @@ from app.panels.lifecycle_panel import LifecyclePanel
 from app.panels.logs_panel import LogsPanel, RosoutLog
 from app.panels.nodes_panel import NodesPanel
 from app.panels.parameters_panel import ParametersPanel
+from app.panels.ros_tools import JOB_DONE
 from app.panels.scene_panel import ScenePanel
 from app.panels.services_panel import ServicesPanel
 from app.panels.topics_panel import TopicsPanel
@@ -33,6 +35,7 @@ from app.topic_tap import TopicTap
 log = logging.getLogger(__name__)
 
 UI_PERIOD_SEC = 0.2  # panels refresh at 5 Hz
+GRAPH_CHECK_SEC = 0.02  # ...and within 20 ms of a node joining/leaving or a click answered
 
 
 class Dashboard:
@@ -103,7 +106,21 @@ class Dashboard:
         self._ui_thread.start()
 
     def _ui_loop(self) -> None:
-        while not self._stop.wait(UI_PERIOD_SEC):
+        # A cheap look at the node list (and at finished panel jobs) every
+        # GRAPH_CHECK_SEC refreshes at once when something changed; otherwise
+        # at UI_PERIOD_SEC. A node shows up within a frame, not a 5 Hz tick.
+        last_nodes: object = None
+        due = 0.0
+        while not self._stop.wait(GRAPH_CHECK_SEC):
+            try:
+                nodes = self.runtime.node.get_node_names_and_namespaces()
+            except Exception:
+                nodes = last_nodes
+            now = time.monotonic()
+            if nodes == last_nodes and now < due and not JOB_DONE.is_set():
+                continue
+            JOB_DONE.clear()
+            last_nodes, due = nodes, now + UI_PERIOD_SEC
             try:
                 self.graph = snapshot(self.runtime.node)
                 self.supervisor.note_visible_nodes(self.graph.nodes)

@@ -14,6 +14,7 @@ import argparse
 import datetime
 import json
 import math
+import os
 import subprocess
 import sys
 import time
@@ -23,6 +24,7 @@ from typing import Any
 from bench._common import ROOT, machine, require_private_netns
 
 RESULTS = ROOT / "bench" / "results" / "summary.md"
+LOAD = [0.0]  # the 1-minute load average when the run began: others may share the cores
 
 # (benchmark, short arguments); optional ones are skipped when their module is absent.
 RUNS: tuple[tuple[str, list[str]], ...] = (
@@ -263,6 +265,7 @@ def markdown(results: dict[str, dict[str, Any]], times: dict[str, float]) -> str
         f"Date: {datetime.datetime.now().astimezone().strftime('%Y-%m-%d %H:%M %Z')}  ",
         f"Machine: {m['cores']} cores, {m['ram_gb']} GB RAM, {m['cpu_model']}; "
         f"Python {m['python']}; {m['os']}  ",
+        f"Load average (1 min) at start / end: {LOAD[0]:.1f} / {os.getloadavg()[0]:.1f}  ",
         "Command: `make bench` (short settings; each benchmark alone takes more samples). "
         "Dashboard and baseline are measured in the same run; ratios matter, "
         "absolute times on a shared machine are noise.",
@@ -287,6 +290,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--no-write", action="store_true", help="do not write summary.md")
     args = parser.parse_args(argv)
     require_private_netns("")
+    LOAD[0] = os.getloadavg()[0]
     here = Path(__file__).parent
     results: dict[str, dict[str, Any]] = {}
     times: dict[str, float] = {}

@@ -20,6 +20,10 @@ from app.ros2cli.convert import ConversionError, fill_from_form, leaf_fields, ty
 log = logging.getLogger(__name__)
 
 
+# Set when any panel job ends; the dashboard's UI loop then refreshes at once.
+JOB_DONE = threading.Event()
+
+
 def run_job(work: Callable[[], None], on_error: Callable[[str], None]) -> threading.Thread:
     """Run ``work`` off the callback thread; any failure reaches ``on_error`` as one line."""
 
@@ -31,6 +35,8 @@ def run_job(work: Callable[[], None], on_error: Callable[[str], None]) -> thread
         except Exception as exc:  # never a traceback in the page; keep it in the log
             log.exception("panel job failed")
             on_error(f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}")
+        finally:
+            JOB_DONE.set()  # the dashboard shows the outcome now, not at its next 5 Hz tick
 
     thread = threading.Thread(target=body, name="panel-job", daemon=True)
     thread.start()
