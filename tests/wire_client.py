@@ -89,12 +89,16 @@ class WireClient:
         kind = message.get("type", "?")
         self.counts[kind] += 1
         uuid = message.get("uuid")
+        if kind == "PointCloudMessage":
+            self.counts["cloud_frames"] += 1
         if kind.startswith("Gui") and "props" in message and uuid:
             self.gui[uuid] = {"type": kind, **dict(message["props"])}
             if "value" in message:
                 self.gui[uuid]["value"] = message["value"]
         elif kind == "GuiUpdateMessage" and uuid in self.gui:
             self.gui[uuid].update(message.get("updates", {}))
+        elif kind == "SceneNodeUpdateMessage" and "points" in message.get("updates", {}):
+            self.counts["cloud_frames"] += 1  # a new cloud drawn in place of the old one
         elif kind == "GuiRemoveMessage" and uuid:
             self.gui.pop(uuid, None)
 
