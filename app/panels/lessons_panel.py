@@ -18,6 +18,12 @@ _MARKS = {PASS: "✓", FAIL: "✗", "waiting": "…"}
 _CHOOSE = "(choose an answer)"
 
 
+def _without_title(markdown: str) -> str:
+    """Drop a leading '# Title' line: the step title is already shown above."""
+    first, _, rest = markdown.lstrip().partition("\n")
+    return rest.lstrip() if first.startswith("# ") else markdown
+
+
 def _label(lesson: Lesson) -> str:
     return f"{lesson.unit:02d} · {lesson.title}"
 
@@ -47,11 +53,16 @@ class LessonsPanel:
         self._message = MarkdownView(gui)
         self._back = gui.add_button("Back", icon=viser.Icon.ARROW_LEFT)
         self._next = gui.add_button("Next", icon=viser.Icon.ARROW_RIGHT)
-        with gui.add_folder("Source code of this lesson's nodes", expand_by_default=False):
-            self._code = MarkdownView(gui)
         with gui.add_folder("Course outline", expand_by_default=False):
             self._outline = MarkdownView(gui)
             self._reset = gui.add_button("Reset my progress", color="gray")
+        # The code the lesson talks about sits beside the text, in its own
+        # window docked on the left (the learner can minimise or move it).
+        self._code_window = gui.add_panel()
+        with self._code_window.add_tab("Code of this lesson", viser.Icon.CODE):
+            self._code = MarkdownView(gui)
+        self._code_window.dock_left()
+        self._code_window.set_width(520)
         self._lesson = current
         self._step = min(progress.lesson(current.id)["step"], len(current.steps) - 1)
         self._selector.on_update(lambda _: self._select(by_label[self._selector.value], 0))
@@ -87,9 +98,10 @@ class LessonsPanel:
                 f"### {lesson.title}\n{lesson.summary}\n\n**Goals**\n{goals}\n\n"
                 f"**Step {step + 1} of {len(lesson.steps)}: {current.title}**"
             )
-            self._text.show(current.text)
+            self._text.show(_without_title(current.text))
             self._command.show(f"In a terminal: `{current.command}`" if current.command else "")
             self._code.show(self._source_listing(lesson))
+            self._code_window.visible = bool(lesson.code)
             self._message.show("")
             self._rebuild_step_widgets()
             self._back.disabled = step == 0
