@@ -66,7 +66,7 @@ class GraphPanel:
         if node is not None:
             with gui.add_folder("Options", expand_by_default=False):
                 self._show_quiet = gui.add_checkbox(
-                    "Show /rosout, /parameter_events, parameter services", False
+                    "Show /rosout, /parameter_events, parameter and lifecycle services", False
                 )
                 self._show_self = gui.add_checkbox("Show this dashboard's own node", False)
                 self._live = gui.add_checkbox("Live rates", True)

@@ -19,10 +19,11 @@ from typing import Literal
 Kind = Literal["node", "topic", "service", "action"]
 
 BOX_W, BOX_H = 168, 34  # two boxes a row fit the control panel at about 1:1 scale
-GAP_X, ROW_GAP = 14, 44
+GAP_X, ROW_GAP = 14, 40
 MARGIN = 8
 MAX_LABEL = 25
 PER_ROW = 2
+GROUP_GAP = 18  # extra space between unconnected groups
 STYLE: dict[str, tuple[str, str, str]] = {  # fill, stroke, shape rounding
     "node": ("#dbe4ff", "#3b5bdb", "17"),
     "topic": ("#d3f9d8", "#2f9e44", "4"),
@@ -102,8 +103,40 @@ def layers(keys: list[str], edges: list[Edge]) -> dict[str, int]:
     return layer
 
 
+def components(keys: list[str], edges: list[Edge]) -> list[list[str]]:
+    """Groups of vertices joined by edges, each in ``keys`` order, ordered by first member."""
+    parent = {k: k for k in keys}
+
+    def root(k: str) -> str:
+        while parent[k] != k:
+            parent[k] = parent[parent[k]]
+            k = parent[k]
+        return k
+
+    for edge in edges:
+        a, b = root(edge.source), root(edge.target)
+        if a != b:
+            parent[max(a, b)] = min(a, b)
+    groups: dict[str, list[str]] = defaultdict(list)
+    for key in keys:
+        groups[root(key)].append(key)
+    return list(groups.values())
+
+
+def _barycentre(sources: list[str], slot: dict[str, float]) -> float:
+    """Mean slot of what feeds a vertex: puts it under its publishers, fewer crossings."""
+    known = [slot[p] for p in sources if p in slot]
+    return sum(known) / len(known) if known else float("inf")
+
+
 def layout(vertices: list[Vertex], edges: list[Edge], per_row: int = PER_ROW) -> list[Placed]:
-    """Top-left corners of every box: layers as rows, wrapped at ``per_row`` boxes."""
+    """Top-left corners of every box.
+
+    Each connected group (talker, /chatter, listeners; a server and its service)
+    is drawn on its own, one under the other, so edges stay short; inside a
+    group layers are rows, wrapped at ``per_row`` boxes. Lone vertices share
+    rows at the end.
+    """
     order = sorted(vertices, key=lambda v: (list(STYLE).index(v.kind), v.name))
     keys = [v.key for v in order]
     by_key = {v.key: v for v in order}
@@ -112,30 +145,39 @@ def layout(vertices: list[Vertex], edges: list[Edge], per_row: int = PER_ROW) ->
     preds: dict[str, list[str]] = defaultdict(list)
     for edge in edges:
         preds[edge.target].append(edge.source)
-    grouped: dict[int, list[str]] = defaultdict(list)
-    for key in keys:
-        grouped[layer_of[key]].append(key)
-    position: dict[str, float] = {}
+    groups = components(keys, edges)
+    rows: list[list[str]] = []
+    gaps: set[int] = set()  # row indexes that start a new group
+    for group in (g for g in groups if len(g) > 1):
+        gaps.add(len(rows))
+        grouped: dict[int, list[str]] = defaultdict(list)
+        for key in group:
+            grouped[layer_of[key]].append(key)
+        slot: dict[str, float] = {}
+        for level in sorted(grouped):
+            members = grouped[level]
+            members.sort(key=lambda k: (_barycentre(preds[k], slot), keys.index(k)))  # noqa: B023
+            for start in range(0, len(members), per_row):
+                row = members[start : start + per_row]
+                rows.append(row)
+                for i, key in enumerate(row):
+                    slot[key] = i - (len(row) - 1) / 2
+    lone = [g[0] for g in groups if len(g) == 1]
+    if lone:
+        gaps.add(len(rows))
+        rows += [lone[i : i + per_row] for i in range(0, len(lone), per_row)]
     placed: list[Placed] = []
-    y = MARGIN
     width = per_row * BOX_W + (per_row - 1) * GAP_X
-    for level in sorted(grouped):
-        members = grouped[level]
-
-        def barycentre(key: str) -> float:
-            known = [position[p] for p in preds[key] if p in position]
-            return sum(known) / len(known) if known else float("inf")
-
-        members.sort(key=lambda k: (barycentre(k), keys.index(k)))
-        for start in range(0, len(members), per_row):
-            row = members[start : start + per_row]
-            row_width = len(row) * BOX_W + (len(row) - 1) * GAP_X
-            x = MARGIN + (width - row_width) / 2
-            for key in row:
-                placed.append(Placed(by_key[key], x, y))
-                position[key] = x
-                x += BOX_W + GAP_X
-            y += BOX_H + ROW_GAP
+    y = float(MARGIN)
+    for index, row in enumerate(rows):
+        if index in gaps and index > 0:
+            y += GROUP_GAP
+        row_width = len(row) * BOX_W + (len(row) - 1) * GAP_X
+        x = MARGIN + (width - row_width) / 2
+        for key in row:
+            placed.append(Placed(by_key[key], x, y))
+            x += BOX_W + GAP_X
+        y += BOX_H + ROW_GAP
     return placed
 
 
@@ -203,8 +245,9 @@ def render_svg(vertices: list[Vertex], edges: list[Edge], per_row: int = PER_ROW
         name_y = p.y + (14 if v.detail else 21)
         parts.append(
             f'<g class="rg-vertex" data-kind="{v.kind}" data-name="{escape(v.name)}">'
-            f"<title>{escape(title)}</title>"
-            f'<rect x="{p.x:.0f}" y="{p.y:.0f}" width="{BOX_W}" height="{BOX_H}" rx="{radius}" '
+            # A tooltip only for cut names: a hidden title would shadow the visible text.
+            + (f"<title>{escape(title)}</title>" if _short(v.name) != v.name else "")
+            + f'<rect x="{p.x:.0f}" y="{p.y:.0f}" width="{BOX_W}" height="{BOX_H}" rx="{radius}" '
             f'fill="{fill}" stroke="{stroke}" stroke-width="1.5"/>'
             f'<text x="{cx:.0f}" y="{name_y:.0f}" font-size="12" text-anchor="middle" '
             f'fill="#111">{escape(_short(v.name))}</text>'
@@ -240,6 +283,9 @@ QUIET_TOPICS = ("/rosout", "/parameter_events")
 PARAMETER_SERVICES = (
     "/describe_parameters", "/get_parameter_types", "/get_parameters", "/get_type_description",
     "/list_parameters", "/set_parameters", "/set_parameters_atomically",
+    # lifecycle plumbing: the Lifecycle tab shows it better than five boxes here
+    "/change_state", "/get_state", "/get_available_states", "/get_available_transitions",
+    "/get_transition_graph",
 )  # fmt: skip
 HEAVY_TYPES = (
     "sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage", "sensor_msgs/msg/PointCloud2",
@@ -271,8 +317,8 @@ def graph_picture(
     *,
     show_quiet: bool = False,
 ) -> tuple[list[Vertex], list[Edge]]:
-    """Vertices and edges to draw; /rosout, /parameter_events and parameter services are
-    left out unless ``show_quiet`` (every node has them: they hide the interesting part).
+    """Vertices and edges to draw; /rosout, /parameter_events, parameter and lifecycle
+    services are left out unless ``show_quiet`` (many nodes have them: they hide the rest).
     ``rates`` maps a topic to its label, e.g. '2.0 Hz'."""
     rates = rates or {}
     vertices: dict[str, Vertex] = {}
@@ -293,19 +339,18 @@ def graph_picture(
         me = add("node", node.name)
         for topic, kind in sorted(node.publishes.items()):
             if not quiet_topic(topic):
-                detail = " · ".join(x for x in (_short_type(kind), rates.get(topic, "")) if x)
-                edges.append(Edge(me, add("topic", topic, detail), rates.get(topic, "")))
+                edges.append(Edge(me, add("topic", topic, _short_type(kind)), rates.get(topic, "")))
         for service, kind in sorted(node.servers.items()):
             if not quiet_service(service):
                 edges.append(Edge(me, add("service", service, _short_type(kind))))
         for action, kind in sorted(node.action_servers.items()):
             edges.append(Edge(me, add("action", action, _short_type(kind))))
-    for node in nodes:  # second pass: a topic's detail comes from its publisher side first
+    for node in nodes:  # second pass: what nodes use, after what they offer
         me = f"node:{node.name}"
         for topic, kind in sorted(node.subscribes.items()):
             if not quiet_topic(topic):
-                detail = " · ".join(x for x in (_short_type(kind), rates.get(topic, "")) if x)
-                edges.append(Edge(add("topic", topic, detail), me, rates.get(topic, "")))
+                source = add("topic", topic, _short_type(kind))
+                edges.append(Edge(source, me, rates.get(topic, "")))
         for service, kind in sorted(node.clients.items()):
             if not quiet_service(service):
                 edges.append(Edge(me, add("service", service, _short_type(kind)), dashed=True))

@@ -135,9 +135,9 @@ class ParametersPanel:
         )
         self._selector = gui.add_dropdown("Node", [NONE], initial_value=NONE)
         self._info = MarkdownView(gui, "")
+        self._result = MarkdownView(gui, "")  # above the editors: seen right after a click
         self._editors = gui.add_folder("Parameters", expand_by_default=True)
         self._editor_folder: Any = None
-        self._result = MarkdownView(gui, "")
         self._activity = MarkdownView(gui, "")
         self._selector.on_update(lambda _: self._select(self._selector.value))
 
@@ -239,12 +239,17 @@ class ParametersPanel:
             self._message = f"`{command}` …"
 
         def work() -> None:
-            ok, reason = rp.set_value(self._ctx(), target, name, value)
-            verdict = (
-                "✅ Set parameter successful"
-                if ok
-                else "❌ Set parameter failed" + (f": **{reason}**" if reason else "")
-            )
+            ctx = self._ctx()
+            ok, reason = rp.set_value(ctx, target, name, value)
+            if ok:
+                verdict = "✅ Set parameter successful"
+            else:
+                kept = rp.python_value(rp.get_values(ctx, target, [name])[0])
+                verdict = (
+                    "❌ Set parameter failed"
+                    + (f": **{reason}**" if reason else "")
+                    + f"\n\nThe node keeps `{name}` = `{command_value(kept)}`."
+                )
             with self._lock:
                 self._message = f"`{command}`\n\n{verdict}"
                 if ok:
@@ -293,8 +298,7 @@ class ParametersPanel:
                 options = [NONE, *nodes]
                 if current not in options:
                     options.append(current)
-                self._selector.options = options
-                self._selector.value = current
+                self._selector.options = options  # the value stays: it is in options
         with self._lock:
             target, loaded, message = self._target, self._loaded, self._message
         if loaded is not None and loaded[0] == target and self._built_for != target:

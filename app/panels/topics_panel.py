@@ -308,9 +308,9 @@ class TopicsPanel:
             current = self._selector.value
             if current not in options:
                 options.append(current)  # keep a vanished topic selected: it may come back
+            # Never write the value back: the learner may have just picked another topic.
             self._selector.options = options
-            self._selector.value = current
-            self._select(current)
+            self._select(self._selector.value)
 
     def _take_fresh(self, monitor: TopicMonitor | None) -> list[tuple[float, Any]]:
         """New messages since the last refresh (at most KEEP), fed to echo and the plot."""

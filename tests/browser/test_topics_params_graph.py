@@ -116,6 +116,7 @@ def test_parameters_set_rate_and_refused_greeting(page):
     field(page, "greeting").fill("")
     click(page, "Set greeting")
     expect_regex(page, r"Set parameter failed: greeting must not be empty")
+    expect_regex(page, r"The node keeps greeting = Hello")
 
 
 def test_graph_shows_services_actions_and_rates(page):

@@ -66,7 +66,7 @@ def test_picture_has_services_actions_and_flow_edges():
     assert ("node:/add_two_ints_client", "service:/add_two_ints", "", True) in flows
     assert ("node:/fibonacci_action_server", "action:/fibonacci", "", False) in flows
     chatter = next(v for v in vertices if v.key == "topic:/chatter")
-    assert chatter.detail == "std_msgs/String · 2.0 Hz"
+    assert chatter.detail == "std_msgs/String"
 
 
 def test_quiet_topics_and_parameter_services_on_request():
