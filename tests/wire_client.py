@@ -111,6 +111,15 @@ class WireClient:
                     return uuid
         return None
 
+    def graph_nodes(self) -> list[str]:
+        """The Logs panel's node filter: exactly the nodes the dashboard's DDS sees."""
+        with self.lock:
+            for props in self.gui.values():
+                options = props.get("options") or []
+                if props["type"] == "GuiDropdownMessage" and "(all nodes)" in options:
+                    return [o for o in options if str(o).startswith("/")]
+        return []
+
     def markdown(self) -> str:
         with self.lock:
             return "\n".join(str(p["_markdown"]) for p in self.gui.values() if "_markdown" in p)

@@ -20,10 +20,7 @@ pytestmark = pytest.mark.ros
 
 
 def _graph_nodes(client: WireClient) -> list[str]:
-    """The Logs panel's node filter lists exactly the nodes the dashboard's DDS sees."""
-    uuid = client.find("Node", "GuiDropdownMessage")
-    with client.lock:
-        return [o for o in client.gui[uuid].get("options", []) if o.startswith("/")] if uuid else []
+    return client.graph_nodes()
 
 
 def test_three_isolated_learners(ros_env, tmp_path):

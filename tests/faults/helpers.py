@@ -41,12 +41,7 @@ def rss_mb(pid: int) -> float:
 
 
 def graph_nodes(client: WireClient) -> list[str]:
-    """The Logs panel's node filter: exactly the nodes the dashboard's DDS sees."""
-    uuid = client.find("Node", "GuiDropdownMessage")
-    if uuid is None:
-        return []
-    with client.lock:
-        return [o for o in client.gui[uuid].get("options", []) if o.startswith("/")]
+    return client.graph_nodes()
 
 
 def choose(client: WireClient, label: str, value: str) -> None:
