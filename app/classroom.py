@@ -12,6 +12,7 @@ from __future__ import annotations
 import ctypes
 import os
 import signal
+import socket
 import subprocess
 import sys
 import threading
@@ -38,7 +39,8 @@ class Learner:
     token: str | None = None
 
     def url(self, host: str) -> str:
-        shown = "127.0.0.1" if host in ("0.0.0.0", "localhost") else host
+        # 0.0.0.0 is every address: show the name other machines can use.
+        shown = socket.gethostname() if host == "0.0.0.0" else host
         query = f"/?token={self.token}" if self.token else ""
         return f"http://{shown}:{self.port}{query}"
 
