@@ -25,16 +25,23 @@ def in_private_netns() -> bool:
 
 
 def wait_until(
-    predicate: Callable[[], object], timeout: float = 15.0, interval: float = 0.05, what: str = ""
+    predicate: Callable[[], object],
+    timeout: float = 15.0,
+    interval: float = 0.05,
+    what: str | Callable[[], str] = "",
 ) -> object:
-    """Poll until ``predicate()`` is truthy; fail the test with ``what`` on timeout."""
+    """Poll until ``predicate()`` is truthy; fail the test with ``what`` on timeout.
+
+    ``what`` may be a callable, evaluated at the timeout to describe the state then.
+    """
     deadline = time.monotonic() + timeout
     while True:
         value = predicate()
         if value:
             return value
         if time.monotonic() > deadline:
-            pytest.fail(f"timed out after {timeout:.0f} s waiting for {what or predicate}")
+            described = what() if callable(what) else what
+            pytest.fail(f"timed out after {timeout:.0f} s waiting for {described or predicate}")
         time.sleep(interval)
 
 

@@ -37,8 +37,14 @@ def live(dashboard_node, supervisor):
 
     def watch_graph() -> None:  # what the dashboard's UI loop does
         while not stop.wait(0.2):
-            runtime.graph = snapshot(dashboard_node)
+            try:
+                runtime.graph = snapshot(dashboard_node)
+            except Exception as exc:  # noqa: BLE001 - a graph query raced a leaving node
+                errors.append(repr(exc))
+                continue
             supervisor.note_visible_nodes(runtime.graph.nodes)
+
+    errors: list[str] = []
 
     thread = threading.Thread(target=watch_graph, daemon=True)
     thread.start()
@@ -66,8 +72,10 @@ def test_every_step_of_the_lesson_passes_on_real_nodes(live, lesson):
                 lambda c=check: live.evaluate(c).state == PASS,
                 timeout=45,
                 interval=0.2,
-                what=f"{lesson.id} step {index + 1} check {check.key}: "
-                f"{live.evaluate(check).reason}",
+                what=lambda c=check, i=index: (
+                    f"{lesson.id} step {i + 1} check {c.key}: {live.evaluate(c).reason}; "
+                    f"processes: {[s.describe() for s in live.supervisor.statuses().values()]}"
+                ),
             )
 
 
