@@ -9,7 +9,7 @@ from rclpy.node import Node
 
 from app.graph import GraphSnapshot
 from app.panels import MarkdownView, code_block
-from app.panels.ros_tools import MessageForm, run_job, yaml_inline
+from app.panels.ros_tools import FormSlot, run_job, yaml_inline
 from app.ros2cli import CONSOLE_LIMITS, Ros2Error, VerbContext
 from app.ros2cli.calls import GoalRun, action_type_of, send_goal
 from app.ros2cli.convert import ConversionError, import_type, to_yaml
@@ -23,14 +23,11 @@ class ActionsPanel:
         self._gui = gui
         self._node = node
         self._lock = threading.Lock()
-        self._form_lock = threading.Lock()
         self._actions: tuple[str, ...] = ()
         self._types: dict[str, str] = {}
         self._selector = gui.add_dropdown("Action", [NONE], initial_value=NONE)
         self._info = MarkdownView(gui, "")
-        self._form_slot = gui.add_folder("Goal", expand_by_default=True)
-        self._form: MessageForm | None = None
-        self._form_key: tuple[str, str] | None = None
+        self._form_slot = FormSlot(gui, "Goal")
         self._send = gui.add_button("Send goal", icon=viser.Icon.SEND, disabled=True)
         self._cancel = gui.add_button("Cancel goal", icon=viser.Icon.X, disabled=True)
         self._view = MarkdownView(gui, "")
@@ -42,38 +39,25 @@ class ActionsPanel:
         self._selector.on_update(lambda _: self._rebuild_form())
 
     def _rebuild_form(self) -> None:
-        # Called from the UI thread and from viser callbacks: one rebuild at a time.
-        with self._form_lock:
-            self._rebuild_form_locked()
-
-    def _rebuild_form_locked(self) -> None:
         name = self._selector.value
         type_text = self._types.get(name)
         if type_text is None and name in self._actions:
             type_text = action_type_of(VerbContext(self._node, lambda _l: None), name)
             if type_text:
                 self._types[name] = type_text
-        key = (name, type_text or "")
-        if key == self._form_key:
-            return
-        if self._form is not None:
-            self._form.remove()
-            self._form = None
-        self._form_key = key
-        if not type_text:
-            self._send.disabled = True
-            return
+
+        def build() -> tuple[type, str]:
+            return import_type(type_text, "action").Goal, f"{type_text} goal"
+
         try:
-            action = import_type(type_text, "action")
+            form = self._form_slot.show((name, type_text or ""), build if type_text else None)
         except ConversionError as exc:
             self._message = f"⚠️ {exc}"
-            return
-        with self._form_slot:
-            self._form = MessageForm(self._gui, action.Goal, f"{type_text} goal")
-        self._send.disabled = False
+            form = None
+        self._send.disabled = form is None
 
     def _do_send(self) -> None:
-        name, form = self._selector.value, self._form
+        name, form = self._selector.value, self._form_slot.form
         type_text = self._types.get(name)
         if form is None or type_text is None:
             return

@@ -107,3 +107,37 @@ def yaml_inline(msg: Any) -> str:
 
     text = yaml.safe_dump(to_plain(msg), default_flow_style=True, width=10_000).strip()
     return "'" + text.replace("'", "'\"'\"'") + "'"
+
+
+class FormSlot:
+    """A folder that holds the MessageForm of one message class at a time.
+
+    The Services, Actions and Topics panels call ``show(key, build)`` whenever
+    their selection may have changed (from viser callbacks and from the UI
+    thread); the form is rebuilt only when ``key`` differs from the one shown.
+    """
+
+    def __init__(self, gui: viser.GuiApi, title: str) -> None:
+        self._gui = gui
+        self._folder = gui.add_folder(title, expand_by_default=True)
+        self._lock = threading.Lock()
+        self._key: object = object()
+        self.form: MessageForm | None = None
+
+    def show(self, key: object, build: Callable[[], tuple[type, str]] | None) -> MessageForm | None:
+        """The form for ``key``; ``build`` gives (message class, title), None for no form.
+
+        A ConversionError from ``build`` propagates, leaving no form for ``key``.
+        """
+        with self._lock:
+            if key == self._key:
+                return self.form
+            self._key = key
+            if self.form is not None:
+                self.form.remove()
+                self.form = None
+            if build is not None:
+                cls, title = build()
+                with self._folder:
+                    self.form = MessageForm(self._gui, cls, title)
+            return self.form

@@ -9,7 +9,7 @@ from rclpy.node import Node
 
 from app.graph import GraphSnapshot
 from app.panels import MarkdownView
-from app.panels.ros_tools import MessageForm, run_job, yaml_inline
+from app.panels.ros_tools import FormSlot, run_job, yaml_inline
 from app.ros2cli import CONSOLE_LIMITS, Ros2Error, VerbContext
 from app.ros2cli.calls import call_service
 from app.ros2cli.convert import ConversionError, import_type, message_repr
@@ -26,14 +26,11 @@ class ServicesPanel:
         self._gui = gui
         self._node = node
         self._lock = threading.Lock()
-        self._form_lock = threading.Lock()
         self._services: dict[str, str] = {}
         self._show_all = gui.add_checkbox("Show parameter services", False)
         self._selector = gui.add_dropdown("Service", [NONE], initial_value=NONE)
         self._info = MarkdownView(gui, "")
-        self._form_slot = gui.add_folder("Request", expand_by_default=True)
-        self._form: MessageForm | None = None
-        self._form_for: str | None = None
+        self._form_slot = FormSlot(gui, "Request")
         self._call = gui.add_button("Call", icon=viser.Icon.SEND, disabled=True)
         self._result = MarkdownView(gui, "")
         self._message = ""
@@ -41,39 +38,25 @@ class ServicesPanel:
         self._selector.on_update(lambda _: self._rebuild_form())
 
     def _rebuild_form(self) -> None:
-        # Called from the UI thread and from viser callbacks: one rebuild at a time.
-        with self._form_lock:
-            self._rebuild_form_locked()
-
-    def _rebuild_form_locked(self) -> None:
         name = self._selector.value
         type_text = self._services.get(name)
-        if (name, type_text) == (self._form_for, getattr(self._form, "type_text", None)):
-            return
-        if self._form is not None:
-            self._form.remove()
-            self._form = None
-        self._form_for = name
-        if type_text is None:
-            self._call.disabled = True
-            return
+
+        def build() -> tuple[type, str]:
+            return import_type(type_text, "srv").Request, f"{type_text} request"
+
         try:
-            srv = import_type(type_text, "srv")
+            form = self._form_slot.show((name, type_text), build if type_text else None)
         except ConversionError as exc:
             self._set_message(f"⚠️ {exc}")
-            self._call.disabled = True
-            return
-        with self._form_slot:
-            self._form = MessageForm(self._gui, srv.Request, f"{type_text} request")
-        self._form.type_text = type_text  # type: ignore[attr-defined]
-        self._call.disabled = False
+            form = None
+        self._call.disabled = form is None
 
     def _set_message(self, text: str) -> None:
         with self._lock:
             self._message = text
 
     def _do_call(self) -> None:
-        name, form = self._selector.value, self._form
+        name, form = self._selector.value, self._form_slot.form
         type_text = self._services.get(name)
         if form is None or type_text is None:
             return

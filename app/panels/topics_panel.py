@@ -24,7 +24,7 @@ from rclpy.timer import Timer
 
 from app.graph import GraphSnapshot
 from app.panels import MarkdownView, code_block
-from app.panels.ros_tools import MessageForm, run_job, yaml_inline
+from app.panels.ros_tools import FormSlot, run_job, yaml_inline
 from app.ros2cli import Ros2Error
 from app.ros2cli.convert import (
     ConversionError,
@@ -122,8 +122,7 @@ class TopicsPanel:
                 visible=False,
             )
         with gui.add_folder("Publish", expand_by_default=True):
-            self._form_slot = gui.add_folder("Message", expand_by_default=True)
-            self._form: MessageForm | None = None
+            self._form_slot = FormSlot(gui, "Message")
             self._rate = gui.add_number("Rate (Hz)", 1.0, min=0.1, max=MAX_RATE_HZ, step=0.1)
             self._once = gui.add_button("Publish once", icon=viser.Icon.SEND, disabled=True)
             self._start = gui.add_button(
@@ -156,9 +155,6 @@ class TopicsPanel:
             if self._monitor is not None:
                 self._monitor.close()
                 self._monitor = None
-            if self._form is not None:
-                self._form.remove()
-                self._form = None
             self._topic, self._seen = chosen, 0
             self._latest.clear()
             self._pub_message = ""
@@ -173,13 +169,14 @@ class TopicsPanel:
                 qos = matching_qos(self._node, chosen, depth=KEEP)
                 self._monitor = TopicMonitor(self._node, chosen, cls, keep=KEEP, qos=qos)
                 fields = numeric_fields(cls)
-                with self._form_slot:
-                    self._form = MessageForm(self._gui, cls, type_text or "")
+            form = self._form_slot.show(
+                (chosen, type_text), (lambda: (cls, type_text or "")) if cls is not None else None
+            )
             self._field.options = [NO_FIELD, *fields]
             self._field.value = preferred_field(cls) if cls is not None else NO_FIELD
             self._clear_plot()
             for button in (self._once, self._start):
-                button.disabled = self._form is None
+                button.disabled = form is None
 
     def _clear_plot(self) -> None:
         with self._lock:
@@ -189,7 +186,7 @@ class TopicsPanel:
     # --- publishing ------------------------------------------------------------
 
     def _message(self) -> Any | None:
-        form = self._form
+        form = self._form_slot.form
         if form is None:
             return None
         try:
