@@ -27,6 +27,8 @@ class GraphSnapshot:
     topics: tuple[TopicInfo, ...] = ()
     services: tuple[tuple[str, tuple[str, ...]], ...] = ()
     actions: tuple[str, ...] = field(default=())
+    # Names DDS still lists but that have no endpoints left (see _is_ghost).
+    ghosts: tuple[str, ...] = ()
 
     def topic(self, name: str) -> TopicInfo | None:
         return next((t for t in self.topics if t.name == name), None)
@@ -39,8 +41,26 @@ def _fqn(name: str, namespace: str) -> str:
     return f"{namespace.rstrip('/')}/{name}"
 
 
+def _is_ghost(node: Node, name: str, namespace: str) -> bool:
+    """A listed node without a single publisher is a leftover, not a live node.
+
+    Every rclpy node publishes /rosout and /parameter_events. The graph cache
+    learns node names from one DDS message and endpoints from others; when a
+    process leaves while its messages cross, the name can outlive its
+    endpoints for good (a "ghost" in `ros2 node list`). Its endpoints are
+    reliably removed, so an empty endpoint list tells a ghost apart.
+    """
+    try:
+        return not node.get_publisher_names_and_types_by_node(name, namespace)
+    except Exception:  # noqa: BLE001 - the name vanished between two queries
+        return True
+
+
 def snapshot(node: Node, *, include_hidden: bool = False) -> GraphSnapshot:
-    nodes = sorted(_fqn(n, ns) for n, ns in node.get_node_names_and_namespaces())
+    live, ghosts = [], []
+    for name, namespace in node.get_node_names_and_namespaces():
+        (ghosts if _is_ghost(node, name, namespace) else live).append(_fqn(name, namespace))
+    nodes = sorted(live)
     topics = []
     for name, types in node.get_topic_names_and_types():
         if not include_hidden and ACTION_MARKER in name:
@@ -65,4 +85,5 @@ def snapshot(node: Node, *, include_hidden: bool = False) -> GraphSnapshot:
         topics=tuple(sorted(topics, key=lambda t: t.name)),
         services=tuple(sorted(services)),
         actions=tuple(sorted(actions)),
+        ghosts=tuple(sorted(ghosts)),
     )

@@ -85,6 +85,12 @@ class GraphPanel:
         self._refresh_picture(graph)
         parts = [f"**Nodes ({len(graph.nodes)})** · `ros2 node list`", ""]
         parts += [f"- `{name}`" for name in graph.nodes] or ["- (none)"]
+        if graph.ghosts:
+            parts += [
+                "",
+                "Stale names (their process is gone, DDS still lists them): "
+                + ", ".join(f"`{name}`" for name in graph.ghosts),
+            ]
         parts += ["", f"**Topics ({len(graph.topics)})** · `ros2 topic list -t`", ""]
         parts += ["| topic | type | pub | sub |", "|---|---|---|---|"]
         for topic in graph.topics:
