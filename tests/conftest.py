@@ -45,9 +45,35 @@ def wait_until(
         time.sleep(interval)
 
 
+def _same_netns(pid: int) -> bool:
+    try:
+        return os.readlink(f"/proc/{pid}/ns/net") == os.readlink("/proc/self/ns/net")
+    except OSError:
+        return False
+
+
+def leftover_node_processes() -> list[str]:
+    """Catalog node processes still alive in this test run's network namespace."""
+    import psutil
+
+    found = []
+    for proc in psutil.process_iter(["pid", "cmdline", "status"]):
+        cmdline = proc.info["cmdline"] or []
+        if proc.info["status"] == psutil.STATUS_ZOMBIE or "-m" not in cmdline:
+            continue
+        module = cmdline[cmdline.index("-m") + 1] if cmdline[-1] != "-m" else ""
+        if module.startswith("nodes.") and _same_netns(proc.info["pid"]):
+            found.append(f"{module} (pid {proc.info['pid']})")
+    return found
+
+
 @pytest.fixture
-def ros_env(monkeypatch: pytest.MonkeyPatch) -> dict[str, str]:
-    """A fresh ROS domain on loopback for one test; fails (never skips) outside the netns."""
+def ros_env(monkeypatch: pytest.MonkeyPatch) -> Iterator[dict[str, str]]:
+    """A fresh ROS domain on loopback for one test; fails (never skips) outside the netns.
+
+    A test must leave no node process behind: a leftover would show up in the
+    graph of a later test that happens to get the same domain id.
+    """
     if not in_private_netns():
         pytest.fail(
             "DDS tests must run inside a private network namespace with only loopback: "
@@ -59,7 +85,14 @@ def ros_env(monkeypatch: pytest.MonkeyPatch) -> dict[str, str]:
     for key in ("ROS_DOMAIN_ID", "FASTRTPS_DEFAULT_PROFILES_FILE", "RMW_IMPLEMENTATION"):
         monkeypatch.setenv(key, env[key])
     monkeypatch.delenv("ROS_AUTOMATIC_DISCOVERY_RANGE", raising=False)
-    return env
+    yield env
+    deadline = time.monotonic() + 8.0
+    while (left := leftover_node_processes()) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    if left:
+        for entry in left:  # do not let them spoil later tests either
+            os.kill(int(entry.rsplit(" ", 1)[1].rstrip(")")), 9)
+        pytest.fail(f"the test left node processes running: {', '.join(left)}")
 
 
 @pytest.fixture
@@ -67,7 +100,7 @@ def probe(ros_env):
     """A ROS node in the test process, spun in its own thread, to observe over DDS."""
     from app.ros_runtime import RosRuntime
 
-    runtime = RosRuntime("test_probe", threads=2)
+    runtime = RosRuntime("test_probe")
     yield runtime
     runtime.shutdown()
 
