@@ -2,9 +2,15 @@
 
 ``rclpy`` is initialised on the calling (main) thread with its signal
 handlers off (the CLI owns SIGINT/SIGTERM); the observer node
-``/classroom_dashboard`` is spun by one MultiThreadedExecutor in one thread.
+``/classroom_dashboard`` is spun by one executor in one thread.
 Everything else in the dashboard creates its subscriptions and clients on
 ``runtime.node`` and never spins it.
+
+The executor is single-threaded on purpose: every dashboard callback is short
+(it records a message or a result and returns; waiting happens in worker
+threads on futures), and rclpy's MultiThreadedExecutor costs so much per
+callback that it took about 3,500 small messages a second here against about
+8,400 for the single-threaded one (10 topics at 1 kHz, measured side by side).
 """
 
 from __future__ import annotations
@@ -13,7 +19,7 @@ import threading
 
 import rclpy
 from rclpy.context import Context
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
@@ -21,11 +27,11 @@ DASHBOARD_NODE_NAME = "classroom_dashboard"
 
 
 class RosRuntime:
-    def __init__(self, node_name: str = DASHBOARD_NODE_NAME, *, threads: int = 4) -> None:
+    def __init__(self, node_name: str = DASHBOARD_NODE_NAME) -> None:
         self.context = Context()
         rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO)
         self.node = Node(node_name, context=self.context)
-        self.executor = MultiThreadedExecutor(num_threads=threads, context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
         self._thread = threading.Thread(target=self._spin, name="ros-executor", daemon=True)
         self._thread.start()

@@ -108,7 +108,7 @@ def serve_baseline(port: int) -> None:
     from app.scene.cloud_codec import decode_cloud
     from app.scene.qos import newest_only_qos
 
-    runtime = RosRuntime("bench_baseline", threads=2)
+    runtime = RosRuntime("bench_baseline")
     # Subscribe once the publisher is known, as the dashboard's picker does.
     deadline = time.monotonic() + 20
     while not runtime.node.get_publishers_info_by_topic(BASE_TOPIC):
@@ -243,7 +243,7 @@ class CloudPublisher:
         from app.ros_runtime import RosRuntime
         from nodes.common.pointcloud import xyz_to_pointcloud2 as encode_cloud
 
-        self.runtime = RosRuntime("bench_cloud_publisher", threads=1)
+        self.runtime = RosRuntime("bench_cloud_publisher")
         qos = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
         node = self.runtime.node
         self.publishers = {
