@@ -48,6 +48,7 @@ def live(dashboard_node, supervisor):
 
     thread = threading.Thread(target=watch_graph, daemon=True)
     thread.start()
+    runtime.graph_errors = errors  # type: ignore[attr-defined]
     yield runtime
     stop.set()
     thread.join()
@@ -74,7 +75,9 @@ def test_every_step_of_the_lesson_passes_on_real_nodes(live, lesson):
                 interval=0.2,
                 what=lambda c=check, i=index: (
                     f"{lesson.id} step {i + 1} check {c.key}: {live.evaluate(c).reason}; "
-                    f"processes: {[s.describe() for s in live.supervisor.statuses().values()]}"
+                    f"processes: {[s.describe() for s in live.supervisor.statuses().values()]}; "
+                    f"graph query errors: {live.graph_errors[-3:]}; "
+                    f"nodes now: {snapshot(live.node).nodes}"
                 ),
             )
 
