@@ -27,7 +27,7 @@ class GraphSnapshot:
     topics: tuple[TopicInfo, ...] = ()
     services: tuple[tuple[str, tuple[str, ...]], ...] = ()
     actions: tuple[str, ...] = field(default=())
-    # Names DDS still lists but that have no endpoints left (see _is_ghost).
+    # Names DDS still lists but that have no endpoints left (see is_ghost).
     ghosts: tuple[str, ...] = ()
 
     def topic(self, name: str) -> TopicInfo | None:
@@ -41,7 +41,7 @@ def _fqn(name: str, namespace: str) -> str:
     return f"{namespace.rstrip('/')}/{name}"
 
 
-def _is_ghost(node: Node, name: str, namespace: str) -> bool:
+def is_ghost(node: Node, name: str, namespace: str) -> bool:
     """A listed node without a single publisher is a leftover, not a live node.
 
     Every rclpy node publishes /rosout and /parameter_events. The graph cache
@@ -59,7 +59,7 @@ def _is_ghost(node: Node, name: str, namespace: str) -> bool:
 def snapshot(node: Node, *, include_hidden: bool = False) -> GraphSnapshot:
     live, ghosts = [], []
     for name, namespace in node.get_node_names_and_namespaces():
-        (ghosts if _is_ghost(node, name, namespace) else live).append(_fqn(name, namespace))
+        (ghosts if is_ghost(node, name, namespace) else live).append(_fqn(name, namespace))
     nodes = sorted(live)
     topics = []
     for name, types in node.get_topic_names_and_types():

@@ -24,6 +24,7 @@ import threading
 import time
 from typing import Any
 
+from app.graph import is_ghost
 from bench._common import (
     configure_dds,
     launch_browser,
@@ -88,8 +89,12 @@ class GraphObserver:
     def _poll(self) -> None:
         present = None
         while not self._stop.wait(OBSERVER_PERIOD_SEC):
-            names = {f"{ns.rstrip('/')}/{n}" for n, ns in self.node.get_node_names_and_namespaces()}
-            now = (FQN in names, time.time())
+            pairs = self.node.get_node_names_and_namespaces()
+            # Same rule as the dashboard: a listed name with no endpoints is a ghost.
+            seen = any(
+                f"{ns.rstrip('/')}/{n}" == FQN and not is_ghost(self.node, n, ns) for n, ns in pairs
+            )
+            now = (seen, time.time())
             if now[0] != present:
                 present = now[0]
                 with self._lock:
