@@ -20,7 +20,7 @@ from sensor_msgs.msg import JointState
 from app.scene import transforms as tf
 from app.scene.frames import BASE_PATH
 from app.scene.latest import LatestWorker
-from app.scene.qos import SCENE_CALLBACK_GROUP
+from app.scene.qos import resubscribe
 from app.scene.topic_picker import NONE
 from nodes.common.arm_kinematics import JOINT_NAMES, link_points
 
@@ -104,15 +104,9 @@ class ArmLayer:
                 return
             old, self._subscription = self._subscription, None
             self._topic = topic
-        if old is not None:
-            self._node.destroy_subscription(old)
-        self.worker.reset()
-        if topic != NONE:
-            sub = self._node.create_subscription(
-                JointState, topic, self.worker.offer, 10, callback_group=SCENE_CALLBACK_GROUP
-            )
-            with self._lock:
-                self._subscription = sub
+        sub = resubscribe(self._node, old, self.worker, JointState, topic, qos=10)
+        with self._lock:
+            self._subscription = sub
 
     def _draw(self, msg: JointState) -> None:
         if self._on_joints is not None and len(msg.position):

@@ -18,7 +18,7 @@ from sensor_msgs.msg import Image
 from app.scene.frames import FrameTree
 from app.scene.image_codec import ImageFormatError, downscale, image_to_rgb
 from app.scene.latest import LatestWorker
-from app.scene.qos import SCENE_CALLBACK_GROUP, newest_only_qos
+from app.scene.qos import resubscribe
 from app.scene.topic_picker import NONE
 
 MAX_HZ = 10.0
@@ -53,19 +53,9 @@ class ImageLayer:
             old, self._subscription = self._subscription, None
             self._topic = topic
             self.info = ""
-        if old is not None:
-            self._node.destroy_subscription(old)
-        self.worker.reset()
-        if topic != NONE:
-            sub = self._node.create_subscription(
-                Image,
-                topic,
-                self.worker.offer,
-                newest_only_qos(self._node, topic),
-                callback_group=SCENE_CALLBACK_GROUP,
-            )
-            with self._lock:
-                self._subscription = sub
+        sub = resubscribe(self._node, old, self.worker, Image, topic)
+        with self._lock:
+            self._subscription = sub
 
     def show_on_frustum(self, enabled: bool) -> None:
         self.on_frustum = enabled

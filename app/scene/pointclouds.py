@@ -20,7 +20,7 @@ from sensor_msgs.msg import PointCloud2
 from app.scene.cloud_codec import CloudFormatError, decode_cloud
 from app.scene.frames import scene_path_for_frame
 from app.scene.latest import LatestWorker
-from app.scene.qos import SCENE_CALLBACK_GROUP, newest_only_qos
+from app.scene.qos import resubscribe
 from app.scene.topic_picker import NONE
 
 DEFAULT_BUDGET = 200_000
@@ -82,20 +82,10 @@ class PointCloudLayer:
             old, self._subscription = self._subscription, None
             self._topic = topic
             self._status = CloudStatus(topic, budget=self.budget)
-        if old is not None:
-            self._node.destroy_subscription(old)
-        self.worker.reset()
-        if topic != NONE:
-            sub = self._node.create_subscription(
-                PointCloud2,
-                topic,
-                self.worker.offer,
-                newest_only_qos(self._node, topic),
-                callback_group=SCENE_CALLBACK_GROUP,
-            )
-            with self._lock:
-                self._subscription = sub
-        else:
+        sub = resubscribe(self._node, old, self.worker, PointCloud2, topic)
+        with self._lock:
+            self._subscription = sub
+        if sub is None:
             self._remove_handle()
 
     def _remove_handle(self) -> None:
