@@ -9,6 +9,11 @@ and how long each took from ``publish()`` to the page (p50, p95):
   A frame counts when the panel's status line with that frame's
   ``header.stamp`` reaches the page's main thread; it is sent right after the
   points, in order, so the points have arrived by then.
+  The same frame is also timed inside viser's websocket worker, when it has
+  arrived in the browser and been decoded (``dashboard_worker_*``): headless
+  Chromium here has no GPU, and while software WebGL draws, the page's main
+  thread stalls (counted as ``dashboard_page_stalls_*``), which delays the
+  first figure but not the second.
 - **baseline**: the least a browser view can do: one rclpy subscriber, the
   same numpy decode, and one websocket send of the same points (float16 +
   rgb, as viser sends them) to a bare page, no throttle, no scene.
@@ -52,14 +57,57 @@ MEASURE_SEC = 3.0
 ROUNDS = 2
 TAIL_SEC = 0.8
 
-# The dashboard page: time-stamp every message batch viser's websocket worker
-# hands to the main thread, and pick out the cloud status line's stamp.
+# The dashboard page, timed at two places for each cloud status line (which
+# viser sends right after the points, in order):
+# - "worker": viser's websocket worker has received and decoded the batch and
+#   hands it to the page. Measured inside that worker (its script is wrapped
+#   so its postMessage time-stamps batches), so it does not wait for the page.
+# - "page": the page's main thread has taken the batch. Without a GPU the main
+#   thread can stall for hundreds of ms while software WebGL (SwiftShader)
+#   draws, so both are reported; the stalls themselves are logged in
+#   window.__stalls (gaps of more than 50 ms in a 10 ms interval timer).
 DASHBOARD_PROBE_JS = r"""
-window.__frames = [];
+window.__frames = []; window.__workerFrames = []; window.__stalls = [];
+const STAMP = /stamp (\d+)\.(\d{9})/;
+const WORKER_PREFIX = `(() => {
+  const channel = new BroadcastChannel('__bench_probe');
+  const post = self.postMessage.bind(self);
+  self.postMessage = (message, transfer) => {
+    try {
+      if (message && message.type === 'message_batch') {
+        const t = performance.timeOrigin + performance.now();
+        for (const m of message.messages) {
+          if (m.type !== 'GuiUpdateMessage' || !m.updates) continue;
+          for (const v of Object.values(m.updates)) {
+            const r = typeof v === 'string' && /stamp (\\d+)\\.(\\d{9})/.exec(v);
+            if (r) channel.postMessage([r[1], r[2], t]);
+          }
+        }
+      }
+    } catch (e) {}
+    return post(message, transfer);
+  };
+})();
+`;
+new BroadcastChannel('__bench_probe').onmessage = (e) => window.__workerFrames.push(e.data);
+let lastTick = performance.now();
+setInterval(() => {
+  const now = performance.now();
+  if (now - lastTick > 50) window.__stalls.push(Math.round(now - lastTick));
+  lastTick = now;
+}, 10);
 const OrigWorker = window.Worker;
 window.Worker = class extends OrigWorker {
-  constructor(...args) {
-    super(...args);
+  constructor(url, options) {
+    let wrapped = url;
+    try {
+      const xhr = new XMLHttpRequest();
+      xhr.open('GET', String(url), false);
+      xhr.send();
+      const blob = new Blob([WORKER_PREFIX + xhr.responseText], {type: 'text/javascript'});
+      wrapped = URL.createObjectURL(blob);
+    } catch (e) { console.error('bench probe: worker not wrapped', e); }
+    super(wrapped, options);
     this.addEventListener('message', (event) => {
       const data = event.data;
       if (!data || data.type !== 'message_batch') return;
@@ -68,7 +116,7 @@ window.Worker = class extends OrigWorker {
         if (m.type !== 'GuiUpdateMessage' || !m.updates) continue;
         for (const v of Object.values(m.updates)) {
           if (typeof v !== 'string') continue;
-          const r = /stamp (\d+)\.(\d{9})/.exec(v);
+          const r = STAMP.exec(v);
           if (r) window.__frames.push([r[1], r[2], t]);
         }
       }
@@ -323,8 +371,12 @@ def measure_round(
     topic: str,
     size: int,
     hz: float,
-) -> tuple[dict[int, float], int]:
-    """One fresh page, one burst of clouds: (arrivals in the window, clouds published in it)."""
+) -> tuple[dict[str, dict[int, float]], list[int], int]:
+    """One fresh page, one burst of clouds.
+
+    Returns the arrivals in the window per probe ("page", and "worker" on the
+    dashboard), the page's main-thread stalls (ms) and the clouds published in it.
+    """
     context = browser.new_context(viewport={"width": 1280, "height": 800})
     try:
         page = context.new_page()
@@ -333,11 +385,18 @@ def measure_round(
         page.goto(url)
         page.wait_for_function(ready_js, polling=100, timeout=30_000)
         page.wait_for_timeout(1000)  # let the initial scene replay settle
+        page.evaluate("window.__stalls = []")
         sent = publisher.run(topic, size, hz, WARMUP_SEC + MEASURE_SEC)
         page.wait_for_timeout(TAIL_SEC * 1000)
-        frames = page.evaluate("window.__frames")
+        probes = page.evaluate(
+            "({page: window.__frames, worker: window.__workerFrames || null,"
+            " stalls: window.__stalls || []})"
+        )
         in_window = round(MEASURE_SEC * hz)
-        return window_arrivals(frames, sent), in_window
+        arrivals = {"page": window_arrivals(probes["page"], sent)}
+        if probes["worker"] is not None:
+            arrivals["worker"] = window_arrivals(probes["worker"], sent)
+        return arrivals, probes["stalls"], in_window
     finally:
         context.close()
 
@@ -428,7 +487,12 @@ def run_bench(cases: tuple[tuple[int, int], ...]) -> dict[str, Any]:
             for size, hz in cases:
                 label = f"{size // 1000}k" if size < 1_000_000 else f"{size // 1_000_000}M"
                 key = f"{label}_{hz}hz"
-                rounds: dict[str, list[dict[int, float]]] = {"baseline": [], "dashboard": []}
+                rounds: dict[str, list[dict[int, float]]] = {
+                    "baseline": [],
+                    "dashboard": [],
+                    "dashboard_worker": [],
+                }
+                stalls: list[int] = []
                 published: list[int] = []
                 for _ in range(ROUNDS):  # alternate, so a load spike hits both alike
                     for name, url, init_js, ready_js, topic in (
@@ -441,18 +505,25 @@ def run_bench(cases: tuple[tuple[int, int], ...]) -> dict[str, Any]:
                             DASH_TOPIC,
                         ),
                     ):
-                        arrivals, count = measure_round(
+                        arrivals, page_stalls, count = measure_round(
                             browser, url, init_js, ready_js, publisher, topic, size, hz
                         )
-                        rounds[name].append(arrivals)
+                        rounds[name].append(arrivals["page"])
                         if name == "dashboard":
+                            rounds["dashboard_worker"].append(arrivals["worker"])
+                            stalls.extend(page_stalls)
                             published.append(count)
                 base = summarise(rounds["baseline"], published)
                 dash = summarise(rounds["dashboard"], published)
+                worker = summarise(rounds["dashboard_worker"], published)
                 for name, res in (("baseline", base), ("dashboard", dash)):
                     results[f"{name}_fps_{key}"] = res["fps"]
                     results[f"{name}_p50_ms_{key}"] = res["p50_ms"]
                     results[f"{name}_p95_ms_{key}"] = res["p95_ms"]
+                results[f"dashboard_worker_p50_ms_{key}"] = worker["p50_ms"]
+                results[f"dashboard_worker_p95_ms_{key}"] = worker["p95_ms"]
+                results[f"dashboard_page_stalls_{key}"] = len(stalls)
+                results[f"dashboard_page_stall_max_ms_{key}"] = max(stalls, default=0)
                 results[f"published_fps_{key}"] = dash["published_fps"]
                 results[f"fps_ratio_{key}"] = (
                     round(dash["fps"] / base["fps"], 2) if base["fps"] else None
@@ -461,7 +532,10 @@ def run_bench(cases: tuple[tuple[int, int], ...]) -> dict[str, Any]:
                     f"{label:>4} points @ {hz:2d} Hz | published {dash['published_fps']:5.1f} fps"
                     f" | baseline {base['fps']:5.1f} fps p50 {base['p50_ms']:7.1f} ms"
                     f" p95 {base['p95_ms']:7.1f} ms | dashboard {dash['fps']:5.1f} fps"
-                    f" p50 {dash['p50_ms']:7.1f} ms p95 {dash['p95_ms']:7.1f} ms",
+                    f" p50 {dash['p50_ms']:7.1f} ms p95 {dash['p95_ms']:7.1f} ms"
+                    f" (in its websocket worker: p50 {worker['p50_ms']:6.1f} ms"
+                    f" p95 {worker['p95_ms']:6.1f} ms) | page main thread stalled"
+                    f" {len(stalls)} times > 50 ms, longest {max(stalls, default=0)} ms",
                     flush=True,
                 )
             browser.close()
@@ -471,10 +545,10 @@ def run_bench(cases: tuple[tuple[int, int], ...]) -> dict[str, Any]:
         stop(dashboard)
     results["dashboard_point_budget"] = 200_000
     if "dashboard_fps_100k_20hz" in results:
-        results["aim_met_100k_20hz"] = bool(
-            results["dashboard_p95_ms_100k_20hz"] < 100
-            and results["fps_ratio_100k_20hz"] is not None
-            and results["fps_ratio_100k_20hz"] >= 0.8
+        fps_ok = (results["fps_ratio_100k_20hz"] or 0) >= 0.8
+        results["aim_met_100k_20hz"] = bool(results["dashboard_p95_ms_100k_20hz"] < 100 and fps_ok)
+        results["aim_met_100k_20hz_in_browser_worker"] = bool(
+            results["dashboard_worker_p95_ms_100k_20hz"] < 100 and fps_ok
         )
     return results
 
