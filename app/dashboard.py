@@ -132,6 +132,8 @@ class Dashboard:
                     panel.refresh(self.graph)
                 except Exception:  # one panel's bug (or a forged widget value) freezes no other
                     log.exception("refresh of %s failed", type(panel).__name__)
+            # Send now: viser otherwise holds a lone update up to one 60 Hz window.
+            self.server.flush()
 
     def stop(self) -> None:
         self._stop.set()
