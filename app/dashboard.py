@@ -60,7 +60,11 @@ class Dashboard:
     def _build_gui(self) -> list[Panel]:
         gui = self.server.gui
         gui.configure_theme(titlebar_content=None, control_width="large", show_share_button=False)
-        self.server.scene.configure_environment_map(None)  # avoids a stall in software WebGL
+        # Both cost a lot where WebGL runs in software (no GPU: headless
+        # browsers, many classroom VMs). The shadow pass of the arm on the grid
+        # alone stalled the page ~100 ms on every redraw (measured; findings.md).
+        self.server.scene.configure_environment_map(None)
+        self.server.scene.configure_default_lights(cast_shadow=False)
         self.server.scene.add_grid("/grid", width=4.0, height=4.0, cell_size=0.25)
         self.server.scene.add_frame("/world", axes_length=0.3, axes_radius=0.01)
         gui.add_markdown(
