@@ -28,9 +28,9 @@ from app.panels.ros_tools import JOB_DONE
 from app.panels.scene_panel import ScenePanel
 from app.panels.services_panel import ServicesPanel
 from app.panels.topics_panel import TopicsPanel
+from app.ros2cli.topic import TopicMonitor
 from app.ros_runtime import RosRuntime
 from app.supervisor import Supervisor
-from app.topic_tap import TopicTap
 
 log = logging.getLogger(__name__)
 
@@ -53,7 +53,7 @@ class Dashboard:
         self.lessons = LessonRuntime(runtime.node, supervisor)
         self._stop = threading.Event()
         self.graph = GraphSnapshot()
-        self._chatter = TopicTap(runtime.node, "/chatter", String)
+        self._chatter = TopicMonitor(runtime.node, "/chatter", String, keep=50, qos=10)
         self._panels: list[Panel] = self._build_gui()
         self._ui_thread = threading.Thread(target=self._ui_loop, name="ui-refresh", daemon=True)
 

@@ -27,8 +27,8 @@ from app.graph import GraphSnapshot
 from app.lessons.schema import Spec
 from app.ros2cli.common import Ros2Error
 from app.ros2cli.convert import fill, import_type
+from app.ros2cli.topic import TopicMonitor
 from app.supervisor import Supervisor
-from app.topic_tap import TopicTap
 
 PASS, FAIL, WAITING = "pass", "fail", "waiting"
 RECALL_PERIOD_SEC = 1.0
@@ -39,6 +39,7 @@ TRANSITIONS = ("configure", "cleanup", "activate", "deactivate", "shutdown")
 # Best effort hears reliable and best-effort publishers alike (camera images
 # are usually best effort); a reliable tap would hear only the former.
 TAP_QOS = QoSProfile(depth=50, reliability=ReliabilityPolicy.BEST_EFFORT)
+TAP_KEEP = 50  # messages a check can look back on
 
 
 @dataclass(frozen=True)
@@ -83,7 +84,7 @@ class LessonRuntime:
         self.supervisor = supervisor
         self.graph = GraphSnapshot()
         self._lock = threading.Lock()
-        self._taps: dict[tuple[str, str], TopicTap] = {}
+        self._taps: dict[tuple[str, str], TopicMonitor] = {}
         self._clients: dict[tuple[str, str], Any] = {}
         self._calls: dict[str, _Call] = {}
         self._action_clients: dict[tuple[str, str], ActionClient] = {}
@@ -94,11 +95,13 @@ class LessonRuntime:
 
     # -- shared helpers ----------------------------------------------------
 
-    def tap(self, topic: str, type_name: str) -> TopicTap:
+    def tap(self, topic: str, type_name: str) -> TopicMonitor:
         with self._lock:
             key = (topic, type_name)
             if key not in self._taps:
-                self._taps[key] = TopicTap(self.node, topic, import_type(type_name), qos=TAP_QOS)
+                self._taps[key] = TopicMonitor(
+                    self.node, topic, import_type(type_name), keep=TAP_KEEP, qos=TAP_QOS
+                )
             return self._taps[key]
 
     def _client(self, service: str, srv_type: type) -> Any:

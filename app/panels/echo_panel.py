@@ -8,14 +8,14 @@ import viser
 
 from app.graph import GraphSnapshot
 from app.panels import MarkdownView, code_block
-from app.topic_tap import TopicTap
+from app.ros2cli.topic import TopicMonitor
 
 SHOWN_MESSAGES = 10
 FAST_HZ = 50.0
 
 
 class EchoPanel:
-    def __init__(self, gui: viser.GuiApi, tap: TopicTap) -> None:
+    def __init__(self, gui: viser.GuiApi, tap: TopicMonitor) -> None:
         self._tap = tap
         self._view = MarkdownView(gui)
 

@@ -144,8 +144,10 @@ class TopicMonitor:
         *,
         window: int = 10_000,
         keep: int = 100,
-        qos: QoSProfile | None = None,
+        qos: QoSProfile | int | None = None,
     ) -> None:
+        # qos: a profile, a depth (reliable, volatile), or None to match the
+        # topic's current publishers as `ros2 topic echo` does.
         self.topic = topic
         self.msg_type = msg_type
         self._node = node
@@ -155,7 +157,11 @@ class TopicMonitor:
         self._recent: deque[tuple[float, bytes]] = deque(maxlen=keep)
         self.count = 0
         self._sub = node.create_subscription(
-            msg_type, topic, self._on_message, qos or matching_qos(node, topic), raw=True
+            msg_type,
+            topic,
+            self._on_message,
+            matching_qos(node, topic) if qos is None else qos,
+            raw=True,
         )
 
     def _on_message(self, data: bytes) -> None:
@@ -178,6 +184,19 @@ class TopicMonitor:
                 return None
             stamp, data = self._recent[-index_from_end]
         return stamp, deserialize_message(data, self.msg_type)
+
+    def recent(self, last: int | None = None) -> list[tuple[float, Any]]:
+        """The newest ``last`` kept messages (all kept ones for None), oldest first."""
+        with self._cond:
+            raw = list(self._recent)
+        if last is not None:
+            raw = raw[-last:] if last > 0 else []
+        return [(stamp, deserialize_message(data, self.msg_type)) for stamp, data in raw]
+
+    def rate_hz(self, window_sec: float = 5.0) -> float | None:
+        """Mean rate over the last ``window_sec``; None with fewer than two messages."""
+        stats = self.rate(window_sec)
+        return stats.rate if stats else None
 
     def messages_since(self, count_before: int) -> list[tuple[float, Any]]:
         """Messages that arrived after the total count was ``count_before`` (as kept)."""

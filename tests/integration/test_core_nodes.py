@@ -14,8 +14,8 @@ from std_msgs.msg import Float64, String
 from tutorial_interfaces.action import Fibonacci
 from tutorial_interfaces.srv import AddTwoInts
 
+from app.ros2cli.topic import TopicMonitor
 from app.supervisor import NodeState
-from app.topic_tap import TopicTap
 from tests.conftest import wait_until
 from tests.integration.core_helpers import (
     DISCOVERY_TIMEOUT,
@@ -185,7 +185,7 @@ def current_state(probe) -> str:
     ).current_state.label
 
 
-def assert_silent(tap: TopicTap, seconds: float = 1.5) -> None:
+def assert_silent(tap: TopicMonitor, seconds: float = 1.5) -> None:
     time.sleep(0.5)  # let anything already in flight land
     count = tap.count
     time.sleep(seconds)
@@ -193,7 +193,7 @@ def assert_silent(tap: TopicTap, seconds: float = 1.5) -> None:
 
 
 def test_lifecycle_talker_every_transition_and_the_failing_one(supervisor, probe):
-    tap = TopicTap(probe.node, "/lifecycle_chatter", String)
+    tap = TopicMonitor(probe.node, "/lifecycle_chatter", String, qos=10)
     supervisor.start("lifecycle_talker", ["-p", "publish_period:=0.1"])
     assert current_state(probe) == "unconfigured"
     assert probe.node.count_publishers("/lifecycle_chatter") == 0
@@ -261,7 +261,7 @@ def test_lifecycle_talker_every_transition_and_the_failing_one(supervisor, probe
 
 
 def test_parameters_node_accepts_and_rejects_changes(supervisor, probe):
-    tap = TopicTap(probe.node, "/greeting", String)
+    tap = TopicMonitor(probe.node, "/greeting", String, qos=10)
     supervisor.start("parameters_node")
     wait_until(lambda: tap.count >= 2, timeout=DISCOVERY_TIMEOUT, what="/greeting messages")
     assert tap.recent()[-1][1].data.startswith("Hello from parameters_node #")
@@ -313,7 +313,7 @@ def test_qos_mismatch_is_reported_and_compatible_pairs_talk(supervisor, probe):
 
     # A best-effort subscriber on the probe hears the best-effort talker too.
     best_effort = QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT)
-    tap = TopicTap(probe.node, "/qos_chatter", String, qos=best_effort)
+    tap = TopicMonitor(probe.node, "/qos_chatter", String, qos=best_effort)
     wait_until(lambda: tap.count >= 2, timeout=DISCOVERY_TIMEOUT, what="best-effort messages")
 
 
@@ -326,15 +326,15 @@ def test_qos_transient_local_history_reaches_a_late_joiner(supervisor, probe):
         reliability=ReliabilityPolicy.RELIABLE,
         durability=DurabilityPolicy.TRANSIENT_LOCAL,
     )
-    late = TopicTap(probe.node, "/qos_chatter", String, qos=history)
-    fresh = TopicTap(probe.node, "/qos_chatter", String, qos=10)
+    late = TopicMonitor(probe.node, "/qos_chatter", String, qos=history)
+    fresh = TopicMonitor(probe.node, "/qos_chatter", String, qos=10)
     wait_until(
         lambda: late.count >= 1 and fresh.count >= 1,
         timeout=DISCOVERY_TIMEOUT,
         what="messages for both late joiners",
     )
 
-    def first_number(tap: TopicTap) -> int:
+    def first_number(tap: TopicMonitor) -> int:
         return int(tap.recent()[0][1].data.rsplit(" ", 1)[1])
 
     assert first_number(late) < first_number(fresh), (first_number(late), first_number(fresh))
@@ -344,8 +344,8 @@ def test_qos_transient_local_history_reaches_a_late_joiner(supervisor, probe):
 
 
 def test_executor_demo_single_thread_starves_multi_thread_does_not(supervisor, probe):
-    single = TopicTap(probe.node, "/executor_demo/fast_rate", Float64)
-    multi = TopicTap(probe.node, "/executor_demo_multi/fast_rate", Float64)
+    single = TopicMonitor(probe.node, "/executor_demo/fast_rate", Float64, qos=10)
+    multi = TopicMonitor(probe.node, "/executor_demo_multi/fast_rate", Float64, qos=10)
     supervisor.start("executor_demo")
     supervisor.start("executor_demo_multi")
     # The first report covers a short window; use the later ones.

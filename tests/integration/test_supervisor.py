@@ -13,15 +13,15 @@ import pytest
 from std_msgs.msg import String
 
 from app import PROJECT_ROOT
+from app.ros2cli.topic import TopicMonitor
 from app.supervisor import NodeState
-from app.topic_tap import TopicTap
 from tests.conftest import wait_until
 
 pytestmark = pytest.mark.ros
 
 
 def test_talker_and_listener_talk_over_dds(supervisor, probe):
-    tap = TopicTap(probe.node, "/chatter", String)
+    tap = TopicMonitor(probe.node, "/chatter", String, qos=10)
     supervisor.start("talker")
     supervisor.start("listener")
     wait_until(lambda: tap.count >= 3, what="/chatter messages at the probe")
