@@ -23,9 +23,9 @@ all processes on this machine. Run it inside the loopback-only namespace:
 ``.venv/bin/python tests/run.py --bench cloud_to_browser``. The last line
 printed is one JSON object with every figure.
 
-``BENCH_DDS=buffers`` (or ``shm``, or ``buffers+shm``) runs everything with a
-variant of the loopback DDS profile (4 MB UDP socket buffers; a shared-memory
-transport), to see how much of the cost is the DDS transport itself.
+``BENCH_DDS=shm`` runs everything with a variant of the loopback DDS profile
+that adds Fast DDS's shared-memory transport, to see how much of the cost is
+the UDP transport itself.
 """
 
 from __future__ import annotations
@@ -440,12 +440,6 @@ def run_bench(cases: tuple[tuple[int, int], ...]) -> dict[str, Any]:
         from app.dds import LOOPBACK_PROFILE, PROFILE_VAR
 
         xml = LOOPBACK_PROFILE.read_text()
-        if "buffers" in variant:
-            xml = xml.replace(
-                "<maxInitialPeersRange>",
-                "<sendBufferSize>4194304</sendBufferSize>"
-                "<receiveBufferSize>4194304</receiveBufferSize><maxInitialPeersRange>",
-            )
         if "shm" in variant:
             xml = xml.replace(
                 "  </transport_descriptors>",
