@@ -27,7 +27,7 @@ class GraphSnapshot:
     topics: tuple[TopicInfo, ...] = ()
     services: tuple[tuple[str, tuple[str, ...]], ...] = ()
     actions: tuple[str, ...] = field(default=())
-    # Names DDS still lists but that have no endpoints left (see is_ghost).
+    # Names DDS still lists but that own no endpoint any more (see endpoint_owners).
     ghosts: tuple[str, ...] = ()
 
     def topic(self, name: str) -> TopicInfo | None:
@@ -41,38 +41,41 @@ def _fqn(name: str, namespace: str) -> str:
     return f"{namespace.rstrip('/')}/{name}"
 
 
-def is_ghost(node: Node, name: str, namespace: str) -> bool:
-    """A listed node without a single publisher is a leftover, not a live node.
+def endpoint_owners(node: Node) -> tuple[list[TopicInfo], set[str]]:
+    """Every topic with its counts, and the nodes that own at least one endpoint.
 
-    Every rclpy node publishes /rosout and /parameter_events. The graph cache
-    learns node names from one DDS message and endpoints from others; when a
-    process leaves while its messages cross, the name can outlive its
-    endpoints for good (a "ghost" in `ros2 node list`). Its endpoints are
-    reliably removed, so an empty endpoint list tells a ghost apart.
+    Owning an endpoint is what tells a live node from a leftover name. Every
+    rclpy node publishes /rosout and /parameter_events. The graph cache learns
+    node names from one DDS message and endpoints from others; when a process
+    leaves while its messages cross, its name can outlive its endpoints for
+    good (a "ghost" in `ros2 node list`). Asking by name would not do: a
+    ghost and a restarted node of the same name share it, and the query
+    answers for whichever comes first. Endpoint records carry their owner.
     """
-    try:
-        return not node.get_publisher_names_and_types_by_node(name, namespace)
-    except Exception:  # noqa: BLE001 - the name vanished between two queries
-        return True
+    topics, owners = [], set()
+    for name, types in node.get_topic_names_and_types():
+        publishers = node.get_publishers_info_by_topic(name)
+        subscribers = node.get_subscriptions_info_by_topic(name)
+        owners.update(_fqn(e.node_name, e.node_namespace) for e in (*publishers, *subscribers))
+        topics.append(TopicInfo(name, tuple(types), len(publishers), len(subscribers)))
+    return topics, owners
+
+
+def _live_and_ghosts(node: Node, owners: set[str]) -> tuple[list[str], list[str]]:
+    listed = {_fqn(n, ns) for n, ns in node.get_node_names_and_namespaces()}
+    return sorted(listed & owners), sorted(listed - owners)
+
+
+def live_and_ghost_nodes(node: Node) -> tuple[list[str], list[str]]:
+    """Listed node names split into live ones and ghosts (see endpoint_owners)."""
+    return _live_and_ghosts(node, endpoint_owners(node)[1])
 
 
 def snapshot(node: Node, *, include_hidden: bool = False) -> GraphSnapshot:
-    live, ghosts = [], []
-    for name, namespace in node.get_node_names_and_namespaces():
-        (ghosts if is_ghost(node, name, namespace) else live).append(_fqn(name, namespace))
-    nodes = sorted(live)
-    topics = []
-    for name, types in node.get_topic_names_and_types():
-        if not include_hidden and ACTION_MARKER in name:
-            continue  # action internals are listed as actions
-        topics.append(
-            TopicInfo(
-                name,
-                tuple(types),
-                node.count_publishers(name),
-                node.count_subscribers(name),
-            )
-        )
+    all_topics, owners = endpoint_owners(node)
+    nodes, ghosts = _live_and_ghosts(node, owners)
+    # Action internals are listed as actions, not topics.
+    topics = [t for t in all_topics if include_hidden or ACTION_MARKER not in t.name]
     services = []
     actions = set()
     for name, types in node.get_service_names_and_types():
@@ -85,5 +88,5 @@ def snapshot(node: Node, *, include_hidden: bool = False) -> GraphSnapshot:
         topics=tuple(sorted(topics, key=lambda t: t.name)),
         services=tuple(sorted(services)),
         actions=tuple(sorted(actions)),
-        ghosts=tuple(sorted(ghosts)),
+        ghosts=tuple(ghosts),
     )

@@ -3,13 +3,16 @@
 In headless Chromium we click **Start** for ``talker`` in the Nodes tab and
 time how long until the Graph panel's update listing ``/talker`` reaches the
 page; then **Stop** until the update without it. The baseline, in the same
-run and from the same click, is plain rclpy observers in this process that
-poll ``get_node_names_and_namespaces()`` every 10 ms: they show how long the
-node itself takes to start (or leave) and be discovered, which no dashboard
-can beat. There are two, one joined before the dashboard and one after, and
-the earlier of them counts: which DDS participant hears of a new node first
-depends on discovery order (a late match waits for Fast DDS's next heartbeat,
-up to about 3 s), and the baseline should not lose that lottery.
+run and from the same click, is a plain rclpy observer in this process that
+polls the graph every 10 ms (started before the dashboard, as a terminal's
+`ros2` would be): it shows how long the node itself takes to start (or
+leave) and be discovered, which no dashboard can beat.
+
+Each participant learns of a new node at its own pace: a newcomer often
+misses the first answers and waits for each peer's next periodic
+announcement (every 250 ms with our DDS profile), so per trial either side
+may win by up to that much. A second observer, joined after the dashboard,
+gives a stricter figure too: the earlier of the two observers.
 
 Run: ``.venv/bin/python tests/run.py --bench start_to_visible [--trials N]``.
 The last line printed is one JSON object (``stop_to_gone`` reports the stop
@@ -24,7 +27,7 @@ import threading
 import time
 from typing import Any
 
-from app.graph import is_ghost
+from app.graph import live_and_ghost_nodes
 from bench._common import (
     configure_dds,
     launch_browser,
@@ -89,11 +92,8 @@ class GraphObserver:
     def _poll(self) -> None:
         present = None
         while not self._stop.wait(OBSERVER_PERIOD_SEC):
-            pairs = self.node.get_node_names_and_namespaces()
-            # Same rule as the dashboard: a listed name with no endpoints is a ghost.
-            seen = any(
-                f"{ns.rstrip('/')}/{n}" == FQN and not is_ghost(self.node, n, ns) for n, ns in pairs
-            )
+            # Same rule as the dashboard: a listed name that owns no endpoint is a ghost.
+            seen = FQN in live_and_ghost_nodes(self.node)[0]
             now = (seen, time.time())
             if now[0] != present:
                 present = now[0]
@@ -112,16 +112,15 @@ class GraphObserver:
 
 
 class Observers:
-    """Several observers read as one: the earliest of them."""
+    """Several observers, each read on its own."""
 
     def __init__(self, *observers: GraphObserver) -> None:
         self.observers = observers
 
-    def first(self, present: bool, after: float) -> float | None:
+    def first(self, present: bool, after: float) -> list[float] | None:
+        """When each observer first saw it; None until all of them have."""
         seen = [o.first(present, after) for o in self.observers]
-        if any(t is None for t in seen):
-            return None
-        return min(t for t in seen if t is not None)
+        return None if any(t is None for t in seen) else [t for t in seen if t is not None]
 
     def close(self) -> None:
         for o in self.observers:
@@ -135,16 +134,24 @@ def page_first(page: Any, present: bool, after: float) -> float | None:
     return None
 
 
-def wait_both(page: Any, observer: Observers, present: bool, t0: float) -> tuple[float, float]:
+def wait_both(
+    page: Any, observer: Observers, present: bool, t0: float
+) -> tuple[float, list[float]]:
     deadline = time.monotonic() + TIMEOUT_SEC
+    seen_obs = seen_page = None
     while time.monotonic() < deadline:
         seen_obs = observer.first(present, t0)
         seen_page = page_first(page, present, t0)
         if seen_obs is not None and seen_page is not None:
-            return seen_page - t0, seen_obs - t0
+            return seen_page - t0, [t - t0 for t in seen_obs]
         time.sleep(0.05)
     what = "never appeared" if present else "never left"
-    raise SystemExit(f"{FQN} {what} within {TIMEOUT_SEC} s")
+    missed = [
+        view
+        for view, seen in (("the dashboard page", seen_page), ("the plain observers", seen_obs))
+        if seen is None
+    ]
+    raise SystemExit(f"{FQN} {what} within {TIMEOUT_SEC} s in {' and '.join(missed)}")
 
 
 def run(trials: int) -> dict[str, Any]:
@@ -152,9 +159,8 @@ def run(trials: int) -> dict[str, Any]:
 
     require_private_netns("start_to_visible")
     configure_dds(10)
-    # Two plain observers, one joined before the dashboard and one after: which
-    # participant hears a new node first depends on DDS discovery order (a
-    # late match waits for the next heartbeat), so the baseline is the earlier.
+    # The baseline observer joins before the dashboard; a second one after it
+    # gives the stricter "earlier of two" figure (see the module docstring).
     first = GraphObserver("bench_observer_first")
     try:
         dashboard, url = start_dashboard("bench-start-dashboard.log")
@@ -162,8 +168,8 @@ def run(trials: int) -> dict[str, Any]:
         first.close()
         raise
     observer = Observers(first, GraphObserver("bench_observer_last"))
-    starts: dict[str, list[float]] = {"dashboard": [], "baseline": []}
-    stops: dict[str, list[float]] = {"dashboard": [], "baseline": []}
+    starts: dict[str, list[float]] = {"dashboard": [], "baseline": [], "best_of_two": []}
+    stops: dict[str, list[float]] = {"dashboard": [], "baseline": [], "best_of_two": []}
     try:
         with sync_playwright() as pw:
             browser = launch_browser(pw)
@@ -181,18 +187,22 @@ def run(trials: int) -> dict[str, Any]:
                 )
                 t0 = time.time()
                 start_button.click()
-                dash, base = wait_both(page, observer, True, t0)
+                dash, seen = wait_both(page, observer, True, t0)
+                base = seen[0]
                 starts["dashboard"].append(dash)
                 starts["baseline"].append(base)
+                starts["best_of_two"].append(min(seen))
                 page.wait_for_timeout(800)  # let the node settle (topics, services)
                 page.wait_for_function(
                     "b => !b.disabled", arg=stop_button.element_handle(), polling=50
                 )
                 t0 = time.time()
                 stop_button.click()
-                dash_gone, base_gone = wait_both(page, observer, False, t0)
+                dash_gone, seen = wait_both(page, observer, False, t0)
+                base_gone = seen[0]
                 stops["dashboard"].append(dash_gone)
                 stops["baseline"].append(base_gone)
+                stops["best_of_two"].append(min(seen))
                 print(
                     f"trial {trial + 1}: start->visible dashboard {dash * 1000:6.0f} ms, "
                     f"observer {base * 1000:6.0f} ms | stop->gone dashboard "
@@ -206,6 +216,7 @@ def run(trials: int) -> dict[str, Any]:
         stop(dashboard)
     ds, bs = summary(starts["dashboard"]), summary(starts["baseline"])
     dg, bg = summary(stops["dashboard"]), summary(stops["baseline"])
+    best = summary(starts["best_of_two"])
     return {
         "trials": trials,
         "start_dashboard_p50_ms": ds["p50"] * 1000,
@@ -214,6 +225,8 @@ def run(trials: int) -> dict[str, Any]:
         "start_baseline_p95_ms": bs["p95"] * 1000,
         "start_ratio": ratio(ds["p50"], bs["p50"]),
         "start_extra_ms": (ds["p50"] - bs["p50"]) * 1000,
+        "start_best_of_two_p50_ms": best["p50"] * 1000,
+        "start_ratio_best_of_two": ratio(ds["p50"], best["p50"]),
         "stop_to_gone_s": dg["p50"],
         "stop_to_gone_p95_s": dg["p95"],
         "stop_baseline_s": bg["p50"],
@@ -227,6 +240,10 @@ def report(figures: dict[str, Any]) -> None:
         f"plain observer {figures['start_baseline_p50_ms']:.0f} ms -> "
         f"ratio {figures['start_ratio']:.2f}x, +{figures['start_extra_ms']:.0f} ms "
         "(aim <= 1.2x and < 150 ms)"
+    )
+    print(
+        f"  stricter: against the earlier of two observers "
+        f"({figures['start_best_of_two_p50_ms']:.0f} ms) {figures['start_ratio_best_of_two']:.2f}x"
     )
     print(
         f"stop -> gone (p50): dashboard {figures['stop_to_gone_s']:.3f} s, "

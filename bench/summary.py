@@ -64,6 +64,14 @@ ROWS: tuple[tuple[str, str, str, str, str, Any], ...] = (
         lambda v: v <= 1.2,
     ),
     (
+        "Node start → visible, ratio against the earlier of two observers (stricter)",
+        "start_to_visible",
+        "start_ratio_best_of_two",
+        "x",
+        "",
+        None,
+    ),
+    (
         "Node start → visible, extra over observer",
         "start_to_visible",
         "start_extra_ms",
