@@ -10,7 +10,7 @@ from std_msgs.msg import String
 from tutorial_interfaces.msg import DetectedObject
 from visualization_msgs.msg import Marker, MarkerArray
 
-from app.topic_tap import TopicTap
+from app.ros2cli.topic import TopicMonitor
 from nodes.common.arm_kinematics import forward_kinematics
 from nodes.common.image_conversion import image_to_array
 from nodes.common.pointcloud import pointcloud2_to_xyz_rgb
@@ -29,11 +29,13 @@ def _xyz(point) -> np.ndarray:
 
 def test_camera_to_arm_chain_reaches_the_target(supervisor, probe):
     taps = {
-        "cam": TopicTap(probe.node, "/pos_in_cam_frame", PointStamped, keep=100),
-        "base": TopicTap(probe.node, "/pos_in_robot_base_frame", PointStamped, keep=100),
-        "joints": TopicTap(probe.node, "/joint_states", JointState, keep=5),
-        "pose": TopicTap(probe.node, "/end_effector_pose", PoseStamped, keep=5),
-        "status": TopicTap(probe.node, "/arm_status", String, keep=50),
+        "cam": TopicMonitor(probe.node, "/pos_in_cam_frame", PointStamped, keep=100, qos=10),
+        "base": TopicMonitor(
+            probe.node, "/pos_in_robot_base_frame", PointStamped, keep=100, qos=10
+        ),
+        "joints": TopicMonitor(probe.node, "/joint_states", JointState, keep=5, qos=10),
+        "pose": TopicMonitor(probe.node, "/end_effector_pose", PoseStamped, keep=5, qos=10),
+        "status": TopicMonitor(probe.node, "/arm_status", String, keep=50, qos=10),
     }
     supervisor.start("robotic_arm")
     supervisor.start("coordinate_transform")
@@ -104,8 +106,8 @@ def test_camera_to_arm_chain_reaches_the_target(supervisor, probe):
 
 
 def test_image_pipeline_finds_the_ball(supervisor, probe):
-    objects = TopicTap(probe.node, "/object_detection/object", DetectedObject, keep=20)
-    annotated = TopicTap(probe.node, "/object_detection/output", Image, keep=2)
+    objects = TopicMonitor(probe.node, "/object_detection/object", DetectedObject, keep=20, qos=10)
+    annotated = TopicMonitor(probe.node, "/object_detection/output", Image, keep=2, qos=10)
     supervisor.start("object_detector")
     supervisor.start("image_publisher", ["-p", "fps:=10.0"])
     wait_until(lambda: objects.count >= 3, timeout=60, what="detections of the red ball")
@@ -121,9 +123,9 @@ def test_image_pipeline_finds_the_ball(supervisor, probe):
 
 
 def test_video_to_slam_chain_builds_a_growing_map(supervisor, probe):
-    clouds = TopicTap(probe.node, "/cam/map_points", PointCloud2, keep=3)
-    markers = TopicTap(probe.node, "/cam/camera_pose", MarkerArray, keep=2)
-    features = TopicTap(probe.node, "/cam/feature_ext_viz", Image, keep=2)
+    clouds = TopicMonitor(probe.node, "/cam/map_points", PointCloud2, keep=3, qos=10)
+    markers = TopicMonitor(probe.node, "/cam/camera_pose", MarkerArray, keep=2, qos=10)
+    features = TopicMonitor(probe.node, "/cam/feature_ext_viz", Image, keep=2, qos=10)
     supervisor.start("slam_node")
     supervisor.start("video_publisher", ["-p", "fps:=10.0"])
 
