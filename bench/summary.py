@@ -29,7 +29,7 @@ LOAD = [0.0]  # the 1-minute load average when the run began: others may share t
 # (benchmark, short arguments); optional ones are skipped when their module is absent.
 RUNS: tuple[tuple[str, list[str]], ...] = (
     ("start_to_visible", ["--trials", "15"]),
-    ("echo_hz_load", ["--seconds", "5"]),
+    ("echo_hz_load", ["--seconds", "10"]),
     ("click_to_effect", ["--repeats", "4"]),
     ("idle_cost", ["--seconds", "8"]),
     ("startup", ["--rounds", "2"]),
