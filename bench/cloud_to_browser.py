@@ -35,20 +35,27 @@ import asyncio
 import http
 import json
 import os
-import socket
 import statistics
 import struct
-import subprocess
 import sys
 import threading
 import time
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-CHROMIUM = "/usr/bin/chromium"
+from bench._common import (
+    LOGS,
+    configure_dds,
+    free_port,
+    launch_browser,
+    require_private_netns,
+    spawn,
+    start_dashboard,
+    stop,
+    wait_for_text,
+)
+
 DASH_TOPIC = "/bench/cloud_dash"
 BASE_TOPIC = "/bench/cloud_base"
 CASES = ((100_000, 10), (100_000, 20), (1_000_000, 10), (1_000_000, 20))
@@ -241,46 +248,6 @@ def serve_baseline(port: int) -> None:
 # --------------------------------------------------------------------------- the benchmark
 
 
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
-
-
-def wait_for_line(proc: subprocess.Popen, log: Path, text: str, timeout: float) -> None:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if text in log.read_text(errors="replace"):
-            return
-        if proc.poll() is not None:
-            raise SystemExit(f"{log.name}: exited early:\n{log.read_text(errors='replace')}")
-        time.sleep(0.1)
-    raise SystemExit(f"{log.name}: not ready after {timeout:.0f} s")
-
-
-def start(argv: list[str], log: Path, ready: str) -> subprocess.Popen:
-    proc = subprocess.Popen(
-        argv,
-        cwd=ROOT,
-        env={**os.environ, "PYTHONUNBUFFERED": "1"},
-        stdout=log.open("wb"),
-        stderr=subprocess.STDOUT,
-        start_new_session=True,
-    )
-    wait_for_line(proc, log, ready, 60.0)
-    return proc
-
-
-def stop(proc: subprocess.Popen) -> None:
-    if proc.poll() is None:
-        proc.terminate()
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
-
-
 class CloudPublisher:
     """Pre-built clouds (the decode side is what we measure); only the stamp changes."""
 
@@ -427,14 +394,8 @@ def pick_cloud_topic(browser, url: str) -> None:
 def run_bench(cases: tuple[tuple[int, int], ...]) -> dict[str, Any]:
     from playwright.sync_api import sync_playwright
 
-    from app.dds import configure_this_process
-
-    if [name for _, name in socket.if_nameindex()] != ["lo"]:
-        raise SystemExit(
-            "run this inside the loopback-only namespace: "
-            ".venv/bin/python tests/run.py --bench cloud_to_browser"
-        )
-    configure_this_process(domain_id=60 + os.getpid() % 30, network=False)
+    require_private_netns("cloud_to_browser")
+    configure_dds(60)
     variant = os.environ.get("BENCH_DDS", "")
     if variant:
         from app.dds import LOOPBACK_PROFILE, PROFILE_VAR
@@ -451,32 +412,23 @@ def run_bench(cases: tuple[tuple[int, int], ...]) -> dict[str, Any]:
                 "<transport_id>classroom_loopback_udp</transport_id>\n"
                 "        <transport_id>classroom_shm</transport_id>\n      </userTransports>",
             )
-        custom = ROOT / "test-artifacts" / "bench-dds.xml"
+        custom = LOGS / "bench-dds.xml"
         custom.parent.mkdir(exist_ok=True)
         custom.write_text(xml)
         os.environ[PROFILE_VAR] = str(custom)
-    logs = ROOT / "test-artifacts"
-    logs.mkdir(exist_ok=True)
-    dash_port, base_port = free_port(), free_port()
-    py = sys.executable
-    dashboard = start(
-        [py, "-m", "app", "serve", "--port", str(dash_port)],
-        logs / "bench-dashboard.log",
-        "is ready",
-    )
+    dashboard, dash_url = start_dashboard()
     publisher = CloudPublisher()  # first: the baseline subscribes once it sees it
-    baseline = start(
-        [py, "-m", "bench.cloud_to_browser", "--serve-baseline", str(base_port)],
-        logs / "bench-baseline.log",
-        "BASELINE READY",
+    base_port = free_port()
+    baseline, log = spawn(
+        [sys.executable, "-m", "bench.cloud_to_browser", "--serve-baseline", str(base_port)],
+        "bench-baseline.log",
     )
+    wait_for_text(baseline, log, "BASELINE READY", 60.0)
     results: dict[str, Any] = {}
     try:
         with sync_playwright() as pw:
-            browser = pw.chromium.launch(
-                executable_path=CHROMIUM, args=["--no-sandbox", "--disable-dev-shm-usage"]
-            )
-            dash_url, base_url = f"http://127.0.0.1:{dash_port}", f"http://127.0.0.1:{base_port}/"
+            browser = launch_browser(pw)
+            base_url = f"http://127.0.0.1:{base_port}/"
             pick_cloud_topic(browser, dash_url)
             for size, hz in cases:
                 label = f"{size // 1000}k" if size < 1_000_000 else f"{size // 1_000_000}M"
