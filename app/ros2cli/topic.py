@@ -11,6 +11,7 @@ import math
 import threading
 import time
 from collections import deque
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -192,6 +193,13 @@ class TopicMonitor:
         if last is not None:
             raw = raw[-last:] if last > 0 else []
         return [(stamp, deserialize_message(data, self.msg_type)) for stamp, data in raw]
+
+    def newest(self) -> Iterator[tuple[float, Any]]:
+        """Kept messages newest first, each deserialised only when reached."""
+        with self._cond:
+            raw = list(self._recent)
+        for stamp, data in reversed(raw):
+            yield stamp, deserialize_message(data, self.msg_type)
 
     def rate_hz(self, window_sec: float = 5.0) -> float | None:
         """Mean rate over the last ``window_sec``; None with fewer than two messages."""
