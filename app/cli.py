@@ -91,7 +91,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     from app.access import make_server
     from app.dashboard import Dashboard
     from app.lessons.progress import DEFAULT_DIR, ProgressStore
-    from app.ros_runtime import RosRuntime
+    from app.ros.runtime import RosRuntime
     from app.supervisor import Supervisor
 
     progress = ProgressStore(args.learner, args.progress_dir or DEFAULT_DIR)

@@ -1,4 +1,8 @@
-"""Wires the web server, the ROS runtime, the supervisor and the panels. Nothing else."""
+"""Wires the web server, the ROS runtime, the supervisor and the panels. Nothing else.
+
+The dashboard owns the UI thread (see the threading model in app.ui): it
+applies posted intents, takes a graph snapshot, and refreshes every panel.
+"""
 
 from __future__ import annotations
 
@@ -8,34 +12,41 @@ import threading
 import time
 
 import viser
-from std_msgs.msg import String
 
-from app.graph import GraphSnapshot, snapshot
-from app.lessons.live import LessonRuntime
+from app.lessons.panel import LessonsPanel
 from app.lessons.progress import ProgressStore
+from app.lessons.runtime import LessonRuntime
 from app.lessons.schema import load_course
-from app.panels import Panel
 from app.panels.actions_panel import ActionsPanel
-from app.panels.console_panel import ConsolePanel
 from app.panels.echo_panel import EchoPanel
 from app.panels.graph_panel import GraphPanel
-from app.panels.lessons_panel import LessonsPanel
 from app.panels.lifecycle_panel import LifecyclePanel
-from app.panels.logs_panel import LogsPanel, RosoutLog
+from app.panels.logs_panel import LogsPanel
 from app.panels.nodes_panel import NodesPanel
 from app.panels.parameters_panel import ParametersPanel
-from app.panels.ros_tools import JOB_DONE
 from app.panels.scene_panel import ScenePanel
 from app.panels.services_panel import ServicesPanel
 from app.panels.topics_panel import TopicsPanel
-from app.ros2cli.topic import TopicMonitor
-from app.ros_runtime import RosRuntime
+from app.ros.graph import GraphSnapshot, snapshot
+from app.ros.rosout import RosoutLog
+from app.ros.runtime import RosRuntime
+from app.ros2cli.console_panel import ConsolePanel
 from app.supervisor import Supervisor
+from app.ui import TAB_NAMES, Panel
+from app.ui.loop import UiLoop
 
 log = logging.getLogger(__name__)
 
 UI_PERIOD_SEC = 0.2  # panels refresh at 5 Hz
-GRAPH_CHECK_SEC = 0.02  # ...and within 20 ms of a node joining/leaving or a click answered
+GRAPH_CHECK_SEC = 0.02  # ...and within 20 ms of a node joining/leaving or an intent
+
+_ICONS = {
+    "Lessons": viser.Icon.SCHOOL, "Nodes": viser.Icon.CPU, "Graph": viser.Icon.SITEMAP,
+    "Echo": viser.Icon.MESSAGE, "3D view": viser.Icon.CUBE, "Topics": viser.Icon.LIST_DETAILS,
+    "Parameters": viser.Icon.ADJUSTMENTS, "Console": viser.Icon.TERMINAL,
+    "Services": viser.Icon.ARROWS_EXCHANGE, "Actions": viser.Icon.ROCKET,
+    "Lifecycle": viser.Icon.PROGRESS, "Logs": viser.Icon.FILE_TEXT,
+}  # fmt: skip
 
 
 class Dashboard:
@@ -50,15 +61,16 @@ class Dashboard:
         self.runtime = runtime
         self.supervisor = supervisor
         self.progress = progress
+        self.ui = UiLoop()
         self.lessons = LessonRuntime(runtime.node, supervisor)
+        self.rosout = RosoutLog(runtime.node)
         self._stop = threading.Event()
         self.graph = GraphSnapshot()
-        self._chatter = TopicMonitor(runtime.node, "/chatter", String, keep=50, qos=10)
         self._panels: list[Panel] = self._build_gui()
         self._ui_thread = threading.Thread(target=self._ui_loop, name="ui-refresh", daemon=True)
 
     def _build_gui(self) -> list[Panel]:
-        gui = self.server.gui
+        gui, ui, node = self.server.gui, self.ui, self.runtime.node
         gui.configure_theme(titlebar_content=None, control_width="large", show_share_button=False)
         # Both cost a lot where WebGL runs in software (no GPU: headless
         # browsers, many classroom VMs). The shadow pass of the arm on the grid
@@ -72,58 +84,47 @@ class Dashboard:
             f"Domain id **{os.environ.get('ROS_DOMAIN_ID', '0')}** · "
             "this dashboard is the ROS node `/classroom_dashboard`."
         )
+        builders = {
+            "Lessons": lambda: LessonsPanel(gui, ui, load_course(), self.lessons, self.progress),
+            "Nodes": lambda: NodesPanel(gui, ui, self.supervisor),
+            "Graph": lambda: GraphPanel(gui, node),
+            "Echo": lambda: EchoPanel(gui, node),
+            "3D view": lambda: ScenePanel(self.server, ui, node),
+            "Topics": lambda: TopicsPanel(gui, ui, node),
+            "Parameters": lambda: ParametersPanel(gui, ui, node, self.rosout),
+            "Console": lambda: ConsolePanel(gui, ui, node),
+            "Services": lambda: ServicesPanel(gui, ui, node),
+            "Actions": lambda: ActionsPanel(gui, ui, node),
+            "Lifecycle": lambda: LifecyclePanel(gui, ui, node, self.rosout),
+            "Logs": lambda: LogsPanel(gui, self.rosout),
+        }
+        assert tuple(builders) == TAB_NAMES, "every tab lessons may name has a panel"
         tabs = gui.add_tab_group()
-        with tabs.add_tab("Lessons", viser.Icon.SCHOOL):
-            lessons = LessonsPanel(gui, load_course(), self.lessons, self.progress)
-        with tabs.add_tab("Nodes", viser.Icon.CPU):
-            nodes = NodesPanel(gui, self.supervisor)
-        with tabs.add_tab("Graph", viser.Icon.SITEMAP):
-            graph = GraphPanel(gui, self.runtime.node)
-        with tabs.add_tab("Echo", viser.Icon.MESSAGE):
-            echo = EchoPanel(gui, self._chatter)
-        with tabs.add_tab("3D view", viser.Icon.CUBE):
-            scene = ScenePanel(self.server, self.runtime.node)
-        ros_panels = self._build_ros_panels(tabs)
-        return [lessons, nodes, graph, echo, scene, *ros_panels]
-
-    def _build_ros_panels(self, tabs: viser.GuiTabGroupHandle) -> list[Panel]:
-        """The ros2 command line and rqt, in the browser (issue 4)."""
-        gui, node = self.server.gui, self.runtime.node
-        rosout = RosoutLog(node)
-        with tabs.add_tab("Topics", viser.Icon.LIST_DETAILS):
-            topics = TopicsPanel(gui, node)
-        with tabs.add_tab("Parameters", viser.Icon.ADJUSTMENTS):
-            parameters = ParametersPanel(gui, node, rosout)
-        with tabs.add_tab("Console", viser.Icon.TERMINAL):
-            console = ConsolePanel(gui, node)
-        with tabs.add_tab("Services", viser.Icon.ARROWS_EXCHANGE):
-            services = ServicesPanel(gui, node)
-        with tabs.add_tab("Actions", viser.Icon.ROCKET):
-            actions = ActionsPanel(gui, node)
-        with tabs.add_tab("Lifecycle", viser.Icon.PROGRESS):
-            lifecycle = LifecyclePanel(gui, node, rosout)
-        with tabs.add_tab("Logs", viser.Icon.FILE_TEXT):
-            logs = LogsPanel(gui, rosout)
-        return [topics, parameters, console, services, actions, lifecycle, logs]
+        panels: list[Panel] = []
+        for name in TAB_NAMES:
+            with tabs.add_tab(name, _ICONS[name]):
+                panels.append(builders[name]())
+        return panels
 
     def start(self) -> None:
         self._ui_thread.start()
 
     def _ui_loop(self) -> None:
-        # A cheap look at the node list (and at finished panel jobs) every
-        # GRAPH_CHECK_SEC refreshes at once when something changed; otherwise
-        # at UI_PERIOD_SEC. A node shows up within a frame, not a 5 Hz tick.
+        # A cheap look at the node list every GRAPH_CHECK_SEC, and any posted
+        # intent, refresh at once; otherwise panels refresh at UI_PERIOD_SEC.
+        # A node shows up within a frame, a click's effect within one pass.
         last_nodes: object = None
         due = 0.0
-        while not self._stop.wait(GRAPH_CHECK_SEC):
+        while not self._stop.is_set():
+            woken = self.ui.wait(GRAPH_CHECK_SEC)
+            applied = self.ui.apply_pending()
             try:
                 nodes = self.runtime.node.get_node_names_and_namespaces()
-            except Exception:
+            except Exception:  # noqa: BLE001 - the graph may be unreadable for a moment
                 nodes = last_nodes
             now = time.monotonic()
-            if nodes == last_nodes and now < due and not JOB_DONE.is_set():
+            if nodes == last_nodes and now < due and not (woken or applied):
                 continue
-            JOB_DONE.clear()
             last_nodes, due = nodes, now + UI_PERIOD_SEC
             try:
                 self.graph = snapshot(self.runtime.node)
@@ -140,5 +141,14 @@ class Dashboard:
             self.server.flush()
 
     def stop(self) -> None:
+        """Stop the UI thread, then close every panel (their subscriptions, timers)."""
         self._stop.set()
+        self.ui.post(lambda: None)  # wake the loop now
         self._ui_thread.join(timeout=2.0)
+        self.ui.close()
+        for panel in self._panels:
+            try:
+                panel.close()
+            except Exception:  # noqa: BLE001 - shutting down: close the others anyway
+                log.exception("close of %s failed", type(panel).__name__)
+        self.rosout.close()

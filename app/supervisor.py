@@ -9,7 +9,9 @@ SIGKILL. Output is kept in a bounded buffer per node.
 Threads: children are spawned from one long-lived thread (the parent-death
 signal is tied to the *thread* that forked), each child has one reader thread
 that also reaps it, and stops escalate in short-lived threads. All state
-lives in ``_Process`` objects guarded by one lock.
+lives in ``_Process`` objects guarded by one lock; ``start`` holds a second
+lock across "is it running?" and the spawn, so two concurrent starts of one
+node make one process, never two with the first one lost.
 """
 
 from __future__ import annotations
@@ -22,8 +24,9 @@ import sys
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Iterable, Mapping
 from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import TimeoutError as FutureTimeout  # not TimeoutError on 3.10
 from dataclasses import dataclass
 from enum import Enum
 
@@ -122,7 +125,6 @@ class Supervisor:
         max_log_lines: int = 400,
         sigint_timeout: float = 3.0,
         sigterm_timeout: float = 2.0,
-        on_change: Callable[[NodeStatus], None] | None = None,
     ) -> None:
         self._env = dict(env)
         self._env.setdefault("PYTHONUNBUFFERED", "1")
@@ -130,8 +132,8 @@ class Supervisor:
         self._max_log_lines = max_log_lines
         self.max_log_lines = max_log_lines
         self._timeouts = (sigint_timeout, sigterm_timeout)
-        self._on_change = on_change
         self._lock = threading.Lock()
+        self._start_lock = threading.Lock()  # check-then-spawn is one step
         self._procs: dict[str, _Process] = {}
         self._ended: deque[NodeStatus] = deque(maxlen=500)  # who ended, newest last
         self._spawner = ThreadPoolExecutor(max_workers=1, thread_name_prefix="supervisor-spawn")
@@ -181,17 +183,24 @@ class Supervisor:
     # -- control -----------------------------------------------------------
 
     def start(self, name: str, extra_ros_args: Iterable[str] = ()) -> NodeStatus:
-        """Start a catalog node (no-op if it is already active)."""
+        """Start a catalog node: a no-op if it is starting or running, after the reap if stopping."""
         entry = lookup(name)
-        with self._lock:
-            if self._closed:
-                raise RuntimeError("the supervisor is shutting down")
-            current = self._procs.get(name)
-            if current and current.state in ACTIVE_STATES:
-                return current.status()
-        status = self._spawner.submit(self._spawn, entry, tuple(extra_ros_args)).result()
-        self._notify(status)
-        return status
+        while True:
+            with self._start_lock:
+                with self._lock:
+                    if self._closed:
+                        raise RuntimeError("the supervisor is shutting down")
+                    current = self._procs.get(name)
+                    stopping = current is not None and current.state is NodeState.STOPPING
+                    if current is not None and current.state in ACTIVE_STATES and not stopping:
+                        return current.status()
+                if not stopping:
+                    return self._spawner.submit(self._spawn, entry, tuple(extra_ros_args)).result()
+            # Start right after Stop: the old process is not reaped yet. Starting
+            # nothing would be wrong, starting beside it too: wait (bounded by
+            # the stop's SIGKILL escalation), then start anew.
+            assert current is not None
+            current.done.wait()
 
     def stop(self, name: str) -> Future[NodeStatus]:
         """Ask a node to stop; the future resolves once it has been reaped."""
@@ -204,8 +213,6 @@ class Supervisor:
                 return future
             proc.stop_requested = True
             proc.state = NodeState.STOPPING
-            status = proc.status()
-        self._notify(status)
         threading.Thread(
             target=self._escalate_stop, args=(proc, future), name=f"stop-{name}", daemon=True
         ).start()
@@ -218,14 +225,10 @@ class Supervisor:
     def note_visible_nodes(self, node_names: Iterable[str]) -> None:
         """Called with the graph's node names: a STARTING node seen there is RUNNING."""
         seen = set(node_names)
-        changed = []
         with self._lock:
             for proc in self._procs.values():
                 if proc.state is NodeState.STARTING and proc.entry.node_name in seen:
                     proc.state = NodeState.RUNNING
-                    changed.append(proc.status())
-        for status in changed:
-            self._notify(status)
 
     def shutdown(self, timeout: float = 4.0) -> None:
         """Stop every child in parallel and reap them all."""
@@ -237,7 +240,7 @@ class Supervisor:
         for future in futures:
             try:
                 future.result(timeout=max(0.1, deadline - time.monotonic()))
-            except TimeoutError:
+            except FutureTimeout:
                 pass
         with self._lock:
             leftovers = [p for p in self._procs.values() if not p.done.is_set()]
@@ -288,10 +291,8 @@ class Supervisor:
                 proc.state = NodeState.STOPPED
             else:
                 proc.state = NodeState.EXITED if code == 0 else NodeState.CRASHED
-            status = proc.status()
-            self._ended.append(status)
+            self._ended.append(proc.status())
         proc.done.set()
-        self._notify(status)
 
     def _escalate_stop(self, proc: _Process, future: Future[NodeStatus]) -> None:
         # SIGINT is Ctrl+C: rclpy nodes leave spin and shut down cleanly, so
@@ -315,7 +316,3 @@ class Supervisor:
             os.killpg(proc.popen.pid, sig)
         except (ProcessLookupError, PermissionError):
             pass  # already gone
-
-    def _notify(self, status: NodeStatus) -> None:
-        if self._on_change is not None:
-            self._on_change(status)

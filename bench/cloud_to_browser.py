@@ -159,7 +159,7 @@ def serve_baseline(port: int) -> None:
     from websockets.datastructures import Headers
     from websockets.http11 import Response
 
-    from app.ros_runtime import RosRuntime
+    from app.ros.runtime import RosRuntime
     from app.scene.cloud_codec import decode_cloud
     from app.scene.qos import newest_only_qos
 
@@ -255,7 +255,7 @@ class CloudPublisher:
         from rclpy.qos import QoSProfile, ReliabilityPolicy
         from sensor_msgs.msg import PointCloud2
 
-        from app.ros_runtime import RosRuntime
+        from app.ros.runtime import RosRuntime
         from nodes.common.pointcloud import xyz_to_pointcloud2 as encode_cloud
 
         self.runtime = RosRuntime("bench_cloud_publisher")

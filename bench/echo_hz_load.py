@@ -60,7 +60,7 @@ def _types() -> tuple[type, type]:
 
 
 def _measure_qos() -> Any:
-    from app.ros2cli.topic import MEASURE_QOS
+    from app.ros.qos import MEASURE_QOS
 
     return MEASURE_QOS
 
@@ -143,11 +143,11 @@ def dashboard_main(t0: float, t1: float, out: Path) -> None:
 
     from app.dashboard import Dashboard
     from app.lessons.progress import ProgressStore
-    from app.panels import MarkdownView, code_block
-    from app.ros2cli.convert import to_yaml
-    from app.ros2cli.topic import TopicMonitor
-    from app.ros_runtime import RosRuntime
+    from app.ros.convert import to_yaml
+    from app.ros.monitor import TopicMonitor
+    from app.ros.runtime import RosRuntime
     from app.supervisor import Supervisor
+    from app.ui import MarkdownView, code_block
 
     Int64, Image = _types()
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)

@@ -27,7 +27,7 @@ import threading
 import time
 from typing import Any
 
-from app.graph import live_and_ghost_nodes
+from app.ros.graph import live_and_ghost_nodes
 from bench._common import (
     configure_dds,
     launch_browser,

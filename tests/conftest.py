@@ -98,7 +98,7 @@ def ros_env(monkeypatch: pytest.MonkeyPatch) -> Iterator[dict[str, str]]:
 @pytest.fixture
 def probe(ros_env):
     """A ROS node in the test process, spun in its own thread, to observe over DDS."""
-    from app.ros_runtime import RosRuntime
+    from app.ros.runtime import RosRuntime
 
     runtime = RosRuntime("test_probe")
     yield runtime

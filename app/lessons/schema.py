@@ -1,8 +1,10 @@
 """Lesson files: ``lessons/NN_slug/lesson.toml`` plus Markdown, validated at load.
 
 A broken lesson gives a ``LessonError`` naming the file and the field; the
-loader keeps the rest of the course. Lessons are data only: the actions and
-check kinds they may name are fixed here and implemented in ``app.lessons``.
+loader keeps the rest of the course. Lessons are data only: the action and
+check kinds they may name are registered in ``app.lessons.kinds`` and
+implemented in ``app.lessons.runtime``; the catalog nodes, ROS node names and
+tabs they name are checked against the product at load.
 """
 
 from __future__ import annotations
@@ -18,40 +20,13 @@ except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
 from app import PROJECT_ROOT
+from app.catalog import ENTRIES, GROUPS
+from app.lessons.kinds import ACTION_KINDS, CHECK_KINDS, Kind
+from app.ros.runtime import DASHBOARD_NODE_NAME
+from app.ui import TAB_NAMES
 
 LESSONS_DIR = PROJECT_ROOT / "lessons"
 _DIR_PATTERN = re.compile(r"^(\d{2})_[a-z0-9_]+$")
-
-# kind -> (required fields, optional fields)
-ACTION_FIELDS: dict[str, tuple[set[str], set[str]]] = {
-    "start": ({"node"}, {"label"}),
-    "stop": ({"node"}, {"label"}),
-    "start_group": ({"group"}, {"label"}),
-    "stop_group": ({"group"}, {"label"}),
-    "lifecycle": ({"node", "transition"}, {"label"}),
-    "set_param": ({"node", "name", "value"}, {"label"}),
-    "call_service": ({"service", "type", "request"}, {"label"}),
-    "send_goal": ({"action", "type", "goal"}, {"label", "cancel_after_feedback"}),
-    "open_panel": ({"panel"}, {"label"}),
-}
-CHECK_FIELDS: dict[str, tuple[set[str], set[str]]] = {
-    "node_running": ({"node"}, set()),
-    "node_absent": ({"node"}, set()),
-    "topic_messages": ({"topic", "type", "at_least"}, {"field", "contains"}),
-    "topic_rate": ({"topic", "type", "min_hz", "max_hz"}, set()),
-    "topic_subscribers": ({"topic", "at_least"}, set()),
-    "log_contains": ({"node", "text"}, {"at_least"}),
-    "lifecycle_state": ({"node", "state"}, set()),
-    "parameter_equals": ({"node", "name", "value"}, set()),
-    "service_returns": ({"service", "type", "request", "field", "equals"}, set()),
-    "action_result": ({"action", "status"}, set()),
-    "pointcloud_points": ({"topic", "at_least"}, set()),
-    "arm_reached": ({"tolerance"}, set()),
-    "interface_exists": ({"type"}, set()),
-    "quiz": ({"question", "options", "answer"}, set()),
-}
-PANELS = {"Nodes", "Graph", "Echo", "Console", "Topics", "Services", "Actions", "Parameters",
-          "Lifecycle", "Logs", "Scene", "Lessons"}  # fmt: skip
 
 
 class LessonError(ValueError):
@@ -117,13 +92,38 @@ def _require(table: dict, key: str, kind: type | tuple[type, ...], where: str) -
     return value
 
 
-def _spec(raw: Any, table: dict[str, tuple[set[str], set[str]]], where: str) -> Spec:
+_CATALOG_NAMES = frozenset(entry.name for entry in ENTRIES)
+_GROUP_NAMES = frozenset(group.name for group in GROUPS)
+# Every ROS node name a lesson can expect on the graph: what catalog entries create.
+_ROS_NODE_NAMES = frozenset({entry.node_name for entry in ENTRIES} | {f"/{DASHBOARD_NODE_NAME}"})
+
+
+def _check_names(kind: str, fields: dict[str, Any], where: str) -> None:
+    """Names a lesson uses must exist in the product it runs in."""
+    if "catalog_node" in fields and fields["catalog_node"] not in _CATALOG_NAMES:
+        raise LessonError(
+            f"{where}: no catalog node '{fields['catalog_node']}' (see the Nodes tab)"
+        )
+    if "group" in fields and fields["group"] not in _GROUP_NAMES:
+        raise LessonError(f"{where}: no launch group '{fields['group']}'")
+    if "node" in fields and fields["node"] not in _ROS_NODE_NAMES:
+        raise LessonError(
+            f"{where}: no catalog entry creates the ROS node '{fields['node']}' "
+            "(a ROS node name starts with '/'; catalog names go in 'catalog_node')"
+        )
+    if kind == "open_panel" and fields["panel"] not in TAB_NAMES:
+        raise LessonError(
+            f"{where}: there is no tab '{fields['panel']}' (tabs: {', '.join(TAB_NAMES)})"
+        )
+
+
+def _spec(raw: Any, table: dict[str, Kind], where: str) -> Spec:
     if not isinstance(raw, dict):
         raise LessonError(f"{where}: must be a table, got {type(raw).__name__}")
     kind = _require(raw, "kind", str, where)
     if kind not in table:
         raise LessonError(f"{where}: unknown kind '{kind}' (known: {', '.join(sorted(table))})")
-    required, optional = table[kind]
+    required, optional = table[kind].required, table[kind].optional
     fields = {k: v for k, v in raw.items() if k != "kind"}
     missing = required - fields.keys()
     if missing:
@@ -131,8 +131,7 @@ def _spec(raw: Any, table: dict[str, tuple[set[str], set[str]]], where: str) -> 
     unknown = fields.keys() - required - optional
     if unknown:
         raise LessonError(f"{where}: kind '{kind}' has unknown field '{sorted(unknown)[0]}'")
-    if kind == "open_panel" and fields["panel"] not in PANELS:
-        raise LessonError(f"{where}: unknown panel '{fields['panel']}'")
+    _check_names(kind, fields, where)
     if kind == "quiz" and fields["answer"] not in fields["options"]:
         raise LessonError(f"{where}: quiz answer must be one of its options")
     return Spec(kind, fields)
@@ -179,11 +178,11 @@ def load_lesson(directory: Path) -> Lesson:
         text_file = _require(raw, "text", str, step_where)
         text = _inside(directory, text_file, f"{step_where}.text").read_text(encoding="utf-8")
         actions = [
-            _spec(a, ACTION_FIELDS, f"{step_where}.actions[{j}]")
+            _spec(a, ACTION_KINDS, f"{step_where}.actions[{j}]")
             for j, a in enumerate(_require(raw, "actions", list, step_where))
         ] if "actions" in raw else []  # fmt: skip
         checks = [
-            _spec(c, CHECK_FIELDS, f"{step_where}.checks[{j}]")
+            _spec(c, CHECK_KINDS, f"{step_where}.checks[{j}]")
             for j, c in enumerate(_require(raw, "checks", list, step_where))
         ] if "checks" in raw else []  # fmt: skip
         command = _require(raw, "command", str, step_where) if "command" in raw else ""

@@ -5,21 +5,24 @@ from __future__ import annotations
 import time
 
 import viser
+from rclpy.node import Node
+from std_msgs.msg import String
 
-from app.graph import GraphSnapshot
-from app.panels import MarkdownView, code_block
-from app.ros2cli.topic import TopicMonitor
+from app.ros.graph import GraphSnapshot
+from app.ros.monitor import TopicMonitor
+from app.ui import MarkdownView, code_block
 
+TOPIC = "/chatter"
 SHOWN_MESSAGES = 10
 FAST_HZ = 50.0
 
 
 class EchoPanel:
-    def __init__(self, gui: viser.GuiApi, tap: TopicMonitor) -> None:
-        self._tap = tap
+    def __init__(self, gui: viser.GuiApi, node: Node) -> None:
+        self._tap = TopicMonitor(node, TOPIC, String, keep=50, qos=10)
         self._view = MarkdownView(gui)
 
-    def refresh(self, graph: GraphSnapshot | None) -> None:
+    def refresh(self, graph: GraphSnapshot) -> None:
         recent = self._tap.recent(SHOWN_MESSAGES)
         lines = [
             f"[{time.strftime('%H:%M:%S', time.localtime(t))}] data: {msg.data!r}"
@@ -29,9 +32,11 @@ class EchoPanel:
         rate_text = f"{rate:.1f} Hz" if rate else "no messages lately"
         if rate and rate > FAST_HZ:  # say so: most messages scroll by unseen
             rate_text += f" · ⚠ too fast to read: showing only the newest {SHOWN_MESSAGES}"
-        header = f"`ros2 topic echo {self._tap.topic}` · {self._tap.count} received · {rate_text}"
-        publishers = (
-            graph.topic(self._tap.topic).publishers if graph and graph.topic(self._tap.topic) else 0
+        header = f"`ros2 topic echo {TOPIC}` · {self._tap.count} received · {rate_text}"
+        hint = (
+            "" if graph.publishers(TOPIC) else "\n\n_No publisher on this topic: start **talker**._"
         )
-        hint = "" if publishers else "\n\n_No publisher on this topic: start **talker**._"
         self._view.show(header + hint + "\n\n" + code_block(lines, "(waiting for messages)"))
+
+    def close(self) -> None:
+        self._tap.close()

@@ -9,79 +9,41 @@ subscriptions on the topics in the picture only. The text lists below
 
 from __future__ import annotations
 
-import logging
 import time
 
 import viser
-from rclpy.action import (
-    get_action_client_names_and_types_by_node,
-    get_action_server_names_and_types_by_node,
-)
 from rclpy.node import Node
 
-from app.graph import GraphSnapshot
-from app.panels import MarkdownView
-from app.panels.graph_svg import (
-    NodeEndpoints,
-    graph_picture,
-    legend_html,
-    render_svg,
-    topics_to_measure,
-)
-from app.panels.rates import RateBoard, rate_text
-from app.ros2cli.common import split_node_name
-
-log = logging.getLogger(__name__)
+from app.panels.graph_svg import graph_picture, legend_html, render_svg, topics_to_measure
+from app.ros.graph import GraphSnapshot, node_endpoints
+from app.ros.rates import RateBoard, rate_text
+from app.ui import MarkdownView
 
 PICTURE_PERIOD_SEC = 1.0
 
 
-def _first_types(pairs: list[tuple[str, list[str]]]) -> dict[str, str]:
-    return {name: types[0] for name, types in pairs if types}
-
-
-def node_endpoints(node: Node, fqn: str) -> NodeEndpoints | None:
-    """One node's endpoints from the local graph cache; None if it just vanished."""
-    name, namespace = split_node_name(fqn)
-    try:
-        return NodeEndpoints(
-            fqn,
-            _first_types(node.get_publisher_names_and_types_by_node(name, namespace)),
-            _first_types(node.get_subscriber_names_and_types_by_node(name, namespace)),
-            _first_types(node.get_service_names_and_types_by_node(name, namespace)),
-            _first_types(node.get_client_names_and_types_by_node(name, namespace)),
-            _first_types(get_action_server_names_and_types_by_node(node, name, namespace)),
-            _first_types(get_action_client_names_and_types_by_node(node, name, namespace)),
-        )
-    except Exception:  # noqa: BLE001 - the node left between listing and asking
-        return None
-
-
 class GraphPanel:
-    def __init__(self, gui: viser.GuiApi, node: Node | None = None) -> None:
+    def __init__(self, gui: viser.GuiApi, node: Node) -> None:
         self._node = node
-        self._rates = RateBoard(node) if node is not None else None
+        self._rates = RateBoard(node)
         self._last_picture = 0.0
         self._svg = ""
-        if node is not None:
-            with gui.add_folder("Options", expand_by_default=False):
-                self._show_quiet = gui.add_checkbox(
-                    "Show /rosout, /parameter_events, parameter and lifecycle services", False
-                )
-                self._show_self = gui.add_checkbox("Show this dashboard's own node", False)
-                self._live = gui.add_checkbox("Live rates", True)
-                self._heavy = gui.add_checkbox(
-                    "Rates of images and clouds too",
-                    False,
-                    hint="Large messages cost bandwidth even when only counted",
-                )
-            gui.add_html(legend_html())
-            self._picture = gui.add_html(render_svg([], []))
+        with gui.add_folder("Options", expand_by_default=False):
+            self._show_quiet = gui.add_checkbox(
+                "Show /rosout, /parameter_events, parameter and lifecycle services", False
+            )
+            self._show_self = gui.add_checkbox("Show this dashboard's own node", False)
+            self._live = gui.add_checkbox("Live rates", True)
+            self._heavy = gui.add_checkbox(
+                "Rates of images and clouds too",
+                False,
+                hint="Large messages cost bandwidth even when only counted",
+            )
+        gui.add_html(legend_html())
+        self._picture = gui.add_html(render_svg([], []))
         self._view = MarkdownView(gui, "Waiting for the first look at the graph…")
 
-    def refresh(self, graph: GraphSnapshot | None) -> None:
-        if graph is None:
-            return
+    def refresh(self, graph: GraphSnapshot) -> None:
         self._refresh_picture(graph)
         parts = [f"**Nodes ({len(graph.nodes)})** · `ros2 node list`", ""]
         parts += [f"- `{name}`" for name in graph.nodes] or ["- (none)"]
@@ -105,8 +67,6 @@ class GraphPanel:
 
     def _refresh_picture(self, graph: GraphSnapshot) -> None:
         node, rates = self._node, self._rates
-        if node is None or rates is None:
-            return
         now = time.monotonic()
         if now - self._last_picture < PICTURE_PERIOD_SEC:
             return
@@ -130,3 +90,6 @@ class GraphPanel:
         if svg != self._svg:
             self._svg = svg
             self._picture.content = svg
+
+    def close(self) -> None:
+        self._rates.close()

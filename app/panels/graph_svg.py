@@ -1,4 +1,4 @@
-"""A layered drawing of the ROS graph as SVG, in plain Python (no ROS, no browser).
+"""A layered drawing of the ROS graph as SVG, in plain Python (no ROS calls, no browser).
 
 rqt_graph needs Qt and Graphviz and hides services and actions; here the
 picture is a small SVG string the Graph panel puts in an HTML widget. Data
@@ -16,6 +16,9 @@ from dataclasses import dataclass
 from html import escape
 from typing import Literal
 
+from app.ros.graph import NodeEndpoints
+from app.ros.names import ACTION_MARKER, QUIET_TOPICS
+
 Kind = Literal["node", "topic", "service", "action"]
 
 BOX_W, BOX_H = 168, 34  # two boxes a row fit the control panel at about 1:1 scale
@@ -30,7 +33,6 @@ STYLE: dict[str, tuple[str, str, str]] = {  # fill, stroke, shape rounding
     "service": ("#fff4e6", "#e8590c", "4"),
     "action": ("#f3d9fa", "#ae3ec9", "4"),
 }
-KIND_WORD = {"node": "node", "topic": "topic", "service": "service", "action": "action"}
 
 
 @dataclass(frozen=True)
@@ -241,7 +243,7 @@ def render_svg(vertices: list[Vertex], edges: list[Edge], per_row: int = PER_ROW
         fill, stroke, radius = STYLE[p.vertex.kind]
         v = p.vertex
         cx = p.x + BOX_W / 2
-        title = f"{KIND_WORD[v.kind]} {v.name}" + (f" ({v.detail})" if v.detail else "")
+        title = f"{v.kind} {v.name}" + (f" ({v.detail})" if v.detail else "")
         name_y = p.y + (14 if v.detail else 21)
         parts.append(
             f'<g class="rg-vertex" data-kind="{v.kind}" data-name="{escape(v.name)}">'
@@ -279,7 +281,6 @@ def legend_html() -> str:
 
 # ------------------------------------------------------------ from endpoints
 
-QUIET_TOPICS = ("/rosout", "/parameter_events")
 PARAMETER_SERVICES = (
     "/describe_parameters", "/get_parameter_types", "/get_parameters", "/get_type_description",
     "/list_parameters", "/set_parameters", "/set_parameters_atomically",
@@ -291,19 +292,6 @@ HEAVY_TYPES = (
     "sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage", "sensor_msgs/msg/PointCloud2",
     "sensor_msgs/msg/LaserScan",
 )  # fmt: skip
-
-
-@dataclass(frozen=True)
-class NodeEndpoints:
-    """What one node offers and uses, as `ros2 node info` lists it (name -> type)."""
-
-    name: str
-    publishes: dict[str, str]
-    subscribes: dict[str, str]
-    servers: dict[str, str]
-    clients: dict[str, str]
-    action_servers: dict[str, str]
-    action_clients: dict[str, str]
 
 
 def _short_type(type_text: str) -> str:
@@ -330,10 +318,10 @@ def graph_picture(
         return vertex.key
 
     def quiet_topic(name: str) -> bool:
-        return "/_action/" in name or (not show_quiet and name in QUIET_TOPICS)
+        return ACTION_MARKER in name or (not show_quiet and name in QUIET_TOPICS)
 
     def quiet_service(name: str) -> bool:
-        return "/_action/" in name or (not show_quiet and name.endswith(PARAMETER_SERVICES))
+        return ACTION_MARKER in name or (not show_quiet and name.endswith(PARAMETER_SERVICES))
 
     for node in nodes:
         me = add("node", node.name)

@@ -2,30 +2,26 @@
 
 The state comes from ``<node>/get_state`` and, as soon as anyone changes it
 (a launch file, a terminal, this panel), from ``<node>/transition_event``.
-Each click runs ``ros2 lifecycle set`` through app.ros2cli on a worker thread.
+Each click runs the same code as ``ros2 lifecycle set`` on a worker thread.
 """
 
 from __future__ import annotations
 
-import threading
 import time
 
 import viser
 from lifecycle_msgs.msg import TransitionEvent
 from rclpy.node import Node
+from rclpy.subscription import Subscription
 
-from app.graph import GraphSnapshot
-from app.panels import MarkdownView, code_block
-from app.panels.logs_panel import RosoutLog, format_record
-from app.panels.ros_tools import run_job
-from app.ros2cli import CONSOLE_LIMITS, VerbContext
-from app.ros2cli import lifecycle as lc
-from app.ros2cli.common import split_node_name
-from app.ros2cli.convert import import_type
-from app.ros2cli.topic import MEASURE_QOS, TopicMonitor
+from app.ros import lifecycle as lc
+from app.ros.context import panel_context
+from app.ros.graph import GraphSnapshot, published_topics
+from app.ros.rates import RateBoard, rate_text
+from app.ros.rosout import RosoutLog, format_record
+from app.ui import MarkdownView, code_block, set_options
+from app.ui.loop import UiLoop
 
-PRIMARY = ("unconfigured", "inactive", "active", "finalized")
-BUTTONS = ("configure", "activate", "deactivate", "cleanup", "shutdown")
 EDGES = (
     ("unconfigured", "configure", "inactive"),
     ("inactive", "activate", "active"),
@@ -35,14 +31,12 @@ EDGES = (
 )
 NONE = "(no lifecycle node)"
 POLL_SEC = 2.0
-QUIET_TOPICS = ("/rosout", "/parameter_events")
-RATE_WINDOW_SEC = 3.0
 
 
 def draw_state_machine(current: str | None) -> str:
     """The four primary states in a row, the current one highlighted, and the transitions."""
     cells = []
-    for state in PRIMARY:
+    for state in lc.PRIMARY_STATES:
         if state == current:
             cells.append(
                 f'<td style="background:#2f9e44;color:white;font-weight:bold;'
@@ -52,7 +46,7 @@ def draw_state_machine(current: str | None) -> str:
             cells.append(f'<td style="padding:6px;color:#555">{state}</td>')
     rows = "".join(f"<tr><td>{a}</td><td>—<b>{t}</b>→</td><td>{b}</td></tr>" for a, t, b in EDGES)
     extra = ""
-    if current and current not in PRIMARY:
+    if current and current not in lc.PRIMARY_STATES:
         extra = f'<div style="color:#e67700"><b>in transition: {current}</b></div>'
     return (
         '<div style="font-family:sans-serif;font-size:13px">'
@@ -62,167 +56,149 @@ def draw_state_machine(current: str | None) -> str:
 
 
 class LifecyclePanel:
-    def __init__(self, gui: viser.GuiApi, node: Node, rosout: RosoutLog) -> None:
+    def __init__(self, gui: viser.GuiApi, ui: UiLoop, node: Node, rosout: RosoutLog) -> None:
+        self._ui = ui
         self._node = node
         self._rosout = rosout
-        self._lock = threading.Lock()
         self._target: str | None = None
         self._state: str | None = None
         self._available: set[str] = set()
         self._message = ""
-        self._busy = False
+        self._polling = False  # a get_state job is out: never two at once
+        self._changing = False  # a transition job is out: buttons stay disabled
         self._last_poll = 0.0
-        self._event_sub = None
+        self._event_sub: Subscription | None = None
         self._nodes: list[str] = []
-        self._monitors: dict[str, TopicMonitor] = {}
+        self._rates = RateBoard(node, limit=8)
         self._selector = gui.add_dropdown("Lifecycle node", [NONE], initial_value=NONE)
         self._diagram = gui.add_html(draw_state_machine(None))
         self._diagram_html = ""
         self._buttons = {}
-        for label in BUTTONS:
+        for label in lc.TRANSITION_LABELS:
             button = gui.add_button(label, disabled=True)
-            button.on_click(lambda _e, label=label: self._transition(label))
+            button.on_click(lambda _e, label=label: ui.post(lambda: self._transition(label)))
             self._buttons[label] = button
         self._result = MarkdownView(gui, "")
         self._log = MarkdownView(gui, "")
-        self._selector.on_update(lambda _: self._select(self._selector.value))
+        self._selector.on_update(lambda _: ui.post(lambda: self._select(self._selector.value)))
 
-    # --- selection and state -------------------------------------------------
+    # --- selection and state (UI thread) -------------------------------------------
 
-    def _ctx(self) -> VerbContext:
-        return VerbContext(self._node, lambda _line: None, CONSOLE_LIMITS)
-
-    def _select(self, target: str) -> None:
-        with self._lock:
-            if target == self._target:
-                return
-            self._target = None if target == NONE else target
-            self._state, self._available, self._message = None, set(), ""
-            old, self._event_sub = self._event_sub, None
-        if old is not None:
-            self._node.destroy_subscription(old)
-        with self._lock:
-            monitors, self._monitors = list(self._monitors.values()), {}
-        for monitor in monitors:
-            monitor.close()
-        if self._target:
+    def _select(self, choice: str) -> None:
+        target = None if choice == NONE else choice
+        if target == self._target:
+            return
+        self._target = target
+        self._state, self._available, self._message = None, set(), ""
+        self._rates.watch({})
+        if self._event_sub is not None:
+            self._node.destroy_subscription(self._event_sub)
+            self._event_sub = None
+        if target:
+            # The executor thread hands each event to the UI thread.
             self._event_sub = self._node.create_subscription(
-                TransitionEvent, f"{self._target}/transition_event", self._on_event, 10
+                TransitionEvent,
+                f"{target}/transition_event",
+                lambda event: self._ui.post(lambda: self._on_event(target, event)),
+                10,
             )
             self._poll()
 
-    def _on_event(self, event: TransitionEvent) -> None:
-        # Runs on the executor thread: record the new state, fetch transitions elsewhere.
-        with self._lock:
+    def _on_event(self, target: str, event: TransitionEvent) -> None:
+        if target == self._target:
             self._state = event.goal_state.label
-        self._poll()
+            self._poll()
 
     def _poll(self) -> None:
         target = self._target
-        if target is None or self._busy:
+        if target is None or self._polling:
             return
-        self._busy = True
+        self._polling = True
         self._last_poll = time.monotonic()
+        ctx = panel_context(self._node)
 
-        def work() -> None:
-            try:
-                ctx = self._ctx()
-                _id, state = lc.get_state(ctx, target)
-                available = {t.label for t in lc.available_transitions(ctx, target)}
-                self._watch_topics(target)
-                with self._lock:
-                    if self._target == target:
-                        self._state, self._available = state, available
-            finally:
-                self._busy = False
+        def work() -> tuple[str, set[str]]:
+            _id, state = lc.get_state(ctx, target)
+            return state, {t.label for t in lc.available_transitions(ctx, target)}
 
-        run_job(work, self._show_error)
+        def done(answer: tuple[str, set[str]]) -> None:
+            self._polling = False
+            if self._target == target:
+                self._state, self._available = answer
 
-    def _watch_topics(self, target: str) -> None:
-        """Measure the rate of every topic the node publishes (they appear on configure)."""
-        name, namespace = split_node_name(target)
-        for topic, types in self._node.get_publisher_names_and_types_by_node(name, namespace):
-            if topic in self._monitors or topic in QUIET_TOPICS or "/_" in topic:
-                continue
-            if topic.endswith("/transition_event"):
-                continue
-            monitor = TopicMonitor(
-                self._node, topic, import_type(types[0]), qos=MEASURE_QOS, keep=1
-            )
-            with self._lock:
-                self._monitors[topic] = monitor
-
-    def _rates_text(self) -> str:
-        parts = []
-        with self._lock:
-            monitors = sorted(self._monitors.items())
-        for topic, monitor in monitors:
-            stats = monitor.rate(window_sec=RATE_WINDOW_SEC)
-            rate = f"**{stats.rate:.1f} Hz**" if stats else "**silent**"
-            parts.append(f"`{topic}`: {rate} (`ros2 topic hz {topic}`)")
-        return "Publishing: " + (" · ".join(parts) if parts else "no topics yet")
-
-    def _show_error(self, text: str) -> None:
-        with self._lock:
+        def failed(text: str) -> None:
+            self._polling = False
             self._message = f"⚠️ {text}"
+
+        self._ui.run_job(work, done, failed)
 
     def _transition(self, label: str) -> None:
         target = self._target
-        if target is None:
+        if target is None or self._changing or label not in self._available:
             return
         command = f"ros2 lifecycle set {target} {label}"
-        with self._lock:
-            self._message = f"`{command}` …"
-            self._available = set()  # no double clicks while it runs
+        self._message = f"`{command}` …"
+        self._changing = True
+        ctx = panel_context(self._node)
 
-        def work() -> None:
-            ok, chosen = lc.change_state(self._ctx(), target, label)
+        def done(answer: tuple[bool, lc.TransitionInfo]) -> None:
+            ok, chosen = answer
+            self._changing = False
             verdict = "Transitioning successful" if ok else "Transitioning failed"
-            with self._lock:
-                self._message = f"`{command}` → **{verdict}** ({chosen.start} → {chosen.goal})"
-            self._busy = False
+            self._message = f"`{command}` → **{verdict}** ({chosen.start} → {chosen.goal})"
             self._poll()
 
-        run_job(work, self._show_error)
+        def failed(text: str) -> None:
+            self._changing = False
+            self._message = f"⚠️ {text}"
+            self._poll()
+
+        self._ui.run_job(lambda: lc.change_state(ctx, target, label), done, failed)
 
     # --- refresh ---------------------------------------------------------------
 
-    def refresh(self, graph: GraphSnapshot | None) -> None:
-        if graph is not None:
-            nodes = sorted(
-                name[: -len("/get_state")]
-                for name, types in graph.services
-                if name.endswith("/get_state") and lc.GET_STATE_TYPE in types
-            )
-            if nodes != self._nodes:
-                self._nodes = nodes
-                options = nodes or [NONE]
-                self._selector.options = options
-                if self._selector.value not in options:
-                    self._selector.value = options[0]
-                self._select(self._selector.value)
-        if self._target and time.monotonic() - self._last_poll > POLL_SEC:
+    def refresh(self, graph: GraphSnapshot) -> None:
+        nodes = graph.nodes_serving("/get_state", lc.GET_STATE_TYPE)
+        if nodes != self._nodes:
+            self._nodes = nodes
+            set_options(self._selector, nodes or [NONE], keep_current=False)
+            self._select(self._selector.value)
+        target = self._target
+        if target and time.monotonic() - self._last_poll > POLL_SEC:
             self._poll()
-        with self._lock:
-            state, available, message = self._state, set(self._available), self._message
-        html = draw_state_machine(state)
+        html = draw_state_machine(self._state)
         if html != self._diagram_html:
             self._diagram_html = html
             self._diagram.content = html
         for label, button in self._buttons.items():
-            disabled = label not in available
+            disabled = self._changing or label not in self._available
             if button.disabled != disabled:
                 button.disabled = disabled
-        target = self._target
-        header = (
-            f"Current state of `{target}`: **{state or '…'}** · `ros2 lifecycle get {target}`"
-            if target
-            else "_Start **lifecycle_talker** in the Nodes tab._"
-        )
-        rates = "\n\n" + self._rates_text() if target else ""
-        self._result.show(header + rates + ("\n\n" + message if message else ""))
-        if target:
-            lines = [format_record(r) for r in self._rosout.records(target, last=12)]
-            self._log.show(f"Log of `{target}` (/rosout):\n\n" + code_block(lines))
-        else:
+        if target is None:
+            self._result.show("_Start **lifecycle_talker** in the Nodes tab._")
             self._log.show("")
+            return
+        # Publishers appear on configure and go on cleanup: measure what exists now.
+        self._rates.watch(published_topics(self._node, target))
+        self._result.show(
+            f"Current state of `{target}`: **{self._state or '…'}** · "
+            f"`ros2 lifecycle get {target}`\n\n"
+            + self._rates_text()
+            + (f"\n\n{self._message}" if self._message else "")
+        )
+        lines = [format_record(r) for r in self._rosout.records(target, last=12)]
+        self._log.show(f"Log of `{target}` (/rosout):\n\n" + code_block(lines))
+
+    def _rates_text(self) -> str:
+        parts = [
+            f"`{topic}`: **{rate_text(self._rates.rate(topic)) or 'silent'}** "
+            f"(`ros2 topic hz {topic}`)"
+            for topic in self._rates.watched()
+        ]
+        return "Publishing: " + (" · ".join(parts) if parts else "no topics yet")
+
+    def close(self) -> None:
+        self._rates.close()
+        if self._event_sub is not None:
+            self._node.destroy_subscription(self._event_sub)
+            self._event_sub = None

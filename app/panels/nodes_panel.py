@@ -2,15 +2,14 @@
 
 from __future__ import annotations
 
-import threading
-
 import viser
 
-from app.catalog import ENTRIES, GROUPS, UnknownNodeError, lookup, lookup_group
-from app.graph import GraphSnapshot
+from app.catalog import ENTRIES, GROUPS, lookup, lookup_group
 from app.launch import launch_file_text
-from app.panels import MarkdownView, code_block
+from app.ros.graph import GraphSnapshot
 from app.supervisor import ACTIVE_STATES, NodeState, NodeStatus, Supervisor
+from app.ui import MarkdownView, code_block
+from app.ui.loop import UiLoop
 
 _STATE_ICONS = {
     NodeState.STARTING: "◐",
@@ -35,9 +34,10 @@ def _notes(status: NodeStatus, stale: bool) -> str:
 
 
 class NodesPanel:
-    def __init__(self, gui: viser.GuiApi, supervisor: Supervisor) -> None:
+    def __init__(self, gui: viser.GuiApi, ui: UiLoop, supervisor: Supervisor) -> None:
+        self._ui = ui
         self._supervisor = supervisor
-        self._one_action = threading.Lock()
+        self._graph = GraphSnapshot()
         self._selector = gui.add_dropdown(
             "Catalog node",
             [entry.name for entry in ENTRIES],
@@ -60,49 +60,59 @@ class NodesPanel:
             self._group_details = MarkdownView(gui)
         with gui.add_folder("All catalog nodes"):
             self._overview = MarkdownView(gui)
-        self._start_group.on_click(lambda _: self._act_on_group(self._supervisor.start, "Started"))
-        self._stop_group.on_click(lambda _: self._act_on_group(self._supervisor.stop, "Stopping"))
-        self._group_selector.on_update(lambda _: self.refresh(None))
-        self._start.on_click(lambda _: self._act(self._do_start))
-        self._stop.on_click(lambda _: self._act(self._do_stop))
-        self._restart.on_click(lambda _: self._act(self._do_restart))
-        self._selector.on_update(lambda _: self.refresh(None))
+        self._start.on_click(lambda _: ui.post(lambda: self._act("start")))
+        self._stop.on_click(lambda _: ui.post(lambda: self._act("stop")))
+        self._restart.on_click(lambda _: ui.post(lambda: self._act("restart")))
+        self._start_group.on_click(lambda _: ui.post(lambda: self._act_on_group("start")))
+        self._stop_group.on_click(lambda _: ui.post(lambda: self._act_on_group("stop")))
+        # A new choice only needs a refresh, which follows every applied intent.
+        self._selector.on_update(lambda _: ui.post(self._valid_selection))
+        self._group_selector.on_update(lambda _: ui.post(self._valid_selection))
 
-    # Button actions never block the viser callback thread for long: a stop
-    # escalates in the supervisor's own thread.
-    # One click at a time: a Stop that overtook a half-done group Start would
-    # miss the members started after it, and leave them running.
-    def _act(self, action) -> None:
-        with self._one_action:
-            name = self._selector.value
-            try:
-                self._message.show(action(name))
-            except (UnknownNodeError, RuntimeError, OSError) as exc:
-                self._message.show(f"⚠ {exc}")
-        self.refresh(None)
+    # -- clicks (UI thread) ------------------------------------------------------
+    # Every click becomes a job in one lane: clicks run one at a time, in the
+    # order they were made, so a Stop never overtakes a half-done group Start.
 
-    def _act_on_group(self, action, verb: str) -> None:
-        with self._one_action:
-            try:
-                group = lookup_group(self._group_selector.value)
-                for member in group.members:
-                    action(member)
-                self._message.show(f"{verb} group **{group.name}**: {', '.join(group.members)}.")
-            except (UnknownNodeError, RuntimeError, OSError) as exc:
-                self._message.show(f"⚠ {exc}")
-        self.refresh(None)
+    def _act(self, verb: str) -> None:
+        name = self._selector.value
+        work = {"start": self._do_start, "stop": self._do_stop, "restart": self._do_restart}[verb]
+        if verb == "restart":
+            self._message.show(f"Restarting **{name}**…")
+        self._ui.run_job(lambda: work(name), self._message.show, self._show_error, lane="nodes")
+
+    def _act_on_group(self, verb: str) -> None:
+        name = self._group_selector.value
+
+        def work() -> str:
+            group = lookup_group(name)
+            for member in group.members:
+                if verb == "start":
+                    self._supervisor.start(member)
+                else:
+                    self._supervisor.stop(member)
+            done = "Started" if verb == "start" else "Stopping"
+            return f"{done} group **{group.name}**: {', '.join(group.members)}."
+
+        self._ui.run_job(work, self._message.show, self._show_error, lane="nodes")
+
+    def _show_error(self, text: str) -> None:
+        self._message.show(f"⚠ {text}")
+
+    # -- jobs (lane "nodes") -------------------------------------------------------
 
     def _do_start(self, name: str) -> str:
         status = self._supervisor.start(name)
         return f"Started **{name}** (pid {status.pid})."
 
     def _do_stop(self, name: str) -> str:
-        self._supervisor.stop(name)
+        self._supervisor.stop(name)  # escalates in the supervisor's own thread
         return f"Stopping **{name}** (Ctrl+C, as in a terminal)…"
 
     def _do_restart(self, name: str) -> str:
-        threading.Thread(target=self._supervisor.restart, args=(name,), daemon=True).start()
-        return f"Restarting **{name}**…"
+        self._supervisor.restart(name)
+        return f"Restarted **{name}**."
+
+    # -- UI thread -------------------------------------------------------------
 
     def _valid_selection(self) -> None:
         """Dropdown values come from the browser: anything outside the catalog is reset."""
@@ -111,10 +121,10 @@ class NodesPanel:
         if self._group_selector.value not in _GROUP_NAMES:
             self._group_selector.value = GROUPS[0].name
 
-    def refresh(self, graph: GraphSnapshot | None) -> None:
+    def refresh(self, graph: GraphSnapshot) -> None:
         self._valid_selection()
         statuses = self._supervisor.statuses()
-        stale = self._supervisor.stale_in_graph(graph.nodes) if graph is not None else {}
+        stale = self._supervisor.stale_in_graph(graph.nodes)
         rows = ["| node | state |", "|---|---|"]
         for entry in ENTRIES:
             status = statuses.get(entry.name, NodeStatus(entry.name, NodeState.STOPPED))
@@ -150,3 +160,6 @@ class NodesPanel:
             else ""
         )
         self._log.show(f"Log of **{name}**:\n\n" + code_block(lines) + dropped)
+
+    def close(self) -> None:
+        """The supervisor, not this panel, owns the processes: nothing to release."""

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import math
 import shlex
-import threading
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -21,15 +20,13 @@ import viser
 from rcl_interfaces.msg import ParameterDescriptor, ParameterType, ParameterValue
 from rclpy.node import Node
 
-from app.graph import GraphSnapshot
-from app.panels import MarkdownView, code_block
-from app.panels.graph_svg import QUIET_TOPICS
-from app.panels.logs_panel import RosoutLog, format_record
-from app.panels.rates import RateBoard, rate_text
-from app.panels.ros_tools import run_job
-from app.ros2cli import CONSOLE_LIMITS, VerbContext
-from app.ros2cli import param as rp
-from app.ros2cli.common import split_node_name
+from app.ros import params as rp
+from app.ros.context import CallContext, panel_context
+from app.ros.graph import GraphSnapshot, published_topics
+from app.ros.rates import RateBoard, rate_text
+from app.ros.rosout import RosoutLog, format_record
+from app.ui import MarkdownView, code_block, set_options
+from app.ui.loop import UiLoop
 
 NONE = "(pick a node)"
 SYNC_PERIOD_SEC = 3.0
@@ -112,22 +109,25 @@ def describe_spec(spec: ParamSpec) -> str:
 
 
 class ParametersPanel:
-    def __init__(self, gui: viser.GuiApi, node: Node, rosout: RosoutLog | None = None) -> None:
+    def __init__(
+        self, gui: viser.GuiApi, ui: UiLoop, node: Node, rosout: RosoutLog | None = None
+    ) -> None:
         self._gui = gui
+        self._ui = ui
         self._node = node
         self._rosout = rosout
-        self._lock = threading.Lock()
         self._nodes: list[str] = []
         self._target: str | None = None
-        self._loaded: tuple[str, list[ParamSpec]] | None = None  # from a worker
+        self._loading = False
+        self._syncing = False
+        self._synced_at = 0.0
         self._built_for: str | None = None
         self._specs: dict[str, ParamSpec] = {}
         self._widgets: dict[str, Any] = {}
+        # What each editor showed when it last matched the node: an editor whose
+        # value differs from it is being edited, and a sync leaves it alone.
         self._known: dict[str, Any] = {}
-        self._busy = False
-        self._synced_at = 0.0
         self._message = ""
-        self._pending_values: dict[str, Any] | None = None
         self._rates = RateBoard(node, limit=8)
         gui.add_markdown(
             "A node's parameters are settings it reads while it runs. Pick a node, "
@@ -139,58 +139,60 @@ class ParametersPanel:
         self._editors = gui.add_folder("Parameters", expand_by_default=True)
         self._editor_folder: Any = None
         self._activity = MarkdownView(gui, "")
-        self._selector.on_update(lambda _: self._select(self._selector.value))
+        self._selector.on_update(lambda _: ui.post(lambda: self._select(self._selector.value)))
 
-    def _ctx(self) -> VerbContext:
-        return VerbContext(self._node, lambda _line: None, CONSOLE_LIMITS)
+    def _ctx(self) -> CallContext:
+        return panel_context(self._node)
 
     def _show_error(self, text: str) -> None:
-        with self._lock:
-            self._message = f"⚠️ {text}"
-            self._busy = False
+        self._message = f"⚠️ {text}"
 
     # --- loading ---------------------------------------------------------------
 
     def _select(self, choice: str) -> None:
         target = None if choice == NONE else choice
-        with self._lock:
-            if target == self._target:
-                return
-            self._target, self._loaded, self._message = target, None, ""
-            self._busy = False
+        if target == self._target:
+            return
+        self._target, self._message = target, ""
         self._rates.watch({})
+        self._remove_editors()
         if target:
             self._load(target)
 
     def _load(self, target: str) -> None:
-        """Fetch names, values and descriptors off the callback thread."""
-        with self._lock:
-            if self._busy:
-                return
-            self._busy = True
-            self._synced_at = time.monotonic()
+        """Fetch names, values and descriptors on a worker; build the editors after."""
+        self._loading = True
+        self._synced_at = time.monotonic()
+        ctx = self._ctx()
 
-        def work() -> None:
-            ctx = self._ctx()
+        def work() -> list[ParamSpec]:
             names = rp.list_names(ctx, target)
             values = rp.get_values(ctx, target, names) if names else []
             descriptors = rp.describe(ctx, target, names) if names else []
-            specs = [
-                spec_from(n, v, d) for n, v, d in zip(names, values, descriptors, strict=False)
-            ]
-            with self._lock:
-                if self._target == target:
-                    self._loaded = (target, specs)
-                self._busy = False
+            return [spec_from(n, v, d) for n, v, d in zip(names, values, descriptors, strict=False)]
 
-        run_job(work, self._show_error)
+        def done(specs: list[ParamSpec]) -> None:
+            self._loading = False
+            if self._target == target:
+                self._build(target, specs)
 
-    # --- editors (UI thread) ------------------------------------------------------
+        def failed(text: str) -> None:
+            self._loading = False
+            self._show_error(text)
 
-    def _build(self, target: str, specs: list[ParamSpec]) -> None:
+        self._ui.run_job(work, done, failed)
+
+    # --- editors -------------------------------------------------------------------
+
+    def _remove_editors(self) -> None:
         if self._editor_folder is not None:
             self._editor_folder.remove()
-        self._widgets, self._known = {}, {}
+            self._editor_folder = None
+        self._built_for = None
+        self._widgets, self._known, self._specs = {}, {}, {}
+
+    def _build(self, target: str, specs: list[ParamSpec]) -> None:
+        self._remove_editors()
         self._specs = {s.name: s for s in specs}
         gui = self._gui
         with self._editors:
@@ -205,7 +207,7 @@ class ParametersPanel:
                 button = gui.add_button(
                     f"Set {spec.name}", icon=viser.Icon.DEVICE_FLOPPY, disabled=spec.read_only
                 )
-                button.on_click(lambda _e, name=spec.name: self._set(name))
+                button.on_click(lambda _e, name=spec.name: self._ui.post(lambda: self._set(name)))
         self._built_for = target
 
     def _editor(self, spec: ParamSpec) -> Any:
@@ -232,115 +234,99 @@ class ParametersPanel:
         try:
             value = value_for(spec, widget.value)
         except ValueError as exc:
-            self._message = f"⚠️ {exc}"
+            self._show_error(str(exc))
             return
         command = f"ros2 param set {target} {name} {command_value(value)}"
-        with self._lock:
-            self._message = f"`{command}` …"
+        self._message = f"`{command}` …"
+        ctx = self._ctx()
 
-        def work() -> None:
-            ctx = self._ctx()
+        def work() -> tuple[bool, str, Any]:
             ok, reason = rp.set_value(ctx, target, name, value)
+            kept = None if ok else rp.python_value(rp.get_values(ctx, target, [name])[0])
+            return ok, reason, kept
+
+        def done(answer: tuple[bool, str, Any]) -> None:
+            ok, reason, kept = answer
             if ok:
                 verdict = "✅ Set parameter successful"
+                # The node now holds what was *sent*; the editor may hold a newer edit.
+                if self._built_for == target and name in self._known:
+                    self._known[name] = shown_value(spec, value)
             else:
-                kept = rp.python_value(rp.get_values(ctx, target, [name])[0])
                 verdict = (
                     "❌ Set parameter failed"
                     + (f": **{reason}**" if reason else "")
                     + f"\n\nThe node keeps `{name}` = `{command_value(kept)}`."
                 )
-            with self._lock:
-                self._message = f"`{command}`\n\n{verdict}"
-                if ok:
-                    self._known[name] = widget.value
+            self._message = f"`{command}`\n\n{verdict}"
             self._sync(target)
 
-        run_job(work, self._show_error)
+        self._ui.run_job(work, done, lambda text: self._show_error(f"`{command}`: {text}"))
 
     def _sync(self, target: str) -> None:
         """Re-read values: another tool may have changed them (e.g. the Console)."""
         names = list(self._specs)
-        if not names:
+        if not names or self._syncing:
             return
-        values = rp.get_values(self._ctx(), target, names)
-        fresh = {n: rp.python_value(v) for n, v in zip(names, values, strict=False)}
-        with self._lock:
-            if self._target == target:
-                self._pending_values = fresh
+        self._syncing = True
+        self._synced_at = time.monotonic()
+        ctx = self._ctx()
 
-    def _apply_synced(self) -> None:
-        with self._lock:
-            fresh = self._pending_values
-            self._pending_values = None
-        for name, value in (fresh or {}).items():
+        def work() -> dict[str, Any]:
+            values = rp.get_values(ctx, target, names)
+            return {n: rp.python_value(v) for n, v in zip(names, values, strict=False)}
+
+        def done(fresh: dict[str, Any]) -> None:
+            self._syncing = False
+            if self._built_for == target:
+                self._apply_synced(fresh)
+
+        def failed(text: str) -> None:
+            self._syncing = False
+            self._show_error(text)
+
+        self._ui.run_job(work, done, failed)
+
+    def _apply_synced(self, fresh: dict[str, Any]) -> None:
+        for name, value in fresh.items():
             widget, spec = self._widgets.get(name), self._specs.get(name)
             if widget is None or spec is None or value is None:
                 continue
-            shown = value if spec.type in _PLAIN_TYPES else str(value)
+            shown = shown_value(spec, value)
             # Only overwrite what the learner has not started editing.
             if widget.value == self._known.get(name) and widget.value != shown:
                 widget.value = shown
-            self._known[name] = widget.value if widget.value == shown else shown
+            if widget.value == shown:
+                self._known[name] = shown
 
     # --- refresh ---------------------------------------------------------------
 
-    def refresh(self, graph: GraphSnapshot | None) -> None:
-        if graph is not None:
-            nodes = sorted(
-                name[: -len("/list_parameters")]
-                for name, _types in graph.services
-                if name.endswith("/list_parameters")
-            )
-            if nodes != self._nodes:
-                self._nodes = nodes
-                current = self._selector.value
-                options = [NONE, *nodes]
-                if current not in options:
-                    options.append(current)
-                self._selector.options = options  # the value stays: it is in options
-        with self._lock:
-            target, loaded, message = self._target, self._loaded, self._message
-        if loaded is not None and loaded[0] == target and self._built_for != target:
-            self._build(*loaded)
-        elif target is None and self._built_for is not None:
-            if self._editor_folder is not None:
-                self._editor_folder.remove()
-                self._editor_folder = None
-            self._built_for = None
-        self._apply_synced()
-        if target and self._built_for == target and not self._busy:
+    def refresh(self, graph: GraphSnapshot) -> None:
+        nodes = graph.nodes_serving("/list_parameters")
+        if nodes != self._nodes:
+            self._nodes = nodes
+            set_options(self._selector, [NONE, *nodes])  # the value stays: it is in options
+        target = self._target
+        if target and self._built_for == target and not self._loading:
             if time.monotonic() - self._synced_at > SYNC_PERIOD_SEC:
-                self._synced_at = time.monotonic()
-                run_job(lambda: self._sync(target), self._show_error)
-        self._show_status(target, graph, message)
+                self._sync(target)
+        self._show_status(target, graph)
 
-    def _show_status(self, target: str | None, graph: GraphSnapshot | None, message: str) -> None:
+    def _show_status(self, target: str | None, graph: GraphSnapshot) -> None:
         if target is None:
             self._info.show("_Start **parameters_node** in the Nodes tab, then pick it here._")
             self._activity.show("")
-            self._result.show(message)
+            self._result.show(self._message)
             return
-        gone = graph is not None and not graph.has_node(target)
+        gone = not graph.has_node(target)
         self._info.show(
             (f"⚠️ `{target}` is not on the graph now.\n\n" if gone else "")
             + f"`ros2 param list {target}` · `ros2 param dump {target}`"
             + ("" if self._built_for == target else "\n\nreading parameters…")
         )
-        self._result.show(message)
-        name, namespace = split_node_name(target)
-        if graph is not None and not gone:
-            try:
-                published = self._node.get_publisher_names_and_types_by_node(name, namespace)
-            except Exception:  # noqa: BLE001 - the node left between two looks
-                published = []
-            self._rates.watch(
-                {
-                    topic: types[0]
-                    for topic, types in published
-                    if types and topic not in QUIET_TOPICS and "/_" not in topic
-                }
-            )
+        self._result.show(self._message)
+        if not gone:
+            self._rates.watch(published_topics(self._node, target))
         rates = [
             f"`{topic}`: **{rate_text(self._rates.rate(topic)) or '…'}** (`ros2 topic hz {topic}`)"
             for topic in self._rates.watched()
@@ -350,6 +336,14 @@ class ParametersPanel:
             lines = [format_record(r) for r in self._rosout.records(target, last=LOG_LINES)]
             parts += ["", f"Latest log lines of `{target}`:", "", code_block(lines)]
         self._activity.show("\n".join(parts))
+
+    def close(self) -> None:
+        self._rates.close()
+
+
+def shown_value(spec: ParamSpec, value: Any) -> Any:
+    """A parameter value as its editor holds it: plain types as they are, others as text."""
+    return value if spec.type in _PLAIN_TYPES else str(value)
 
 
 _PLAIN_TYPES = (

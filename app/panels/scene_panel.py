@@ -1,19 +1,19 @@
 """3D view panel: pick what the scene draws, see how much of it arrives, edit the camera pose.
 
 The scene layers (``app/scene``) draw from their own worker threads; this
-panel only owns the controls and the status text, and refreshes them from
-the dashboard's UI thread a few times a second.
+panel owns the controls and the status text. Its callbacks post intents, so
+layers are switched and the pose is changed on the UI thread only.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import viser
 from rclpy.node import Node
 
-from app.graph import GraphSnapshot
-from app.panels import MarkdownView, code_block
+from app.ros.graph import GraphSnapshot
 from app.scene import topic_picker as picker
 from app.scene import transforms as tf
 from app.scene.arm import ArmLayer
@@ -24,6 +24,8 @@ from app.scene.markers import MarkerLayer
 from app.scene.plots import JointPlot
 from app.scene.pointclouds import PointCloudLayer
 from app.scene.stamped import StampedLayer
+from app.ui import MarkdownView, code_block
+from app.ui.loop import UiLoop
 
 INTRO = (
     "The **3D view** draws live topics, as rviz does. Drag to orbit, scroll to zoom. "
@@ -54,21 +56,22 @@ class _TopicRow:
         self.dropdown = gui.add_dropdown(label, self._options, initial_value=picker.NONE, hint=hint)
         self.note = MarkdownView(gui)
 
-    def on_pick(self, select) -> None:
-        def handle(_event: object) -> None:
+    def on_pick(self, ui: UiLoop, select: Callable[[str], None]) -> None:
+        def picked() -> None:
             if not self._setting:
                 self.chosen_by_learner = True
             select(self.dropdown.value)
 
-        self.dropdown.on_update(handle)
+        self.dropdown.on_update(lambda _event: ui.post(picked))
 
-    def refresh_options(self, graph: GraphSnapshot | None) -> None:
+    def refresh_options(self, graph: GraphSnapshot) -> None:
         opts = tuple(picker.options(graph, self.types, self.dropdown.value))
         if opts != self._options:
             self._options = opts
             self.dropdown.options = opts
         if not self.chosen_by_learner and self.dropdown.value == picker.NONE and len(opts) > 1:
             choice = next((t for t in self.preferred if t in opts), opts[1])
+            # Our own choice: the intent it posts must not count as the learner's.
             self._setting = True
             try:
                 self.dropdown.value = choice
@@ -77,9 +80,10 @@ class _TopicRow:
 
 
 class ScenePanel:
-    def __init__(self, server: viser.ViserServer, node: Node) -> None:
+    def __init__(self, server: viser.ViserServer, ui: UiLoop, node: Node) -> None:
         gui, scene = server.gui, server.scene
         self._server = server
+        self._ui = ui
         MarkdownView(gui, INTRO)
         # Start close to the robot: the arm, the camera and a table-top cloud fill the view.
         server.initial_camera.position = (1.3, -1.4, 1.1)
@@ -162,24 +166,32 @@ class ScenePanel:
 
         self.params = CameraParamSync(node)
         self._syncing_sliders = False
-        self.clouds.on_drawn = lambda _status: self._cloud_status.show(self.clouds.describe())
         self._wire()
         self._show_matrix(self.frames.pose)
 
     def _wire(self) -> None:
-        self._cloud_row.on_pick(self.clouds.select)
-        self._image_row.on_pick(self.images.select)
-        self._marker_row.on_pick(self.markers.select)
-        self._joint_row.on_pick(self._select_joints)
-        self._frame_cloud.on_click(lambda _: self.clouds.frame_in_view(self.frames.to_world))
-        self._budget.on_update(lambda _: setattr(self.clouds, "budget", int(self._budget.value)))
-        self._image_on_frustum.on_update(
-            lambda _: self.images.show_on_frustum(self._image_on_frustum.value)
+        ui = self._ui
+        self._cloud_row.on_pick(ui, self.clouds.select)
+        self._image_row.on_pick(ui, self.images.select)
+        self._marker_row.on_pick(ui, self.markers.select)
+        self._joint_row.on_pick(ui, self._select_joints)
+        self._frame_cloud.on_click(
+            lambda _: ui.post(lambda: self.clouds.frame_in_view(self.frames.to_world))
         )
-        self._gizmo.on_update(lambda _: self.frames.show_gizmo(self._gizmo.value))
+        self._budget.on_update(lambda _: ui.post(self._apply_budget))
+        self._image_on_frustum.on_update(
+            lambda _: ui.post(lambda: self.images.show_on_frustum(self._image_on_frustum.value))
+        )
+        self._gizmo.on_update(lambda _: ui.post(lambda: self.frames.show_gizmo(self._gizmo.value)))
         for slider in self._sliders.values():
-            slider.on_update(lambda _: self._on_slider())
-        self.frames.on_change(self._on_pose_changed)
+            slider.on_update(lambda _: ui.post(self._on_slider))
+        # The gizmo moves on a viser thread: the new pose is applied here.
+        self.frames.on_change(
+            lambda pose, source: ui.post(lambda: self._on_pose_changed(pose, source))
+        )
+
+    def _apply_budget(self) -> None:
+        self.clouds.budget = int(self._budget.value)
 
     def _select_joints(self, topic: str) -> None:
         self.plot.clear()
@@ -221,7 +233,7 @@ class ScenePanel:
             + f"\n\nquaternion (ROS order x, y, z, w): ({x:.3f}, {y:.3f}, {z:.3f}, {w:.3f})"
         )
 
-    def refresh(self, graph: GraphSnapshot | None) -> None:
+    def refresh(self, graph: GraphSnapshot) -> None:
         rows = (
             (self._cloud_row, self.clouds.worker, self.clouds.topic),
             (self._image_row, self.images.worker, self.images.topic),

@@ -1,6 +1,6 @@
 """Topics panel: every topic with its counts; echo, hz, bw, a plot and a publish form for one.
 
-One ``TopicMonitor`` (app.ros2cli, the same one behind `ros2 topic echo/hz/bw`)
+One ``TopicMonitor`` (app.ros.monitor, the same one behind `ros2 topic echo/hz/bw`)
 watches the selected topic as raw bytes; messages are deserialized here only
 when new ones arrived, at most ``KEEP`` per refresh, so a fast or large topic
 costs little. Publishing reuses the generated ``MessageForm``: once (after
@@ -11,7 +11,6 @@ at a rate from a timer on the dashboard's node, never blocking a callback.
 from __future__ import annotations
 
 import math
-import threading
 import time
 from collections import deque
 from typing import Any
@@ -22,19 +21,22 @@ import viser.uplot as uplot
 from rclpy.node import Node
 from rclpy.timer import Timer
 
-from app.graph import GraphSnapshot
-from app.panels import MarkdownView, code_block
-from app.panels.ros_tools import FormSlot, run_job, yaml_inline
-from app.ros2cli import Ros2Error
-from app.ros2cli.convert import (
+from app.ros.convert import (
     ConversionError,
     field_value,
     import_type,
     leaf_fields,
     to_yaml,
     type_name,
+    yaml_inline,
 )
-from app.ros2cli.topic import TopicMonitor, matching_qos
+from app.ros.errors import Ros2Error
+from app.ros.graph import GraphSnapshot
+from app.ros.monitor import TopicMonitor
+from app.ros.qos import matching_qos
+from app.ui import MarkdownView, code_block, set_options
+from app.ui.forms import FormSlot
+from app.ui.loop import UiLoop
 
 NONE = "(pick a topic)"
 NO_FIELD = "(no field)"
@@ -82,10 +84,10 @@ def others_count(infos: list[Any], own_name: str, own_namespace: str) -> int:
 
 
 class TopicsPanel:
-    def __init__(self, gui: viser.GuiApi, node: Node) -> None:
+    def __init__(self, gui: viser.GuiApi, ui: UiLoop, node: Node) -> None:
         self._gui = gui
+        self._ui = ui
         self._node = node
-        self._lock = threading.RLock()
         self._types: dict[str, str] = {}
         self._counts: dict[str, tuple[int, int]] = {}
         self._counts_at = 0.0
@@ -98,7 +100,7 @@ class TopicsPanel:
         self._plot_path = ""
         self._publisher: Any = None
         self._timer: Timer | None = None
-        self._sent = 0
+        self._sent = 0  # written only by the timer's callback (executor thread)
         self._pub_message = ""
 
         gui.add_markdown(
@@ -132,56 +134,54 @@ class TopicsPanel:
                 "Stop publishing", icon=viser.Icon.PLAYER_STOP, disabled=True
             )
             self._pub_view = MarkdownView(gui, "")
-        self._selector.on_update(lambda _: self._select(self._selector.value))
-        self._field.on_update(lambda _: self._clear_plot())
-        self._once.on_click(lambda _: self._publish_once())
-        self._start.on_click(lambda _: self._publish_at_rate())
-        self._stop.on_click(lambda _: self._stop_publishing())
+        self._selector.on_update(lambda _: ui.post(lambda: self._select(self._selector.value)))
+        self._field.on_update(lambda _: ui.post(self._clear_plot))
+        self._once.on_click(lambda _: ui.post(self._publish_once))
+        self._start.on_click(lambda _: ui.post(self._publish_at_rate))
+        self._stop.on_click(lambda _: ui.post(self._stop_publishing))
 
     # --- selection -------------------------------------------------------------
 
     def _select(self, topic: str) -> None:
-        """Called from viser callbacks and the UI thread: one switch at a time."""
-        with self._lock:
-            chosen = None if topic == NONE else topic
-            type_text = self._types.get(chosen or "")
-            current = self._monitor.msg_type if self._monitor else None
-            if chosen == self._topic and (
-                type_text is None or (current and type_name(current) == type_text)
-            ):
-                return
-            self._stop_publishing()
-            self._drop_publisher()
-            if self._monitor is not None:
-                self._monitor.close()
-                self._monitor = None
-            self._topic, self._seen = chosen, 0
-            self._latest.clear()
-            self._pub_message = ""
-            fields: list[str] = []
-            cls = None
-            if chosen and type_text:
-                try:
-                    cls = import_type(type_text, "msg")
-                except ConversionError as exc:
-                    self._pub_message = f"⚠️ {exc}"
-            if chosen and cls is not None:
-                qos = matching_qos(self._node, chosen, depth=KEEP)
-                self._monitor = TopicMonitor(self._node, chosen, cls, keep=KEEP, qos=qos)
-                fields = numeric_fields(cls)
-            form = self._form_slot.show(
-                (chosen, type_text), (lambda: (cls, type_text or "")) if cls is not None else None
-            )
-            self._field.options = [NO_FIELD, *fields]
-            self._field.value = preferred_field(cls) if cls is not None else NO_FIELD
-            self._clear_plot()
-            for button in (self._once, self._start):
-                button.disabled = form is None
+        """Follow another topic: a new monitor, form and plot (UI thread)."""
+        chosen = None if topic == NONE else topic
+        type_text = self._types.get(chosen or "")
+        current = self._monitor.msg_type if self._monitor else None
+        if chosen == self._topic and (
+            type_text is None or (current and type_name(current) == type_text)
+        ):
+            return
+        self._stop_publishing()
+        self._drop_publisher()
+        if self._monitor is not None:
+            self._monitor.close()
+            self._monitor = None
+        self._topic, self._seen = chosen, 0
+        self._latest.clear()
+        self._pub_message = ""
+        fields: list[str] = []
+        cls = None
+        if chosen and type_text:
+            try:
+                cls = import_type(type_text, "msg")
+            except ConversionError as exc:
+                self._pub_message = f"⚠️ {exc}"
+        if chosen and cls is not None:
+            qos = matching_qos(self._node, chosen, depth=KEEP)
+            self._monitor = TopicMonitor(self._node, chosen, cls, keep=KEEP, qos=qos)
+            fields = numeric_fields(cls)
+        form = self._form_slot.show(
+            (chosen, type_text), (lambda: (cls, type_text or "")) if cls is not None else None
+        )
+        self._field.options = [NO_FIELD, *fields]
+        self._field.value = preferred_field(cls) if cls is not None else NO_FIELD
+        self._clear_plot()
+        for button in (self._once, self._start):
+            button.disabled = form is None
 
     def _clear_plot(self) -> None:
-        with self._lock:
-            self._samples.clear()
-            self._plot_dirty = True
+        self._samples.clear()
+        self._plot_dirty = True
 
     # --- publishing ------------------------------------------------------------
 
@@ -196,16 +196,14 @@ class TopicsPanel:
             return None
 
     def _ensure_publisher(self) -> Any:
-        with self._lock:
-            if self._publisher is None and self._monitor is not None:
-                self._publisher = self._node.create_publisher(
-                    self._monitor.msg_type, self._monitor.topic, 10
-                )
-            return self._publisher
+        if self._publisher is None and self._monitor is not None:
+            self._publisher = self._node.create_publisher(
+                self._monitor.msg_type, self._monitor.topic, 10
+            )
+        return self._publisher
 
     def _drop_publisher(self) -> None:
-        with self._lock:
-            publisher, self._publisher = self._publisher, None
+        publisher, self._publisher = self._publisher, None
         if publisher is not None:
             self._node.destroy_publisher(publisher)
 
@@ -214,23 +212,29 @@ class TopicsPanel:
         if msg is None or topic is None:
             return
         command = f"ros2 topic pub --once {topic} {type_text} {yaml_inline(msg)}"
+        publisher = self._ensure_publisher()
+        if publisher is None:
+            return
         self._pub_message = f"`{command}`\n\nwaiting for subscribers to match…"
+        node = self._node
 
         def work() -> None:
-            publisher = self._ensure_publisher()
-            if publisher is None:
-                return
             # A fresh publisher is matched to subscribers after discovery: wait for
             # them (bounded) so a reliable listener does not miss the one message.
             deadline = time.monotonic() + MATCH_WAIT_SEC
             while time.monotonic() < deadline and publisher.get_subscription_count() < (
-                self._node.count_subscribers(topic)
+                node.count_subscribers(topic)
             ):
                 time.sleep(0.05)
             publisher.publish(msg)
+
+        def done(_: None) -> None:
             self._pub_message = f"`{command}`\n\npublished 1 message"
 
-        run_job(work, lambda text: setattr(self, "_pub_message", f"`{command}`\n\n⚠️ {text}"))
+        def failed(text: str) -> None:
+            self._pub_message = f"`{command}`\n\n⚠️ {text}"
+
+        self._ui.run_job(work, done, failed)
 
     def _publish_at_rate(self) -> None:
         msg, topic, type_text = self._message(), self._topic, self._types.get(self._topic or "")
@@ -251,14 +255,12 @@ class TopicsPanel:
             publisher.publish(msg)
             self._sent += 1
 
-        with self._lock:
-            self._timer = self._node.create_timer(1.0 / rate, on_timer)
-            self._pub_message = f"`{command}`"
+        self._timer = self._node.create_timer(1.0 / rate, on_timer)
+        self._pub_message = f"`{command}`"
         self._stop.disabled = False
 
     def _stop_publishing(self) -> None:
-        with self._lock:
-            timer, self._timer = self._timer, None
+        timer, self._timer = self._timer, None
         if timer is not None:
             self._node.destroy_timer(timer)
             self._pub_message += f"\n\nstopped after {self._sent} messages"
@@ -266,16 +268,13 @@ class TopicsPanel:
 
     # --- refresh ---------------------------------------------------------------
 
-    def refresh(self, graph: GraphSnapshot | None) -> None:
-        if graph is not None:
-            self._refresh_list(graph)
-        with self._lock:
-            monitor, topic = self._monitor, self._topic
-            fresh = self._take_fresh(monitor)
+    def refresh(self, graph: GraphSnapshot) -> None:
+        self._refresh_list(graph)
+        monitor, topic = self._monitor, self._topic
+        fresh = self._take_fresh(monitor)
         self._show_topic(topic, monitor, fresh)
         self._show_plot()
-        with self._lock:
-            text, timer = self._pub_message, self._timer
+        text, timer = self._pub_message, self._timer
         if timer is not None:
             text += f"\n\npublishing: {self._sent} sent so far"
         self._pub_view.show(text)
@@ -301,12 +300,8 @@ class TopicsPanel:
         self._table.show("\n".join(rows))
         if types != self._types:
             self._types = types
-            options = [NONE, *sorted(types)]
-            current = self._selector.value
-            if current not in options:
-                options.append(current)  # keep a vanished topic selected: it may come back
-            # Never write the value back: the learner may have just picked another topic.
-            self._selector.options = options
+            # A vanished topic stays selected: it may come back.
+            set_options(self._selector, [NONE, *sorted(types)])
             self._select(self._selector.value)
 
     def _take_fresh(self, monitor: TopicMonitor | None) -> list[tuple[float, Any]]:
@@ -356,8 +351,7 @@ class TopicsPanel:
             f"Messages received: {monitor.count}"
         )
         if fresh or not self._latest:
-            with self._lock:
-                latest = list(self._latest)
+            latest = list(self._latest)
             shown: list[str] = []
             for _stamp, msg in reversed(latest):
                 text = to_yaml(msg) + "\n---"
@@ -382,11 +376,10 @@ class TopicsPanel:
             if self._plot.visible:
                 self._plot.visible = False
             return
-        with self._lock:
-            if not self._plot_dirty:
-                return
-            self._plot_dirty = False
-            samples = list(self._samples)
+        if not self._plot_dirty:
+            return
+        self._plot_dirty = False
+        samples = list(self._samples)
         if samples:
             end = samples[-1][0]
             samples = [s for s in samples if end - s[0] <= PLOT_WINDOW_SEC]
@@ -408,3 +401,10 @@ class TopicsPanel:
         self._plot.data = (t, y)
         if not self._plot.visible:
             self._plot.visible = True
+
+    def close(self) -> None:
+        self._stop_publishing()
+        self._drop_publisher()
+        if self._monitor is not None:
+            self._monitor.close()
+            self._monitor = None

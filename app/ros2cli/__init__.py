@@ -1,29 +1,11 @@
 """ros2-like verbs (node, topic, service, action, param, lifecycle, interface).
 
-One implementation behind three faces: ``ros2-classroom <verb> ...`` on the
-command line, the Console panel in the browser, and the other panels, which
-call the same functions. ros2cli itself is not installable from PyPI.
+One implementation behind two faces: ``ros2-classroom <verb> ...`` on the
+command line and the Console tab in the browser (``console_panel``). The ROS
+work itself is done by app.ros, which the other front ends share.
+ros2cli itself is not installable from PyPI.
 """
 
-from app.ros2cli.common import (
-    CLI_LIMITS,
-    CONSOLE_LIMITS,
-    Cancelled,
-    Limits,
-    Ros2Error,
-    VerbContext,
-)
-from app.ros2cli.parser import GROUPS, run_argv, run_text, split_command
+from app.ros2cli.parser import GROUPS, UsageError, run_argv, run_text, split_command
 
-__all__ = [
-    "CLI_LIMITS",
-    "CONSOLE_LIMITS",
-    "GROUPS",
-    "Cancelled",
-    "Limits",
-    "Ros2Error",
-    "VerbContext",
-    "run_argv",
-    "run_text",
-    "split_command",
-]
+__all__ = ["GROUPS", "UsageError", "run_argv", "run_text", "split_command"]

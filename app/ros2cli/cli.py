@@ -12,7 +12,7 @@ import signal
 import sys
 import threading
 
-from app.ros2cli.common import CLI_LIMITS, VerbContext
+from app.ros.context import CLI_LIMITS, CallContext
 from app.ros2cli.parser import needs_ros, run_argv
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -28,15 +28,15 @@ def main(argv: list[str]) -> int:
     cancel = threading.Event()
     if not needs_ros(argv):
         return run_argv(
-            VerbContext(node=None, write=_print, limits=CLI_LIMITS), argv, "ros2-classroom"
+            CallContext(node=None, write=_print, limits=CLI_LIMITS), argv, "ros2-classroom"
         )  # type: ignore[arg-type]
-    from app.ros_runtime import RosRuntime
+    from app.ros.runtime import RosRuntime
 
     # Ctrl+C (or SIGTERM) asks the running verb to stop at its next wait, so it
     # always cleans up (subscriptions, publishers) instead of dying mid-call.
     previous = {sig: signal.signal(sig, lambda *_: cancel.set()) for sig in STOP_SIGNALS}
     runtime = RosRuntime(f"_ros2_classroom_cli_{os.getpid()}")
-    ctx = VerbContext(node=runtime.node, write=_print, limits=CLI_LIMITS, cancel=cancel)
+    ctx = CallContext(node=runtime.node, write=_print, limits=CLI_LIMITS, cancel=cancel)
     try:
         code = run_argv(ctx, argv, "ros2-classroom")
         return EXIT_INTERRUPTED if cancel.is_set() else code

@@ -8,21 +8,17 @@ from rclpy.action import (
     get_action_server_names_and_types_by_node,
 )
 
-from app.ros2cli.calls import GoalRun, action_type_of, call_service, send_goal
-from app.ros2cli.common import (
-    ACTION_MARKER,
-    Ros2Error,
-    VerbContext,
-    all_nodes,
-    node_fqn,
-    require_node,
-)
-from app.ros2cli.convert import from_yaml, import_type, message_repr, to_yaml
+from app.ros.calls import GoalRun, action_type_of, call_service, send_goal
+from app.ros.context import CallContext
+from app.ros.convert import from_yaml, import_type, message_repr, to_yaml
+from app.ros.errors import Ros2Error
+from app.ros.graph import all_nodes, require_node
+from app.ros.names import ACTION_MARKER, split_node_name
 
 # ------------------------------------------------------------------- node
 
 
-def node_list(ctx: VerbContext, all_: bool = False, count: bool = False) -> int:
+def node_list(ctx: CallContext, all_: bool = False, count: bool = False) -> int:
     names = all_nodes(ctx.node, include_hidden=all_)
     if count:
         ctx.write(str(len(names)))
@@ -36,8 +32,9 @@ def _visible(pairs: list[tuple[str, list[str]]]) -> list[tuple[str, list[str]]]:
     return sorted((n, t) for n, t in pairs if ACTION_MARKER not in n)
 
 
-def node_info(ctx: VerbContext, fqn: str) -> int:
-    name, namespace = require_node(ctx, fqn)
+def node_info(ctx: CallContext, fqn: str) -> int:
+    target = require_node(ctx, fqn)
+    name, namespace = split_node_name(target)
     node = ctx.node
     sections = [
         ("Subscribers", _visible(node.get_subscriber_names_and_types_by_node(name, namespace))),
@@ -47,7 +44,7 @@ def node_info(ctx: VerbContext, fqn: str) -> int:
         ("Action Servers", get_action_server_names_and_types_by_node(node, name, namespace)),
         ("Action Clients", get_action_client_names_and_types_by_node(node, name, namespace)),
     ]
-    ctx.write(node_fqn(name, namespace))
+    ctx.write(target)
     for title, entries in sections:
         ctx.write(f"  {title}:")
         for entry, types in sorted(entries):
@@ -58,7 +55,7 @@ def node_info(ctx: VerbContext, fqn: str) -> int:
 # ---------------------------------------------------------------- service
 
 
-def service_list(ctx: VerbContext, show_types: bool = False, count: bool = False) -> int:
+def service_list(ctx: CallContext, show_types: bool = False, count: bool = False) -> int:
     services = _visible(ctx.node.get_service_names_and_types())
     if count:
         ctx.write(str(len(services)))
@@ -68,7 +65,7 @@ def service_list(ctx: VerbContext, show_types: bool = False, count: bool = False
     return 0
 
 
-def service_type(ctx: VerbContext, name: str) -> int:
+def service_type(ctx: CallContext, name: str) -> int:
     types = dict(ctx.node.get_service_names_and_types()).get(name)
     if not types:
         raise Ros2Error(f"unknown service '{name}' (see `ros2 service list`)")
@@ -77,7 +74,7 @@ def service_type(ctx: VerbContext, name: str) -> int:
     return 0
 
 
-def service_call(ctx: VerbContext, name: str, type_text: str, values: str = "") -> int:
+def service_call(ctx: CallContext, name: str, type_text: str, values: str = "") -> int:
     srv_type = import_type(type_text, "srv")
     request = from_yaml(srv_type.Request, values)
     ctx.write(f"requester: making request: {message_repr(request)}")
@@ -92,7 +89,7 @@ def service_call(ctx: VerbContext, name: str, type_text: str, values: str = "") 
 # ----------------------------------------------------------------- action
 
 
-def action_list(ctx: VerbContext, show_types: bool = False, count: bool = False) -> int:
+def action_list(ctx: CallContext, show_types: bool = False, count: bool = False) -> int:
     actions = sorted(get_action_names_and_types(ctx.node))
     if count:
         ctx.write(str(len(actions)))
@@ -102,13 +99,13 @@ def action_list(ctx: VerbContext, show_types: bool = False, count: bool = False)
     return 0
 
 
-def action_info(ctx: VerbContext, name: str, show_types: bool = False) -> int:
-    action_type = action_type_of(ctx, name)
+def action_info(ctx: CallContext, name: str, show_types: bool = False) -> int:
+    action_type = action_type_of(ctx.node, name)
     if action_type is None:
         raise Ros2Error(f"unknown action '{name}' (see `ros2 action list`)")
     clients, servers = [], []
     for fqn in all_nodes(ctx.node, include_hidden=True):
-        node_name, namespace = fqn.rsplit("/", 1)[1], fqn.rsplit("/", 1)[0] or "/"
+        node_name, namespace = split_node_name(fqn)
         try:
             srv = get_action_server_names_and_types_by_node(ctx.node, node_name, namespace)
             cli = get_action_client_names_and_types_by_node(ctx.node, node_name, namespace)
@@ -134,7 +131,7 @@ def _indented(text: str, spaces: int = 4) -> str:
 
 
 def action_send_goal(
-    ctx: VerbContext, name: str, type_text: str, values: str = "", feedback: bool = False
+    ctx: CallContext, name: str, type_text: str, values: str = "", feedback: bool = False
 ) -> int:
     action_cls = import_type(type_text, "action")
     goal = from_yaml(action_cls.Goal, values)

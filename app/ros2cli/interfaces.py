@@ -13,7 +13,7 @@ import re
 import sys
 from pathlib import Path
 
-from app.ros2cli.common import Ros2Error
+from app.ros.errors import Ros2Error
 
 _EXT = {"msg": ".msg", "srv": ".srv", "action": ".action"}
 

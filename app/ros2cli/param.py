@@ -1,136 +1,28 @@
-"""`ros2 param list/get/set/dump`, through each node's rcl_interfaces parameter services."""
+"""`ros2 param list/get/set/dump` (the parameter services themselves: app.ros.params)."""
 
 from __future__ import annotations
 
-from typing import Any
+from rcl_interfaces.msg import ParameterType
 
-import yaml
-from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
-from rcl_interfaces.srv import (
-    DescribeParameters,
-    GetParameters,
-    ListParameters,
-    SetParameters,
+from app.ros.context import CallContext
+from app.ros.convert import dump_yaml
+from app.ros.errors import Ros2Error
+from app.ros.graph import all_nodes, require_node
+from app.ros.params import (
+    TYPE_NAMES,
+    TYPE_WORDS,
+    describe,
+    dump_dict,
+    get_values,
+    list_names,
+    parse_value,
+    python_value,
+    set_value,
 )
 
-from app.ros2cli.calls import call_service
-from app.ros2cli.common import Ros2Error, VerbContext, all_nodes, node_fqn, require_node
-from app.ros2cli.convert import dump_yaml
 
-_TYPE_WORDS = {
-    ParameterType.PARAMETER_BOOL: ("Boolean value is", "bool_value"),
-    ParameterType.PARAMETER_INTEGER: ("Integer value is", "integer_value"),
-    ParameterType.PARAMETER_DOUBLE: ("Double value is", "double_value"),
-    ParameterType.PARAMETER_STRING: ("String value is", "string_value"),
-    ParameterType.PARAMETER_BYTE_ARRAY: ("Byte values are", "byte_array_value"),
-    ParameterType.PARAMETER_BOOL_ARRAY: ("Boolean values are", "bool_array_value"),
-    ParameterType.PARAMETER_INTEGER_ARRAY: ("Integer values are", "integer_array_value"),
-    ParameterType.PARAMETER_DOUBLE_ARRAY: ("Double values are", "double_array_value"),
-    ParameterType.PARAMETER_STRING_ARRAY: ("String values are", "string_array_value"),
-}
-TYPE_NAMES = {
-    ParameterType.PARAMETER_NOT_SET: "not set",
-    ParameterType.PARAMETER_BOOL: "bool",
-    ParameterType.PARAMETER_INTEGER: "integer",
-    ParameterType.PARAMETER_DOUBLE: "double",
-    ParameterType.PARAMETER_STRING: "string",
-    ParameterType.PARAMETER_BYTE_ARRAY: "byte array",
-    ParameterType.PARAMETER_BOOL_ARRAY: "bool array",
-    ParameterType.PARAMETER_INTEGER_ARRAY: "integer array",
-    ParameterType.PARAMETER_DOUBLE_ARRAY: "double array",
-    ParameterType.PARAMETER_STRING_ARRAY: "string array",
-}
-
-
-def python_value(value: ParameterValue) -> Any:
-    """A ParameterValue as plain Python (None when not set)."""
-    entry = _TYPE_WORDS.get(value.type)
-    if entry is None:
-        return None
-    raw = getattr(value, entry[1])
-    if hasattr(raw, "tolist"):
-        raw = raw.tolist()
-    if isinstance(raw, list | tuple):
-        return [b[0] if isinstance(b, bytes) else b for b in raw]
-    return raw
-
-
-def parameter_value(value: Any) -> ParameterValue:
-    """Plain Python -> ParameterValue, with the type inferred as `ros2 param set` does."""
-    out = ParameterValue()
-    if isinstance(value, bool):
-        out.type, out.bool_value = ParameterType.PARAMETER_BOOL, value
-    elif isinstance(value, int):
-        out.type, out.integer_value = ParameterType.PARAMETER_INTEGER, value
-    elif isinstance(value, float):
-        out.type, out.double_value = ParameterType.PARAMETER_DOUBLE, value
-    elif isinstance(value, str):
-        out.type, out.string_value = ParameterType.PARAMETER_STRING, value
-    elif isinstance(value, list) and value:
-        kinds = {type(v) for v in value}
-        if kinds == {bool}:
-            out.type, out.bool_array_value = ParameterType.PARAMETER_BOOL_ARRAY, value
-        elif kinds == {int}:
-            out.type, out.integer_array_value = ParameterType.PARAMETER_INTEGER_ARRAY, value
-        elif kinds <= {int, float}:
-            out.type = ParameterType.PARAMETER_DOUBLE_ARRAY
-            out.double_array_value = [float(v) for v in value]
-        elif kinds == {str}:
-            out.type, out.string_array_value = ParameterType.PARAMETER_STRING_ARRAY, value
-        else:
-            raise Ros2Error("a parameter list must hold only booleans, numbers or strings")
-    else:
-        raise Ros2Error(f"cannot use {value!r} as a parameter value")
-    return out
-
-
-def parse_value(text: str) -> Any:
-    """'5' -> 5, 'true' -> True, '[1, 2]' -> [1, 2], anything else stays text."""
-    try:
-        value = yaml.safe_load(text)
-    except yaml.YAMLError:
-        return text
-    if value is None:
-        return text
-    return value
-
-
-def _service(fqn: str, suffix: str) -> str:
-    return f"{fqn.rstrip('/')}/{suffix}"
-
-
-def _checked_node(ctx: VerbContext, fqn: str) -> str:
-    name, namespace = require_node(ctx, fqn)
-    return node_fqn(name, namespace)
-
-
-def list_names(ctx: VerbContext, fqn: str) -> list[str]:
-    request = ListParameters.Request()
-    response = call_service(ctx, _service(fqn, "list_parameters"), ListParameters, request)
-    return sorted(response.result.names)
-
-
-def get_values(ctx: VerbContext, fqn: str, names: list[str]) -> list[ParameterValue]:
-    request = GetParameters.Request(names=names)
-    return list(call_service(ctx, _service(fqn, "get_parameters"), GetParameters, request).values)
-
-
-def describe(ctx: VerbContext, fqn: str, names: list[str]) -> list[Any]:
-    request = DescribeParameters.Request(names=names)
-    response = call_service(ctx, _service(fqn, "describe_parameters"), DescribeParameters, request)
-    return list(response.descriptors)
-
-
-def set_value(ctx: VerbContext, fqn: str, name: str, value: Any) -> tuple[bool, str]:
-    """(successful, reason) as the node answered."""
-    request = SetParameters.Request(parameters=[Parameter(name=name, value=parameter_value(value))])
-    response = call_service(ctx, _service(fqn, "set_parameters"), SetParameters, request)
-    result = response.results[0]
-    return bool(result.successful), result.reason
-
-
-def param_list(ctx: VerbContext, fqn: str | None = None, show_types: bool = False) -> int:
-    targets = [_checked_node(ctx, fqn)] if fqn else all_nodes(ctx.node)
+def param_list(ctx: CallContext, fqn: str | None = None, show_types: bool = False) -> int:
+    targets = [require_node(ctx, fqn)] if fqn else all_nodes(ctx.node)
     for target in targets:
         try:
             names = list_names(ctx, target)
@@ -152,19 +44,19 @@ def param_list(ctx: VerbContext, fqn: str | None = None, show_types: bool = Fals
     return 0
 
 
-def param_get(ctx: VerbContext, fqn: str, name: str) -> int:
-    target = _checked_node(ctx, fqn)
+def param_get(ctx: CallContext, fqn: str, name: str) -> int:
+    target = require_node(ctx, fqn)
     value = get_values(ctx, target, [name])
     if not value or value[0].type == ParameterType.PARAMETER_NOT_SET:
         ctx.write("Parameter not set.")
         return 1
-    words, _attr = _TYPE_WORDS[value[0].type]
+    words, _attr = TYPE_WORDS[value[0].type]
     ctx.write(f"{words}: {python_value(value[0])}")
     return 0
 
 
-def param_set(ctx: VerbContext, fqn: str, name: str, text: str) -> int:
-    target = _checked_node(ctx, fqn)
+def param_set(ctx: CallContext, fqn: str, name: str, text: str) -> int:
+    target = require_node(ctx, fqn)
     ok, reason = set_value(ctx, target, name, parse_value(text))
     if ok:
         ctx.write("Set parameter successful" + (f": {reason}" if reason else ""))
@@ -173,21 +65,7 @@ def param_set(ctx: VerbContext, fqn: str, name: str, text: str) -> int:
     return 1
 
 
-def dump_dict(ctx: VerbContext, fqn: str) -> dict[str, Any]:
-    target = _checked_node(ctx, fqn)
-    names = list_names(ctx, target)
-    values = get_values(ctx, target, names) if names else []
-    params: dict[str, Any] = {}
-    for name, value in zip(names, values, strict=False):
-        node = params
-        parts = name.split(".")
-        for part in parts[:-1]:
-            node = node.setdefault(part, {})
-        node[parts[-1]] = python_value(value)
-    return {target: {"ros__parameters": params}}
-
-
-def param_dump(ctx: VerbContext, fqn: str) -> int:
+def param_dump(ctx: CallContext, fqn: str) -> int:
     text = dump_yaml(dump_dict(ctx, fqn))
     for line in text.rstrip().splitlines():
         ctx.write(line)

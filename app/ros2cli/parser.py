@@ -13,8 +13,10 @@ import shlex
 from collections.abc import Callable
 from typing import Any, NoReturn
 
+from app.ros.context import CallContext, Write
+from app.ros.errors import Cancelled, Ros2Error
 from app.ros2cli import graph_verbs, interfaces, lifecycle, param, topic
-from app.ros2cli.common import Cancelled, Ros2Error, VerbContext, Write, settle_discovery
+from app.ros2cli.common import settle_discovery
 
 GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface")
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
@@ -61,7 +63,7 @@ def split_command(text: str) -> list[str]:
     return words
 
 
-Handler = Callable[[VerbContext, argparse.Namespace], int]
+Handler = Callable[[CallContext, argparse.Namespace], int]
 
 
 def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
@@ -272,7 +274,7 @@ def needs_ros(argv: list[str]) -> bool:
     return tuple(words[:2]) not in _NO_DDS
 
 
-def _interface_list(ctx: VerbContext, args: argparse.Namespace) -> int:
+def _interface_list(ctx: CallContext, args: argparse.Namespace) -> int:
     found = interfaces.all_interfaces()
     chosen = [
         k
@@ -291,13 +293,13 @@ def _interface_list(ctx: VerbContext, args: argparse.Namespace) -> int:
     return 0
 
 
-def _interface_packages(ctx: VerbContext, args: argparse.Namespace) -> int:
+def _interface_packages(ctx: CallContext, args: argparse.Namespace) -> int:
     for package in interfaces.interface_packages():
         ctx.write(package)
     return 0
 
 
-def _interface_package(ctx: VerbContext, args: argparse.Namespace) -> int:
+def _interface_package(ctx: CallContext, args: argparse.Namespace) -> int:
     packages = interfaces.interface_packages()
     if args.package_name not in packages:
         raise Ros2Error(f"unknown interface package '{args.package_name}'")
@@ -306,7 +308,7 @@ def _interface_package(ctx: VerbContext, args: argparse.Namespace) -> int:
     return 0
 
 
-def _interface_show(ctx: VerbContext, args: argparse.Namespace) -> int:
+def _interface_show(ctx: CallContext, args: argparse.Namespace) -> int:
     for line in interfaces.show(args.type, expand=not args.no_expand).splitlines():
         ctx.write(line)
     return 0
@@ -324,7 +326,7 @@ def parse(argv: list[str], write: Write, prog: str = "ros2") -> argparse.Namespa
         raise UsageError(str(exc)) from None
 
 
-def run_argv(ctx: VerbContext, argv: list[str], prog: str = "ros2") -> int:
+def run_argv(ctx: CallContext, argv: list[str], prog: str = "ros2") -> int:
     """Run one verb; every failure becomes one 'error: ...' line and an exit code."""
     try:
         args = parse(argv, ctx.write, prog)
@@ -350,7 +352,7 @@ def run_argv(ctx: VerbContext, argv: list[str], prog: str = "ros2") -> int:
         return EXIT_FAILED
 
 
-def run_text(ctx: VerbContext, text: str) -> int:
+def run_text(ctx: CallContext, text: str) -> int:
     """What the console does with a line of text."""
     try:
         argv = split_command(text)

@@ -15,7 +15,7 @@ import viser
 from geometry_msgs.msg import PointStamped, PoseStamped
 from rclpy.node import Node
 
-from app.graph import GraphSnapshot
+from app.ros.graph import GraphSnapshot
 from app.scene import topic_picker as picker
 from app.scene.frames import scene_path_for_frame
 from app.scene.latest import LatestWorker

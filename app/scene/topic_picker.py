@@ -6,7 +6,7 @@ choices and notes are unit-testable without a ROS graph.
 
 from __future__ import annotations
 
-from app.graph import GraphSnapshot
+from app.ros.graph import GraphSnapshot
 
 NONE = "(none)"
 

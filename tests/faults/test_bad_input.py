@@ -16,7 +16,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from app.catalog import ENTRIES
-from app.ros2cli import Limits, VerbContext, run_text
+from app.ros.context import CallContext, Limits
+from app.ros2cli import run_text
 from tests.conftest import wait_until
 from tests.faults.helpers import overview, record
 from tests.wire_client import WireClient
@@ -60,7 +61,7 @@ def _commands() -> st.SearchStrategy[str]:
 @given(text=st.one_of(_commands(), st.text(max_size=60)))
 def test_every_console_verb_answers_bad_input_with_one_clear_line(probe, text):
     lines: list[str] = []
-    code = run_text(VerbContext(probe.node, lines.append, TINY), text)
+    code = run_text(CallContext(probe.node, lines.append, TINY), text)
     out = "\n".join(lines)
     assert "Traceback" not in out, out
     assert sum(line.startswith("error:") for line in out.splitlines()) <= 1, out

@@ -7,7 +7,8 @@ from collections.abc import Callable
 
 import pytest
 
-from app.ros2cli import Limits, VerbContext, run_text
+from app.ros.context import CallContext, Limits
+from app.ros2cli import run_text
 
 # Generous, bounded: discovery and replies are slow when two cores are busy.
 TEST_LIMITS = Limits(max_messages=3, max_seconds=6.0, service_timeout=15.0, action_timeout=40.0)
@@ -21,7 +22,7 @@ class Ros2Runner:
 
     def __call__(self, text: str, limits: Limits | None = None) -> tuple[int, list[str]]:
         lines: list[str] = []
-        ctx = VerbContext(self.node, lines.append, limits or TEST_LIMITS)
+        ctx = CallContext(self.node, lines.append, limits or TEST_LIMITS)
         code = run_text(ctx, text)
         return code, "\n".join(lines).splitlines()
 

@@ -14,7 +14,7 @@ from std_msgs.msg import Float64, String
 from tutorial_interfaces.action import Fibonacci
 from tutorial_interfaces.srv import AddTwoInts
 
-from app.ros2cli.topic import TopicMonitor
+from app.ros.monitor import TopicMonitor
 from app.supervisor import NodeState
 from tests.conftest import wait_until
 from tests.integration.core_helpers import (

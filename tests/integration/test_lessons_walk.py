@@ -11,9 +11,10 @@ import threading
 
 import pytest
 
-from app.graph import snapshot
-from app.lessons.live import FAIL, PASS, LessonRuntime
-from app.lessons.schema import CHECK_FIELDS, Spec, load_course
+from app.lessons.kinds import CHECK_KINDS
+from app.lessons.runtime import FAIL, PASS, LessonRuntime
+from app.lessons.schema import Spec, load_course
+from app.ros.graph import snapshot
 from tests.conftest import wait_until
 
 pytestmark = pytest.mark.ros
@@ -23,7 +24,7 @@ COURSE = load_course()
 @pytest.fixture
 def dashboard_node(ros_env):
     """The same ROS node the dashboard has, so graph checks see the same names."""
-    from app.ros_runtime import RosRuntime
+    from app.ros.runtime import RosRuntime
 
     runtime = RosRuntime()
     yield runtime.node
@@ -97,7 +98,7 @@ FAILING_CHECKS = [
         "topic_rate", {"topic": "/silent", "type": "std_msgs/msg/String", "min_hz": 1, "max_hz": 2}
     ),
     Spec("topic_subscribers", {"topic": "/silent", "at_least": 1}),
-    Spec("log_contains", {"node": "talker", "text": "never said"}),
+    Spec("log_contains", {"catalog_node": "talker", "text": "never said"}),
     Spec("lifecycle_state", {"node": "/nobody_here", "state": "active"}),
     Spec("parameter_equals", {"node": "/nobody_here", "name": "x", "value": 1}),
     Spec(
@@ -119,7 +120,7 @@ FAILING_CHECKS = [
 
 
 def test_every_check_kind_can_fail(live):
-    assert {spec.kind for spec in FAILING_CHECKS} == set(CHECK_FIELDS)
+    assert {spec.kind for spec in FAILING_CHECKS} == set(CHECK_KINDS)
     live.quiz_answers[FAILING_CHECKS[-1].key] = "3"
     wait_until(lambda: live.graph.has_node("/classroom_dashboard"), what="our node in the graph")
     for spec in FAILING_CHECKS:

@@ -10,7 +10,7 @@ from std_msgs.msg import String
 from tutorial_interfaces.msg import DetectedObject
 from visualization_msgs.msg import Marker, MarkerArray
 
-from app.ros2cli.topic import TopicMonitor
+from app.ros.monitor import TopicMonitor
 from nodes.common.arm_kinematics import forward_kinematics
 from nodes.common.image_conversion import image_to_array
 from nodes.common.pointcloud import pointcloud2_to_xyz_rgb

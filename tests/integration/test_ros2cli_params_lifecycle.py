@@ -6,7 +6,7 @@ import re
 
 import pytest
 
-from app.ros2cli import Limits
+from app.ros.context import Limits
 from tests.integration.conftest import TEST_LIMITS, one_error_line
 
 pytestmark = pytest.mark.ros

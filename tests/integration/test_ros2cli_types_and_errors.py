@@ -14,7 +14,7 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from std_srvs.srv import SetBool, Trigger
 
 from app import PROJECT_ROOT
-from app.ros2cli import Limits
+from app.ros.context import Limits
 from tests.conftest import wait_until
 from tests.integration.conftest import one_error_line
 

@@ -10,7 +10,7 @@ import viser
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import PointCloud2
 
-from app.ros_runtime import RosRuntime
+from app.ros.runtime import RosRuntime
 from app.scene.pointclouds import PointCloudLayer
 from nodes.common.pointcloud import xyz_to_pointcloud2 as encode_cloud
 from tests.conftest import free_port, wait_until

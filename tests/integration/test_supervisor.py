@@ -13,7 +13,7 @@ import pytest
 from std_msgs.msg import String
 
 from app import PROJECT_ROOT
-from app.ros2cli.topic import TopicMonitor
+from app.ros.monitor import TopicMonitor
 from app.supervisor import NodeState
 from tests.conftest import wait_until
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from app.graph import live_and_ghost_nodes, snapshot
+from app.ros.graph import live_and_ghost_nodes, snapshot
 
 
 @dataclass(frozen=True)

@@ -12,7 +12,7 @@ from std_msgs.msg import Byte, String
 from std_srvs.srv import SetBool
 from tutorial_interfaces.action import Fibonacci
 
-from app.ros2cli.convert import (
+from app.ros.convert import (
     ConversionError,
     field_value,
     fill_from_form,

@@ -10,7 +10,7 @@ from geometry_msgs.msg import Point
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker
 
-from app.graph import GraphSnapshot, TopicInfo
+from app.ros.graph import GraphSnapshot, TopicInfo
 from app.scene import marker_plan as mp
 from app.scene import topic_picker as picker
 from app.scene import transforms as tf

@@ -17,8 +17,8 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 
 from app.panels.parameters_panel import _nice_step, command_value, spec_from, value_for
-from app.panels.rates import rate_text
 from app.panels.topics_panel import NO_FIELD, numeric_fields, plot_value, preferred_field
+from app.ros.rates import rate_text
 
 
 def test_numeric_fields_include_nested_ones():

@@ -10,32 +10,31 @@ from __future__ import annotations
 
 import math
 import threading
-import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from lifecycle_msgs.msg import Transition
 from lifecycle_msgs.srv import ChangeState, GetState
-from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import GetParameters, SetParameters
-from rclpy.action import ActionClient
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 from app import catalog
-from app.graph import GraphSnapshot
+from app.lessons.kinds import ACTION_KINDS, CHECK_KINDS
 from app.lessons.schema import Spec
-from app.ros2cli.common import Ros2Error
-from app.ros2cli.convert import fill, import_type
-from app.ros2cli.topic import TopicMonitor
+from app.ros import lifecycle, params
+from app.ros.calls import GoalRun, ServicePoller, send_goal
+from app.ros.context import CallContext, Limits
+from app.ros.convert import fill, import_type
+from app.ros.errors import Ros2Error
+from app.ros.graph import GraphSnapshot
+from app.ros.monitor import TopicMonitor
 from app.supervisor import Supervisor
 
 PASS, FAIL, WAITING = "pass", "fail", "waiting"
 RECALL_PERIOD_SEC = 1.0
-ACTION_SERVER_WAIT_SEC = 3.0
-# Transitions are sent by label: the node picks the one valid from its current
-# state ("shutdown" exists from unconfigured, inactive and active).
-TRANSITIONS = ("configure", "cleanup", "activate", "deactivate", "shutdown")
+# A goal from a lesson button: wait a little for the server, then up to a minute.
+GOAL_LIMITS = Limits(service_timeout=3.0, action_timeout=60.0)
 # Best effort hears reliable and best-effort publishers alike (camera images
 # are usually best effort); a reliable tap would hear only the former.
 TAP_QOS = QoSProfile(depth=50, reliability=ReliabilityPolicy.BEST_EFFORT)
@@ -48,36 +47,15 @@ class CheckResult:
     reason: str = ""
 
 
-def _parameter_value(value: ParameterValue) -> Any:
-    return {
-        ParameterType.PARAMETER_BOOL: value.bool_value,
-        ParameterType.PARAMETER_INTEGER: value.integer_value,
-        ParameterType.PARAMETER_DOUBLE: value.double_value,
-        ParameterType.PARAMETER_STRING: value.string_value,
-    }.get(value.type)
-
-
-def _to_parameter_value(value: Any) -> ParameterValue:
-    if isinstance(value, bool):
-        return ParameterValue(type=ParameterType.PARAMETER_BOOL, bool_value=value)
-    if isinstance(value, int):
-        return ParameterValue(type=ParameterType.PARAMETER_INTEGER, integer_value=value)
-    if isinstance(value, float):
-        return ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=value)
-    return ParameterValue(type=ParameterType.PARAMETER_STRING, string_value=str(value))
-
-
-class _Call:
-    """The latest answer of a service that a check polls about once a second."""
-
-    def __init__(self) -> None:
-        self.future: Any = None
-        self.result: Any = None
-        self.sent_at = 0.0
-
-
 class LessonRuntime:
-    """Performs step actions and evaluates checks on the live graph. Thread-safe."""
+    """Performs step actions and evaluates checks on the live graph.
+
+    ``perform`` may block briefly (it starts processes): call it from a job,
+    never a viser callback. ``evaluate`` never blocks: service answers come
+    from a ``ServicePoller``, goals run on their own threads. The UI thread
+    sets ``graph`` and calls both; the topic taps and the poller have their
+    own locks, and ``quiz_answers`` is written only by the UI thread.
+    """
 
     def __init__(self, node: Node, supervisor: Supervisor) -> None:
         self.node = node
@@ -85,15 +63,9 @@ class LessonRuntime:
         self.graph = GraphSnapshot()
         self._lock = threading.Lock()
         self._taps: dict[tuple[str, str], TopicMonitor] = {}
-        self._clients: dict[tuple[str, str], Any] = {}
-        self._calls: dict[str, _Call] = {}
-        self._action_clients: dict[tuple[str, str], ActionClient] = {}
-        self.action_results: dict[str, str] = {}
-        self.action_feedback: dict[str, list[Any]] = {}
+        self._services = ServicePoller(node, RECALL_PERIOD_SEC)
+        self._goals: dict[str, GoalRun] = {}
         self.quiz_answers: dict[str, str] = {}
-        self.last_action_message = ""
-
-    # -- shared helpers ----------------------------------------------------
 
     def tap(self, topic: str, type_name: str) -> TopicMonitor:
         with self._lock:
@@ -104,121 +76,90 @@ class LessonRuntime:
                 )
             return self._taps[key]
 
-    def _client(self, service: str, srv_type: type) -> Any:
+    def close(self) -> None:
         with self._lock:
-            key = (service, srv_type.__name__)
-            if key not in self._clients:
-                self._clients[key] = self.node.create_client(srv_type, service)
-            return self._clients[key]
-
-    def _poll_service(self, key: str, service: str, srv_type: type, request: Any) -> Any:
-        """Latest response (or None); re-asks at most once per RECALL_PERIOD_SEC."""
-        client = self._client(service, srv_type)
-        with self._lock:
-            call = self._calls.setdefault(key, _Call())
-            if call.future is not None and call.future.done():
-                call.result = call.future.result()
-                call.future = None
-            due = time.monotonic() - call.sent_at > RECALL_PERIOD_SEC
-            if call.future is None and due and client.service_is_ready():
-                call.future = client.call_async(request)
-                call.sent_at = time.monotonic()
-            return call.result
+            taps, self._taps = list(self._taps.values()), {}
+            goals = list(self._goals.values())
+        for tap in taps:
+            tap.close()
+        for run in goals:
+            run.cancel()
+        self._services.close()
 
     # -- actions -----------------------------------------------------------
 
     def perform(self, action: Spec) -> str:
         """Do one step action; returns a one-line message for the page."""
-        kind = action.kind
-        with self._lock:
-            self._calls.clear()  # answers from before this action may be stale now
-        if kind == "start":
-            status = self.supervisor.start(action["node"])
-            message = f"Started {action['node']} (pid {status.pid})."
-        elif kind == "stop":
-            self.supervisor.stop(action["node"])
-            message = f"Stopping {action['node']}."
-        elif kind in ("start_group", "stop_group"):
-            group = catalog.lookup_group(action["group"])
-            for member in group.members:
-                if kind == "start_group":
-                    self.supervisor.start(member)
-                else:
-                    self.supervisor.stop(member)
-            verb = "Started" if kind == "start_group" else "Stopping"
-            message = f"{verb} {', '.join(group.members)}."
-        elif kind == "lifecycle":
-            transition = action["transition"]
-            if transition not in TRANSITIONS:
-                raise ValueError(f"unknown lifecycle transition {transition!r}")
-            client = self._client(f"{action['node']}/change_state", ChangeState)
-            request = ChangeState.Request(transition=Transition(label=transition))
-            client.call_async(request)
-            message = f"Asked {action['node']} to {transition}."
-        elif kind == "set_param":
-            client = self._client(f"{action['node']}/set_parameters", SetParameters)
-            param = Parameter(name=action["name"], value=_to_parameter_value(action["value"]))
-            client.call_async(SetParameters.Request(parameters=[param]))
-            message = f"Set {action['name']} = {action['value']!r} on {action['node']}."
-        elif kind == "call_service":
-            srv_type = import_type(action["type"])
-            request = fill(srv_type.Request, action["request"])
-            self._client(action["service"], srv_type).call_async(request)
-            message = f"Called {action['service']}."
-        elif kind == "send_goal":
-            message = self._send_goal(action)
-        elif kind == "open_panel":
-            message = f"Open the {action['panel']} tab."
-        else:  # the schema makes this unreachable
-            raise ValueError(f"unknown action kind {kind!r}")
-        self.last_action_message = message
-        return message
+        self._services.forget_answers()  # answers from before this action may be stale now
+        return _ACTIONS[action.kind](self, action)
+
+    def _start(self, action: Spec) -> str:
+        status = self.supervisor.start(action["catalog_node"])
+        return f"Started {action['catalog_node']} (pid {status.pid})."
+
+    def _stop(self, action: Spec) -> str:
+        self.supervisor.stop(action["catalog_node"])
+        return f"Stopping {action['catalog_node']}."
+
+    def _start_group(self, action: Spec) -> str:
+        group = catalog.lookup_group(action["group"])
+        for member in group.members:
+            self.supervisor.start(member)
+        return f"Started {', '.join(group.members)}."
+
+    def _stop_group(self, action: Spec) -> str:
+        group = catalog.lookup_group(action["group"])
+        for member in group.members:
+            self.supervisor.stop(member)
+        return f"Stopping {', '.join(group.members)}."
+
+    def _lifecycle(self, action: Spec) -> str:
+        request = lifecycle.change_request(action["transition"])
+        self._services.send(f"{action['node']}/change_state", ChangeState, request)
+        return f"Asked {action['node']} to {action['transition']}."
+
+    def _set_param(self, action: Spec) -> str:
+        request = params.set_request(action["name"], action["value"])
+        self._services.send(f"{action['node']}/set_parameters", SetParameters, request)
+        return f"Set {action['name']} = {action['value']!r} on {action['node']}."
+
+    def _call_service(self, action: Spec) -> str:
+        srv_type = import_type(action["type"])
+        request = fill(srv_type.Request, action["request"])
+        self._services.send(action["service"], srv_type, request)
+        return f"Called {action['service']}."
 
     def _send_goal(self, action: Spec) -> str:
-        name, type_name = action["action"], action["type"]
-        action_type = import_type(type_name)
-        with self._lock:
-            client = self._action_clients.get((name, type_name))
-            if client is None:
-                client = ActionClient(self.node, action_type, name)
-                self._action_clients[(name, type_name)] = client
-        # A new client may not have discovered the server yet: wait briefly.
-        if not client.wait_for_server(timeout_sec=ACTION_SERVER_WAIT_SEC):
-            raise RuntimeError(f"no action server on {name}: start it first")
+        name, type_text = action["action"], action["type"]
+        goal = fill(import_type(type_text, "action").Goal, action["goal"])
+        run = GoalRun(name, type_text, goal)
         cancel_after = action.get("cancel_after_feedback")
-        feedback: list[Any] = []
-        self.action_feedback[name] = feedback
-        self.action_results[name] = "running"
-        handle_box: list[Any] = []
 
-        def on_feedback(msg: Any) -> None:
-            feedback.append(msg.feedback)
-            if cancel_after and len(feedback) == cancel_after and handle_box:
-                handle_box[0].cancel_goal_async()
+        def on_feedback(_feedback: Any) -> None:
+            if cancel_after and len(run.feedback) == cancel_after:
+                run.cancel()
 
-        def on_result(future: Any) -> None:
-            status = future.result().status
-            self.action_results[name] = {4: "succeeded", 5: "canceled", 6: "aborted"}.get(
-                status, f"status {status}"
-            )
+        with self._lock:
+            self._goals[name] = run
+        ctx = CallContext(self.node, limits=GOAL_LIMITS)
 
-        def on_goal(future: Any) -> None:
-            handle = future.result()
-            if not handle.accepted:
-                self.action_results[name] = "rejected"
-                return
-            handle_box.append(handle)
-            handle.get_result_async().add_done_callback(on_result)
+        def drive() -> None:
+            try:
+                send_goal(ctx, run, on_feedback)
+            except Ros2Error:
+                pass  # recorded in run.error; the check shows it
 
-        goal = fill(action_type.Goal, action["goal"])
-        client.send_goal_async(goal, feedback_callback=on_feedback).add_done_callback(on_goal)
+        threading.Thread(target=drive, name=f"lesson-goal-{name}", daemon=True).start()
         return f"Sent a goal to {name}."
+
+    def _open_panel(self, action: Spec) -> str:
+        return f"Open the {action['panel']} tab."
 
     # -- checks ------------------------------------------------------------
 
     def evaluate(self, check: Spec) -> CheckResult:
         try:
-            return getattr(self, f"_check_{check.kind}")(check)
+            return _CHECKS[check.kind](self, check)
         except (Ros2Error, ValueError, RuntimeError, catalog.UnknownNodeError) as exc:
             return CheckResult(FAIL, str(exc))
 
@@ -233,8 +174,7 @@ class LessonRuntime:
         return CheckResult(PASS, f"{c['node']} is gone")
 
     def _publishers(self, topic: str) -> int:
-        info = self.graph.topic(topic)
-        return info.publishers if info else 0
+        return self.graph.publishers(topic)
 
     def _check_topic_messages(self, c: Spec) -> CheckResult:
         tap = self.tap(c["topic"], c["type"])
@@ -275,18 +215,21 @@ class LessonRuntime:
         return CheckResult(FAIL, f"{count} of {c['at_least']} subscribers on {c['topic']}")
 
     def _check_log_contains(self, c: Spec) -> CheckResult:
-        lines = [line for line in self.supervisor.output(c["node"]) if c["text"] in line]
+        name = c["catalog_node"]
+        lines = [line for line in self.supervisor.output(name) if c["text"] in line]
         needed = c.get("at_least", 1)
         if len(lines) >= needed:
             return CheckResult(PASS, f"{len(lines)} log lines contain {c['text']!r}")
-        if not self.supervisor.status(c["node"]).active:
-            return CheckResult(FAIL, f"{c['node']} is not running")
+        if not self.supervisor.status(name).active:
+            return CheckResult(FAIL, f"{name} is not running")
         return CheckResult(WAITING, f"{len(lines)} of {needed} log lines so far")
 
     def _check_lifecycle_state(self, c: Spec) -> CheckResult:
         if not self.graph.has_node(c["node"]):
             return CheckResult(FAIL, f"{c['node']} is not on the graph")
-        response = self._poll_service(c.key, f"{c['node']}/get_state", GetState, GetState.Request())
+        response = self._services.latest(
+            c.key, f"{c['node']}/get_state", GetState, GetState.Request()
+        )
         if response is None:
             return CheckResult(WAITING, f"asking {c['node']} for its state")
         label = response.current_state.label
@@ -298,28 +241,25 @@ class LessonRuntime:
         if not self.graph.has_node(c["node"]):
             return CheckResult(FAIL, f"{c['node']} is not on the graph")
         request = GetParameters.Request(names=[c["name"]])
-        response = self._poll_service(c.key, f"{c['node']}/get_parameters", GetParameters, request)
+        response = self._services.latest(
+            c.key, f"{c['node']}/get_parameters", GetParameters, request
+        )
         if response is None:
             return CheckResult(WAITING, f"asking {c['node']} for {c['name']}")
         if not response.values:
             return CheckResult(FAIL, f"{c['node']} has no parameter {c['name']}")
-        value = _parameter_value(response.values[0])
+        value = params.python_value(response.values[0])
         expected = c["value"]
-        same = (
-            math.isclose(value, expected, rel_tol=1e-9)
-            if isinstance(value, float) and isinstance(expected, (int, float))
-            else value == expected
-        )
-        if same:
+        if params.same_value(value, expected):
             return CheckResult(PASS, f"{c['name']} = {value!r}")
         return CheckResult(FAIL, f"{c['name']} = {value!r}, expected {expected!r}")
 
     def _check_service_returns(self, c: Spec) -> CheckResult:
         srv_type = import_type(c["type"])
-        if not self._client(c["service"], srv_type).service_is_ready():
+        if not self._services.client(c["service"], srv_type).service_is_ready():
             return CheckResult(FAIL, f"no server for {c['service']}")
         request = fill(srv_type.Request, c["request"])
-        response = self._poll_service(c.key, c["service"], srv_type, request)
+        response = self._services.latest(c.key, c["service"], srv_type, request)
         if response is None:
             return CheckResult(WAITING, f"calling {c['service']}")
         value = getattr(response, c["field"])
@@ -328,12 +268,16 @@ class LessonRuntime:
         return CheckResult(FAIL, f"{c['field']} = {value!r}, expected {c['equals']!r}")
 
     def _check_action_result(self, c: Spec) -> CheckResult:
-        status = self.action_results.get(c["action"])
-        if status is None:
+        with self._lock:
+            run = self._goals.get(c["action"])
+        if run is None:
             return CheckResult(FAIL, f"no goal sent to {c['action']} yet")
+        status = run.outcome
         if status == "running":
-            done = len(self.action_feedback.get(c["action"], []))
+            done = len(run.feedback)
             return CheckResult(WAITING, f"goal running, {done} feedback messages so far")
+        if run.error:
+            return CheckResult(FAIL, run.error)
         if status == c["status"]:
             return CheckResult(PASS, f"the goal {status}")
         return CheckResult(FAIL, f"the goal {status}, expected {c['status']}")
@@ -376,3 +320,22 @@ class LessonRuntime:
         if answer == c["answer"]:
             return CheckResult(PASS, "correct")
         return CheckResult(FAIL, f"{answer!r} is not right; try again")
+
+
+# The registry's kinds, each mapped to its implementation (checked at import).
+_ACTIONS: dict[str, Callable[[LessonRuntime, Spec], str]] = {
+    "start": LessonRuntime._start,
+    "stop": LessonRuntime._stop,
+    "start_group": LessonRuntime._start_group,
+    "stop_group": LessonRuntime._stop_group,
+    "lifecycle": LessonRuntime._lifecycle,
+    "set_param": LessonRuntime._set_param,
+    "call_service": LessonRuntime._call_service,
+    "send_goal": LessonRuntime._send_goal,
+    "open_panel": LessonRuntime._open_panel,
+}
+_CHECKS: dict[str, Callable[[LessonRuntime, Spec], CheckResult]] = {
+    kind: getattr(LessonRuntime, f"_check_{kind}") for kind in CHECK_KINDS
+}
+if set(_ACTIONS) != set(ACTION_KINDS):
+    raise RuntimeError(f"lesson actions without a handler: {set(ACTION_KINDS) ^ set(_ACTIONS)}")

@@ -1,46 +1,17 @@
-"""Helpers the ROS panels share: background jobs and forms generated from message types.
+"""Forms generated from message types: a widget per field, and a slot that holds one.
 
-viser runs callbacks on its own thread pool; ROS requests wait on futures.
-A click therefore starts a short-lived worker thread (``run_job``) that calls
-the same ros2cli functions the console uses; the callback returns at once.
+Used by the Services, Actions and Topics panels (requests, goals, messages).
+Built and read on the UI thread only (see the threading model in app.ui).
 """
 
 from __future__ import annotations
 
-import logging
-import threading
 from collections.abc import Callable
 from typing import Any
 
 import viser
 
-from app.ros2cli.common import Ros2Error
-from app.ros2cli.convert import ConversionError, fill_from_form, leaf_fields, type_name
-
-log = logging.getLogger(__name__)
-
-
-# Set when any panel job ends; the dashboard's UI loop then refreshes at once.
-JOB_DONE = threading.Event()
-
-
-def run_job(work: Callable[[], None], on_error: Callable[[str], None]) -> threading.Thread:
-    """Run ``work`` off the callback thread; any failure reaches ``on_error`` as one line."""
-
-    def body() -> None:
-        try:
-            work()
-        except Ros2Error as exc:
-            on_error(str(exc))
-        except Exception as exc:  # never a traceback in the page; keep it in the log
-            log.exception("panel job failed")
-            on_error(f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}")
-        finally:
-            JOB_DONE.set()  # the dashboard shows the outcome now, not at its next 5 Hz tick
-
-    thread = threading.Thread(target=body, name="panel-job", daemon=True)
-    thread.start()
-    return thread
+from app.ros.convert import ConversionError, fill_from_form, from_yaml, leaf_fields, type_name
 
 
 class MessageForm:
@@ -84,8 +55,6 @@ class MessageForm:
 
     def message(self) -> Any:
         if self._yaml is not None:
-            from app.ros2cli.convert import from_yaml
-
             return from_yaml(self.cls, self._yaml.value)
         values = self.values()
         for path, (kind, _w) in self._widgets.items():
@@ -99,28 +68,16 @@ class MessageForm:
         self._folder.remove()
 
 
-def yaml_inline(msg: Any) -> str:
-    """A message as '{a: 1, b: 2}' for the equivalent ros2 command line."""
-    import yaml
-
-    from app.ros2cli.convert import to_plain
-
-    text = yaml.safe_dump(to_plain(msg), default_flow_style=True, width=10_000).strip()
-    return "'" + text.replace("'", "'\"'\"'") + "'"
-
-
 class FormSlot:
     """A folder that holds the MessageForm of one message class at a time.
 
-    The Services, Actions and Topics panels call ``show(key, build)`` whenever
-    their selection may have changed (from viser callbacks and from the UI
-    thread); the form is rebuilt only when ``key`` differs from the one shown.
+    Panels call ``show(key, build)`` whenever their selection may have
+    changed; the form is rebuilt only when ``key`` differs from the one shown.
     """
 
     def __init__(self, gui: viser.GuiApi, title: str) -> None:
         self._gui = gui
         self._folder = gui.add_folder(title, expand_by_default=True)
-        self._lock = threading.Lock()
         self._key: object = object()
         self.form: MessageForm | None = None
 
@@ -129,15 +86,14 @@ class FormSlot:
 
         A ConversionError from ``build`` propagates, leaving no form for ``key``.
         """
-        with self._lock:
-            if key == self._key:
-                return self.form
-            self._key = key
-            if self.form is not None:
-                self.form.remove()
-                self.form = None
-            if build is not None:
-                cls, title = build()
-                with self._folder:
-                    self.form = MessageForm(self._gui, cls, title)
+        if key == self._key:
             return self.form
+        self._key = key
+        if self.form is not None:
+            self.form.remove()
+            self.form = None
+        if build is not None:
+            cls, title = build()
+            with self._folder:
+                self.form = MessageForm(self._gui, cls, title)
+        return self.form

@@ -1,4 +1,4 @@
-"""Live topic rates for the panels, measured cheaply.
+"""Live rates of a changing set of topics, measured cheaply.
 
 One best-effort raw ``TopicMonitor`` per watched topic: best effort so a
 reliable publisher is never slowed by us, raw so an image or a point cloud is
@@ -13,8 +13,9 @@ import threading
 
 from rclpy.node import Node
 
-from app.ros2cli.convert import ConversionError, import_type
-from app.ros2cli.topic import MEASURE_QOS, TopicMonitor
+from app.ros.convert import ConversionError, import_type
+from app.ros.monitor import TopicMonitor
+from app.ros.qos import MEASURE_QOS
 
 log = logging.getLogger(__name__)
 

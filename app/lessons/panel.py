@@ -1,18 +1,22 @@
-"""Lessons panel: course outline, the current step, its buttons, live checks, Back/Next."""
+"""Lessons tab: course outline, the current step, its buttons, live checks, Back/Next.
+
+Step buttons run ``LessonRuntime.perform`` as jobs in one lane, so two quick
+clicks happen in the order made; everything else runs on the UI thread.
+"""
 
 from __future__ import annotations
 
-import threading
 from typing import Any
 
 import viser
 
 from app import PROJECT_ROOT
-from app.graph import GraphSnapshot
-from app.lessons.live import FAIL, PASS, LessonRuntime
 from app.lessons.progress import ProgressStore
-from app.lessons.schema import Course, Lesson
-from app.panels import MarkdownView
+from app.lessons.runtime import FAIL, PASS, LessonRuntime
+from app.lessons.schema import Course, Lesson, Spec
+from app.ros.graph import GraphSnapshot
+from app.ui import MarkdownView
+from app.ui.loop import UiLoop
 
 _MARKS = {PASS: "✓", FAIL: "✗", "waiting": "…"}
 _CHOOSE = "(choose an answer)"
@@ -30,13 +34,18 @@ def _label(lesson: Lesson) -> str:
 
 class LessonsPanel:
     def __init__(
-        self, gui: viser.GuiApi, course: Course, live: LessonRuntime, progress: ProgressStore
+        self,
+        gui: viser.GuiApi,
+        ui: UiLoop,
+        course: Course,
+        live: LessonRuntime,
+        progress: ProgressStore,
     ) -> None:
         self._gui = gui
+        self._ui = ui
         self._course = course
         self._live = live
         self._progress = progress
-        self._lock = threading.RLock()
         self._dynamic: list[Any] = []
         by_label = {_label(lesson): lesson for lesson in course.lessons}
         self._by_label = by_label
@@ -65,13 +74,18 @@ class LessonsPanel:
         self._code_window.set_width(520)
         self._lesson = current
         self._step = min(progress.lesson(current.id)["step"], len(current.steps) - 1)
-        self._selector.on_update(lambda _: self._select(by_label[self._selector.value], 0))
-        self._back.on_click(lambda _: self._select(self._lesson, self._step - 1))
-        self._next.on_click(lambda _: self._go_next())
-        self._reset.on_click(lambda _: self._do_reset())
+        self._selector.on_update(lambda _: ui.post(self._on_lesson_picked))
+        self._back.on_click(lambda _: ui.post(lambda: self._select(self._lesson, self._step - 1)))
+        self._next.on_click(lambda _: ui.post(self._go_next))
+        self._reset.on_click(lambda _: ui.post(self._do_reset))
         self._select(current, self._step)
 
     # -- navigation --------------------------------------------------------
+
+    def _on_lesson_picked(self) -> None:
+        lesson = self._by_label.get(self._selector.value)  # a forged value is ignored
+        if lesson is not None and lesson is not self._lesson:
+            self._select(lesson, 0)
 
     def _go_next(self) -> None:
         if self._step + 1 < len(self._lesson.steps):
@@ -80,7 +94,8 @@ class LessonsPanel:
         index = self._course.lessons.index(self._lesson)
         if index + 1 < len(self._course.lessons):
             following = self._course.lessons[index + 1]
-            self._selector.value = _label(following)  # triggers _select via on_update
+            self._selector.value = _label(following)
+            self._select(following, 0)
 
     def _do_reset(self) -> None:
         self._progress.reset()
@@ -88,24 +103,22 @@ class LessonsPanel:
         self._select(self._lesson, 0)
 
     def _select(self, lesson: Lesson, step: int) -> None:
-        with self._lock:
-            step = max(0, min(step, len(lesson.steps) - 1))
-            self._lesson, self._step = lesson, step
-            self._progress.set_position(lesson.id, step)
-            current = lesson.steps[step]
-            goals = "\n".join(f"- {goal}" for goal in lesson.goals)
-            self._header.show(
-                f"### {lesson.title}\n{lesson.summary}\n\n**Goals**\n{goals}\n\n"
-                f"**Step {step + 1} of {len(lesson.steps)}: {current.title}**"
-            )
-            self._text.show(_without_title(current.text))
-            self._command.show(f"In a terminal: `{current.command}`" if current.command else "")
-            self._code.show(self._source_listing(lesson))
-            self._code_window.visible = bool(lesson.code)
-            self._message.show("")
-            self._rebuild_step_widgets()
-            self._back.disabled = step == 0
-        self.refresh(None)
+        step = max(0, min(step, len(lesson.steps) - 1))
+        self._lesson, self._step = lesson, step
+        self._progress.set_position(lesson.id, step)
+        current = lesson.steps[step]
+        goals = "\n".join(f"- {goal}" for goal in lesson.goals)
+        self._header.show(
+            f"### {lesson.title}\n{lesson.summary}\n\n**Goals**\n{goals}\n\n"
+            f"**Step {step + 1} of {len(lesson.steps)}: {current.title}**"
+        )
+        self._text.show(_without_title(current.text))
+        self._command.show(f"In a terminal: `{current.command}`" if current.command else "")
+        self._code.show(self._source_listing(lesson))
+        self._code_window.visible = bool(lesson.code)
+        self._message.show("")
+        self._rebuild_step_widgets()
+        self._back.disabled = step == 0
 
     def _source_listing(self, lesson: Lesson) -> str:
         parts = []
@@ -123,7 +136,7 @@ class LessonsPanel:
             for action in step.actions:
                 label = action.get("label") or f"{action.kind.replace('_', ' ')}"
                 button = self._gui.add_button(label, icon=viser.Icon.PLAYER_PLAY)
-                button.on_click(lambda _, a=action: self._perform(a))
+                button.on_click(lambda _, a=action: self._ui.post(lambda: self._perform(a)))
                 self._dynamic.append(button)
             for check in step.checks:
                 if check.kind != "quiz":
@@ -132,18 +145,22 @@ class LessonsPanel:
                 quiz = self._gui.add_dropdown(
                     check["question"], [_CHOOSE, *check["options"]], initial_value=chosen
                 )
-                quiz.on_update(lambda _, c=check, q=quiz: self._answer(c, q.value))
+                quiz.on_update(
+                    lambda _, c=check, q=quiz: self._ui.post(lambda: self._answer(c, q.value))
+                )
                 self._dynamic.append(quiz)
             if not self._dynamic:
                 self._dynamic.append(self._gui.add_markdown("_Nothing to click: read on._"))
 
-    def _perform(self, action) -> None:
-        try:
-            self._message.show(self._live.perform(action))
-        except Exception as exc:  # shown to the learner, never a traceback
-            self._message.show(f"⚠ {exc}")
+    def _perform(self, action: Spec) -> None:
+        self._ui.run_job(
+            lambda: self._live.perform(action),
+            self._message.show,
+            lambda text: self._message.show(f"⚠ {text}"),
+            lane="lessons",
+        )
 
-    def _answer(self, check, value: str) -> None:
+    def _answer(self, check: Spec, value: str) -> None:
         if value == _CHOOSE:
             self._live.quiz_answers.pop(check.key, None)
         else:
@@ -151,25 +168,21 @@ class LessonsPanel:
 
     # -- live part ---------------------------------------------------------
 
-    def refresh(self, graph: GraphSnapshot | None) -> None:
+    def refresh(self, graph: GraphSnapshot) -> None:
         if not self._course.lessons:
             return
-        with self._lock:
-            lesson, index = self._lesson, self._step
-            step = lesson.steps[index]
-            results = [(check, self._live.evaluate(check)) for check in step.checks]
-            if results and all(result.state == PASS for _, result in results):
-                self._progress.mark_passed(lesson.id, index)
-            lines = [
-                f"- {_MARKS[result.state]} **{result.state}**: {result.reason}"
-                for _, result in results
-            ]
-            passed = set(self._progress.lesson(lesson.id)["passed"])
-            status = "✓ step done" if index in passed else ""
-            self._checks.show(
-                ("**Checks** " + status + "\n\n" + "\n".join(lines)) if lines else status
-            )
-            self._outline.show(self._outline_text(lesson))
+        lesson, index = self._lesson, self._step
+        step = lesson.steps[index]
+        results = [(check, self._live.evaluate(check)) for check in step.checks]
+        if results and all(result.state == PASS for _, result in results):
+            self._progress.mark_passed(lesson.id, index)
+        lines = [
+            f"- {_MARKS[result.state]} **{result.state}**: {result.reason}" for _, result in results
+        ]
+        passed = set(self._progress.lesson(lesson.id)["passed"])
+        status = "✓ step done" if index in passed else ""
+        self._checks.show(("**Checks** " + status + "\n\n" + "\n".join(lines)) if lines else status)
+        self._outline.show(self._outline_text(lesson))
 
     def _outline_text(self, current: Lesson) -> str:
         rows = []
@@ -182,3 +195,6 @@ class LessonsPanel:
         warning = f"⚠ {self._progress.warning}\n\n" if self._progress.warning else ""
         errors = "".join(f"\n\n⚠ {error}" for error in self._course.errors)
         return warning + "| unit | lesson | done |\n|---|---|---|\n" + "\n".join(rows) + errors
+
+    def close(self) -> None:
+        self._live.close()

@@ -19,7 +19,7 @@ from typing import Any
 import yaml
 from rosidl_parser import definition as idl
 
-from app.ros2cli.common import Ros2Error
+from app.ros.errors import Ros2Error
 
 KINDS = ("msg", "srv", "action")
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
@@ -459,3 +459,9 @@ def fill_from_form(cls: type, values: dict[str, Any]) -> Any:
 def message_repr(msg: Any) -> str:
     """ros2cli's one-line form: 'std_msgs.msg.String(data=...)'."""
     return repr(msg)
+
+
+def yaml_inline(msg: Any) -> str:
+    """A message as '{a: 1, b: 2}', quoted for the equivalent ros2 command line."""
+    text = yaml.safe_dump(to_plain(msg), default_flow_style=True, width=10_000).strip()
+    return "'" + text.replace("'", "'\"'\"'") + "'"

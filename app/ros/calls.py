@@ -1,0 +1,230 @@
+"""Service calls and action goals.
+
+Blocking-but-bounded calls (``call_service``, ``send_goal``) run on a worker
+thread, never a viser callback or the executor thread: the request goes out
+with ``call_async`` and this thread waits on the future. ``ServicePoller``
+never blocks: it is for checks that are evaluated many times a second.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from action_msgs.msg import GoalStatus
+from rclpy.action import ActionClient, get_action_names_and_types
+from rclpy.node import Node
+from rclpy.task import Future
+
+from app.ros.context import CallContext
+from app.ros.convert import import_type, type_name
+from app.ros.errors import Cancelled, Ros2Error
+
+STATUS_NAMES = {
+    GoalStatus.STATUS_UNKNOWN: "UNKNOWN",
+    GoalStatus.STATUS_ACCEPTED: "ACCEPTED",
+    GoalStatus.STATUS_EXECUTING: "EXECUTING",
+    GoalStatus.STATUS_CANCELING: "CANCELING",
+    GoalStatus.STATUS_SUCCEEDED: "SUCCEEDED",
+    GoalStatus.STATUS_CANCELED: "CANCELED",
+    GoalStatus.STATUS_ABORTED: "ABORTED",
+}
+
+
+def wait_future(ctx: CallContext, future: Future, timeout: float, what: str) -> Any:
+    """Block this (non-executor) thread until ``future`` is done, bounded and cancellable."""
+    done = threading.Event()
+    future.add_done_callback(lambda _f: done.set())
+    deadline = time.monotonic() + timeout
+    while not done.wait(0.05):
+        if ctx.cancel.is_set():
+            future.cancel()
+            raise Cancelled()
+        if time.monotonic() > deadline:
+            future.cancel()
+            raise Ros2Error(f"no answer from {what} within {timeout:g} s")
+    exc = future.exception()
+    if exc is not None:
+        raise Ros2Error(f"{what} failed: {exc}")
+    return future.result()
+
+
+def wait_for_server(
+    ctx: CallContext, is_ready: Callable[[], bool], timeout: float, what: str
+) -> None:
+    """Poll ``is_ready`` (service_is_ready / server_is_ready) until true or timeout."""
+    deadline = time.monotonic() + timeout
+    while not is_ready():
+        if time.monotonic() > deadline:
+            raise Ros2Error(f"{what} is not available (waited {timeout:g} s)")
+        ctx.sleep(0.1)
+
+
+def service_types(ctx: CallContext, name: str) -> list[str]:
+    return next((list(t) for n, t in ctx.node.get_service_names_and_types() if n == name), [])
+
+
+def check_service_type(ctx: CallContext, name: str, srv_type: type) -> None:
+    """When the service is on the graph with another type, say so instead of timing out."""
+    types = service_types(ctx, name)
+    if types and type_name(srv_type) not in types:
+        raise Ros2Error(f"service '{name}' has type {', '.join(types)}, not {type_name(srv_type)}")
+
+
+def call_service(
+    ctx: CallContext, name: str, srv_type: type, request: Any, timeout: float | None = None
+) -> Any:
+    """Send one request and return the response, or raise one clear Ros2Error."""
+    timeout = ctx.limits.service_timeout if timeout is None else timeout
+    check_service_type(ctx, name, srv_type)
+    client = ctx.node.create_client(srv_type, name)
+    try:
+        wait_for_server(ctx, client.service_is_ready, timeout, f"service '{name}'")
+        return wait_future(ctx, client.call_async(request), timeout, f"service '{name}'")
+    finally:
+        ctx.node.destroy_client(client)
+
+
+def action_type_of(node: Node, name: str) -> str | None:
+    for action, types in get_action_names_and_types(node):
+        if action == name and types:
+            return types[0]
+    return None
+
+
+@dataclass
+class GoalRun:
+    """A goal in flight: the panel reads it while a worker thread drives it."""
+
+    action: str
+    type_text: str
+    goal: Any
+    feedback: list[Any] = field(default_factory=list)
+    status: str = "SENDING"
+    result: Any = None
+    error: str | None = None
+    goal_id: str = ""
+    command: str = ""  # the equivalent `ros2 action send_goal ...` line
+    done: threading.Event = field(default_factory=threading.Event)
+    _handle: Any = None
+
+    @property
+    def outcome(self) -> str:
+        """'running', or the final status in lower case ('succeeded', 'canceled', ...)."""
+        return self.status.lower() if self.done.is_set() else "running"
+
+    def cancel(self) -> None:
+        """Ask the server to cancel; the final status arrives with the result."""
+        handle = self._handle
+        if handle is not None and not self.done.is_set():
+            self.status = "CANCELING"
+            handle.cancel_goal_async()
+
+
+def send_goal(
+    ctx: CallContext,
+    run: GoalRun,
+    on_feedback: Callable[[Any], None] | None = None,
+    on_accepted: Callable[[GoalRun], None] | None = None,
+) -> GoalRun:
+    """Drive ``run`` to its end: accepted or rejected, feedback, final status and result."""
+    action_cls = import_type(run.type_text, "action")
+    known = action_type_of(ctx.node, run.action)
+    if known and known != type_name(action_cls):
+        raise Ros2Error(f"action '{run.action}' has type {known}, not {type_name(action_cls)}")
+    client = ActionClient(ctx.node, action_cls, run.action)
+
+    def feedback_cb(message: Any) -> None:
+        run.feedback.append(message.feedback)
+        if on_feedback:
+            on_feedback(message.feedback)
+
+    try:
+        timeout = ctx.limits.service_timeout
+        wait_for_server(ctx, client.server_is_ready, timeout, f"action server '{run.action}'")
+        future = client.send_goal_async(run.goal, feedback_callback=feedback_cb)
+        handle = wait_future(ctx, future, timeout, f"action server '{run.action}'")
+        if not handle.accepted:
+            run.status = "REJECTED"
+            return run
+        run._handle = handle
+        run.goal_id = bytes(handle.goal_id.uuid).hex()
+        run.status = "EXECUTING"
+        if on_accepted:
+            on_accepted(run)
+        response = wait_future(
+            ctx,
+            handle.get_result_async(),
+            ctx.limits.action_timeout,
+            f"action '{run.action}' (result)",
+        )
+        run.status = STATUS_NAMES.get(response.status, str(response.status))
+        run.result = response.result
+        return run
+    except Cancelled:
+        if run._handle is not None:
+            run._handle.cancel_goal_async()  # Stop/Ctrl+C also stops the server's work
+        run.status = "CANCELED (stopped here)"
+        raise
+    except Ros2Error as exc:
+        run.error = str(exc)
+        run.status = "ERROR"
+        raise
+    finally:
+        run.done.set()
+        client.destroy()
+
+
+class ServicePoller:
+    """The latest answer of a service, re-asked at most once a period; never blocks.
+
+    Lesson checks are evaluated several times a second from the UI thread:
+    they read the last answer and, when it is old, send one new request.
+    """
+
+    def __init__(self, node: Node, period: float = 1.0) -> None:
+        self._node = node
+        self._period = period
+        self._lock = threading.Lock()
+        self._clients: dict[tuple[str, str], Any] = {}
+        self._calls: dict[str, tuple[Future | None, Any, float]] = {}
+
+    def client(self, service: str, srv_type: type) -> Any:
+        """One cached client per (service, type)."""
+        with self._lock:
+            key = (service, type_name(srv_type))
+            if key not in self._clients:
+                self._clients[key] = self._node.create_client(srv_type, service)
+            return self._clients[key]
+
+    def latest(self, key: str, service: str, srv_type: type, request: Any) -> Any:
+        """The newest response for ``key`` (None before the first); asks again when due."""
+        client = self.client(service, srv_type)
+        with self._lock:
+            future, result, sent_at = self._calls.get(key, (None, None, 0.0))
+            if future is not None and future.done():
+                result = future.result() if future.exception() is None else None
+                future = None
+            due = time.monotonic() - sent_at > self._period
+            if future is None and due and client.service_is_ready():
+                future, sent_at = client.call_async(request), time.monotonic()
+            self._calls[key] = (future, result, sent_at)
+            return result
+
+    def send(self, service: str, srv_type: type, request: Any) -> None:
+        """Fire one request and forget the answer (a step action)."""
+        self.client(service, srv_type).call_async(request)
+
+    def forget_answers(self) -> None:
+        """Answers from before an action may be stale now."""
+        with self._lock:
+            self._calls.clear()
+
+    def close(self) -> None:
+        with self._lock:
+            clients, self._clients = list(self._clients.values()), {}
+        for client in clients:
+            self._node.destroy_client(client)

@@ -1,0 +1,11 @@
+"""The two exceptions every ROS-layer call may raise, and every front end catches."""
+
+from __future__ import annotations
+
+
+class Ros2Error(Exception):
+    """A problem the learner can fix; shown as one line, never a traceback."""
+
+
+class Cancelled(Exception):
+    """The learner pressed Stop (or Ctrl+C) while a call was running."""

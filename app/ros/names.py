@@ -1,0 +1,31 @@
+"""ROS names: splitting and joining node names, and the names the graph hides."""
+
+from __future__ import annotations
+
+# Action internals (goal, result, feedback, status) live under this infix.
+ACTION_MARKER = "/_action/"
+# Topics every rclpy node has; listing them on every node only adds noise.
+QUIET_TOPICS = ("/rosout", "/parameter_events")
+
+
+def split_node_name(fqn: str) -> tuple[str, str]:
+    """'/ns/name' -> ('name', '/ns'); 'name' -> ('name', '/')."""
+    if not fqn.startswith("/"):
+        fqn = "/" + fqn
+    namespace, _, name = fqn.rpartition("/")
+    return name, namespace or "/"
+
+
+def node_fqn(name: str, namespace: str) -> str:
+    """('name', '/ns') -> '/ns/name'."""
+    return f"{namespace.rstrip('/')}/{name}"
+
+
+def is_hidden_node(fqn: str) -> bool:
+    """Names starting with '_' are hidden, as `ros2 node list` hides them."""
+    return fqn.rsplit("/", 1)[-1].startswith("_")
+
+
+def is_internal_topic(topic: str) -> bool:
+    """Action internals and hidden topics ('/_...') are nothing a learner publishes."""
+    return ACTION_MARKER in topic or "/_" in topic

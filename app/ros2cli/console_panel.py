@@ -1,0 +1,96 @@
+"""Console tab: type the tutorial's `ros2 ...` command and see what it prints.
+
+The text goes to the parser (shlex + argparse), never to a shell. A command
+runs as a job on a worker thread; it writes its lines into ``_Output`` (its
+own lock), which the UI thread copies. Streaming verbs (echo, hz, bw, pub -r)
+are bounded here: a few messages or seconds, and a Stop button.
+"""
+
+from __future__ import annotations
+
+import threading
+
+import viser
+from rclpy.node import Node
+
+from app.ros.context import CONSOLE_LIMITS, CallContext
+from app.ros.graph import GraphSnapshot
+from app.ros2cli.parser import run_text
+from app.ui import MarkdownView, code_block
+from app.ui.loop import UiLoop
+
+MAX_LINES = 200
+
+
+class _Output:
+    """Lines written by the running command's thread, read by the UI thread."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._lines: list[str] = []
+
+    def start(self, first: str) -> None:
+        with self._lock:
+            self._lines = [first]
+
+    def write(self, text: str) -> None:
+        with self._lock:
+            self._lines.extend(text.splitlines() or [""])
+            del self._lines[1 : max(1, len(self._lines) - MAX_LINES)]
+
+    def lines(self) -> list[str]:
+        with self._lock:
+            return list(self._lines)
+
+
+class ConsolePanel:
+    def __init__(self, gui: viser.GuiApi, ui: UiLoop, node: Node) -> None:
+        self._ui = ui
+        self._node = node
+        self._output = _Output()
+        self._running: CallContext | None = None
+        gui.add_markdown(
+            "Type a command as the tutorials write it, e.g. `ros2 topic list -t`, "
+            "`ros2 lifecycle get /lifecycle_talker`, `ros2 interface show std_msgs/msg/String`. "
+            "Streams stop after "
+            f"{CONSOLE_LIMITS.max_messages} messages or {CONSOLE_LIMITS.max_seconds:g} s."
+        )
+        self._command = gui.add_text("Command", "ros2 topic list -t")
+        self._run = gui.add_button("Run", icon=viser.Icon.PLAYER_PLAY)
+        self._stop = gui.add_button("Stop", icon=viser.Icon.PLAYER_STOP, disabled=True)
+        self._view = MarkdownView(gui, "")
+        self._run.on_click(lambda _: ui.post(lambda: self.run(self._command.value)))
+        self._stop.on_click(lambda _: ui.post(self._cancel))
+
+    def run(self, text: str) -> None:
+        """Start one command (UI thread); one at a time."""
+        if self._running is not None:
+            self._output.write("(a command is still running: press Stop first)")
+            return
+        self._output.start(f"$ {text.strip()}")
+        ctx = CallContext(self._node, self._output.write, CONSOLE_LIMITS)
+        self._running = ctx
+        self._run.disabled = True
+        self._stop.disabled = False
+        self._ui.run_job(lambda: run_text(ctx, text), self._finished, self._crashed)
+
+    def _finished(self, code: int) -> None:
+        self._output.write(f"[exit code {code}]")
+        self._running = None
+        self._run.disabled = False
+        self._stop.disabled = True
+
+    def _crashed(self, text: str) -> None:
+        self._output.write(f"error: {text}")  # a verb bug still ends in one line
+        self._finished(1)
+
+    def _cancel(self) -> None:
+        if self._running is not None:
+            self._running.cancel.set()
+
+    def refresh(self, graph: GraphSnapshot) -> None:
+        lines = self._output.lines()
+        self._view.show(code_block(lines, "(output appears here)") if lines else "")
+
+    def close(self) -> None:
+        self._cancel()

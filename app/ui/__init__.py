@@ -1,0 +1,76 @@
+"""What every browser front end shares: the UI thread, its widgets and the tab names.
+
+Threading model (every panel follows it; see ``UiLoop``):
+
+- One thread, the dashboard's UI thread, owns every panel's state. It applies
+  intents in the order they were posted, then calls ``refresh(graph)`` on each
+  panel. Only it reads or writes a panel's attributes.
+- viser runs browser callbacks on its own thread pool. A callback never
+  touches panel state and never waits: it posts an intent (``ui.post``).
+- The rclpy executor thread runs ROS callbacks. They either record into an
+  object that has its own lock and is read through copies (``TopicMonitor``,
+  ``RosoutLog``), or post an intent.
+- Anything that waits on ROS (a service call, a goal, a parameter read) runs
+  as a job (``ui.run_job``) on a worker thread. A job receives its inputs as
+  arguments and returns a result; the UI thread applies it (``on_done``) or
+  shows the one-line error (``on_error``). Jobs of one lane run one after
+  another, in click order.
+- Each panel has ``close()``; the dashboard calls it once, on shutdown.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Protocol
+
+from app.ros.graph import GraphSnapshot
+
+# The dashboard's tabs, in order. Lessons name them ("Open the Lifecycle tab")
+# and are checked against this list when they load.
+TAB_NAMES = (
+    "Lessons", "Nodes", "Graph", "Echo", "3D view", "Topics", "Parameters",
+    "Console", "Services", "Actions", "Lifecycle", "Logs",
+)  # fmt: skip
+
+
+class Panel(Protocol):
+    def refresh(self, graph: GraphSnapshot) -> None: ...
+
+    def close(self) -> None: ...
+
+
+class MarkdownView:
+    """A markdown handle that is re-sent only when its text changes."""
+
+    def __init__(self, gui: Any, content: str = "", **kwargs: Any) -> None:
+        self._content = content
+        self.handle = gui.add_markdown(content, **kwargs)
+
+    def show(self, content: str) -> None:
+        if content != self._content:
+            self._content = content
+            self.handle.content = content
+
+    @property
+    def content(self) -> str:
+        return self._content
+
+
+def code_block(lines: list[str], empty: str = "(nothing yet)") -> str:
+    body = "\n".join(lines) if lines else empty
+    return f"```\n{body}\n```"
+
+
+def set_options(dropdown: Any, options: list[str], keep_current: bool = True) -> None:
+    """New dropdown options without stealing the learner's choice.
+
+    With ``keep_current`` the current value stays selectable even when it has
+    left the list (a topic that went away may come back); otherwise a value
+    not in the list falls back to the first option.
+    """
+    current = dropdown.value
+    if keep_current and current not in options:
+        options = [*options, current]
+    if tuple(dropdown.options) != tuple(options):
+        dropdown.options = options
+    if current not in options and options:
+        dropdown.value = options[0]

@@ -1,0 +1,115 @@
+"""The UI thread's mailbox: intents from any thread, jobs that wait on ROS off that thread."""
+
+from __future__ import annotations
+
+import logging
+import queue
+import threading
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from typing import TypeVar
+
+from app.ros.errors import Ros2Error
+
+log = logging.getLogger(__name__)
+
+T = TypeVar("T")
+Intent = Callable[[], None]
+
+
+def one_line(exc: BaseException) -> str:
+    """An unexpected error as the learner sees it; the traceback goes to the log."""
+    if isinstance(exc, Ros2Error):
+        return str(exc)
+    text = str(exc).splitlines()[0] if str(exc) else ""
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+class UiLoop:
+    """Intents are applied in order by one thread (see the threading model in app.ui)."""
+
+    def __init__(self) -> None:
+        self._intents: queue.SimpleQueue[Intent] = queue.SimpleQueue()
+        self._wake = threading.Event()
+        self._lanes: dict[str, ThreadPoolExecutor] = {}
+        self._lanes_lock = threading.Lock()
+        self._closed = False
+
+    # -- any thread ------------------------------------------------------------
+
+    def post(self, intent: Intent) -> None:
+        """Ask the UI thread to run ``intent`` soon; returns at once."""
+        self._intents.put(intent)
+        self._wake.set()
+
+    def run_job(
+        self,
+        work: Callable[[], T],
+        on_done: Callable[[T], None] | None = None,
+        on_error: Callable[[str], None] | None = None,
+        *,
+        lane: str | None = None,
+    ) -> None:
+        """Run ``work`` on a worker thread; its outcome comes back as an intent.
+
+        Jobs with the same ``lane`` run one at a time, in the order posted (two
+        clicks on Start never overtake each other); lane-less jobs run at once.
+        """
+
+        def body() -> None:
+            try:
+                result = work()
+            except Exception as exc:  # one line for the page, the traceback for the log
+                if not isinstance(exc, Ros2Error):
+                    log.exception("job failed")
+                if on_error is not None:
+                    message = one_line(exc)
+                    self.post(lambda: on_error(message))
+                else:
+                    self._wake.set()
+                return
+            if on_done is not None:
+                self.post(lambda: on_done(result))
+            else:
+                self._wake.set()  # the page shows the effect at once, not at the next tick
+
+        if lane is None:
+            threading.Thread(target=body, name="ui-job", daemon=True).start()
+            return
+        with self._lanes_lock:
+            if self._closed:
+                return
+            executor = self._lanes.get(lane)
+            if executor is None:
+                executor = ThreadPoolExecutor(1, thread_name_prefix=f"ui-lane-{lane}")
+                self._lanes[lane] = executor
+            executor.submit(body)
+
+    # -- the UI thread -----------------------------------------------------------
+
+    def wait(self, timeout: float) -> bool:
+        """Sleep until something was posted or a job ended, at most ``timeout`` s."""
+        woken = self._wake.wait(timeout)
+        self._wake.clear()
+        return woken
+
+    def apply_pending(self) -> int:
+        """Run every posted intent in order; one failing intent stops no other."""
+        applied = 0
+        while True:
+            try:
+                intent = self._intents.get_nowait()
+            except queue.Empty:
+                return applied
+            applied += 1
+            try:
+                intent()
+            except Exception:  # a bug in one panel (or a forged widget value) freezes nothing
+                log.exception("UI intent failed")
+
+    def close(self) -> None:
+        with self._lanes_lock:
+            self._closed = True
+            lanes, self._lanes = list(self._lanes.values()), {}
+        for executor in lanes:
+            executor.shutdown(wait=False, cancel_futures=True)
