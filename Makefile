@@ -42,15 +42,19 @@ browser:
 
 # Every test runs inside a private network namespace with only loopback
 # (tests/run.py sets it up): DDS traffic cannot leave the machine.
-test: setup browser
+test: setup browser lint
 	$(VPY) tests/run.py $(ARGS)
 
+# Style, the layer contracts of pyproject.toml (import-linter) and types (mypy).
+# PYTHONPATH: check this checkout's app/, whatever the editable install points at.
 lint: setup
 	$(VENV)/bin/ruff check app nodes tests bench
 	$(VENV)/bin/ruff format --check app nodes tests bench
+	PYTHONPATH=$(CURDIR) $(VENV)/bin/lint-imports
+	PYTHONPATH=$(CURDIR) $(VPY) -m mypy
 
 bench: setup browser
 	$(VPY) tests/run.py --bench $(ARGS)
 
 clean:
-	rm -rf $(VENV) $(INTERFACES)/build
+	rm -rf $(VENV) $(INTERFACES)/build .mypy_cache .import_linter_cache

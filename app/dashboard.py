@@ -10,6 +10,7 @@ import logging
 import os
 import threading
 import time
+from collections.abc import Callable
 
 import viser
 
@@ -84,7 +85,7 @@ class Dashboard:
             f"Domain id **{os.environ.get('ROS_DOMAIN_ID', '0')}** · "
             "this dashboard is the ROS node `/classroom_dashboard`."
         )
-        builders = {
+        builders: dict[str, Callable[[], Panel]] = {
             "Lessons": lambda: LessonsPanel(gui, ui, load_course(), self.lessons, self.progress),
             "Nodes": lambda: NodesPanel(gui, ui, self.supervisor),
             "Graph": lambda: GraphPanel(gui, node),
@@ -113,7 +114,7 @@ class Dashboard:
         # A cheap look at the node list every GRAPH_CHECK_SEC, and any posted
         # intent, refresh at once; otherwise panels refresh at UI_PERIOD_SEC.
         # A node shows up within a frame, a click's effect within one pass.
-        last_nodes: object = None
+        last_nodes: list[tuple[str, str]] | None = None
         due = 0.0
         while not self._stop.is_set():
             woken = self.ui.wait(GRAPH_CHECK_SEC)
@@ -121,7 +122,7 @@ class Dashboard:
             try:
                 nodes = self.runtime.node.get_node_names_and_namespaces()
             except Exception:  # noqa: BLE001 - the graph may be unreadable for a moment
-                nodes = last_nodes
+                nodes = last_nodes or []
             now = time.monotonic()
             if nodes == last_nodes and now < due and not (woken or applied):
                 continue

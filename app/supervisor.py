@@ -183,7 +183,7 @@ class Supervisor:
     # -- control -----------------------------------------------------------
 
     def start(self, name: str, extra_ros_args: Iterable[str] = ()) -> NodeStatus:
-        """Start a catalog node: a no-op if it is starting or running, after the reap if stopping."""
+        """Start a catalog node; a no-op if it is running, done after the reap if stopping."""
         entry = lookup(name)
         while True:
             with self._start_lock:

@@ -15,7 +15,7 @@ from app.lessons.progress import ProgressStore
 from app.lessons.runtime import FAIL, PASS, LessonRuntime
 from app.lessons.schema import Course, Lesson, Spec
 from app.ros.graph import GraphSnapshot
-from app.ui import MarkdownView
+from app.ui import MarkdownView, assign
 from app.ui.loop import UiLoop
 
 _MARKS = {PASS: "✓", FAIL: "✗", "waiting": "…"}
@@ -74,10 +74,10 @@ class LessonsPanel:
         self._code_window.set_width(520)
         self._lesson = current
         self._step = min(progress.lesson(current.id)["step"], len(current.steps) - 1)
-        self._selector.on_update(lambda _: ui.post(self._on_lesson_picked))
+        self._selector.on_update(ui.callback(self._on_lesson_picked))
         self._back.on_click(lambda _: ui.post(lambda: self._select(self._lesson, self._step - 1)))
-        self._next.on_click(lambda _: ui.post(self._go_next))
-        self._reset.on_click(lambda _: ui.post(self._do_reset))
+        self._next.on_click(ui.callback(self._go_next))
+        self._reset.on_click(ui.callback(self._do_reset))
         self._select(current, self._step)
 
     # -- navigation --------------------------------------------------------
@@ -94,7 +94,7 @@ class LessonsPanel:
         index = self._course.lessons.index(self._lesson)
         if index + 1 < len(self._course.lessons):
             following = self._course.lessons[index + 1]
-            self._selector.value = _label(following)
+            assign(self._selector, _label(following))
             self._select(following, 0)
 
     def _do_reset(self) -> None:
@@ -136,7 +136,7 @@ class LessonsPanel:
             for action in step.actions:
                 label = action.get("label") or f"{action.kind.replace('_', ' ')}"
                 button = self._gui.add_button(label, icon=viser.Icon.PLAYER_PLAY)
-                button.on_click(lambda _, a=action: self._ui.post(lambda: self._perform(a)))
+                button.on_click(self._ui.callback(self._perform, action))
                 self._dynamic.append(button)
             for check in step.checks:
                 if check.kind != "quiz":
@@ -145,9 +145,7 @@ class LessonsPanel:
                 quiz = self._gui.add_dropdown(
                     check["question"], [_CHOOSE, *check["options"]], initial_value=chosen
                 )
-                quiz.on_update(
-                    lambda _, c=check, q=quiz: self._ui.post(lambda: self._answer(c, q.value))
-                )
+                quiz.on_update(self._ui.callback(self._answer, check, quiz))
                 self._dynamic.append(quiz)
             if not self._dynamic:
                 self._dynamic.append(self._gui.add_markdown("_Nothing to click: read on._"))
@@ -160,7 +158,8 @@ class LessonsPanel:
             lane="lessons",
         )
 
-    def _answer(self, check: Spec, value: str) -> None:
+    def _answer(self, check: Spec, quiz: viser.GuiDropdownHandle) -> None:
+        value = quiz.value
         if value == _CHOOSE:
             self._live.quiz_answers.pop(check.key, None)
         else:

@@ -17,7 +17,7 @@ from typing import Any
 try:
     import tomllib
 except ModuleNotFoundError:  # Python 3.10
-    import tomli as tomllib  # type: ignore[no-redef]
+    import tomli as tomllib
 
 from app import PROJECT_ROOT
 from app.catalog import ENTRIES, GROUPS

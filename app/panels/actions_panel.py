@@ -32,9 +32,9 @@ class ActionsPanel:
         self._send = gui.add_button("Send goal", icon=viser.Icon.SEND, disabled=True)
         self._cancel = gui.add_button("Cancel goal", icon=viser.Icon.X, disabled=True)
         self._view = MarkdownView(gui, "")
-        self._send.on_click(lambda _: ui.post(self._do_send))
-        self._cancel.on_click(lambda _: ui.post(self._do_cancel))
-        self._selector.on_update(lambda _: ui.post(self._rebuild_form))
+        self._send.on_click(ui.callback(self._do_send))
+        self._cancel.on_click(ui.callback(self._do_cancel))
+        self._selector.on_update(ui.callback(self._rebuild_form))
 
     def _rebuild_form(self) -> None:
         name = self._selector.value

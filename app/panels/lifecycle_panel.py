@@ -76,7 +76,7 @@ class LifecyclePanel:
         self._buttons = {}
         for label in lc.TRANSITION_LABELS:
             button = gui.add_button(label, disabled=True)
-            button.on_click(lambda _e, label=label: ui.post(lambda: self._transition(label)))
+            button.on_click(ui.callback(self._transition, label))
             self._buttons[label] = button
         self._result = MarkdownView(gui, "")
         self._log = MarkdownView(gui, "")

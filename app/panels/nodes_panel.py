@@ -8,7 +8,7 @@ from app.catalog import ENTRIES, GROUPS, lookup, lookup_group
 from app.launch import launch_file_text
 from app.ros.graph import GraphSnapshot
 from app.supervisor import ACTIVE_STATES, NodeState, NodeStatus, Supervisor
-from app.ui import MarkdownView, code_block
+from app.ui import MarkdownView, assign, code_block
 from app.ui.loop import UiLoop
 
 _STATE_ICONS = {
@@ -60,14 +60,14 @@ class NodesPanel:
             self._group_details = MarkdownView(gui)
         with gui.add_folder("All catalog nodes"):
             self._overview = MarkdownView(gui)
-        self._start.on_click(lambda _: ui.post(lambda: self._act("start")))
-        self._stop.on_click(lambda _: ui.post(lambda: self._act("stop")))
-        self._restart.on_click(lambda _: ui.post(lambda: self._act("restart")))
-        self._start_group.on_click(lambda _: ui.post(lambda: self._act_on_group("start")))
-        self._stop_group.on_click(lambda _: ui.post(lambda: self._act_on_group("stop")))
+        self._start.on_click(ui.callback(self._act, "start"))
+        self._stop.on_click(ui.callback(self._act, "stop"))
+        self._restart.on_click(ui.callback(self._act, "restart"))
+        self._start_group.on_click(ui.callback(self._act_on_group, "start"))
+        self._stop_group.on_click(ui.callback(self._act_on_group, "stop"))
         # A new choice only needs a refresh, which follows every applied intent.
-        self._selector.on_update(lambda _: ui.post(self._valid_selection))
-        self._group_selector.on_update(lambda _: ui.post(self._valid_selection))
+        self._selector.on_update(ui.callback(self._valid_selection))
+        self._group_selector.on_update(ui.callback(self._valid_selection))
 
     # -- clicks (UI thread) ------------------------------------------------------
     # Every click becomes a job in one lane: clicks run one at a time, in the
@@ -117,9 +117,9 @@ class NodesPanel:
     def _valid_selection(self) -> None:
         """Dropdown values come from the browser: anything outside the catalog is reset."""
         if self._selector.value not in _ENTRY_NAMES:
-            self._selector.value = ENTRIES[0].name
+            assign(self._selector, ENTRIES[0].name)
         if self._group_selector.value not in _GROUP_NAMES:
-            self._group_selector.value = GROUPS[0].name
+            assign(self._group_selector, GROUPS[0].name)
 
     def refresh(self, graph: GraphSnapshot) -> None:
         self._valid_selection()

@@ -207,7 +207,7 @@ class ParametersPanel:
                 button = gui.add_button(
                     f"Set {spec.name}", icon=viser.Icon.DEVICE_FLOPPY, disabled=spec.read_only
                 )
-                button.on_click(lambda _e, name=spec.name: self._ui.post(lambda: self._set(name)))
+                button.on_click(self._ui.callback(self._set, spec.name))
         self._built_for = target
 
     def _editor(self, spec: ParamSpec) -> Any:

@@ -35,8 +35,8 @@ class ServicesPanel:
         self._form_slot = FormSlot(gui, "Request")
         self._call = gui.add_button("Call", icon=viser.Icon.SEND, disabled=True)
         self._result = MarkdownView(gui, "")
-        self._call.on_click(lambda _: ui.post(self._do_call))
-        self._selector.on_update(lambda _: ui.post(self._rebuild_form))
+        self._call.on_click(ui.callback(self._do_call))
+        self._selector.on_update(ui.callback(self._rebuild_form))
 
     def _rebuild_form(self) -> None:
         name = self._selector.value

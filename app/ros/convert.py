@@ -22,6 +22,10 @@ from rosidl_parser import definition as idl
 from app.ros.errors import Ros2Error
 
 KINDS = ("msg", "srv", "action")
+# A generated message, service or action class: its attributes (Request,
+# Goal, SLOT_TYPES, get_fields_and_field_types) are made by rosidl at build
+# time, so the type checker cannot know them.
+RosType = Any
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 
 _INT_RANGES = {
@@ -50,13 +54,13 @@ class ConversionError(Ros2Error):
 # ----------------------------------------------------------------- type lookup
 
 
-def type_name(cls: type) -> str:
+def type_name(cls: RosType) -> str:
     """'std_msgs/msg/String' for the class std_msgs.msg.String."""
     module = cls.__module__.split(".")
     return f"{module[0]}/{module[1]}/{cls.__name__}"
 
 
-def import_type(name: str, kind: str | None = None) -> type:
+def import_type(name: str, kind: str | None = None) -> RosType:
     """Import 'pkg/msg/Name' or 'pkg/Name' (msg, then srv, then action)."""
     if not isinstance(name, str) or not name.strip():
         raise ConversionError("empty type name (expected e.g. std_msgs/msg/String)")
@@ -104,11 +108,11 @@ def is_message(value: Any) -> bool:
     return hasattr(type(value), "get_fields_and_field_types") and hasattr(value, "__slots__")
 
 
-def _nested_class(slot: idl.NamespacedType) -> type:
+def _nested_class(slot: idl.NamespacedType) -> RosType:
     return import_type("/".join([*slot.namespaces, slot.name]))
 
 
-def fields_of(cls: type) -> list[tuple[str, str, Any]]:
+def fields_of(cls: RosType) -> list[tuple[str, str, Any]]:
     """(name, ros type text, rosidl slot type) for every field of a message class."""
     names = list(cls.get_fields_and_field_types().items())
     return [(n, t, slot) for (n, t), slot in zip(names, cls.SLOT_TYPES, strict=True)]

@@ -78,7 +78,8 @@ def endpoint_owners(node: Node) -> tuple[list[TopicInfo], set[str]]:
     ghost and a restarted node of the same name share it, and the query
     answers for whichever comes first. Endpoint records carry their owner.
     """
-    topics, owners = [], set()
+    topics: list[TopicInfo] = []
+    owners: set[str] = set()
     for name, types in node.get_topic_names_and_types():
         publishers = node.get_publishers_info_by_topic(name)
         subscribers = node.get_subscriptions_info_by_topic(name)

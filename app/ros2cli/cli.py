@@ -11,6 +11,9 @@ import os
 import signal
 import sys
 import threading
+from typing import cast
+
+from rclpy.node import Node
 
 from app.ros.context import CLI_LIMITS, CallContext
 from app.ros2cli.parser import needs_ros, run_argv
@@ -27,9 +30,11 @@ def main(argv: list[str]) -> int:
     """Run one verb; the caller has already configured DDS for this process."""
     cancel = threading.Event()
     if not needs_ros(argv):
+        # Verbs that need no ROS (interface ...) never touch the node: none is made.
+        no_node = cast(Node, None)
         return run_argv(
-            CallContext(node=None, write=_print, limits=CLI_LIMITS), argv, "ros2-classroom"
-        )  # type: ignore[arg-type]
+            CallContext(node=no_node, write=_print, limits=CLI_LIMITS), argv, "ros2-classroom"
+        )
     from app.ros.runtime import RosRuntime
 
     # Ctrl+C (or SIGTERM) asks the running verb to stop at its next wait, so it

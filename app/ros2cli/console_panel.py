@@ -60,7 +60,7 @@ class ConsolePanel:
         self._stop = gui.add_button("Stop", icon=viser.Icon.PLAYER_STOP, disabled=True)
         self._view = MarkdownView(gui, "")
         self._run.on_click(lambda _: ui.post(lambda: self.run(self._command.value)))
-        self._stop.on_click(lambda _: ui.post(self._cancel))
+        self._stop.on_click(ui.callback(self._cancel))
 
     def run(self, text: str) -> None:
         """Start one command (UI thread); one at a time."""

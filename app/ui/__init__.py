@@ -55,6 +55,11 @@ class MarkdownView:
         return self._content
 
 
+def assign(handle: Any, value: Any) -> None:
+    """Set a viser input's value (viser 1.1's setter is not typed as one)."""
+    handle.value = value
+
+
 def code_block(lines: list[str], empty: str = "(nothing yet)") -> str:
     body = "\n".join(lines) if lines else empty
     return f"```\n{body}\n```"
@@ -73,4 +78,4 @@ def set_options(dropdown: Any, options: list[str], keep_current: bool = True) ->
     if tuple(dropdown.options) != tuple(options):
         dropdown.options = options
     if current not in options and options:
-        dropdown.value = options[0]
+        assign(dropdown, options[0])

@@ -32,12 +32,13 @@ class MessageForm:
         with self._folder:
             if not fields:
                 gui.add_markdown("_(no fields)_")
+            self._yaml: viser.GuiTextHandle | None = None
             if len(fields) > self.MAX_FIELDS:
                 self._yaml = gui.add_text("YAML", "{}", hint=f"fields of {type_name(cls)}")
                 return
-            self._yaml = None
             for path, ros_type, kind in fields:
                 label = f"{path} ({ros_type})"
+                widget: Any
                 if kind == "bool":
                     widget = gui.add_checkbox(label, False)
                 elif kind == "int":

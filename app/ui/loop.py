@@ -7,7 +7,7 @@ import queue
 import threading
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
-from typing import TypeVar
+from typing import Any, TypeVar
 
 from app.ros.errors import Ros2Error
 
@@ -41,6 +41,14 @@ class UiLoop:
         """Ask the UI thread to run ``intent`` soon; returns at once."""
         self._intents.put(intent)
         self._wake.set()
+
+    def callback(self, intent: Callable[..., None], *args: Any) -> Callable[[Any], None]:
+        """A viser callback that posts ``intent(*args)``: the usual way to wire a widget."""
+
+        def on_event(_event: Any) -> None:
+            self.post(lambda: intent(*args))
+
+        return on_event
 
     def run_job(
         self,

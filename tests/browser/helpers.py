@@ -19,4 +19,5 @@ def click(page: Page, button: str) -> None:
 
 
 def expect_text(page: Page, text: str, timeout: float = 20_000) -> None:
-    expect(page.get_by_text(text).first).to_be_visible(timeout=timeout)
+    """``text`` is on screen: hidden copies (other tabs, closed folders) do not count."""
+    expect(page.get_by_text(text).filter(visible=True).first).to_be_visible(timeout=timeout)

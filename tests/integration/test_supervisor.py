@@ -128,3 +128,45 @@ def _alive(pid: int) -> bool:
 
 def _node_names(probe) -> list[str]:
     return [f"{ns.rstrip('/')}/{n}" for n, ns in probe.node.get_node_names_and_namespaces()]
+
+
+def _node_children(module: str) -> list[psutil.Process]:
+    me = psutil.Process()
+    return [
+        p
+        for p in me.children(recursive=True)
+        if p.status() != psutil.STATUS_ZOMBIE and f"nodes.{module}" in p.cmdline()
+    ]
+
+
+def test_two_concurrent_starts_make_one_process(supervisor):
+    """A double click on Start once spawned two /talker processes and lost the first."""
+    import threading
+
+    barrier = threading.Barrier(4)
+    pids: list[int | None] = []
+
+    def click() -> None:
+        barrier.wait()
+        pids.append(supervisor.start("talker").pid)
+
+    threads = [threading.Thread(target=click) for _ in range(4)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join(10)
+    assert len(set(pids)) == 1, f"several processes started: {pids}"
+    assert [p.pid for p in _node_children("talker")] == pids[:1]
+    supervisor.stop("talker").result(timeout=10)
+    assert _node_children("talker") == []
+
+
+def test_start_right_after_stop_starts_a_new_process(supervisor):
+    """Start during a stop used to be a no-op: the node stayed stopped (flaky 50-cycle test)."""
+    first = supervisor.start("talker").pid
+    supervisor.stop("talker")  # not waited for: the process is still being stopped
+    second = supervisor.start("talker")
+    assert second.pid != first
+    assert second.state is NodeState.STARTING
+    assert [p.pid for p in _node_children("talker")] == [second.pid]
+    supervisor.stop("talker").result(timeout=10)

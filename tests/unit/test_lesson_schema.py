@@ -106,3 +106,49 @@ def test_invalid_toml_is_reported_and_the_rest_still_loads(tmp_path):
     course = load_course(tmp_path)
     assert len(course.lessons) == 1
     assert len(course.errors) == 1 and "not valid TOML" in course.errors[0]
+
+
+@pytest.mark.parametrize(
+    ("spec", "message"),
+    [
+        ({"kind": "open_panel", "panel": "Scene"}, "there is no tab 'Scene'"),
+        ({"kind": "start", "catalog_node": "warp_drive"}, "no catalog node 'warp_drive'"),
+        ({"kind": "start_group", "group": "everything"}, "no launch group 'everything'"),
+        ({"kind": "lifecycle", "node": "lifecycle_talker", "transition": "configure"},
+         "no catalog entry creates the ROS node 'lifecycle_talker'"),
+        ({"kind": "stop", "node": "/talker"}, "kind 'stop' needs field 'catalog_node'"),
+    ],
+)  # fmt: skip
+def test_names_that_do_not_exist_in_the_product_are_errors(lesson_copy, spec, message):
+    directory, data = lesson_copy
+    data["steps"][0]["actions"] = [spec]
+    _dump(data, directory / "lesson.toml")
+    with pytest.raises(LessonError, match=message):
+        load_lesson(directory)
+
+
+def test_a_check_naming_a_node_nobody_starts_is_an_error(lesson_copy):
+    directory, data = lesson_copy
+    data["steps"][0]["checks"] = [{"kind": "node_running", "node": "/turtlesim"}]
+    _dump(data, directory / "lesson.toml")
+    with pytest.raises(LessonError, match="no catalog entry creates the ROS node '/turtlesim'"):
+        load_lesson(directory)
+
+
+def test_a_broken_lesson_is_listed_in_the_outline_errors(tmp_path):
+    source = LESSONS_DIR / "03_topics"
+    shutil.copytree(source, tmp_path / source.name)
+    toml = tmp_path / source.name / "lesson.toml"
+    assert 'catalog_node = "' in toml.read_text()
+    toml.write_text(toml.read_text().replace('catalog_node = "', 'catalog_node = "x_', 1))
+    course = load_course(tmp_path)
+    assert course.lessons == ()
+    assert "no catalog node 'x_" in course.errors[0]
+
+
+def test_schema_and_runtime_share_one_registry_of_kinds():
+    from app.lessons import runtime
+    from app.lessons.kinds import ACTION_KINDS, CHECK_KINDS
+
+    assert set(runtime._ACTIONS) == set(ACTION_KINDS)
+    assert set(runtime._CHECKS) == set(CHECK_KINDS)
