@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import ipaddress
+import logging
 import os
 import signal
 import socket
@@ -94,6 +95,10 @@ def cmd_serve(args: argparse.Namespace) -> int:
     from app.ros.runtime import RosRuntime
     from app.supervisor import Supervisor
 
+    # Tracebacks behind the one-line errors of the page go to this process's log.
+    logging.basicConfig(
+        level=logging.INFO, format="%(asctime)s %(levelname)s %(name)s: %(message)s"
+    )
     progress = ProgressStore(args.learner, args.progress_dir or DEFAULT_DIR)
     stop_requested = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):

@@ -180,29 +180,23 @@ def run(trials: int) -> dict[str, Any]:
             start_button = page.get_by_role("button", name="Start", exact=True)
             stop_button = page.get_by_role("button", name="Stop", exact=True)
             page.wait_for_timeout(1500)  # the observer has discovered the dashboard by now
+
+            def timed_click(button: Any, appears: bool, into: dict[str, list[float]]):
+                """Click once enabled; the dashboard's and the observers' times, recorded."""
+                page.wait_for_function("b => !b.disabled", arg=button.element_handle(), polling=50)
+                t0 = time.time()
+                button.click()
+                dash, seen = wait_both(page, observer, appears, t0)
+                into["dashboard"].append(dash)
+                into["baseline"].append(seen[0])
+                into["best_of_two"].append(min(seen))
+                return dash, seen[0]
+
             for trial in range(trials):
                 start_button.wait_for(state="visible")
-                page.wait_for_function(
-                    "b => !b.disabled", arg=start_button.element_handle(), polling=50
-                )
-                t0 = time.time()
-                start_button.click()
-                dash, seen = wait_both(page, observer, True, t0)
-                base = seen[0]
-                starts["dashboard"].append(dash)
-                starts["baseline"].append(base)
-                starts["best_of_two"].append(min(seen))
+                dash, base = timed_click(start_button, True, starts)
                 page.wait_for_timeout(800)  # let the node settle (topics, services)
-                page.wait_for_function(
-                    "b => !b.disabled", arg=stop_button.element_handle(), polling=50
-                )
-                t0 = time.time()
-                stop_button.click()
-                dash_gone, seen = wait_both(page, observer, False, t0)
-                base_gone = seen[0]
-                stops["dashboard"].append(dash_gone)
-                stops["baseline"].append(base_gone)
-                stops["best_of_two"].append(min(seen))
+                dash_gone, base_gone = timed_click(stop_button, False, stops)
                 print(
                     f"trial {trial + 1}: start->visible dashboard {dash * 1000:6.0f} ms, "
                     f"observer {base * 1000:6.0f} ms | stop->gone dashboard "

@@ -24,6 +24,20 @@ def in_private_netns() -> bool:
     return [name for _, name in socket.if_nameindex()] == ["lo"]
 
 
+def run_cli(
+    *args: str, env: dict[str, str] | None = None, timeout: float = 60
+) -> subprocess.CompletedProcess[str]:
+    """``python -m app ARGS`` as a learner runs ``ros2-classroom ARGS``, output captured."""
+    return subprocess.run(
+        [sys.executable, "-m", "app", *args],
+        cwd=PROJECT_ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+
+
 def wait_until(
     predicate: Callable[[], object],
     timeout: float = 15.0,

@@ -9,6 +9,15 @@ from app.ros.context import CallContext
 MIN_DISCOVERY_SEC = 1.5
 
 
+def write_names(ctx: CallContext, lines: list[str], count: bool = False) -> int:
+    """A listing as the `ros2 ... list` verbs print it: one per line, or (-c) how many."""
+    if count:
+        ctx.write(str(len(lines)))
+    for line in [] if count else lines:
+        ctx.write(line)
+    return 0
+
+
 def settle_discovery(ctx: CallContext) -> None:
     """A brand-new node sees the graph piece by piece: wait until it stops changing."""
     if ctx.limits.discovery_wait <= 0:

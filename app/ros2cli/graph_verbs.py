@@ -14,18 +14,17 @@ from app.ros.convert import from_yaml, import_type, message_repr, to_yaml
 from app.ros.errors import Ros2Error
 from app.ros.graph import all_nodes, require_node
 from app.ros.names import ACTION_MARKER, split_node_name
+from app.ros2cli.common import write_names
 
 # ------------------------------------------------------------------- node
 
 
 def node_list(ctx: CallContext, all_: bool = False, count: bool = False) -> int:
-    names = all_nodes(ctx.node, include_hidden=all_)
-    if count:
-        ctx.write(str(len(names)))
-        return 0
-    for name in names:
-        ctx.write(name)
-    return 0
+    return write_names(ctx, all_nodes(ctx.node, include_hidden=all_), count)
+
+
+def _with_types(pairs: list[tuple[str, list[str]]], show_types: bool) -> list[str]:
+    return [f"{name} [{', '.join(types)}]" if show_types else name for name, types in pairs]
 
 
 def _visible(pairs: list[tuple[str, list[str]]]) -> list[tuple[str, list[str]]]:
@@ -57,12 +56,7 @@ def node_info(ctx: CallContext, fqn: str) -> int:
 
 def service_list(ctx: CallContext, show_types: bool = False, count: bool = False) -> int:
     services = _visible(ctx.node.get_service_names_and_types())
-    if count:
-        ctx.write(str(len(services)))
-        return 0
-    for name, types in services:
-        ctx.write(f"{name} [{', '.join(types)}]" if show_types else name)
-    return 0
+    return write_names(ctx, _with_types(services, show_types), count)
 
 
 def service_type(ctx: CallContext, name: str) -> int:
@@ -91,12 +85,7 @@ def service_call(ctx: CallContext, name: str, type_text: str, values: str = "") 
 
 def action_list(ctx: CallContext, show_types: bool = False, count: bool = False) -> int:
     actions = sorted(get_action_names_and_types(ctx.node))
-    if count:
-        ctx.write(str(len(actions)))
-        return 0
-    for name, types in actions:
-        ctx.write(f"{name} [{', '.join(types)}]" if show_types else name)
-    return 0
+    return write_names(ctx, _with_types(actions, show_types), count)
 
 
 def action_info(ctx: CallContext, name: str, show_types: bool = False) -> int:

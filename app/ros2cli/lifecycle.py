@@ -10,16 +10,11 @@ from app.ros.lifecycle import (
     lifecycle_nodes,
     lifecycle_target,
 )
+from app.ros2cli.common import write_names
 
 
 def verb_nodes(ctx: CallContext, count: bool = False) -> int:
-    nodes = lifecycle_nodes(ctx)
-    if count:
-        ctx.write(str(len(nodes)))
-        return 0
-    for name in nodes:
-        ctx.write(name)
-    return 0
+    return write_names(ctx, lifecycle_nodes(ctx), count)
 
 
 def verb_get(ctx: CallContext, fqn: str | None = None) -> int:

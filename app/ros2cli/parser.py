@@ -9,6 +9,7 @@ instead of printing and exiting, so every mistake becomes one line.
 from __future__ import annotations
 
 import argparse
+import logging
 import shlex
 from collections.abc import Callable
 from typing import Any, NoReturn
@@ -17,6 +18,8 @@ from app.ros.context import CallContext, Write
 from app.ros.errors import Cancelled, Ros2Error
 from app.ros2cli import graph_verbs, interfaces, lifecycle, param, topic
 from app.ros2cli.common import settle_discovery
+
+log = logging.getLogger(__name__)
 
 GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface")
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
@@ -66,6 +69,16 @@ def split_command(text: str) -> list[str]:
 Handler = Callable[[CallContext, argparse.Namespace], int]
 
 
+def topic_and_type(p: argparse.ArgumentParser) -> None:
+    """The two positional arguments of echo, hz and bw: a topic, and optionally its type."""
+    p.add_argument("topic_name")
+    p.add_argument("message_type", nargs="?")
+
+
+def _measure_handler(measure: Callable[..., int]) -> Handler:
+    return lambda c, a: measure(c, a.topic_name, a.message_type, a.window)
+
+
 def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
     parser = _Parser(prog=prog, write=write, description="ros2-like verbs")
     groups = parser.add_subparsers(dest="group", metavar="COMMAND", parser_class=_Parser)
@@ -81,6 +94,17 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
         p = verbs.add_parser(name, help=help_text, write=write)
         p.set_defaults(handler=handler)
         return p
+
+    def typed_list(verbs, noun: str, listing: Callable[..., int]) -> None:
+        """`ros2 service list` and `ros2 action list`, with -t (types) and -c (count)."""
+        p = verb(
+            verbs,
+            "list",
+            f"list {noun}s",
+            lambda c, a: listing(c, a.show_types, getattr(a, f"count_{noun}s")),
+        )
+        p.add_argument("-t", "--show-types", action="store_true")
+        p.add_argument("-c", f"--count-{noun}s", action="store_true")
 
     # node
     v = group("node", "nodes on the graph")
@@ -111,28 +135,16 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
         "print messages",
         lambda c, a: topic.echo(c, a.topic_name, a.message_type, once=a.once, field=a.field),
     )
-    p.add_argument("topic_name")
-    p.add_argument("message_type", nargs="?")
+    topic_and_type(p)
     p.add_argument("--once", action="store_true", help="print one message and exit")
     p.add_argument("--field", help="print only this field, e.g. linear.x")
-    p = verb(
-        v,
-        "hz",
-        "receive rate",
-        lambda c, a: topic.hz(c, a.topic_name, a.message_type, a.window),
-    )
-    p.add_argument("topic_name")
-    p.add_argument("message_type", nargs="?")
-    p.add_argument("-w", "--window", type=int, default=10_000, help="messages in the window")
-    p = verb(
-        v,
-        "bw",
-        "bandwidth",
-        lambda c, a: topic.bw(c, a.topic_name, a.message_type, a.window),
-    )
-    p.add_argument("topic_name")
-    p.add_argument("message_type", nargs="?")
-    p.add_argument("-w", "--window", type=int, default=100, help="messages in the window")
+    for name, help_text, measure, window in (
+        ("hz", "publishing rate", topic.hz, 10_000),
+        ("bw", "bandwidth", topic.bw, 100),
+    ):
+        p = verb(v, name, help_text, _measure_handler(measure))
+        topic_and_type(p)
+        p.add_argument("-w", "--window", type=int, default=window, help="messages in the window")
     p = verb(
         v,
         "pub",
@@ -158,14 +170,7 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
 
     # service
     v = group("service", "services")
-    p = verb(
-        v,
-        "list",
-        "list services",
-        lambda c, a: graph_verbs.service_list(c, a.show_types, a.count_services),
-    )
-    p.add_argument("-t", "--show-types", action="store_true")
-    p.add_argument("-c", "--count-services", action="store_true")
+    typed_list(v, "service", graph_verbs.service_list)
     p = verb(
         v, "type", "a service's type", lambda c, a: graph_verbs.service_type(c, a.service_name)
     )
@@ -182,14 +187,7 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
 
     # action
     v = group("action", "actions")
-    p = verb(
-        v,
-        "list",
-        "list actions",
-        lambda c, a: graph_verbs.action_list(c, a.show_types, a.count_actions),
-    )
-    p.add_argument("-t", "--show-types", action="store_true")
-    p.add_argument("-c", "--count-actions", action="store_true")
+    typed_list(v, "action", graph_verbs.action_list)
     p = verb(
         v,
         "info",
@@ -349,6 +347,8 @@ def run_argv(ctx: CallContext, argv: list[str], prog: str = "ros2") -> int:
         # still one line for the learner, never a traceback.
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         ctx.write(f"error: {first}")
+        # The traceback goes to the dashboard's log (INFO: a terminal user sees one line).
+        log.info("ros2 %s failed", " ".join(argv), exc_info=True)
         return EXIT_FAILED
 
 

@@ -138,8 +138,14 @@ def _measure(ctx: CallContext, topic: str, type_text: str | None, window: int, r
 
 def hz(ctx: CallContext, topic: str, type_text: str | None = None, window: int = 10_000) -> int:
     def report(monitor: TopicMonitor) -> str | None:
+        # ros2's own two lines (the tutorials show them), then what ros2 cannot
+        # tell: the publisher's rate by its clock and the samples missed here.
         stats = monitor.rate()
-        return stats.ros2_text() if stats else None
+        if stats is None:
+            return None
+        published = monitor.published_rate()
+        extra = f"\n{published.ros2_line(monitor.why_missed())}" if published else ""
+        return stats.ros2_text() + extra
 
     return _measure(ctx, topic, type_text, window, report)
 

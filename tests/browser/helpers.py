@@ -18,6 +18,22 @@ def click(page: Page, button: str) -> None:
     page.get_by_role("button", name=button, exact=True).click()
 
 
+def start_node(page: Page, name: str) -> None:
+    """Start one catalog node from the Nodes tab, as a learner does."""
+    open_tab(page, "Nodes")
+    choose(page, "Catalog node", name)
+    click(page, "Start")
+    expect_text(page, f"Started {name}")
+
+
+def start_group(page: Page, group: str) -> None:
+    """Start a launch group from the Nodes tab."""
+    open_tab(page, "Nodes")
+    choose(page, "Launch group", group)
+    click(page, "Start group")
+    expect_text(page, "Started group")
+
+
 def expect_text(page: Page, text: str, timeout: float = 20_000) -> None:
     """``text`` is on screen: hidden copies (other tabs, closed folders) do not count."""
     expect(page.get_by_text(text).filter(visible=True).first).to_be_visible(timeout=timeout)

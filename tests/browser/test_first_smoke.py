@@ -7,21 +7,14 @@ import re
 import pytest
 from playwright.sync_api import expect
 
-from tests.browser.helpers import choose, click, expect_text, open_tab
+from tests.browser.helpers import choose, click, expect_text, open_tab, start_node
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
 
-def start(page, name: str) -> None:
-    open_tab(page, "Nodes")
-    choose(page, "Catalog node", name)
-    click(page, "Start")
-    expect_text(page, "Started")
-
-
 def test_start_watch_and_stop_talker_and_listener(page):
-    start(page, "talker")
-    start(page, "listener")
+    start_node(page, "talker")
+    start_node(page, "listener")
 
     open_tab(page, "Echo")
     expect(page.get_by_text(re.compile(r"data: 'Hello World: \d+'")).first).to_be_visible(
@@ -46,7 +39,7 @@ def test_start_watch_and_stop_talker_and_listener(page):
 
 
 def test_crashed_node_shows_exit_code_and_restarts(page):
-    start(page, "crashing_node")
+    start_node(page, "crashing_node")
     expect_text(page, "crashed (exit code 1)", timeout=30_000)
     expect_text(page, "simulated bug")
     click(page, "Restart")

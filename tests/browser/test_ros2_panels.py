@@ -7,16 +7,9 @@ import re
 import pytest
 from playwright.sync_api import expect
 
-from tests.browser.helpers import choose, click, expect_text, open_tab
+from tests.browser.helpers import click, open_tab, start_node
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
-
-
-def start(page, name: str) -> None:
-    open_tab(page, "Nodes")
-    choose(page, "Catalog node", name)
-    click(page, "Start")
-    expect_text(page, "Started")
 
 
 def field(page, label: str):
@@ -47,7 +40,7 @@ def test_console_runs_ros2_topic_list(page):
 
 
 def test_lifecycle_walk_changes_state_and_rate(page):
-    start(page, "lifecycle_talker")
+    start_node(page, "lifecycle_talker")
     open_tab(page, "Lifecycle")
     expect_regex(page, r"Current state of /lifecycle_talker: unconfigured")
     activate = page.get_by_role("button", name="activate", exact=True)
@@ -75,7 +68,7 @@ def test_lifecycle_walk_changes_state_and_rate(page):
 
 
 def test_fibonacci_goal_feedback_then_result(page):
-    start(page, "fibonacci_action_server")
+    start_node(page, "fibonacci_action_server")
     open_tab(page, "Actions")
     expect_shown(page, "Type: tutorial_interfaces/action/Fibonacci", timeout=30_000)
     field(page, "order (int32)").fill("6")
@@ -87,7 +80,7 @@ def test_fibonacci_goal_feedback_then_result(page):
 
 
 def test_add_two_ints_from_the_form(page):
-    start(page, "add_two_ints_server")
+    start_node(page, "add_two_ints_server")
     open_tab(page, "Services")
     expect_shown(page, "Type: tutorial_interfaces/srv/AddTwoInts", timeout=30_000)
     field(page, "a (int64)").fill("20")

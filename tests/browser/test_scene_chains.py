@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from playwright.sync_api import expect
 
-from tests.browser.helpers import choose, click, expect_text, open_tab
+from tests.browser.helpers import open_tab, start_group
 from tests.browser.scene_helpers import wait_scene_points
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -24,13 +24,6 @@ IMAGE_SRC_JS = """() => {
   const img = label && label.parentElement && label.parentElement.querySelector('img');
   return img && img.naturalWidth > 64 ? img.src : null;
 }"""
-
-
-def start_group(page, group: str) -> None:
-    open_tab(page, "Nodes")
-    choose(page, "Launch group", group)
-    click(page, "Start group")
-    expect_text(page, "Started group")
 
 
 def test_arm_chain_moves_the_arm_and_shows_the_target(page):

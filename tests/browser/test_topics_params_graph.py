@@ -9,16 +9,9 @@ import pytest
 from playwright.sync_api import Page, expect
 from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
-from tests.browser.helpers import click, expect_text, open_tab
+from tests.browser.helpers import click, expect_text, open_tab, start_node
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
-
-
-def start(page: Page, name: str) -> None:
-    open_tab(page, "Nodes")
-    choose(page, "Catalog node", name)
-    click(page, "Start")
-    expect_text(page, f"Started {name}")
 
 
 def stop(page: Page, name: str) -> None:
@@ -63,8 +56,8 @@ def expect_regex(page: Page, pattern: str, timeout: float = 30_000) -> None:
 
 
 def test_topics_echo_hz_publish_and_plot(page):
-    start(page, "talker")
-    start(page, "camera_publisher")
+    start_node(page, "talker")
+    start_node(page, "camera_publisher")
     open_tab(page, "Topics")
     choose(page, "Topic", "/chatter")
     expect_regex(page, r"data: 'Hello World: \d+'")
@@ -97,7 +90,7 @@ def test_topics_echo_hz_publish_and_plot(page):
 
 
 def test_parameters_set_rate_and_refused_greeting(page):
-    start(page, "parameters_node")
+    start_node(page, "parameters_node")
     open_tab(page, "Parameters")
     choose(page, "Node", "/parameters_node")
     set_rate = page.get_by_role("button", name="Set publish_rate_hz", exact=True)
@@ -121,7 +114,7 @@ def test_parameters_set_rate_and_refused_greeting(page):
 
 def test_graph_shows_services_actions_and_rates(page):
     for name in ("talker", "add_two_ints_server", "fibonacci_action_server"):
-        start(page, name)
+        start_node(page, name)
     open_tab(page, "Graph")
 
     def vertex(kind: str, name: str):

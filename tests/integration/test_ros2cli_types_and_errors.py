@@ -15,7 +15,7 @@ from std_srvs.srv import SetBool, Trigger
 
 from app import PROJECT_ROOT
 from app.ros.context import Limits
-from tests.conftest import wait_until
+from tests.conftest import run_cli, wait_until
 from tests.integration.conftest import one_error_line
 
 pytestmark = pytest.mark.ros
@@ -24,14 +24,7 @@ RATE_HZ = 20.0
 
 
 def cli(env: dict[str, str], *words: str, timeout: float = 60) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "app", *words],
-        cwd=PROJECT_ROOT,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-    )
+    return run_cli(*words, env=env, timeout=timeout)
 
 
 def test_set_bool_service_and_twist_topic(probe, ros2):

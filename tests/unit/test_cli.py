@@ -1,20 +1,8 @@
 """Bad input on the command line: one clear line and a non-zero exit, no traceback."""
 
 import socket
-import subprocess
-import sys
 
-from app import PROJECT_ROOT
-
-
-def run_cli(*args: str, timeout: float = 60) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "app", *args],
-        cwd=PROJECT_ROOT,
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-    )
+from tests.conftest import run_cli
 
 
 def test_list_prints_the_catalog():

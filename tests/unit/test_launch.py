@@ -2,25 +2,15 @@
 
 from __future__ import annotations
 
-import subprocess
 import sys
 import types
 
 import pytest
 
-from app import PROJECT_ROOT, catalog
+from app import catalog
 from app.catalog import CatalogEntry
 from app.launch import launch_file_text, node_spec
-
-
-def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "app", *args],
-        cwd=PROJECT_ROOT,
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
+from tests.conftest import run_cli
 
 
 def evaluate_launch_file(text: str, monkeypatch: pytest.MonkeyPatch) -> list[dict]:
