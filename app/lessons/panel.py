@@ -75,7 +75,7 @@ class LessonsPanel:
         self._lesson = current
         self._step = min(progress.lesson(current.id)["step"], len(current.steps) - 1)
         self._selector.on_update(ui.callback(self._on_lesson_picked))
-        self._back.on_click(lambda _: ui.post(lambda: self._select(self._lesson, self._step - 1)))
+        self._back.on_click(ui.callback(lambda: self._select(self._lesson, self._step - 1)))
         self._next.on_click(ui.callback(self._go_next))
         self._reset.on_click(ui.callback(self._do_reset))
         self._select(current, self._step)

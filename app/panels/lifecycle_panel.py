@@ -80,7 +80,7 @@ class LifecyclePanel:
             self._buttons[label] = button
         self._result = MarkdownView(gui, "")
         self._log = MarkdownView(gui, "")
-        self._selector.on_update(lambda _: ui.post(lambda: self._select(self._selector.value)))
+        self._selector.on_update(ui.callback(lambda: self._select(self._selector.value)))
 
     # --- selection and state (UI thread) -------------------------------------------
 

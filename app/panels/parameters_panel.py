@@ -139,7 +139,7 @@ class ParametersPanel:
         self._editors = gui.add_folder("Parameters", expand_by_default=True)
         self._editor_folder: Any = None
         self._activity = MarkdownView(gui, "")
-        self._selector.on_update(lambda _: ui.post(lambda: self._select(self._selector.value)))
+        self._selector.on_update(ui.callback(lambda: self._select(self._selector.value)))
 
     def _ctx(self) -> CallContext:
         return panel_context(self._node)

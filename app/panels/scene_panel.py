@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import NamedTuple
 
 import viser
 from rclpy.node import Node
@@ -24,13 +25,33 @@ from app.scene.markers import MarkerLayer
 from app.scene.plots import JointPlot
 from app.scene.pointclouds import PointCloudLayer
 from app.scene.stamped import StampedLayer
-from app.ui import MarkdownView, code_block
+from app.ui import MarkdownView, assign, code_block
 from app.ui.loop import UiLoop
 
 INTRO = (
     "The **3D view** draws live topics, as rviz does. Drag to orbit, scroll to zoom. "
     "Axes are red = x, green = y, blue = z."
 )
+
+
+class _Offer(NamedTuple):
+    """What a topic dropdown offers: topics of ``types``; it picks ``preferred`` ones first."""
+
+    types: tuple[str, ...]
+    hint: str
+    preferred: tuple[str, ...]
+
+
+CLOUDS = _Offer(picker.CLOUD_TYPES, "sensor_msgs/msg/PointCloud2 topics", ("/cam/map_points",))
+IMAGES = _Offer(
+    picker.IMAGE_TYPES,
+    "sensor_msgs/msg/Image topics",
+    ("/object_detection/output", "/camera/image_raw", "/cam/feature_ext_viz"),
+)
+MARKERS = _Offer(
+    picker.MARKER_TYPES, "visualization_msgs Marker or MarkerArray topics", ("/cam/camera_pose",)
+)
+JOINTS = _Offer(picker.JOINT_TYPES, "sensor_msgs/msg/JointState topics", ("/joint_states",))
 
 
 class _TopicRow:
@@ -40,43 +61,34 @@ class _TopicRow:
     by itself (``preferred`` names first), so starting a node is enough to see it.
     """
 
-    def __init__(
-        self,
-        gui: viser.GuiApi,
-        label: str,
-        types: tuple[str, ...],
-        hint: str,
-        preferred: tuple[str, ...] = (),
-    ) -> None:
-        self.types = types
-        self.preferred = preferred
+    def __init__(self, gui: viser.GuiApi, label: str, offer: _Offer) -> None:
+        self.offer = offer
         self.chosen_by_learner = False
-        self._setting = False
+        self._select: Callable[[str], None] = lambda _topic: None
         self._options: tuple[str, ...] = (picker.NONE,)
-        self.dropdown = gui.add_dropdown(label, self._options, initial_value=picker.NONE, hint=hint)
+        self.dropdown = gui.add_dropdown(
+            label, self._options, initial_value=picker.NONE, hint=offer.hint
+        )
         self.note = MarkdownView(gui)
 
     def on_pick(self, ui: UiLoop, select: Callable[[str], None]) -> None:
-        def picked() -> None:
-            if not self._setting:
-                self.chosen_by_learner = True
-            select(self.dropdown.value)
+        """``select(topic)`` follows a topic: the learner's pick, or our own first choice."""
+        self._select = select
+        self.dropdown.on_update(ui.callback(self._picked_by_learner))
 
-        self.dropdown.on_update(lambda _event: ui.post(picked))
+    def _picked_by_learner(self) -> None:
+        self.chosen_by_learner = True
+        self._select(self.dropdown.value)
 
     def refresh_options(self, graph: GraphSnapshot) -> None:
-        opts = tuple(picker.options(graph, self.types, self.dropdown.value))
+        opts = tuple(picker.options(graph, self.offer.types, self.dropdown.value))
         if opts != self._options:
             self._options = opts
             self.dropdown.options = opts
         if not self.chosen_by_learner and self.dropdown.value == picker.NONE and len(opts) > 1:
-            choice = next((t for t in self.preferred if t in opts), opts[1])
-            # Our own choice: the intent it posts must not count as the learner's.
-            self._setting = True
-            try:
-                self.dropdown.value = choice
-            finally:
-                self._setting = False
+            choice = next((t for t in self.offer.preferred if t in opts), opts[1])
+            assign(self.dropdown, choice)  # our own choice: posts no intent
+            self._select(choice)
 
 
 class ScenePanel:
@@ -94,13 +106,7 @@ class ScenePanel:
         self.stamped = StampedLayer(node, server)
 
         with gui.add_folder("Point cloud"):
-            self._cloud_row = _TopicRow(
-                gui,
-                "Cloud topic",
-                picker.CLOUD_TYPES,
-                "sensor_msgs/msg/PointCloud2 topics",
-                ("/cam/map_points",),
-            )
+            self._cloud_row = _TopicRow(gui, "Cloud topic", CLOUDS)
             self._budget = gui.add_slider(
                 "Point budget",
                 min=10_000,
@@ -114,33 +120,15 @@ class ScenePanel:
                 "Look at the cloud", icon=viser.Icon.FOCUS_2, hint="Move the 3D camera to it"
             )
         with gui.add_folder("Camera image"):
-            self._image_row = _TopicRow(
-                gui,
-                "Image topic",
-                picker.IMAGE_TYPES,
-                "sensor_msgs/msg/Image topics",
-                ("/object_detection/output", "/camera/image_raw", "/cam/feature_ext_viz"),
-            )
+            self._image_row = _TopicRow(gui, "Image topic", IMAGES)
             self.images = ImageLayer(node, gui, self.frames)
             self._image_on_frustum = gui.add_checkbox("Image on the 3D camera", False)
             self._image_info = MarkdownView(gui)
         with gui.add_folder("Markers"):
-            self._marker_row = _TopicRow(
-                gui,
-                "Marker topic",
-                picker.MARKER_TYPES,
-                "visualization_msgs Marker or MarkerArray topics",
-                ("/cam/camera_pose",),
-            )
+            self._marker_row = _TopicRow(gui, "Marker topic", MARKERS)
             self._marker_info = MarkdownView(gui)
         with gui.add_folder("Robot arm"):
-            self._joint_row = _TopicRow(
-                gui,
-                "Joint topic",
-                picker.JOINT_TYPES,
-                "sensor_msgs/msg/JointState topics",
-                ("/joint_states",),
-            )
+            self._joint_row = _TopicRow(gui, "Joint topic", JOINTS)
             self.plot = JointPlot(gui)
             self.arm = ArmLayer(node, server, on_joints=self.plot.add)
             self._arm_info = MarkdownView(gui)
@@ -165,7 +153,6 @@ class ScenePanel:
         self._stamped_info = MarkdownView(gui)
 
         self.params = CameraParamSync(node)
-        self._syncing_sliders = False
         self._wire()
         self._show_matrix(self.frames.pose)
 
@@ -175,20 +162,21 @@ class ScenePanel:
         self._image_row.on_pick(ui, self.images.select)
         self._marker_row.on_pick(ui, self.markers.select)
         self._joint_row.on_pick(ui, self._select_joints)
-        self._frame_cloud.on_click(
-            lambda _: ui.post(lambda: self.clouds.frame_in_view(self.frames.to_world))
-        )
-        self._budget.on_update(lambda _: ui.post(self._apply_budget))
+        self._frame_cloud.on_click(ui.callback(self._look_at_cloud))
+        self._budget.on_update(ui.callback(self._apply_budget))
         self._image_on_frustum.on_update(
-            lambda _: ui.post(lambda: self.images.show_on_frustum(self._image_on_frustum.value))
+            ui.callback(lambda: self.images.show_on_frustum(self._image_on_frustum.value))
         )
-        self._gizmo.on_update(lambda _: ui.post(lambda: self.frames.show_gizmo(self._gizmo.value)))
+        self._gizmo.on_update(ui.callback(lambda: self.frames.show_gizmo(self._gizmo.value)))
         for slider in self._sliders.values():
-            slider.on_update(lambda _: ui.post(self._on_slider))
+            slider.on_update(ui.callback(self._on_slider))
         # The gizmo moves on a viser thread: the new pose is applied here.
         self.frames.on_change(
             lambda pose, source: ui.post(lambda: self._on_pose_changed(pose, source))
         )
+
+    def _look_at_cloud(self) -> None:
+        self.clouds.frame_in_view(self.frames.to_world)
 
     def _apply_budget(self) -> None:
         self.clouds.budget = int(self._budget.value)
@@ -198,8 +186,6 @@ class ScenePanel:
         self.arm.select(topic)
 
     def _on_slider(self) -> None:
-        if self._syncing_sliders:
-            return
         v = {k: float(s.value) for k, s in self._sliders.items()}
         pose = CameraPose(
             v["x"],
@@ -212,16 +198,11 @@ class ScenePanel:
         self.frames.set_pose(pose, "sliders")
 
     def _on_pose_changed(self, pose: CameraPose, source: str) -> None:
-        if source == "gizmo":  # keep the sliders in step without echoing back
-            self._syncing_sliders = True
-            try:
-                for key, slider in self._sliders.items():
-                    value = getattr(pose, key)
-                    slider.value = round(
-                        math.degrees(value) if key in ("roll", "pitch", "yaw") else value, 2
-                    )
-            finally:
-                self._syncing_sliders = False
+        if source == "gizmo":  # keep the sliders in step (our own assignments post nothing)
+            for key, slider in self._sliders.items():
+                value = getattr(pose, key)
+                shown = math.degrees(value) if key in ("roll", "pitch", "yaw") else value
+                assign(slider, round(shown, 2))
         self._show_matrix(pose)
         self.params.push(pose)
 

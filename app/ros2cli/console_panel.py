@@ -59,7 +59,7 @@ class ConsolePanel:
         self._run = gui.add_button("Run", icon=viser.Icon.PLAYER_PLAY)
         self._stop = gui.add_button("Stop", icon=viser.Icon.PLAYER_STOP, disabled=True)
         self._view = MarkdownView(gui, "")
-        self._run.on_click(lambda _: ui.post(lambda: self.run(self._command.value)))
+        self._run.on_click(ui.callback(lambda: self.run(self._command.value)))
         self._stop.on_click(ui.callback(self._cancel))
 
     def run(self, text: str) -> None:

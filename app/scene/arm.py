@@ -8,9 +8,7 @@ says. Nodes are created once; each joint_states message only moves them.
 from __future__ import annotations
 
 import math
-import threading
 from collections.abc import Callable, Sequence
-from typing import Any
 
 import numpy as np
 import viser
@@ -18,9 +16,9 @@ from rclpy.node import Node
 from sensor_msgs.msg import JointState
 
 from app.scene import transforms as tf
+from app.scene.follow import OneTopicLayer, TopicFollower
 from app.scene.frames import BASE_PATH
 from app.scene.latest import LatestWorker
-from app.scene.qos import resubscribe
 from app.scene.topic_picker import NONE
 from nodes.common.arm_kinematics import JOINT_NAMES, link_points
 
@@ -46,12 +44,11 @@ def segment_poses(
     """(centre, wxyz, length) of a cylinder along each consecutive pair of joint points."""
     out = []
     for a, b in zip(points[:-1], points[1:], strict=True):
-        centre = tuple(float(v) for v in (a + b) / 2)
-        out.append((centre, tf.quat_z_to(b - a), float(np.linalg.norm(b - a))))
+        out.append((tf.as_xyz((a + b) / 2), tf.quat_z_to(b - a), float(np.linalg.norm(b - a))))
     return out
 
 
-class ArmLayer:
+class ArmLayer(OneTopicLayer):
     def __init__(
         self,
         node: Node,
@@ -59,12 +56,8 @@ class ArmLayer:
         *,
         on_joints: Callable[[Sequence[str], Sequence[float]], None] | None = None,
     ) -> None:
-        self._node = node
         self._server = server
         self._on_joints = on_joints
-        self._lock = threading.Lock()
-        self._topic = NONE
-        self._subscription: Any = None
         self.joints = np.zeros(len(JOINT_NAMES))
         self._note = ""
         scene = server.scene
@@ -87,26 +80,13 @@ class ArmLayer:
                 radius=0.03 if i else 0.06,
                 color=(40, 40, 40),
                 subdivisions=2,
-                position=tuple(pts[i]),
+                position=tf.as_xyz(pts[i]),
             )
             for i in range(len(pts))
         ]
         scene.add_label(f"{ARM_PATH}/label", "arm", position=(0.0, 0.0, 0.16))
-        self.worker = LatestWorker("arm", self._draw, MAX_HZ)
-
-    @property
-    def topic(self) -> str:
-        return self._topic
-
-    def select(self, topic: str) -> None:
-        with self._lock:
-            if topic == self._topic:
-                return
-            old, self._subscription = self._subscription, None
-            self._topic = topic
-        sub = resubscribe(self._node, old, self.worker, JointState, topic, qos=10)
-        with self._lock:
-            self._subscription = sub
+        worker = LatestWorker("arm", self._draw, MAX_HZ)
+        super().__init__(TopicFollower(node, worker, JointState, qos=10))
 
     def _draw(self, msg: JointState) -> None:
         if self._on_joints is not None and len(msg.position):
@@ -123,13 +103,11 @@ class ArmLayer:
     def set_joints(self, joints: np.ndarray) -> None:
         pts = link_points(joints)
         with self._server.atomic():
-            for handle, (centre, wxyz, _length) in zip(
-                self._links, segment_poses(pts), strict=True
-            ):
-                handle.position = centre
-                handle.wxyz = wxyz
-            for handle, p in zip(self._joints, pts, strict=True):
-                handle.position = tuple(float(v) for v in p)
+            for link, (centre, wxyz, _length) in zip(self._links, segment_poses(pts), strict=True):
+                link.position = centre
+                link.wxyz = wxyz
+            for joint, p in zip(self._joints, pts, strict=True):
+                joint.position = tf.as_xyz(p)
         self.joints = np.asarray(joints, dtype=float)
         tip = pts[-1]
         angles = ", ".join(
@@ -138,8 +116,4 @@ class ArmLayer:
         self._note = f"{angles} · gripper at ({tip[0]:.2f}, {tip[1]:.2f}, {tip[2]:.2f}) m"
 
     def describe(self) -> str:
-        return self._note if self._topic != NONE else ""
-
-    def close(self) -> None:
-        self.select(NONE)
-        self.worker.stop()
+        return self._note if self.topic != NONE else ""

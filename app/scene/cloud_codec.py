@@ -45,8 +45,14 @@ class DecodedCloud:
         return int(self.points.shape[0])
 
 
+def _pointfield_dtype(datatype: int) -> np.dtype | None:
+    """The numpy dtype of a PointField datatype code; None for an unknown code."""
+    dtype = POINTFIELD_DTYPES.get(datatype)
+    return dtype if isinstance(dtype, np.dtype) else None
+
+
 def _field_view(buf: np.ndarray, n: int, step: int, field: Any, big_endian: bool) -> np.ndarray:
-    dtype = POINTFIELD_DTYPES.get(int(field.datatype))
+    dtype = _pointfield_dtype(int(field.datatype))
     if dtype is None:
         raise CloudFormatError(f"field {field.name!r} has unknown datatype {field.datatype}")
     if big_endian:
@@ -95,7 +101,8 @@ def decode_cloud(msg: Any, budget: int | None = None) -> DecodedCloud:
     def packed_colour(name: str) -> np.ndarray | None:
         """The 4 bytes of a packed rgb(a) field read as one integer, whatever its declared type."""
         field = fields[name]
-        size = POINTFIELD_DTYPES.get(int(field.datatype), np.dtype(np.uint8)).itemsize
+        declared = _pointfield_dtype(int(field.datatype))
+        size = declared.itemsize if declared is not None else 1
         if size != 4 or field.offset + 4 > step:
             return None
         dtype = np.dtype(">u4" if msg.is_bigendian else "<u4")

@@ -75,7 +75,7 @@ class CameraPose:
         return tf.make_matrix(self.wxyz, self.position)
 
     @classmethod
-    def from_wxyz_position(cls, wxyz, position) -> CameraPose:
+    def from_wxyz_position(cls, wxyz: tf.Vector, position: tf.Vector) -> CameraPose:
         roll, pitch, yaw = tf.quat_to_rpy(wxyz)
         x, y, z = (float(v) for v in position)
         return cls(x, y, z, roll, pitch, yaw)
@@ -138,12 +138,12 @@ class FrameTree:
         for listener in self._listeners:
             listener(pose, source)
 
-    def to_world(self, path: str, point) -> tuple[float, float, float]:
+    def to_world(self, path: str, point: tf.Vector) -> tuple[float, float, float]:
         """A point given in the frame drawn at scene ``path``, in world coordinates."""
         p = np.asarray(point, dtype=np.float64).reshape(1, 3)
         if path == CAMERA_PATH:
             p = tf.apply(self.pose.matrix(), p)
-        return tuple(float(v) for v in p[0])
+        return tf.as_xyz(p[0])
 
     def show_gizmo(self, visible: bool) -> None:
         self.gizmo.visible = visible

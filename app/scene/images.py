@@ -7,55 +7,36 @@ a few tens of kilobytes.
 
 from __future__ import annotations
 
-import threading
-from typing import Any
-
 import numpy as np
 import viser
 from rclpy.node import Node
 from sensor_msgs.msg import Image
 
+from app.scene.follow import OneTopicLayer, TopicFollower
 from app.scene.frames import FrameTree
 from app.scene.image_codec import ImageFormatError, downscale, image_to_rgb
 from app.scene.latest import LatestWorker
-from app.scene.qos import resubscribe
-from app.scene.topic_picker import NONE
 
 MAX_HZ = 10.0
 PANEL_WIDTH = 480
 FRUSTUM_WIDTH = 160
 
 
-class ImageLayer:
+class ImageLayer(OneTopicLayer):
     def __init__(
         self, node: Node, gui: viser.GuiApi, frames: FrameTree, *, label: str = "Camera image"
     ) -> None:
-        self._node = node
         self._frames = frames
-        self._lock = threading.Lock()
-        self._topic = NONE
-        self._subscription: Any = None
         self.on_frustum = False
         self.info = ""
         self.frames_shown = 0
         blank = np.full((48, 64, 3), 235, dtype=np.uint8)  # placeholder until a frame arrives
         self.handle = gui.add_image(blank, label=label, format="jpeg", jpeg_quality=80)
-        self.worker = LatestWorker("image", self._draw, MAX_HZ)
+        worker = LatestWorker("image", self._draw, MAX_HZ)
+        super().__init__(TopicFollower(node, worker, Image, on_switch=self._forget))
 
-    @property
-    def topic(self) -> str:
-        return self._topic
-
-    def select(self, topic: str) -> None:
-        with self._lock:
-            if topic == self._topic:
-                return
-            old, self._subscription = self._subscription, None
-            self._topic = topic
-            self.info = ""
-        sub = resubscribe(self._node, old, self.worker, Image, topic)
-        with self._lock:
-            self._subscription = sub
+    def _forget(self, _topic: str) -> None:
+        self.info = ""
 
     def show_on_frustum(self, enabled: bool) -> None:
         self.on_frustum = enabled
@@ -75,7 +56,3 @@ class ImageLayer:
             frustum.image = np.ascontiguousarray(downscale(rgb, FRUSTUM_WIDTH))
         self.frames_shown += 1
         self.info = f"{msg.width}×{msg.height} `{msg.encoding}` · frame `{msg.header.frame_id}`"
-
-    def close(self) -> None:
-        self.select(NONE)
-        self.worker.stop()

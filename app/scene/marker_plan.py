@@ -6,8 +6,8 @@ mapping pure makes every type, scale rule and colour rule unit-testable.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, Literal, TypedDict
 
 import numpy as np
 
@@ -35,17 +35,75 @@ TYPE_NAMES = {
 }
 
 
+Vec3 = tuple[float, float, float]
+
+
+# What each kind of primitive needs; ``kind`` picks the viser call, the other
+# keys are its geometry, named as viser's arguments are.
+class SphereArgs(TypedDict):
+    kind: Literal["sphere"]
+    radius: float
+    scale: Vec3
+
+
+class BoxArgs(TypedDict):
+    kind: Literal["box"]
+    dimensions: Vec3
+
+
+class CylinderArgs(TypedDict):
+    kind: Literal["cylinder"]
+    radius: float
+    height: float
+
+
+class ArrowsArgs(TypedDict):
+    kind: Literal["arrows"]
+    points: np.ndarray  # (N, 2, 3) start and end of each arrow
+    shaft_radius: float
+    head_radius: float
+    head_length: float
+
+
+class LinesArgs(TypedDict):
+    kind: Literal["lines"]
+    points: np.ndarray  # (N, 2, 3) segment ends
+    colors: np.ndarray  # (N, 2, 3) uint8, per end
+    thickness: float
+
+
+class PointsArgs(TypedDict):
+    kind: Literal["points"]
+    points: np.ndarray  # (N, 3)
+    colors: np.ndarray  # (N, 3) uint8
+    point_size: float
+    point_shape: Literal["square", "circle"]
+
+
+class TextArgs(TypedDict):
+    kind: Literal["text"]
+    text: str
+    font_scene_height: float
+
+
+ShapeArgs = SphereArgs | BoxArgs | CylinderArgs | ArrowsArgs | LinesArgs | PointsArgs | TextArgs
+
+
 @dataclass(frozen=True)
 class Shape:
-    """One scene primitive: ``kind`` picks the viser call, ``args`` its geometry."""
+    """One scene primitive: ``args`` says which (``kind``) and its geometry."""
 
     key: tuple[str, int]  # (namespace, id): what DELETE and MODIFY refer to
-    kind: str  # sphere | box | cylinder | arrows | lines | points | text
     frame_id: str
-    position: tuple[float, float, float]
+    position: Vec3
     wxyz: tuple[float, float, float, float]
     color: tuple[int, int, int]
-    args: dict[str, Any] = field(default_factory=dict)
+    args: ShapeArgs
+
+    @property
+    def kind(self) -> str:
+        """sphere | box | cylinder | arrows | lines | points | text"""
+        return self.args["kind"]
 
 
 @dataclass(frozen=True)
@@ -58,8 +116,12 @@ class Plan:
     skipped: str = ""  # why nothing is drawn (unsupported type)
 
 
+def _byte(v: float) -> int:
+    return int(np.clip(round(float(v) * 255), 0, 255))
+
+
 def _rgb(c: Any) -> tuple[int, int, int]:
-    return tuple(int(np.clip(round(float(v) * 255), 0, 255)) for v in (c.r, c.g, c.b))
+    return (_byte(c.r), _byte(c.g), _byte(c.b))
 
 
 def _points(marker: Any) -> np.ndarray:
@@ -88,21 +150,30 @@ def plan_marker(marker: Any) -> Plan:
         return Plan(delete_all=True)
     if marker.action == DELETE:
         return Plan(delete=key)
-    p, o, s = marker.pose.position, marker.pose.orientation, marker.scale
-    position = (float(p.x), float(p.y), float(p.z))
-    wxyz = ros_to_wxyz(o.x, o.y, o.z, o.w)
-    color = _rgb(marker.color)
-    common = {"key": key, "frame_id": str(marker.header.frame_id), "color": color}
-    t = int(marker.type)
+    args = _shape_args(marker)
+    if isinstance(args, str):
+        return Plan(skipped=args)
+    p, o = marker.pose.position, marker.pose.orientation
+    shape = Shape(
+        key=key,
+        frame_id=str(marker.header.frame_id),
+        position=(float(p.x), float(p.y), float(p.z)),
+        wxyz=ros_to_wxyz(o.x, o.y, o.z, o.w),
+        color=_rgb(marker.color),
+        args=args,
+    )
+    return Plan(shape)
+
+
+def _shape_args(marker: Any) -> ShapeArgs | str:
+    """The primitive a Marker's type maps to, or why it is not drawn."""
+    s, t = marker.scale, int(marker.type)
     if t == SPHERE:
-        args = {"radius": 0.5, "scale": (float(s.x), float(s.y), float(s.z))}
-        return Plan(Shape(kind="sphere", position=position, wxyz=wxyz, args=args, **common))
+        return SphereArgs(kind="sphere", radius=0.5, scale=(float(s.x), float(s.y), float(s.z)))
     if t == CUBE:
-        args = {"dimensions": (float(s.x), float(s.y), float(s.z))}
-        return Plan(Shape(kind="box", position=position, wxyz=wxyz, args=args, **common))
+        return BoxArgs(kind="box", dimensions=(float(s.x), float(s.y), float(s.z)))
     if t == CYLINDER:
-        args = {"radius": float(s.x) / 2, "height": float(s.z)}
-        return Plan(Shape(kind="cylinder", position=position, wxyz=wxyz, args=args, **common))
+        return CylinderArgs(kind="cylinder", radius=float(s.x) / 2, height=float(s.z))
     if t == ARROW:
         pts = _points(marker)
         if len(pts) >= 2:  # start/end form: scale.x shaft diameter, y head diameter, z head length
@@ -113,13 +184,13 @@ def plan_marker(marker: Any) -> Plan:
             seg = np.array([[[0, 0, 0], [float(s.x), 0, 0]]], dtype=np.float32)
             shaft, head = float(s.y) / 2, float(s.z) / 2
             head_len = min(float(s.x) * 0.3, 4 * head) if head else float(s.x) * 0.3
-        args = {
-            "points": seg.astype(np.float32),
-            "shaft_radius": max(shaft, 1e-4),
-            "head_radius": max(head, 1e-4),
-            "head_length": max(head_len, 1e-4),
-        }
-        return Plan(Shape(kind="arrows", position=position, wxyz=wxyz, args=args, **common))
+        return ArrowsArgs(
+            kind="arrows",
+            points=seg.astype(np.float32),
+            shaft_radius=max(shaft, 1e-4),
+            head_radius=max(head, 1e-4),
+            head_length=max(head_len, 1e-4),
+        )
     if t in (LINE_STRIP, LINE_LIST):
         pts = _points(marker)
         segs = _segments(pts, strip=(t == LINE_STRIP))
@@ -129,22 +200,22 @@ def plan_marker(marker: Any) -> Plan:
         else:
             seg_colors = per_point[: 2 * len(segs)].reshape(-1, 2, 3)
         if seg_colors is None or len(segs) == 0:
-            return Plan(skipped=f"{TYPE_NAMES[t]} with fewer than 2 points")
-        args = {"points": segs, "colors": seg_colors, "thickness": max(float(s.x), 1e-3)}
-        return Plan(Shape(kind="lines", position=position, wxyz=wxyz, args=args, **common))
+            return f"{TYPE_NAMES[t]} with fewer than 2 points"
+        return LinesArgs(
+            kind="lines", points=segs, colors=seg_colors, thickness=max(float(s.x), 1e-3)
+        )
     if t in (POINTS, SPHERE_LIST, CUBE_LIST):
         pts = _points(marker)
-        args = {
-            "points": pts,
-            "colors": _point_colors(marker, len(pts)),
-            "point_size": max(float(s.x), 1e-3),
-            "point_shape": "square" if t == CUBE_LIST else "circle",
-        }
-        return Plan(Shape(kind="points", position=position, wxyz=wxyz, args=args, **common))
+        return PointsArgs(
+            kind="points",
+            points=pts,
+            colors=_point_colors(marker, len(pts)),
+            point_size=max(float(s.x), 1e-3),
+            point_shape="square" if t == CUBE_LIST else "circle",
+        )
     if t == TEXT_VIEW_FACING:
-        args = {"text": str(marker.text), "font_scene_height": max(float(s.z), 0.01)}
-        return Plan(Shape(kind="text", position=position, wxyz=wxyz, args=args, **common))
-    return Plan(skipped=f"{TYPE_NAMES.get(t, t)} markers are not drawn here")
+        return TextArgs(kind="text", text=str(marker.text), font_scene_height=max(float(s.z), 0.01))
+    return f"{TYPE_NAMES.get(t, t)} markers are not drawn here"
 
 
 def scene_name(key: tuple[str, int]) -> str:

@@ -11,79 +11,80 @@ from __future__ import annotations
 
 import threading
 from collections import deque
-from typing import Any
+from collections.abc import Mapping
+from typing import Any, TypedDict
 
+import numpy as np
 import viser
 from rclpy.node import Node
 from visualization_msgs.msg import Marker, MarkerArray
 
+from app.scene.follow import OneTopicLayer, TopicFollower
 from app.scene.frames import scene_path_for_frame
 from app.scene.latest import LatestWorker
 from app.scene.marker_plan import Plan, Shape, plan_marker, scene_name
-from app.scene.qos import SCENE_CALLBACK_GROUP
 from app.scene.topic_picker import NONE
 
 MAX_HZ = 15.0
 MAX_QUEUED = 2000  # markers kept between two draws; older ones are dropped first
 
 
+class _Pose(TypedDict):
+    position: tuple[float, float, float]
+    wxyz: tuple[float, float, float, float]
+
+
+def _same_value(v: object, w: object) -> bool:
+    if isinstance(v, np.ndarray) and isinstance(w, np.ndarray):
+        return v.shape == w.shape and bool((v == w).all())
+    return v == w
+
+
 def _same_geometry(a: Shape, b: Shape) -> bool:
     if a.kind != b.kind or a.color != b.color or a.frame_id != b.frame_id:
         return False
-    if a.args.keys() != b.args.keys():
+    mine: Mapping[str, object] = a.args
+    theirs: Mapping[str, object] = b.args
+    if mine.keys() != theirs.keys():
         return False
-    for k, v in a.args.items():
-        w = b.args[k]
-        if hasattr(v, "shape"):
-            if v.shape != w.shape or not (v == w).all():
-                return False
-        elif v != w:
-            return False
-    return True
+    return all(_same_value(v, theirs[k]) for k, v in mine.items())
 
 
-class MarkerLayer:
+class MarkerLayer(OneTopicLayer):
     def __init__(self, node: Node, server: viser.ViserServer) -> None:
         self._node = node
         self._scene = server.scene
         self._server = server
-        self._lock = threading.Lock()
-        self._topic = NONE
-        self._subscription: Any = None
+        self._lock = threading.Lock()  # the queue: the executor fills it, the worker empties it
         self._queue: deque[Any] = deque(maxlen=MAX_QUEUED)
-        self._drawn: dict[tuple[str, int], tuple[Shape, Any]] = {}
+        self._drawn: dict[tuple[str, int], tuple[Shape, viser.SceneNodeHandle]] = {}
         self._skipped = ""
         self._clear_pending = False
-        self.worker = LatestWorker("markers", self._apply, MAX_HZ)
-
-    @property
-    def topic(self) -> str:
-        return self._topic
+        worker = LatestWorker("markers", self._apply, MAX_HZ)
+        super().__init__(
+            TopicFollower(
+                node,
+                worker,
+                MarkerArray,
+                qos=10,
+                deliver=self._on_message,
+                on_switch=self._forget,
+            )
+        )
 
     def select(self, topic: str, type_name: str | None = None) -> None:
-        with self._lock:
-            if topic == self._topic:
-                return
-            old, self._subscription = self._subscription, None
-            self._topic = topic
-            self._queue.clear()
-        if old is not None:
-            self._node.destroy_subscription(old)
-        self.worker.reset()
-        with self._lock:
-            self._clear_pending = True  # the worker removes the old topic's markers
-        self.worker.offer(True)
-        if topic == NONE:
-            return
-        if type_name is None:
+        """Follow ``topic`` as a Marker or MarkerArray topic (its advertised type unless given)."""
+        if type_name is None and topic not in (NONE, self.topic):
             types = dict(self._node.get_topic_names_and_types()).get(topic, [])
             type_name = types[0] if types else "visualization_msgs/msg/MarkerArray"
-        msg_type = Marker if type_name.endswith("/Marker") else MarkerArray
-        sub = self._node.create_subscription(
-            msg_type, topic, self._on_message, 10, callback_group=SCENE_CALLBACK_GROUP
-        )
+        single = type_name is not None and type_name.endswith("/Marker")
+        self._follower.select(topic, Marker if single else MarkerArray)
+
+    def _forget(self, _topic: str) -> None:
         with self._lock:
-            self._subscription = sub
+            self._queue.clear()
+            self._clear_pending = True  # the worker removes the old topic's markers
+        self.worker.offer(True)
 
     def _on_message(self, msg: Any) -> None:
         markers = msg.markers if isinstance(msg, MarkerArray) else [msg]
@@ -130,32 +131,53 @@ class MarkerLayer:
             old[1].remove()
         parent, _known = scene_path_for_frame(shape.frame_id)
         name = f"{parent}/markers/{scene_name(shape.key)}"
-        pose = {"position": shape.position, "wxyz": shape.wxyz}
-        a, s = shape.args, self._scene
-        if shape.kind == "sphere":
-            handle = s.add_icosphere(name, color=shape.color, subdivisions=2, **a, **pose)
-        elif shape.kind == "box":
-            handle = s.add_box(name, color=shape.color, **a, **pose)
-        elif shape.kind == "cylinder":
-            handle = s.add_cylinder(name, color=shape.color, **a, **pose)
-        elif shape.kind == "arrows":
-            handle = s.add_arrows(name, colors=shape.color, **a, **pose)
-        elif shape.kind == "lines":
-            handle = s.add_line_segments(name, **a, **pose)
-        elif shape.kind == "points":
-            handle = s.add_point_cloud(name, point_shading="flat", **a, **pose)
-        else:
-            handle = s.add_label(
+        self._drawn[shape.key] = (shape, self._add(name, shape))
+
+    def _add(self, name: str, shape: Shape) -> viser.SceneNodeHandle:
+        a, s, color = shape.args, self._scene, shape.color
+        pose = _Pose(position=shape.position, wxyz=shape.wxyz)
+        if a["kind"] == "sphere":
+            return s.add_icosphere(
+                name, a["radius"], color, subdivisions=2, scale=a["scale"], **pose
+            )
+        if a["kind"] == "box":
+            return s.add_box(name, color, a["dimensions"], **pose)
+        if a["kind"] == "cylinder":
+            return s.add_cylinder(name, a["radius"], a["height"], color, **pose)
+        if a["kind"] == "lines":
+            return s.add_line_segments(
+                name, a["points"], a["colors"], thickness=a["thickness"], **pose
+            )
+        if a["kind"] == "arrows":
+            return s.add_arrows(
                 name,
-                a["text"],
-                font_size_mode="scene",
-                font_scene_height=a["font_scene_height"],
+                a["points"],
+                color,
+                shaft_radius=a["shaft_radius"],
+                head_radius=a["head_radius"],
+                head_length=a["head_length"],
                 **pose,
             )
-        self._drawn[shape.key] = (shape, handle)
+        if a["kind"] == "points":
+            return s.add_point_cloud(
+                name,
+                a["points"],
+                a["colors"],
+                point_size=a["point_size"],
+                point_shape=a["point_shape"],
+                point_shading="flat",
+                **pose,
+            )
+        return s.add_label(
+            name,
+            a["text"],
+            font_size_mode="scene",
+            font_scene_height=a["font_scene_height"],
+            **pose,
+        )
 
     def describe(self) -> str:
-        if self._topic == NONE:
+        if self.topic == NONE:
             return ""
         kinds: dict[str, int] = {}
         for shape, _h in list(self._drawn.values()):
@@ -163,7 +185,3 @@ class MarkerLayer:
         listed = ", ".join(f"{n} {k}" for k, n in sorted(kinds.items())) or "none yet"
         skipped = f" · skipped: {self._skipped}" if self._skipped else ""
         return f"Markers shown: {listed}{skipped}"
-
-    def close(self) -> None:
-        self.select(NONE)
-        self.worker.stop()

@@ -9,19 +9,22 @@ place (``handle.points``/``handle.colors``), never re-added per message.
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import viser
 from rclpy.node import Node
 from sensor_msgs.msg import PointCloud2
 
+from app.scene import transforms as tf
 from app.scene.cloud_codec import CloudFormatError, decode_cloud
+from app.scene.follow import OneTopicLayer, TopicFollower
 from app.scene.frames import scene_path_for_frame
 from app.scene.latest import LatestWorker
-from app.scene.qos import resubscribe
 from app.scene.topic_picker import NONE
+
+Point3 = tuple[float, float, float]
 
 DEFAULT_BUDGET = 200_000
 MAX_HZ = 30.0  # above the 20 Hz a typical depth camera publishes, so none is skipped
@@ -51,23 +54,17 @@ class CloudStatus:
     radius: float = 0.0  # half the bounding-box diagonal, metres
 
 
-class PointCloudLayer:
+class PointCloudLayer(OneTopicLayer):
     def __init__(self, node: Node, server: viser.ViserServer) -> None:
-        self._node = node
         self._server = server
-        self._lock = threading.Lock()
-        self._draw_lock = threading.Lock()  # the handle: worker draws, viser thread removes
-        self._topic = NONE
-        self._subscription: Any = None
+        self._lock = threading.Lock()  # the status: the worker writes, the UI thread reads
+        self._draw_lock = threading.Lock()  # the handle: the worker draws, the UI thread removes
         self._handle: viser.PointCloudHandle | None = None
         self._handle_path = ""
         self.budget = DEFAULT_BUDGET
         self._status = CloudStatus(NONE)
-        self.worker = LatestWorker("cloud", self._draw, MAX_HZ)
-
-    @property
-    def topic(self) -> str:
-        return self._topic
+        worker = LatestWorker("cloud", self._draw, MAX_HZ)
+        super().__init__(TopicFollower(node, worker, PointCloud2, on_switch=self._forget))
 
     @property
     def status(self) -> CloudStatus:
@@ -76,17 +73,12 @@ class PointCloudLayer:
 
     def select(self, topic: str) -> None:
         """Follow ``topic`` (or nothing, for "(none)"): one subscription at a time."""
-        with self._lock:
-            if topic == self._topic:
-                return
-            old, self._subscription = self._subscription, None
-            self._topic = topic
-            self._status = CloudStatus(topic, budget=self.budget)
-        sub = resubscribe(self._node, old, self.worker, PointCloud2, topic)
-        with self._lock:
-            self._subscription = sub
-        if sub is None:
+        if self._follower.select(topic) and topic == NONE:
             self._remove_handle()
+
+    def _forget(self, topic: str) -> None:
+        with self._lock:
+            self._status = CloudStatus(topic, budget=self.budget)
 
     def _remove_handle(self) -> None:
         with self._draw_lock:
@@ -105,7 +97,7 @@ class PointCloudLayer:
             self.on_drawn(self.status)
 
     def _draw_locked(self, msg: PointCloud2) -> None:
-        if self._topic == NONE:  # unpicked while this message waited
+        if self.topic == NONE:  # unpicked while this message waited
             return
         budget = self.budget
         stamp = f"{msg.header.stamp.sec}.{msg.header.stamp.nanosec:09d}"
@@ -113,14 +105,14 @@ class PointCloudLayer:
             cloud = decode_cloud(msg, budget)
         except CloudFormatError as exc:
             with self._lock:
-                self._status = CloudStatus(self._topic, budget=budget, error=str(exc))
+                self._status = CloudStatus(self.topic, budget=budget, error=str(exc))
             return
-        parent, known = scene_path_for_frame(msg.header.frame_id, self._topic)
+        parent, known = scene_path_for_frame(msg.header.frame_id, self.topic)
         path = f"{parent}/cloud"
         centre, radius = (0.0, 0.0, 0.0), 0.0
         if cloud.shown:
             lo, hi = cloud.points.min(axis=0), cloud.points.max(axis=0)
-            centre = tuple(float(v) for v in (lo + hi) / 2)
+            centre = tf.as_xyz((lo + hi) / 2)
             radius = float(np.linalg.norm(hi - lo)) / 2
         size = point_size_for(cloud.shown)
         if self._handle is not None and self._handle_path == path:
@@ -142,7 +134,7 @@ class PointCloudLayer:
             self._handle_path = path
         with self._lock:
             self._status = CloudStatus(
-                self._topic,
+                self.topic,
                 total=cloud.total,
                 shown=cloud.shown,
                 centre=centre,
@@ -154,9 +146,10 @@ class PointCloudLayer:
                 stamp=stamp,
             )
 
-    on_drawn: Any = None  # set by the panel: refresh the status line right after a draw
+    # set by the panel: refresh the status line right after a draw
+    on_drawn: Callable[[CloudStatus], None] | None = None
 
-    def frame_in_view(self, world_from_frame) -> bool:
+    def frame_in_view(self, world_from_frame: Callable[[str, Point3], Point3]) -> bool:
         """Point every browser's camera at the cloud; False when nothing is drawn yet."""
         s = self.status
         if not s.shown or self._handle is None:
@@ -166,8 +159,8 @@ class PointCloudLayer:
         eye = np.asarray(centre) + distance * np.array([1.0, -1.0, 0.8])
         for client in self._server.get_clients().values():
             with client.atomic():
-                client.camera.position = tuple(float(v) for v in eye)
-                client.camera.look_at = tuple(float(v) for v in centre)
+                client.camera.position = tf.as_xyz(eye)
+                client.camera.look_at = tf.as_xyz(centre)
         return True
 
     def describe(self) -> str:
@@ -189,7 +182,3 @@ class PointCloudLayer:
         if not s.frame_known:
             frame += " (unknown here: drawn at base_link)"
         return f"{cut} · colour: {s.colour_source} · {frame} · stamp {s.stamp}"
-
-    def close(self) -> None:
-        self.select(NONE)
-        self.worker.stop()

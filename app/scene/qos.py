@@ -9,15 +9,9 @@ of them offers it. Depth 1: the scene only ever wants the newest message.
 
 from __future__ import annotations
 
-from typing import Any
-
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from rclpy.subscription import Subscription
-
-from app.scene.latest import LatestWorker
-from app.scene.topic_picker import NONE
 
 
 def newest_only_qos(node: Node, topic: str) -> QoSProfile:
@@ -36,26 +30,3 @@ def newest_only_qos(node: Node, topic: str) -> QoSProfile:
 # alongside each other and alongside the other panels' callbacks: a slow
 # callback elsewhere in the dashboard must not hold up the 3D view.
 SCENE_CALLBACK_GROUP = ReentrantCallbackGroup()
-
-
-def resubscribe(
-    node: Node,
-    old: Subscription | None,
-    worker: LatestWorker,
-    msg_type: type,
-    topic: str,
-    qos: QoSProfile | int | None = None,
-) -> Subscription | None:
-    """Move a scene layer to ``topic`` (NONE: to nothing), dropping the old topic's backlog.
-
-    Messages go straight into ``worker``; ``qos`` defaults to newest_only_qos.
-    """
-    if old is not None:
-        node.destroy_subscription(old)
-    worker.reset()
-    if topic == NONE:
-        return None
-    profile: Any = qos if qos is not None else newest_only_qos(node, topic)
-    return node.create_subscription(
-        msg_type, topic, worker.offer, profile, callback_group=SCENE_CALLBACK_GROUP
-    )

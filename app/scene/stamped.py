@@ -8,7 +8,6 @@ coincide in the 3D view.
 
 from __future__ import annotations
 
-import threading
 from typing import Any
 
 import viser
@@ -17,9 +16,9 @@ from rclpy.node import Node
 
 from app.ros.graph import GraphSnapshot
 from app.scene import topic_picker as picker
+from app.scene.follow import TopicFollower
 from app.scene.frames import scene_path_for_frame
 from app.scene.latest import LatestWorker
-from app.scene.qos import SCENE_CALLBACK_GROUP
 from app.scene.transforms import ros_to_wxyz
 
 MAX_TOPICS = 8
@@ -30,21 +29,21 @@ def _leaf(topic: str) -> str:
     return "".join(ch if ch.isalnum() else "_" for ch in topic.strip("/")) or "topic"
 
 
-class _Follower:
-    def __init__(self, layer: StampedLayer, topic: str, is_pose: bool, colour) -> None:
+class _StampedTopic:
+    def __init__(
+        self, layer: StampedLayer, topic: str, is_pose: bool, colour: tuple[int, int, int]
+    ) -> None:
         self.topic = topic
         self.is_pose = is_pose
         self.colour = colour
-        self.handle: Any = None
-        self.label: Any = None
+        self.handle: viser.FrameHandle | viser.IcosphereHandle | None = None
         self.path = ""
         self.last = ""
         self.worker = LatestWorker(f"stamped{_leaf(topic)}", self._draw, 10.0)
         self._layer = layer
         msg_type = PoseStamped if is_pose else PointStamped
-        self.subscription = layer.node.create_subscription(
-            msg_type, topic, self.worker.offer, 10, callback_group=SCENE_CALLBACK_GROUP
-        )
+        self._follower = TopicFollower(layer.node, self.worker, msg_type, qos=10)
+        self._follower.select(topic)
 
     def _draw(self, msg: Any) -> None:
         parent, known = scene_path_for_frame(msg.header.frame_id, self.topic)
@@ -56,17 +55,18 @@ class _Follower:
             p = msg.point
             position, wxyz = (p.x, p.y, p.z), (1.0, 0.0, 0.0, 0.0)
         scene = self._layer.scene
-        if path != self.path:
-            if self.handle is not None:
-                self.handle.remove()
+        handle = self.handle
+        if handle is None or path != self.path:
+            if handle is not None:
+                handle.remove()
             if self.is_pose:
-                self.handle = scene.add_frame(path, axes_length=0.1, axes_radius=0.005)
+                handle = scene.add_frame(path, axes_length=0.1, axes_radius=0.005)
             else:
-                self.handle = scene.add_icosphere(path, radius=0.025, color=self.colour)
+                handle = scene.add_icosphere(path, radius=0.025, color=self.colour)
             scene.add_label(f"{path}/label", self.topic, position=(0.0, 0.0, 0.05))
-            self.path = path
-        self.handle.position = position
-        self.handle.wxyz = wxyz
+            self.handle, self.path = handle, path
+        handle.position = position
+        handle.wxyz = wxyz
         where = "" if known else " (unknown frame: drawn at base_link)"
         self.last = (
             f"`{self.topic}` ({p.x:+.3f}, {p.y:+.3f}, {p.z:+.3f}) m in "
@@ -74,8 +74,7 @@ class _Follower:
         )
 
     def close(self) -> None:
-        self._layer.node.destroy_subscription(self.subscription)
-        self.worker.stop()
+        self._follower.close()
         if self.handle is not None:
             self.handle.remove()
 
@@ -84,8 +83,7 @@ class StampedLayer:
     def __init__(self, node: Node, server: viser.ViserServer) -> None:
         self.node = node
         self.scene = server.scene
-        self._lock = threading.Lock()
-        self._followers: dict[str, _Follower] = {}
+        self._followers: dict[str, _StampedTopic] = {}
 
     def refresh(self, graph: GraphSnapshot | None) -> None:
         """Follow every new stamped point/pose topic (UI thread)."""
@@ -95,7 +93,7 @@ class StampedLayer:
             if topic in self._followers or len(self._followers) >= MAX_TOPICS:
                 continue
             colour = _COLOURS[len(self._followers) % len(_COLOURS)]
-            self._followers[topic] = _Follower(self, topic, is_pose, colour)
+            self._followers[topic] = _StampedTopic(self, topic, is_pose, colour)
 
     def describe(self) -> str:
         lines = [f.last for f in self._followers.values() if f.last]

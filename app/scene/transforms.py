@@ -11,6 +11,15 @@ from collections.abc import Sequence
 
 import numpy as np
 
+# A 3- or 4-vector as a tuple, a list or a numpy array.
+Vector = Sequence[float] | np.ndarray
+
+
+def as_xyz(v: Vector) -> tuple[float, float, float]:
+    """A 3-vector as the plain float triple viser's positions take."""
+    x, y, z = (float(c) for c in v)
+    return (x, y, z)
+
 
 def ros_to_wxyz(x: float, y: float, z: float, w: float) -> tuple[float, float, float, float]:
     """A ROS quaternion (x, y, z, w) as viser's (w, x, y, z), normalised."""
@@ -22,13 +31,13 @@ def ros_to_wxyz(x: float, y: float, z: float, w: float) -> tuple[float, float, f
     return (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
 
 
-def wxyz_to_ros(wxyz: Sequence[float]) -> tuple[float, float, float, float]:
+def wxyz_to_ros(wxyz: Vector) -> tuple[float, float, float, float]:
     """viser's (w, x, y, z) as ROS's (x, y, z, w)."""
     w, x, y, z = (float(v) for v in wxyz)
     return (x, y, z, w)
 
 
-def quat_to_matrix(wxyz: Sequence[float]) -> np.ndarray:
+def quat_to_matrix(wxyz: Vector) -> np.ndarray:
     """3x3 rotation matrix of a unit quaternion given as (w, x, y, z)."""
     w, x, y, z = (float(v) for v in wxyz)
     n = w * w + x * x + y * y + z * z
@@ -78,7 +87,7 @@ def rpy_to_quat(roll: float, pitch: float, yaw: float) -> tuple[float, float, fl
     )
 
 
-def quat_to_rpy(wxyz: Sequence[float]) -> tuple[float, float, float]:
+def quat_to_rpy(wxyz: Vector) -> tuple[float, float, float]:
     """Inverse of :func:`rpy_to_quat` (pitch clamped at +-90 deg)."""
     r = quat_to_matrix(wxyz)
     pitch = float(np.arcsin(np.clip(-r[2, 0], -1.0, 1.0)))
@@ -87,7 +96,7 @@ def quat_to_rpy(wxyz: Sequence[float]) -> tuple[float, float, float]:
     return (roll, pitch, yaw)
 
 
-def make_matrix(wxyz: Sequence[float], position: Sequence[float]) -> np.ndarray:
+def make_matrix(wxyz: Vector, position: Vector) -> np.ndarray:
     """4x4 homogeneous matrix T such that p_parent = T @ p_child."""
     t = np.eye(4)
     t[:3, :3] = quat_to_matrix(wxyz)
@@ -107,7 +116,7 @@ def format_matrix(t: np.ndarray, digits: int = 3) -> str:
     return "\n".join(f"[ {row} ]" for row in rows)
 
 
-def quat_z_to(direction: Sequence[float]) -> tuple[float, float, float, float]:
+def quat_z_to(direction: Vector) -> tuple[float, float, float, float]:
     """(w, x, y, z) rotating +z onto ``direction`` (for cylinders and arrows along a segment)."""
     d = np.asarray(direction, dtype=np.float64)
     n = float(np.linalg.norm(d))

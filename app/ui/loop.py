@@ -43,9 +43,16 @@ class UiLoop:
         self._wake.set()
 
     def callback(self, intent: Callable[..., None], *args: Any) -> Callable[[Any], None]:
-        """A viser callback that posts ``intent(*args)``: the usual way to wire a widget."""
+        """A viser callback that posts ``intent(*args)`` when a browser changed the widget.
 
-        def on_event(_event: Any) -> None:
+        viser also runs update callbacks, synchronously, when the server itself
+        assigns a value (``event.client`` is None then): the UI thread made that
+        change and already knows it, so no intent is posted for it.
+        """
+
+        def on_event(event: Any) -> None:
+            if getattr(event, "client", True) is None:
+                return
             self.post(lambda: intent(*args))
 
         return on_event

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 from playwright.sync_api import Page, expect
 
 
@@ -34,6 +36,6 @@ def start_group(page: Page, group: str) -> None:
     expect_text(page, "Started group")
 
 
-def expect_text(page: Page, text: str, timeout: float = 20_000) -> None:
+def expect_text(page: Page, text: str | re.Pattern[str], timeout: float = 20_000) -> None:
     """``text`` is on screen: hidden copies (other tabs, closed folders) do not count."""
     expect(page.get_by_text(text).filter(visible=True).first).to_be_visible(timeout=timeout)

@@ -43,7 +43,7 @@ def test_crashed_node_shows_exit_code_and_restarts(page):
     expect_text(page, "crashed (exit code 1)", timeout=30_000)
     expect_text(page, "simulated bug")
     click(page, "Restart")
-    expect_text(page, "Restarting")
+    expect_text(page, re.compile(r"Restart(ing|ed) crashing_node"))
     expect(page.get_by_text(re.compile(r"(starting|running) \(pid \d+\)")).first).to_be_visible(
         timeout=15_000
     )
