@@ -15,6 +15,7 @@ from app.ui import MarkdownView, code_block
 TOPIC = "/chatter"
 SHOWN_MESSAGES = 10
 FAST_HZ = 50.0
+RATE_WINDOW_SEC = 5.0
 
 
 class EchoPanel:
@@ -28,8 +29,12 @@ class EchoPanel:
             f"[{time.strftime('%H:%M:%S', time.localtime(t))}] data: {msg.data!r}"
             for t, msg in recent
         ]
-        rate = self._tap.rate_hz()
-        rate_text = f"{rate:.1f} Hz" if rate else "no messages lately"
+        # The publisher's rate by its own clock; samples this view missed are
+        # counted, not hidden in a lower rate.
+        published = self._tap.published_rate(window_sec=RATE_WINDOW_SEC)
+        rate = published.rate if published else None
+        rate_text = published.summary(self._tap.why_missed(), 1) if published else ""
+        rate_text = rate_text or "no messages lately"
         if rate and rate > FAST_HZ:  # say so: most messages scroll by unseen
             rate_text += f" · ⚠ too fast to read: showing only the newest {SHOWN_MESSAGES}"
         header = f"`ros2 topic echo {TOPIC}` · {self._tap.count} received · {rate_text}"

@@ -34,7 +34,7 @@ from app.ros.errors import Ros2Error
 from app.ros.graph import GraphSnapshot
 from app.ros.monitor import TopicMonitor
 from app.ros.qos import matching_qos
-from app.ui import MarkdownView, code_block, set_options
+from app.ui import MarkdownView, assign, code_block, set_options
 from app.ui.forms import FormSlot
 from app.ui.loop import UiLoop
 
@@ -134,11 +134,11 @@ class TopicsPanel:
                 "Stop publishing", icon=viser.Icon.PLAYER_STOP, disabled=True
             )
             self._pub_view = MarkdownView(gui, "")
-        self._selector.on_update(lambda _: ui.post(lambda: self._select(self._selector.value)))
-        self._field.on_update(lambda _: ui.post(self._clear_plot))
-        self._once.on_click(lambda _: ui.post(self._publish_once))
-        self._start.on_click(lambda _: ui.post(self._publish_at_rate))
-        self._stop.on_click(lambda _: ui.post(self._stop_publishing))
+        self._selector.on_update(ui.callback(lambda: self._select(self._selector.value)))
+        self._field.on_update(ui.callback(self._clear_plot))
+        self._once.on_click(ui.callback(self._publish_once))
+        self._start.on_click(ui.callback(self._publish_at_rate))
+        self._stop.on_click(ui.callback(self._stop_publishing))
 
     # --- selection -------------------------------------------------------------
 
@@ -174,7 +174,7 @@ class TopicsPanel:
             (chosen, type_text), (lambda: (cls, type_text or "")) if cls is not None else None
         )
         self._field.options = [NO_FIELD, *fields]
-        self._field.value = preferred_field(cls) if cls is not None else NO_FIELD
+        assign(self._field, preferred_field(cls) if cls is not None else NO_FIELD)
         self._clear_plot()
         for button in (self._once, self._start):
             button.disabled = form is None
@@ -337,14 +337,30 @@ class TopicsPanel:
             )
         if monitor is None:
             return
-        rate = monitor.rate(window_sec=STATS_WINDOW_SEC)
+        idle = "silent" if monitor.count else "waiting…"
+        published = monitor.published_rate(window_sec=STATS_WINDOW_SEC)
         band = monitor.bandwidth(window_sec=STATS_WINDOW_SEC)
-        hz = f"**{rate.rate:.2f} Hz**" if rate else ("silent" if monitor.count else "waiting…")
-        bw = (
-            f"**{band.ros2_text().splitlines()[0]}**"
-            if band
-            else ("silent" if monitor.count else "waiting…")
-        )
+        if published is None:
+            hz = idle
+        elif published.fallback:
+            unknown = f"publisher's rate unknown: {published.fallback}"
+            hz = f"**{published.rate:.2f} Hz** arrived ({unknown})"
+        else:
+            # The publisher's clock and sequence numbers: a sample this view
+            # missed does not lower the rate, it is counted as missed.
+            hz = f"**{published.rate:.2f} Hz** published"
+            if published.restarts:
+                hz += " (the publisher restarted)"
+            arrived = monitor.rate(window_sec=STATS_WINDOW_SEC)
+            if published.missed and arrived:
+                hz += (
+                    f" · {arrived.rate:.2f} Hz arrived here: this view missed "
+                    f"{published.missed:,} of {published.published:,} "
+                    f"({monitor.why_missed()})"
+                )
+            else:
+                hz += f" · none missed in the last {STATS_WINDOW_SEC:g} s"
+        bw = f"**{band.ros2_text().splitlines()[0]}**" if band else idle
         self._stats.show(
             f"Rate: {hz} · `ros2 topic hz {topic}`\n\n"
             f"Bandwidth: {bw} · `ros2 topic bw {topic}`\n\n"

@@ -4,6 +4,13 @@
 bandwidth and messages are deserialized only when someone looks at them.
 The subscription callback (executor thread) is its single writer; readers on
 any other thread take its lock and get copies.
+
+The callback takes the middleware's message info too: the publisher's clock
+(``source_timestamp``) and its per-writer ``publication_sequence_number``.
+From those, ``published_rate`` tells how often the publisher *sent*, and how
+many samples this subscription missed; arrival times alone (``rate``, as
+`ros2 topic hz` computes it) only tell what got through, which is less when a
+busy best-effort subscriber drops samples.
 """
 
 from __future__ import annotations
@@ -11,16 +18,30 @@ from __future__ import annotations
 import math
 import threading
 import time
+from bisect import bisect_left
 from collections import deque
-from collections.abc import Iterator
+from collections.abc import Hashable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 from rclpy.node import Node
-from rclpy.qos import QoSProfile
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
 
 from app.ros.qos import matching_qos
+
+# One received sample: arrival (monotonic s), size (bytes), the publisher's
+# clock (ns, 0 when unknown), its sequence number (None when unknown), and the
+# writer it came from (None when the middleware does not say).
+Sample = tuple[float, int, int, int | None, Hashable | None]
+
+# More breaks than this in one writer's sequence numbers within a window is
+# not a publisher restarting: several publishers interleave.
+MAX_RESTARTS = 2
+
+NO_INFO = "the middleware gave no publisher timestamps or sequence numbers"
+INTERLEAVED = "several publishers interleave and this rclpy does not say which sent each sample"
+TOO_FEW = "too few samples from each publisher"
 
 
 @dataclass(frozen=True)
@@ -37,6 +58,48 @@ class RateStats:
             f"\tmin: {self.min_period:.3f}s max: {self.max_period:.3f}s "
             f"std dev: {self.std_dev:.5f}s window: {self.window}"
         )
+
+
+@dataclass(frozen=True)
+class PublishedRate:
+    """How often the publishers sent, from their own clock and sequence numbers.
+
+    With ``fallback`` set, the publishers' side could not be read (the reason
+    is in it) and ``rate`` is what arrived here, as `ros2 topic hz` measures.
+    """
+
+    rate: float  # samples published per second (arrived per second on fallback)
+    published: int | None  # samples published in the window, by sequence numbers
+    received: int  # samples this subscription received in the window
+    missed: int | None  # gaps in the sequence numbers
+    writers: int = 1  # publishers told apart (their GIDs, when rclpy gives them)
+    restarts: int = 0  # a writer's sequence starting over (a publisher restarted)
+    fallback: str = ""
+
+    def summary(self, why_missed: str = "", digits: int = 2) -> str:
+        """'30.00 Hz published; this view missed 412 of 9,000 (why)', for a panel."""
+        hz = f"{self.rate:.{digits}f} Hz"
+        if self.fallback or self.published is None:
+            return f"{hz} arrived (publisher's rate unknown: {self.fallback})"
+        text = f"{hz} published"
+        if self.restarts:
+            text += " (the publisher restarted)"
+        if not self.missed:
+            return text + ", none missed"
+        text += f"; this view missed {self.missed:,} of {self.published:,}"
+        return text + (f" ({why_missed})" if why_missed else "")
+
+    def ros2_line(self, why_missed: str = "") -> str:
+        """The line `ros2 topic hz` gets after its own two."""
+        if self.fallback or self.published is None:
+            return f"\tpublished rate: unknown ({self.fallback}); the average above is what arrived"
+        text = f"\tpublished rate: {self.rate:.3f} by the publisher's clock"
+        if self.restarts:
+            text += " (the publisher restarted)"
+        if not self.missed:
+            return text + f"; none of {self.published:,} missed"
+        text += f"; this subscription missed {self.missed:,} of {self.published:,}"
+        return text + (f" ({why_missed})" if why_missed else "")
 
 
 @dataclass(frozen=True)
@@ -63,8 +126,118 @@ def _human(size: float) -> str:
     return f"{size:.2f} MB"
 
 
+# ------------------------------------------------------------------ pure rate math
+
+
+def arrival_rate(stamps: Sequence[float]) -> float | None:
+    """(n - 1) / (last - first), as `ros2 topic hz` computes it; None if unmeasurable."""
+    if len(stamps) < 2:
+        return None
+    span = stamps[-1] - stamps[0]
+    return (len(stamps) - 1) / span if span > 0 else None
+
+
+def _union_ns(intervals: list[tuple[int, int]]) -> int:
+    """Total length of a set of [start, end] intervals, overlaps counted once."""
+    total, cur_start, cur_end = 0, None, 0
+    for start, end in sorted(intervals):
+        if cur_start is None or start > cur_end:
+            if cur_start is not None:
+                total += cur_end - cur_start
+            cur_start, cur_end = start, end
+        else:
+            cur_end = max(cur_end, end)
+    if cur_start is not None:
+        total += cur_end - cur_start
+    return total
+
+
+def published_rate_of(samples: Sequence[Sample]) -> PublishedRate | None:
+    """The publishers' rate and this subscription's misses over ``samples`` (arrival order).
+
+    Sequence numbers count per writer. Samples are grouped by writer (when the
+    middleware names it) and cut into runs wherever a writer's sequence does
+    not go up (a restarted publisher starts again at 1). Each run sent
+    ``last - first + 1`` samples over ``last - first`` intervals of the
+    publisher's clock; the rate is all intervals over the time covered by any
+    run, so missed samples do not lower it, two concurrent writers add up and
+    the pause of a restart does not count. Fewer than two samples: None.
+    """
+    n = len(samples)
+    if n < 2:
+        return None
+    span = samples[-1][0] - samples[0][0]
+    fallback_rate = (n - 1) / span if span > 0 else None
+
+    def fallback(reason: str) -> PublishedRate | None:
+        if fallback_rate is None:
+            return None
+        return PublishedRate(fallback_rate, None, n, None, writers=0, fallback=reason)
+
+    # run: [first_seq, first_ns, last_seq, last_ns, received]
+    open_runs: dict[Hashable | None, list[int]] = {}
+    runs: list[list[int]] = []
+    breaks = 0
+    for _arrival, _size, stamp, seq, writer in samples:
+        if stamp <= 0 or seq is None:
+            return fallback(NO_INFO)
+        run = open_runs.get(writer)
+        if run is not None and seq > run[2] and stamp >= run[3]:
+            run[2], run[3] = seq, stamp
+            run[4] += 1
+            continue
+        if run is not None:
+            breaks += 1
+        run = [seq, stamp, seq, stamp, 1]
+        open_runs[writer] = run
+        runs.append(run)
+    if breaks > MAX_RESTARTS:
+        return fallback(INTERLEAVED)
+    intervals = sum(r[2] - r[0] for r in runs)
+    covered_ns = _union_ns([(r[1], r[3]) for r in runs if r[3] > r[1]])
+    if intervals <= 0 or covered_ns <= 0:
+        return fallback(TOO_FEW)
+    published = sum(r[2] - r[0] + 1 for r in runs)
+    return PublishedRate(
+        rate=intervals / (covered_ns * 1e-9),
+        published=published,
+        received=n,
+        missed=max(0, published - n),
+        writers=len(open_runs),
+        restarts=breaks,
+    )
+
+
+def rate_stats_of(stamps: Sequence[float]) -> RateStats | None:
+    """`ros2 topic hz`'s figures over arrival times (oldest first)."""
+    if len(stamps) < 2:
+        return None
+    periods = [b - a for a, b in zip(stamps, stamps[1:], strict=False)]
+    mean = (stamps[-1] - stamps[0]) / len(periods)
+    if mean <= 0:
+        return None
+    std = math.sqrt(sum((p - mean) ** 2 for p in periods) / len(periods))
+    return RateStats(1.0 / mean, min(periods), max(periods), std, len(stamps))
+
+
+def why_missed(qos: QoSProfile | None) -> str:
+    """One short phrase on why a subscription with this QoS can miss samples."""
+    if qos is None:
+        return ""
+    if qos.reliability == ReliabilityPolicy.BEST_EFFORT:
+        return "best effort: samples the middleware could not deliver are dropped, not resent"
+    return (
+        f"reliable, but keeps the last {qos.depth}: samples waiting while this view "
+        "was busy were replaced by newer ones"
+    )
+
+
+def _arrival(sample: Sample) -> float:
+    return sample[0]
+
+
 class TopicMonitor:
-    """One raw subscription: arrival stamps, sizes, and the last few messages.
+    """One raw subscription: arrival stamps, sizes, publisher info, and the last few messages.
 
     The subscription callback (executor thread) is the single writer; readers
     on other threads take the lock.
@@ -84,28 +257,49 @@ class TopicMonitor:
         # topic's current publishers as `ros2 topic echo` does.
         self.topic = topic
         self.msg_type = msg_type
+        if qos is None:
+            qos = matching_qos(node, topic)
+        elif isinstance(qos, int):
+            qos = QoSProfile(depth=qos)  # what rclpy makes of a bare depth
+        self.qos: QoSProfile = qos
         self._node = node
         self._cond = threading.Condition()
-        self._stamps: deque[float] = deque(maxlen=window)
-        self._sizes: deque[tuple[float, int]] = deque(maxlen=window)
+        self._samples: deque[Sample] = deque(maxlen=window)
         self._recent: deque[tuple[float, bytes]] = deque(maxlen=keep)
         self.count = 0
+        # Two parameters: rclpy passes the message info (a dict) as the second
+        # (Jazzy's type hint only names the one-parameter form).
         self._sub = node.create_subscription(
             msg_type,
             topic,
-            self._on_message,
-            matching_qos(node, topic) if qos is None else qos,
+            self._on_message,  # type: ignore[arg-type]
+            qos,
             raw=True,
         )
 
-    def _on_message(self, data: bytes) -> None:
+    def _on_message(self, data: bytes, info: dict[str, Any]) -> None:
         now = time.monotonic()
+        gid = info.get("publisher_gid")  # not in Jazzy's rclpy; newer ones name the writer
+        sample = (
+            now,
+            len(data),
+            info.get("source_timestamp") or 0,
+            info.get("publication_sequence_number"),
+            gid["data"] if gid else None,
+        )
         with self._cond:
-            self._stamps.append(now)
-            self._sizes.append((now, len(data)))
+            self._samples.append(sample)
             self._recent.append((time.time(), data))
             self.count += 1
             self._cond.notify_all()
+
+    def _window(self, window_sec: float | None) -> list[Sample]:
+        with self._cond:
+            samples = list(self._samples)
+        if window_sec is not None:
+            start = bisect_left(samples, time.monotonic() - window_sec, key=_arrival)
+            samples = samples[start:]
+        return samples
 
     def wait_for_count(self, count: int, timeout: float) -> bool:
         """Block (not the executor thread) until ``count`` messages arrived in total."""
@@ -135,8 +329,10 @@ class TopicMonitor:
             yield stamp, deserialize_message(data, self.msg_type)
 
     def rate_hz(self, window_sec: float = 5.0) -> float | None:
-        """Mean rate over the last ``window_sec``; None with fewer than two messages."""
-        stats = self.rate(window_sec)
+        """The publishing rate over the last ``window_sec`` (by the publisher's clock
+        where the middleware says it, so samples this view missed do not lower it);
+        None with fewer than two messages."""
+        stats = self.published_rate(window_sec)
         return stats.rate if stats else None
 
     def messages_since(self, count_before: int) -> list[tuple[float, Any]]:
@@ -147,30 +343,23 @@ class TopicMonitor:
         return [(stamp, deserialize_message(data, self.msg_type)) for stamp, data in raw]
 
     def rate(self, window_sec: float | None = None) -> RateStats | None:
-        with self._cond:
-            stamps = list(self._stamps)
-        if window_sec is not None:
-            now = time.monotonic()
-            stamps = [s for s in stamps if now - s <= window_sec]
-        if len(stamps) < 2:
-            return None
-        periods = [b - a for a, b in zip(stamps, stamps[1:], strict=False)]
-        mean = (stamps[-1] - stamps[0]) / len(periods)
-        if mean <= 0:
-            return None
-        std = math.sqrt(sum((p - mean) ** 2 for p in periods) / len(periods))
-        return RateStats(1.0 / mean, min(periods), max(periods), std, len(stamps))
+        """What arrived here, as `ros2 topic hz` reports it (lower than sent when samples drop)."""
+        return rate_stats_of([s[0] for s in self._window(window_sec)])
+
+    def published_rate(self, window_sec: float | None = None) -> PublishedRate | None:
+        """How often the publishers sent, and how many samples this subscription missed."""
+        return published_rate_of(self._window(window_sec))
+
+    def why_missed(self) -> str:
+        """Why this subscription can miss samples, in one phrase (its QoS)."""
+        return why_missed(self.qos)
 
     def bandwidth(self, window_sec: float | None = None) -> BandwidthStats | None:
-        with self._cond:
-            sizes = list(self._sizes)
-        if window_sec is not None:
-            now = time.monotonic()
-            sizes = [(t, s) for t, s in sizes if now - t <= window_sec]
-        if len(sizes) < 2:
+        samples = self._window(window_sec)
+        if len(samples) < 2:
             return None
-        span = sizes[-1][0] - sizes[0][0]
-        values = [s for _t, s in sizes]
+        span = samples[-1][0] - samples[0][0]
+        values = [s[1] for s in samples]
         if span <= 0:
             return None
         return BandwidthStats(

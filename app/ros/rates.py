@@ -60,8 +60,8 @@ class RateBoard:
             entry = self._monitors.get(topic)
         if entry is None:
             return None
-        stats = entry[1].rate(window_sec=window_sec)
-        return stats.rate if stats else 0.0
+        rate = entry[1].rate_hz(window_sec=window_sec)  # as published, not as received
+        return rate if rate is not None else 0.0
 
     def close(self) -> None:
         with self._lock:
