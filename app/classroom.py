@@ -138,7 +138,7 @@ class Classroom:
         log = None
         if self._log_dir is not None:
             self._log_dir.mkdir(parents=True, exist_ok=True)
-            log = open(self._log_dir / f"{learner.name}.log", "ab")  # noqa: SIM115
+            log = open(self._log_dir / f"{learner.name}.log", "ab")
         try:
             for raw in proc.stdout:
                 if log is not None:

@@ -121,7 +121,7 @@ class Dashboard:
             applied = self.ui.apply_pending()
             try:
                 nodes = self.runtime.node.get_node_names_and_namespaces()
-            except Exception:  # noqa: BLE001 - the graph may be unreadable for a moment
+            except Exception:  # the graph may be unreadable for a moment
                 nodes = last_nodes or []
             now = time.monotonic()
             if nodes == last_nodes and now < due and not (woken or applied):
@@ -150,6 +150,6 @@ class Dashboard:
         for panel in self._panels:
             try:
                 panel.close()
-            except Exception:  # noqa: BLE001 - shutting down: close the others anyway
+            except Exception:  # shutting down: close the others anyway
                 log.exception("close of %s failed", type(panel).__name__)
         self.rosout.close()

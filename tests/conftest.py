@@ -142,7 +142,7 @@ class DashboardProcess:
         self.url = f"http://127.0.0.1:{port}"
         self.log_path = ARTIFACTS / f"dashboard-{port}.log"
         ARTIFACTS.mkdir(exist_ok=True)
-        self._log = open(self.log_path, "wb")  # noqa: SIM115 - closed in stop()
+        self._log = open(self.log_path, "wb")
         self.proc = subprocess.Popen(
             [sys.executable, "-m", "app", "serve", "--port", str(port), *(extra or [])],
             cwd=PROJECT_ROOT,

@@ -82,7 +82,7 @@ class WireClient:
                         self._apply(message)
         except ConnectionClosed as exc:
             self.closed_reason = str(exc)
-        except Exception as exc:  # noqa: BLE001 - reported, then the test fails on it
+        except Exception as exc:  # reported, then the test fails on it
             self.closed_reason = f"{type(exc).__name__}: {exc}"
 
     def _apply(self, message: dict[str, Any]) -> None:

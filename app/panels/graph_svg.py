@@ -158,7 +158,7 @@ def layout(vertices: list[Vertex], edges: list[Edge], per_row: int = PER_ROW) ->
         slot: dict[str, float] = {}
         for level in sorted(grouped):
             members = grouped[level]
-            members.sort(key=lambda k: (_barycentre(preds[k], slot), keys.index(k)))  # noqa: B023
+            members.sort(key=lambda k: (_barycentre(preds[k], slot), keys.index(k)))
             for start in range(0, len(members), per_row):
                 row = members[start : start + per_row]
                 rows.append(row)

@@ -166,7 +166,7 @@ def node_endpoints(node: Node, fqn: str) -> NodeEndpoints | None:
             _first_types(get_action_server_names_and_types_by_node(node, name, namespace)),
             _first_types(get_action_client_names_and_types_by_node(node, name, namespace)),
         )
-    except Exception:  # noqa: BLE001 - the node left between listing and asking
+    except Exception:  # the node left between listing and asking
         return None
 
 

@@ -7,8 +7,6 @@ callback that triggered it never waits; a slider drag is coalesced by a
 
 from __future__ import annotations
 
-import threading
-
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
 from rclpy.node import Node
@@ -48,7 +46,6 @@ class CameraParamSync:
         self._client = node.create_client(
             SetParameters, f"{target}/set_parameters", callback_group=SCENE_CALLBACK_GROUP
         )
-        self._lock = threading.Lock()
         self.status = ""
         self._worker = LatestWorker("camera-params", self._send, 3.0)
 

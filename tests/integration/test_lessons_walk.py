@@ -40,7 +40,7 @@ def live(dashboard_node, supervisor):
         while not stop.wait(0.2):
             try:
                 runtime.graph = snapshot(dashboard_node)
-            except Exception as exc:  # noqa: BLE001 - a graph query raced a leaving node
+            except Exception as exc:  # a graph query raced a leaving node
                 errors.append(repr(exc))
                 continue
             supervisor.note_visible_nodes(runtime.graph.nodes)

@@ -87,8 +87,11 @@ def test_an_edit_made_after_set_is_not_overwritten(monkeypatch):
     drain(ui, until=fake.set_called.is_set)
     editor.value = 3.0  # the learner keeps typing while the set is in flight
     fake.release_set.set()
-    refresh = lambda: panel.refresh(PARAM_GRAPH)  # noqa: E731
-    drain(ui, lambda: "successful" in gui.text() and fake.reads_after_set >= 3, refresh)
+    drain(
+        ui,
+        lambda: "successful" in gui.text() and fake.reads_after_set >= 3,
+        lambda: panel.refresh(PARAM_GRAPH),
+    )
     assert fake.value == 2.0
     assert editor.value == 3.0, "the sync overwrote an edit the learner made after Set"
 
