@@ -19,10 +19,10 @@ install ``ros2 service call /add_two_ints tutorial_interfaces/srv/AddTwoInts
 "{a: 2, b: 3}"``.
 """
 
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from tutorial_interfaces.srv import AddTwoInts
+
+from nodes.common.run import spin_node
 
 INT64_MIN, INT64_MAX = -(2**63), 2**63 - 1
 
@@ -47,18 +47,7 @@ class AddTwoIntsServer(Node):
 
 
 def main(args=None) -> None:
-    node = None
-    try:
-        rclpy.init(args=args)
-        node = AddTwoIntsServer()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        # Ctrl+C can arrive before the node exists: clean up only what was made.
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    spin_node(AddTwoIntsServer, args)
 
 
 if __name__ == "__main__":

@@ -22,10 +22,10 @@ Try it: ``ros2-classroom run camera_publisher`` then echo ``/pos_in_cam_frame``.
 """
 
 import numpy as np
-import rclpy
 from geometry_msgs.msg import PointStamped
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
+
+from nodes.common.run import spin_node
 
 
 class CameraPublisher(Node):
@@ -63,18 +63,7 @@ class CameraPublisher(Node):
 
 
 def main(args=None) -> None:
-    node = None
-    try:
-        rclpy.init(args=args)
-        node = CameraPublisher()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        # Ctrl+C can arrive before the node exists: clean up only what was made.
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    spin_node(CameraPublisher, args)
 
 
 if __name__ == "__main__":

@@ -9,10 +9,11 @@ converts any point: ``p_base = T_base_camera @ p_camera``.
 The camera pose is six parameters, in metres and radians, in the base frame:
 ``camera_x``, ``camera_y``, ``camera_z`` and ``camera_roll``, ``camera_pitch``,
 ``camera_yaw`` (roll about x, then pitch about y, then yaw about z, all about
-the fixed base axes). The default puts the camera 0.25 m in front of the arm
-and 0.7 m above the table, looking straight down (roll = pi turns the optical
-z axis from "forward" to "down"). Change one while the node runs and the next
-point uses it: ``ros2 param set /coordinate_transform camera_z 0.8``.
+the fixed base axes; ROS enforces a range, +-10 m and +-2 pi). The default
+puts the camera 0.25 m in front of the arm and 0.7 m above the table, looking
+straight down (roll = pi turns the optical z axis from "forward" to "down").
+Change one while the node runs and the next point uses it:
+``ros2 param set /coordinate_transform camera_z 0.8``.
 
 ROS concepts shown: a node that is both a subscriber and a publisher (a
 "relay" that transforms data), parameters read on every message, and
@@ -23,12 +24,12 @@ install tf2 would hold this transform; here the math is in
 
 import math
 
-import rclpy
 from geometry_msgs.msg import PointStamped
-from rclpy.executors import ExternalShutdownException
+from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor
 from rclpy.node import Node
 
 from nodes.common.frames import pose_to_matrix, transform_points
+from nodes.common.run import spin_node
 
 DEFAULT_CAMERA_POSE = {
     "camera_x": 0.25,
@@ -39,12 +40,25 @@ DEFAULT_CAMERA_POSE = {
     "camera_yaw": 0.0,
 }
 
+POSITION_LIMIT_M = 10.0
+ANGLE_LIMIT_RAD = 2 * math.pi
+
+
+def pose_descriptor(name: str) -> ParameterDescriptor:
+    """A range for one pose parameter: ROS then refuses NaN, infinity and the absurd."""
+    angle = name.endswith(("roll", "pitch", "yaw"))
+    limit = ANGLE_LIMIT_RAD if angle else POSITION_LIMIT_M
+    return ParameterDescriptor(
+        description=f"camera pose in the base frame ({'radians' if angle else 'metres'})",
+        floating_point_range=[FloatingPointRange(from_value=-limit, to_value=limit)],
+    )
+
 
 class CoordinateTransform(Node):
     def __init__(self) -> None:
         super().__init__("coordinate_transform")
         for name, value in DEFAULT_CAMERA_POSE.items():
-            self.declare_parameter(name, value)
+            self.declare_parameter(name, value, pose_descriptor(name))
         self.declare_parameter("base_frame", "base_link")
         self.publisher = self.create_publisher(PointStamped, "pos_in_robot_base_frame", 10)
         self.subscription = self.create_subscription(
@@ -68,18 +82,7 @@ class CoordinateTransform(Node):
 
 
 def main(args=None) -> None:
-    node = None
-    try:
-        rclpy.init(args=args)
-        node = CoordinateTransform()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        # Ctrl+C can arrive before the node exists: clean up only what was made.
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    spin_node(CoordinateTransform, args)
 
 
 if __name__ == "__main__":

@@ -9,9 +9,9 @@ log, and its Restart button starts it again.
 Parameter ``crash_after_sec`` (float, default 3.0): how long it lives.
 """
 
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
+
+from nodes.common.run import spin_node
 
 
 class CrashingNode(Node):
@@ -29,18 +29,7 @@ class CrashingNode(Node):
 
 
 def main(args=None) -> None:
-    node = None
-    try:
-        rclpy.init(args=args)
-        node = CrashingNode()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        # Ctrl+C can arrive before the node exists: clean up only what was made.
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    spin_node(CrashingNode, args)
 
 
 if __name__ == "__main__":

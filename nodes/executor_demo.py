@@ -24,7 +24,8 @@ rate (``std_msgs/Float64``, Hz) on ``~/fast_rate``, i.e.
 
 ROS concepts shown
 - ``SingleThreadedExecutor`` vs ``MultiThreadedExecutor``,
-  ``executor.add_node`` and ``executor.spin`` instead of ``rclpy.spin``;
+  ``executor.add_node`` and ``executor.spin`` instead of ``rclpy.spin``
+  (``main`` hands ``make_executor`` to ``spin_node``, nodes/common/run.py);
 - callback groups passed as ``callback_group=`` to ``create_timer``;
 - why a long callback hurts everything else on the same thread.
 
@@ -32,28 +33,26 @@ Try it: ``ros2-classroom run executor_demo`` and
 ``ros2-classroom run executor_demo_multi`` (``-p executor:=multi``).
 """
 
-import sys
 import time
 from collections import deque
 
-import rclpy
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
 from rclpy.executors import (
     Executor,
-    ExternalShutdownException,
     MultiThreadedExecutor,
     SingleThreadedExecutor,
 )
 from rclpy.node import Node
 from std_msgs.msg import Float64
 
+from nodes.common.run import spin_node
+
 FAST_PERIOD_SEC = 0.1  # expected 10 Hz
 SLOW_PERIOD_SEC = 1.0
 SLOW_WORK_SEC = 0.8  # the slow callback blocks this long
 REPORT_PERIOD_SEC = 2.0
 RATE_WINDOW_SEC = 4.0
-EXIT_BAD_PARAMETER = 2
 
 
 def rate_hz(stamps: list[float]) -> float:
@@ -117,25 +116,9 @@ class ExecutorDemo(Node):
 
 
 def main(args=None) -> None:
-    node = executor = None
-    try:
-        rclpy.init(args=args)
-        node = ExecutorDemo()
-        executor = node.make_executor()
-        executor.add_node(node)
-        executor.spin()
-    except ValueError as exc:  # an unknown executor kind
-        print(f"executor_demo: error: {exc}", file=sys.stderr)
-        raise SystemExit(EXIT_BAD_PARAMETER) from None
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        # Ctrl+C can arrive at any point of start-up: clean up only what was made.
-        if executor is not None:
-            executor.shutdown()
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    # make_executor picks the executor from the parameter; spin_node then calls
+    # executor.add_node(node) and executor.spin() instead of rclpy.spin(node).
+    spin_node(ExecutorDemo, args, executor=ExecutorDemo.make_executor, program="executor_demo")
 
 
 if __name__ == "__main__":

@@ -34,14 +34,15 @@ ROS concepts shown
 
 import threading
 
-import rclpy
 from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.action.server import ServerGoalHandle
 from rclpy.callback_groups import ReentrantCallbackGroup
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 from tutorial_interfaces.action import Fibonacci
+
+from nodes.common.run import spin_node
 
 MIN_ORDER, MAX_ORDER = 0, 46  # F(46) = 1836311903 is the last that fits in int32
 
@@ -59,7 +60,7 @@ class FibonacciActionServer(Node):
         )
         self.goal_lock = threading.Lock()  # guards current_goal and goal state changes
         self.current_goal: ServerGoalHandle | None = None
-        self.shutting_down = threading.Event()  # set by main() on Ctrl+C or SIGTERM
+        self.shutting_down = threading.Event()  # set by stop_goals() on Ctrl+C or SIGTERM
         self.action_server = ActionServer(
             self,
             Fibonacci,
@@ -91,7 +92,9 @@ class FibonacciActionServer(Node):
                 self.get_logger().info("A new goal arrived: aborting the goal still running")
                 previous.abort()
             self.current_goal = goal_handle
-        goal_handle.execute()
+            # Still under the lock: no other goal can see this one as current while it is
+            # only accepted (aborting an accepted goal is an invalid transition that raises).
+            goal_handle.execute()
 
     def on_cancel_request(self, goal_handle: ServerGoalHandle) -> CancelResponse:
         self.get_logger().info("Cancel requested: the goal will stop before its next step")
@@ -133,30 +136,24 @@ class FibonacciActionServer(Node):
                     pass
         return Fibonacci.Result(sequence=sequence)
 
+    def stop_goals(self) -> None:
+        """The node is stopping: a goal sleeping between two steps wakes up and ends."""
+        self.shutting_down.set()
+
     def send_feedback(self, goal_handle: ServerGoalHandle, sequence: list[int]) -> None:
         goal_handle.publish_feedback(Fibonacci.Feedback(partial_sequence=sequence))
         self.get_logger().info(f"Feedback: {sequence}")
 
 
 def main(args=None) -> None:
-    node = executor = None
-    try:
-        rclpy.init(args=args)
-        node = FibonacciActionServer()
-        executor = MultiThreadedExecutor()
-        executor.add_node(node)
-        executor.spin()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        # Ctrl+C can arrive at any point of start-up: clean up only what was made.
-        if node is not None:
-            node.shutting_down.set()  # a goal still executing stops at once
-        if executor is not None:
-            executor.shutdown()
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    # Several threads: while one goal sleeps between steps, another answers new goals
+    # and cancel requests. On Ctrl+C a goal still executing is woken to stop at once.
+    spin_node(
+        FibonacciActionServer,
+        args,
+        executor=MultiThreadedExecutor,
+        before_shutdown=FibonacciActionServer.stop_goals,
+    )
 
 
 if __name__ == "__main__":

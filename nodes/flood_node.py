@@ -13,10 +13,10 @@ Parameters: ``rate_hz`` (messages a second, default 2000), ``topic``
 Try it: ``ros2-classroom run flood_node --ros-args -p rate_hz:=5000``.
 """
 
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from std_msgs.msg import String
+
+from nodes.common.run import spin_node
 
 TICK_SEC = 0.01  # publish in bursts, 100 times a second
 
@@ -44,17 +44,7 @@ class FloodNode(Node):
 
 
 def main(args=None) -> None:
-    node = None
-    try:
-        rclpy.init(args=args)
-        node = FloodNode()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    spin_node(FloodNode, args)
 
 
 if __name__ == "__main__":

@@ -22,13 +22,13 @@ import math
 
 import cv2
 import numpy as np
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import Image
 
 from nodes.common.image_conversion import array_to_image
+from nodes.common.run import spin_node
+from nodes.common.video_capture import read_frame
 
 BALL_RADIUS_PX = 34  # a 4 cm ball, 0.62 m from a 525 px focal-length camera
 
@@ -78,8 +78,9 @@ class ImagePublisher(Node):
         self.scene = None if self.capture else SyntheticScene(self.width, self.height)
         self.publisher = self.create_publisher(Image, "camera/image_raw", qos_profile_sensor_data)
         self.frames = 0
-        fps = float(self.get_parameter("fps").value)
-        self.timer = self.create_timer(1.0 / fps, self.on_timer)
+        # Read once: the timer's period and the synthetic scene's clock must agree.
+        self.fps = float(self.get_parameter("fps").value)
+        self.timer = self.create_timer(1.0 / self.fps, self.on_timer)
 
     def open_capture(self) -> cv2.VideoCapture | None:
         path = self.get_parameter("video_path").value
@@ -98,16 +99,10 @@ class ImagePublisher(Node):
 
     def next_frame(self) -> np.ndarray | None:
         if self.capture is None:
-            return self.scene.render(self.frames / float(self.get_parameter("fps").value))
-        ok, frame = self.capture.read()
-        if not ok and self.get_parameter("loop").value:
-            self.capture.set(cv2.CAP_PROP_POS_FRAMES, 0)
-            ok, frame = self.capture.read()
-        if not ok:
-            return None
-        if frame.shape[1] != self.width or frame.shape[0] != self.height:
-            frame = cv2.resize(frame, (self.width, self.height), interpolation=cv2.INTER_AREA)
-        return frame
+            assert self.scene is not None  # no capture: the synthetic scene exists
+            return self.scene.render(self.frames / self.fps)
+        loop = bool(self.get_parameter("loop").value)
+        return read_frame(self.capture, loop, self.width, self.height)
 
     def on_timer(self) -> None:
         frame = self.next_frame()
@@ -127,18 +122,7 @@ class ImagePublisher(Node):
 
 
 def main(args=None) -> None:
-    node = None
-    try:
-        rclpy.init(args=args)
-        node = ImagePublisher()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        # Ctrl+C can arrive before the node exists: clean up only what was made.
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    spin_node(ImagePublisher, args)
 
 
 if __name__ == "__main__":

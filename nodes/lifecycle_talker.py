@@ -29,7 +29,10 @@ purpose, with an error in the log, until ``fail_on`` is set back to "".
 
 ROS concepts shown
 - ``rclpy.lifecycle.LifecycleNode`` and its services
-  ``/lifecycle_talker/change_state`` and ``/lifecycle_talker/get_state``;
+  ``/lifecycle_talker/change_state`` and ``/lifecycle_talker/get_state``
+  (through ``GuardedLifecycleNode``, nodes/common/lifecycle_guard.py: a
+  transition that is impossible from the current state is refused with
+  ``success: false`` and a warning, as rclcpp does, instead of ending the node);
 - ``create_lifecycle_publisher``; ``TransitionCallbackReturn``;
 - a parameter whose allowed values are checked by a set-parameters callback.
 
@@ -37,19 +40,20 @@ Try it: ``ros2-classroom run lifecycle_talker``, then from a full ROS install
 ``ros2 lifecycle set /lifecycle_talker configure`` and ``... activate``.
 """
 
-import rclpy
 from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParametersResult
-from rclpy.executors import ExternalShutdownException
-from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
+from rclpy.lifecycle import LifecycleState, TransitionCallbackReturn
 from rclpy.lifecycle.publisher import LifecyclePublisher
 from rclpy.parameter import Parameter
 from rclpy.timer import Timer
 from std_msgs.msg import String
 
+from nodes.common.lifecycle_guard import GuardedLifecycleNode
+from nodes.common.run import spin_node
+
 TRANSITIONS = ("configure", "activate", "deactivate", "cleanup", "shutdown")
 
 
-class LifecycleTalker(LifecycleNode):
+class LifecycleTalker(GuardedLifecycleNode):
     def __init__(self) -> None:
         super().__init__("lifecycle_talker")
         self.declare_parameter(
@@ -159,18 +163,7 @@ class LifecycleTalker(LifecycleNode):
 
 
 def main(args=None) -> None:
-    node = None
-    try:
-        rclpy.init(args=args)
-        node = LifecycleTalker()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        # Ctrl+C can arrive before the node exists: clean up only what was made.
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    spin_node(LifecycleTalker, args)
 
 
 if __name__ == "__main__":

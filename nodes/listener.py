@@ -7,10 +7,10 @@ ROS concepts shown
   ``--ros-args -r __node:=listener2`` (the catalog's ``listener2``).
 """
 
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from std_msgs.msg import String
+
+from nodes.common.run import spin_node
 
 
 class Listener(Node):
@@ -23,18 +23,7 @@ class Listener(Node):
 
 
 def main(args=None) -> None:
-    node = None
-    try:
-        rclpy.init(args=args)
-        node = Listener()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        # Ctrl+C can arrive before the node exists: clean up only what was made.
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    spin_node(Listener, args)
 
 
 if __name__ == "__main__":

@@ -16,6 +16,8 @@ ROS concepts shown
 - ``create_timer(period_sec, callback)``;
 - ``get_logger().info(...)``: a log line on the console and on /rosout.
 
+The other nodes of the course hand steps 1, 3 and 4 to ``spin_node``
+(nodes/common/run.py), which does exactly what ``main`` below spells out.
 Compare it with ``minimal_node_procedural``, the same node without a class.
 Try it: ``ros2-classroom run minimal_node`` and ``ros2 node list``.
 """

@@ -11,33 +11,30 @@ ROS concepts shown
 - ``rclpy.create_node(name)`` returns a ready ``Node`` object;
 - any callable can be a callback: here a nested function that captures the
   node from the enclosing scope;
-- the same init / spin / destroy / shutdown life cycle as every node.
+- the same init / spin / destroy / shutdown life cycle as every node:
+  ``spin_node`` (nodes/common/run.py) runs it, ``minimal_node`` writes it out.
 """
 
 import rclpy
-from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+
+from nodes.common.run import spin_node
 
 TIMER_PERIOD_SEC = 0.2  # 5 Hz
 
 
+def make_node() -> Node:
+    node = rclpy.create_node("minimal_node_procedural")
+
+    def on_timer() -> None:
+        node.get_logger().info("Hello ROS2")
+
+    node.create_timer(TIMER_PERIOD_SEC, on_timer)
+    return node
+
+
 def main(args=None) -> None:
-    node = None
-    try:
-        rclpy.init(args=args)
-        node = rclpy.create_node("minimal_node_procedural")
-
-        def on_timer() -> None:
-            node.get_logger().info("Hello ROS2")
-
-        node.create_timer(TIMER_PERIOD_SEC, on_timer)
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        # Ctrl+C can arrive before the node exists: clean up only what was made.
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    spin_node(make_node, args)
 
 
 if __name__ == "__main__":

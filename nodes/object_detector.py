@@ -28,15 +28,16 @@ import math
 
 import cv2
 import numpy as np
-import rclpy
 from geometry_msgs.msg import PointStamped
-from rclpy.executors import ExternalShutdownException
+from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParametersResult
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import Image
 from tutorial_interfaces.msg import DetectedObject
 
-from nodes.common.image_conversion import array_to_image, image_to_array, to_bgr8
+from nodes.common.image_conversion import array_to_image, image_to_bgr8
+from nodes.common.run import spin_node
 
 # Hue ranges in OpenCV's 0..179 scale, with minimum saturation and value.
 COLOURS = {
@@ -66,6 +67,13 @@ def find_ball(bgr: np.ndarray, colour: str, min_radius: float, min_roundness: fl
     return u, v, radius
 
 
+def pixel_range(low: float, high: float, description: str) -> ParameterDescriptor:
+    return ParameterDescriptor(
+        description=f"{description}, pixels",
+        floating_point_range=[FloatingPointRange(from_value=low, to_value=high)],
+    )
+
+
 def pixel_to_camera(u, v, radius_px, ball_radius, fx, fy, cx, cy):
     """Camera-frame centre (m) of a ball of known size seen at (u, v) with radius_px."""
     z = fx * ball_radius / radius_px
@@ -75,12 +83,13 @@ def pixel_to_camera(u, v, radius_px, ball_radius, fx, fy, cx, cy):
 class ObjectDetector(Node):
     def __init__(self) -> None:
         super().__init__("object_detector")
-        self.declare_parameter("colour", "red")
+        self.declare_parameter("colour", "red")  # a key of COLOURS, checked on set
         self.declare_parameter("ball_radius", 0.04)  # metres
-        self.declare_parameter("min_radius", 6.0)  # pixels
+        # Ranges: ROS refuses a zero or NaN divisor (pixel radius, focal length) with a reason.
+        self.declare_parameter("min_radius", 6.0, pixel_range(1.0, 1000.0, "smallest ball radius"))
         self.declare_parameter("min_roundness", 0.6)
-        self.declare_parameter("fx", 525.0)
-        self.declare_parameter("fy", 525.0)
+        self.declare_parameter("fx", 525.0, pixel_range(1.0, 100_000.0, "focal length along x"))
+        self.declare_parameter("fy", 525.0, pixel_range(1.0, 100_000.0, "focal length along y"))
         self.declare_parameter("cx", -1.0)  # negative: the image centre
         self.declare_parameter("cy", -1.0)
         self.declare_parameter("publish_point", False)
@@ -90,13 +99,21 @@ class ObjectDetector(Node):
         self.subscription = self.create_subscription(
             Image, "camera/image_raw", self.on_image, qos_profile_sensor_data
         )
+        self.add_on_set_parameters_callback(self.on_set_parameters)
+
+    def on_set_parameters(self, params: list[Parameter]) -> SetParametersResult:
+        for param in params:
+            if param.name == "colour" and param.value not in COLOURS:
+                return SetParametersResult(
+                    successful=False,
+                    reason=f"colour must be one of {', '.join(COLOURS)}; got {param.value!r:.40}",
+                )
+        return SetParametersResult(successful=True)
 
     def on_image(self, msg: Image) -> None:
-        try:
-            bgr = to_bgr8(image_to_array(msg), msg.encoding)
-        except ValueError as exc:
-            self.get_logger().warning(f"cannot read image: {exc}", throttle_duration_sec=5.0)
-            return
+        bgr = image_to_bgr8(msg, self.get_logger())
+        if bgr is None:
+            return  # an encoding we cannot read: skipped, with a warning
         colour = self.get_parameter("colour").value
         found = find_ball(
             bgr,
@@ -155,18 +172,7 @@ class ObjectDetector(Node):
 
 
 def main(args=None) -> None:
-    node = None
-    try:
-        rclpy.init(args=args)
-        node = ObjectDetector()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        # Ctrl+C can arrive before the node exists: clean up only what was made.
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    spin_node(ObjectDetector, args)
 
 
 if __name__ == "__main__":

@@ -27,17 +27,17 @@ Try it: ``ros2-classroom run parameters_node``, then from a full ROS install
 ``ros2 param set /parameters_node publish_rate_hz 100.0`` (refused).
 """
 
-import rclpy
 from rcl_interfaces.msg import (
     FloatingPointRange,
     ParameterDescriptor,
     ParameterType,
     SetParametersResult,
 )
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from std_msgs.msg import String
+
+from nodes.common.run import spin_node
 
 MAX_GREETING_CHARS = 60
 
@@ -113,18 +113,7 @@ class ParametersNode(Node):
 
 
 def main(args=None) -> None:
-    node = None
-    try:
-        rclpy.init(args=args)
-        node = ParametersNode()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        # Ctrl+C can arrive before the node exists: clean up only what was made.
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    spin_node(ParametersNode, args)
 
 
 if __name__ == "__main__":

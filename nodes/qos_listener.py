@@ -17,29 +17,20 @@ ROS concepts shown
   ``event_callbacks`` to ``create_subscription``.
 """
 
-import sys
-
-import rclpy
-from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.event_handler import QoSRequestedIncompatibleQoSInfo, SubscriptionEventCallbacks
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.qos import qos_policy_name_from_kind
 from std_msgs.msg import String
 
-from nodes.qos_settings import describe, profile_from_names
-
-EXIT_BAD_PARAMETER = 2
+from nodes.common.run import spin_node
+from nodes.qos_settings import declare_qos_parameters, describe
 
 
 class QosListener(Node):
     def __init__(self) -> None:
         super().__init__("qos_listener")
-        read_only = ParameterDescriptor(read_only=True, description="fixed at start-up")
-        reliability = self.declare_parameter("reliability", "reliable", read_only).value
-        durability = self.declare_parameter("durability", "volatile", read_only).value
-        depth = self.declare_parameter("depth", 10, read_only).value
-        qos = profile_from_names(reliability, durability, depth)  # ValueError if bad
+        # Three read-only parameters (reliability, durability, depth) make the profile.
+        qos = declare_qos_parameters(self)  # ValueError if a value is not understood
         self.subscription = self.create_subscription(
             String,
             "qos_chatter",
@@ -67,21 +58,8 @@ class QosListener(Node):
 
 
 def main(args=None) -> None:
-    node = None
-    try:
-        rclpy.init(args=args)
-        node = QosListener()
-        rclpy.spin(node)
-    except ValueError as exc:  # a QoS parameter with an unknown value
-        print(f"qos_listener: error: {exc}", file=sys.stderr)
-        raise SystemExit(EXIT_BAD_PARAMETER) from None
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        # Ctrl+C can arrive before the node exists: clean up only what was made.
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    # A QoS parameter with an unknown value: one error line and exit status 2.
+    spin_node(QosListener, args, program="qos_listener")
 
 
 if __name__ == "__main__":

@@ -1,7 +1,8 @@
 """qos_settings: turn the QoS parameter values of qos_talker/qos_listener into a profile.
 
-Not a node: a small helper both QoS nodes share, kept free of ROS state so
-it can be tested on its own.
+Not a node: a small helper both QoS nodes share. ``declare_qos_parameters``
+declares the three read-only parameters on a node and returns their profile;
+the rest keeps no ROS state, so it can be tested on its own.
 
 A ``QoSProfile`` bundles the policies a publisher offers or a subscriber
 requests. The two taught here:
@@ -18,6 +19,8 @@ publisher, and a transient-local subscriber cannot use a volatile one. Every
 other combination works.
 """
 
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 RELIABILITY = {"reliable": ReliabilityPolicy.RELIABLE, "best_effort": ReliabilityPolicy.BEST_EFFORT}
@@ -48,3 +51,17 @@ def describe(profile: QoSProfile) -> str:
     reliability = {v: k for k, v in RELIABILITY.items()}[profile.reliability]
     durability = {v: k for k, v in DURABILITY.items()}[profile.durability]
     return f"{reliability}, {durability}, depth {profile.depth}"
+
+
+def declare_qos_parameters(node: Node) -> QoSProfile:
+    """Declare ``reliability``, ``durability`` and ``depth`` on ``node``; their profile.
+
+    Read-only: QoS is fixed when a publisher or subscription is created, so a
+    change later could not take effect (``--ros-args -p`` still sets them at
+    start-up). ValueError names a value that is not understood.
+    """
+    read_only = ParameterDescriptor(read_only=True, description="fixed at start-up")
+    reliability = node.declare_parameter("reliability", "reliable", read_only).value
+    durability = node.declare_parameter("durability", "volatile", read_only).value
+    depth = node.declare_parameter("depth", 10, read_only).value
+    return profile_from_names(reliability, durability, depth)

@@ -17,36 +17,28 @@ ROS concepts shown
   ``nodes/qos_settings.py``);
 - ``PublisherEventCallbacks(incompatible_qos=..., matched=...)`` passed as
   ``event_callbacks`` to ``create_publisher``;
-- read-only parameters for settings that cannot change after start-up.
+- read-only parameters for settings that cannot change after start-up
+  (declared in ``qos_settings.declare_qos_parameters``).
 
 Try it: ``ros2-classroom launch qos_mismatch`` (a best-effort talker and a
 reliable listener), or ``ros2-classroom run qos_talker --ros-args -p
 reliability:=best_effort``.
 """
 
-import sys
-
-import rclpy
-from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.event_handler import PublisherEventCallbacks, QoSOfferedIncompatibleQoSInfo
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.qos import qos_policy_name_from_kind
 from std_msgs.msg import String
 
-from nodes.qos_settings import describe, profile_from_names
-
-EXIT_BAD_PARAMETER = 2
+from nodes.common.run import spin_node
+from nodes.qos_settings import declare_qos_parameters, describe
 
 
 class QosTalker(Node):
     def __init__(self) -> None:
         super().__init__("qos_talker")
-        read_only = ParameterDescriptor(read_only=True, description="fixed at start-up")
-        reliability = self.declare_parameter("reliability", "reliable", read_only).value
-        durability = self.declare_parameter("durability", "volatile", read_only).value
-        depth = self.declare_parameter("depth", 10, read_only).value
-        qos = profile_from_names(reliability, durability, depth)  # ValueError if bad
+        # Three read-only parameters (reliability, durability, depth) make the profile.
+        qos = declare_qos_parameters(self)  # ValueError if a value is not understood
         self.count = 0
         self.publisher = self.create_publisher(
             String,
@@ -78,21 +70,8 @@ class QosTalker(Node):
 
 
 def main(args=None) -> None:
-    node = None
-    try:
-        rclpy.init(args=args)
-        node = QosTalker()
-        rclpy.spin(node)
-    except ValueError as exc:  # a QoS parameter with an unknown value
-        print(f"qos_talker: error: {exc}", file=sys.stderr)
-        raise SystemExit(EXIT_BAD_PARAMETER) from None
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        # Ctrl+C can arrive before the node exists: clean up only what was made.
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    # A QoS parameter with an unknown value: one error line and exit status 2.
+    spin_node(QosTalker, args, program="qos_talker")
 
 
 if __name__ == "__main__":

@@ -21,9 +21,8 @@ analytic IK are documented in ``nodes/common/arm_kinematics.py``.
 import math
 
 import numpy as np
-import rclpy
 from geometry_msgs.msg import PointStamped, PoseStamped
-from rclpy.executors import ExternalShutdownException
+from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
@@ -36,6 +35,7 @@ from nodes.common.arm_kinematics import (
     step_towards,
 )
 from nodes.common.frames import matrix_to_quaternion
+from nodes.common.run import spin_node
 
 HOME = (0.0, math.radians(60.0), math.radians(-110.0), math.radians(-40.0))
 
@@ -44,7 +44,15 @@ class RoboticArm(Node):
     def __init__(self) -> None:
         super().__init__("robotic_arm")
         self.declare_parameter("rate", 25.0)  # Hz
-        self.declare_parameter("max_joint_speed", 1.5)  # rad/s
+        self.declare_parameter(
+            "max_joint_speed",
+            1.5,
+            # A range makes ROS refuse 0, a negative or NaN speed, which cannot move the arm.
+            ParameterDescriptor(
+                description="rad/s, the fastest a joint may turn",
+                floating_point_range=[FloatingPointRange(from_value=0.01, to_value=10.0)],
+            ),
+        )
         self.declare_parameter("base_frame", "base_link")
         self.joints = np.array(HOME)
         self.goal = self.joints.copy()
@@ -81,7 +89,8 @@ class RoboticArm(Node):
     def on_timer(self) -> None:
         max_step = float(self.get_parameter("max_joint_speed").value) * self.period
         self.joints = step_towards(self.joints, self.goal, max_step)
-        if self.state == "moving" and np.allclose(self.joints, self.goal, atol=1e-9):
+        arrived = np.allclose(self.joints, self.goal, atol=1e-9)
+        if self.state == "moving" and self.target is not None and arrived:
             self.state = "reached"
             x, y, z = self.target
             self.report(f"reached ({x:.3f}, {y:.3f}, {z:.3f})")
@@ -107,18 +116,7 @@ class RoboticArm(Node):
 
 
 def main(args=None) -> None:
-    node = None
-    try:
-        rclpy.init(args=args)
-        node = RoboticArm()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        # Ctrl+C can arrive before the node exists: clean up only what was made.
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    spin_node(RoboticArm, args)
 
 
 if __name__ == "__main__":

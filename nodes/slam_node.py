@@ -27,16 +27,15 @@ import time
 
 import cv2
 import numpy as np
-import rclpy
 from geometry_msgs.msg import Point
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from sensor_msgs.msg import Image, PointCloud2
 from visualization_msgs.msg import Marker, MarkerArray
 
 from nodes.common.frames import BODY_FROM_OPTICAL, make_transform, matrix_to_quaternion
-from nodes.common.image_conversion import array_to_image, image_to_array, to_bgr8
+from nodes.common.image_conversion import array_to_image, image_to_bgr8
 from nodes.common.pointcloud import xyz_to_pointcloud2
+from nodes.common.run import spin_node
 from nodes.common.slam import FrameResult, MonocularVO
 
 # map frame (z up) from SLAM world (first camera, optical axes)
@@ -81,11 +80,9 @@ class SlamNode(Node):
         return MonocularVO(K)
 
     def on_image(self, msg: Image) -> None:
-        try:
-            bgr = to_bgr8(image_to_array(msg), msg.encoding)
-        except ValueError as exc:
-            self.get_logger().warning(f"cannot read image: {exc}", throttle_duration_sec=5.0)
-            return
+        bgr = image_to_bgr8(msg, self.get_logger())
+        if bgr is None:
+            return  # an encoding we cannot read: skipped, with a warning
         if self.vo is None:
             self.vo = self.make_vo(msg.width, msg.height)
         start = time.perf_counter()
@@ -103,13 +100,13 @@ class SlamNode(Node):
         now = time.monotonic()
         if now - self.last_map_time >= float(self.get_parameter("map_period").value):
             self.last_map_time = now
-            self.publish_map(msg)
+            self.publish_map(self.vo, msg)
         if self.frames % 100 == 0:
             fps = self.frames / max(self.processing_time, 1e-9)
             self.get_logger().info(f"{self.frames} frames, {fps:.1f} frames/s of SLAM work")
 
-    def publish_map(self, msg: Image) -> None:
-        points, colours = self.vo.points, self.vo.colors
+    def publish_map(self, vo: MonocularVO, msg: Image) -> None:
+        points, colours = vo.points, vo.colors
         limit = int(self.get_parameter("max_published_points").value)
         if len(points) > limit:  # the newest points: where the camera is now
             points, colours = points[-limit:], colours[-limit:]
@@ -150,18 +147,7 @@ class SlamNode(Node):
 
 
 def main(args=None) -> None:
-    node = None
-    try:
-        rclpy.init(args=args)
-        node = SlamNode()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        # Ctrl+C can arrive before the node exists: clean up only what was made.
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    spin_node(SlamNode, args)
 
 
 if __name__ == "__main__":

@@ -12,10 +12,10 @@ Try it: ``ros2-classroom run talker`` and, in another terminal,
 ``ros2-classroom run listener``.
 """
 
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from std_msgs.msg import String
+
+from nodes.common.run import spin_node
 
 
 class Talker(Node):
@@ -33,18 +33,7 @@ class Talker(Node):
 
 
 def main(args=None) -> None:
-    node = None
-    try:
-        rclpy.init(args=args)
-        node = Talker()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass  # Ctrl+C (SIGINT) or SIGTERM: leave quietly
-    finally:
-        # Ctrl+C can arrive before the node exists: clean up only what was made.
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    spin_node(Talker, args)
 
 
 if __name__ == "__main__":

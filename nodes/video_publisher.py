@@ -14,15 +14,16 @@ principal point in the image centre; ``slam_node`` assumes the same by default.
 """
 
 import cv2
-import rclpy
+import numpy as np
 from geometry_msgs.msg import PoseStamped
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from sensor_msgs.msg import Image
 
 from nodes.common.frames import matrix_to_quaternion
 from nodes.common.image_conversion import array_to_image
+from nodes.common.run import spin_node
 from nodes.common.synthetic_world import SyntheticSequence
+from nodes.common.video_capture import read_frame
 
 
 class VideoPublisher(Node):
@@ -36,8 +37,8 @@ class VideoPublisher(Node):
         self.declare_parameter("frames_per_loop", 300)  # synthetic: frames for one lap
         self.width = int(self.get_parameter("width").value)
         self.height = int(self.get_parameter("height").value)
-        self.capture = None
-        self.sequence = None
+        self.capture: cv2.VideoCapture | None = None
+        self.sequence: SyntheticSequence | None = None
         path = self.get_parameter("video_path").value
         if path:
             self.capture = cv2.VideoCapture(path)
@@ -54,19 +55,9 @@ class VideoPublisher(Node):
         self.index = 0
         self.timer = self.create_timer(1.0 / float(self.get_parameter("fps").value), self.on_timer)
 
-    def read_video(self):
-        ok, frame = self.capture.read()
-        if not ok and self.get_parameter("loop").value:
-            self.capture.set(cv2.CAP_PROP_POS_FRAMES, 0)
-            ok, frame = self.capture.read()
-        if not ok:
-            return None
-        if frame.shape[1] != self.width or frame.shape[0] != self.height:
-            frame = cv2.resize(frame, (self.width, self.height), interpolation=cv2.INTER_AREA)
-        return frame
-
     def on_timer(self) -> None:
         stamp = self.get_clock().now().to_msg()
+        frame: np.ndarray | None
         if self.sequence is not None:
             frame = self.sequence.frame(self.index)
             pose = self.sequence.pose(self.index)
@@ -79,7 +70,9 @@ class VideoPublisher(Node):
             o.x, o.y, o.z, o.w = matrix_to_quaternion(pose[:3, :3])
             self.truth_publisher.publish(truth)
         else:
-            frame = self.read_video()
+            assert self.capture is not None  # no synthetic sequence: a video file is open
+            loop = bool(self.get_parameter("loop").value)
+            frame = read_frame(self.capture, loop, self.width, self.height)
             if frame is None:
                 self.get_logger().info("end of the video", once=True)
                 return
@@ -96,18 +89,7 @@ class VideoPublisher(Node):
 
 
 def main(args=None) -> None:
-    node = None
-    try:
-        rclpy.init(args=args)
-        node = VideoPublisher()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        # Ctrl+C can arrive before the node exists: clean up only what was made.
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    spin_node(VideoPublisher, args)
 
 
 if __name__ == "__main__":

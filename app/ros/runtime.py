@@ -23,11 +23,16 @@ from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
+from nodes.common.parameter_guard import guard_parameter_services
+
 DASHBOARD_NODE_NAME = "classroom_dashboard"
 
 
 class RosRuntime:
     def __init__(self, node_name: str = DASHBOARD_NODE_NAME) -> None:
+        # Our node serves parameters too: a client sending an unknown parameter
+        # type must get a refusal, not end the dashboard (rclpy 7.1.6 bug).
+        guard_parameter_services()
         self.context = Context()
         rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO)
         self.node = Node(node_name, context=self.context)

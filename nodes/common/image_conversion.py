@@ -16,6 +16,7 @@ The numpy core (:func:`bytes_to_array`, :func:`array_to_bytes`) needs no ROS;
 from __future__ import annotations
 
 import sys
+from typing import Literal
 
 import numpy as np
 
@@ -65,7 +66,7 @@ def bytes_to_array(
     rows = buffer[: height * step].reshape(height, step)[:, :row_bytes]
     if dtype.itemsize > 1:
         rows = np.ascontiguousarray(rows)  # a padded view cannot be re-typed in place
-    order = ">" if is_bigendian else "<"
+    order: Literal[">", "<"] = ">" if is_bigendian else "<"
     pixels = rows.view(dtype.newbyteorder(order)).reshape(height, width, channels)
     if dtype.itemsize > 1 and bool(is_bigendian) != HOST_IS_BIGENDIAN:
         pixels = pixels.astype(dtype)  # to native order
@@ -140,3 +141,15 @@ def array_to_image(array: np.ndarray, encoding: str = "bgr8", header=None):
     if header is not None:
         msg.header = header
     return msg
+
+
+def image_to_bgr8(msg, logger) -> np.ndarray | None:
+    """A received Image as a bgr8 array, or None after a warning (throttled) saying why.
+
+    A subscriber cannot refuse a message: a frame it cannot read is skipped, never fatal.
+    """
+    try:
+        return to_bgr8(image_to_array(msg), msg.encoding)
+    except ValueError as exc:
+        logger.warning(f"cannot read image: {exc}", throttle_duration_sec=5.0)
+        return None

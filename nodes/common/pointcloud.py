@@ -13,10 +13,12 @@ Colours follow the PCL convention: a field named ``rgb`` (or ``rgba``) holding
 
 from __future__ import annotations
 
+from typing import Literal
+
 import numpy as np
 
 # sensor_msgs/PointField datatype constants -> numpy
-POINTFIELD_DTYPES = {
+POINTFIELD_DTYPES: dict[int, np.dtype] = {
     1: np.dtype(np.int8),
     2: np.dtype(np.uint8),
     3: np.dtype(np.int16),
@@ -32,7 +34,7 @@ UINT32 = 6
 
 def fields_to_dtype(fields, point_step: int, is_bigendian: bool = False) -> np.dtype:
     """A structured dtype that lays the fields out exactly as in one point."""
-    order = ">" if is_bigendian else "<"
+    order: Literal[">", "<"] = ">" if is_bigendian else "<"
     names, formats, offsets = [], [], []
     for field in fields:
         base = POINTFIELD_DTYPES.get(int(field.datatype))

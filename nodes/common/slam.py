@@ -32,6 +32,7 @@ estimated trajectory against ground truth up to the unknown similarity
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import cv2
 import numpy as np
@@ -45,7 +46,7 @@ def match_orb(
     gray_a: np.ndarray, gray_b: np.ndarray, n_features: int = 1500, ratio: float = 0.75
 ) -> tuple[np.ndarray, np.ndarray]:
     """ORB keypoints matched between two images (Lowe's ratio test): (N, 2) pixels each."""
-    orb = cv2.ORB_create(nfeatures=n_features)
+    orb = cv2.ORB.create(nfeatures=n_features)
     kp_a, des_a = orb.detectAndCompute(gray_a, None)
     kp_b, des_b = orb.detectAndCompute(gray_b, None)
     if des_a is None or des_b is None or len(kp_a) < 2 or len(kp_b) < 2:
@@ -56,8 +57,8 @@ def match_orb(
         for pair in matcher.knnMatch(des_a, des_b, k=2)
         if len(pair) == 2 and pair[0].distance < ratio * pair[1].distance
     ]
-    pts_a = np.float32([kp_a[m.queryIdx].pt for m in good]).reshape(-1, 2)
-    pts_b = np.float32([kp_b[m.trainIdx].pt for m in good]).reshape(-1, 2)
+    pts_a = np.array([kp_a[m.queryIdx].pt for m in good], np.float32).reshape(-1, 2)
+    pts_b = np.array([kp_b[m.trainIdx].pt for m in good], np.float32).reshape(-1, 2)
     return pts_a, pts_b
 
 
@@ -278,18 +279,20 @@ class MonocularVO:
         self.uid = np.concatenate([self.uid, np.arange(self._next_uid, self._next_uid + n)])
         self._next_uid += n
 
-    def _track(self, gray: np.ndarray) -> None:
+    def _track(self, prev_gray: np.ndarray, gray: np.ndarray) -> None:
         s = self.settings
         if len(self.pts) == 0:
             return
-        params = dict(
+        params: dict[str, Any] = dict(
             winSize=(s.lk_window, s.lk_window),
             maxLevel=s.lk_levels,
             criteria=(cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 30, 0.01),
         )
         p0 = self.pts.reshape(-1, 1, 2)
-        p1, st1, _ = cv2.calcOpticalFlowPyrLK(self.prev_gray, gray, p0, None, **params)
-        back, st2, _ = cv2.calcOpticalFlowPyrLK(gray, self.prev_gray, p1, None, **params)
+        # nextPts=None: OpenCV allocates the output; its type stubs do not allow None there.
+        flow = cv2.calcOpticalFlowPyrLK
+        p1, st1, _ = flow(prev_gray, gray, p0, None, **params)  # type: ignore[call-overload]
+        back, st2, _ = flow(gray, prev_gray, p1, None, **params)  # type: ignore[call-overload]
         p1 = p1.reshape(-1, 2)
         fb = np.linalg.norm(back.reshape(-1, 2) - self.pts, axis=1)
         h, w = gray.shape
@@ -396,7 +399,7 @@ class MonocularVO:
         s = self.settings
         if len(obj) < s.pnp_min_points:
             return None
-        kwargs = {}
+        kwargs: dict[str, Any] = {}
         if guess is not None:
             T_cam_world = invert_transform(guess)
             rvec, _ = cv2.Rodrigues(T_cam_world[:3, :3])
@@ -522,7 +525,7 @@ class MonocularVO:
             self._detect(gray)
             state = "waiting"
         else:
-            self._track(gray)
+            self._track(self.prev_gray, gray)
             if not self.initialised:
                 if self._try_initialise(bgr):
                     state = "initialised"

@@ -100,11 +100,11 @@ class Room:
         dirs = self._camera_rays(intr) @ T_world_cam[:3, :3].T.astype(np.float32)
         # Distance along each ray to the wall it meets on each axis; the nearest one wins.
         dist = []
-        for axis in range(3):
-            d = dirs[:, axis]
+        for i in range(3):
+            d = dirs[:, i]
             with np.errstate(divide="ignore", invalid="ignore"):
-                wall = np.where(d > 0, np.float32(ROOM_MAX[axis]), np.float32(ROOM_MIN[axis]))
-                t = (wall - origin[axis]) / d
+                wall = np.where(d > 0, np.float32(ROOM_MAX[i]), np.float32(ROOM_MIN[i]))
+                t = (wall - origin[i]) / d
             t[~(t > 0)] = np.inf  # parallel rays (d == 0) never meet that wall
             dist.append(t)
         nearest = np.minimum(np.minimum(dist[0], dist[1]), dist[2])
