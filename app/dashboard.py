@@ -152,4 +152,5 @@ class Dashboard:
                 panel.close()
             except Exception:  # shutting down: close the others anyway
                 log.exception("close of %s failed", type(panel).__name__)
+        self.lessons.close()
         self.rosout.close()

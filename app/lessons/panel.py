@@ -196,4 +196,4 @@ class LessonsPanel:
         return warning + "| unit | lesson | done |\n|---|---|---|\n" + "\n".join(rows) + errors
 
     def close(self) -> None:
-        self._live.close()
+        """The dashboard owns the lesson runtime and closes it; nothing else is held."""

@@ -105,7 +105,8 @@ class UiLoop:
     def wait(self, timeout: float) -> bool:
         """Sleep until something was posted or a job ended, at most ``timeout`` s."""
         woken = self._wake.wait(timeout)
-        self._wake.clear()
+        if woken:  # a wake that lands after a timeout stays set for the next wait
+            self._wake.clear()
         return woken
 
     def apply_pending(self) -> int:

@@ -33,9 +33,17 @@ def test_start_watch_and_stop_talker_and_listener(page):
 
     open_tab(page, "Graph")
     expect_text(page, "ros2 node list")
-    expect(page.get_by_text("/talker", exact=True)).to_have_count(0, timeout=15_000)
-    expect(page.get_by_text("/listener", exact=True)).to_have_count(0, timeout=15_000)
-    expect_text(page, "/classroom_dashboard")  # the graph is still drawn, now without them
+
+    def listed_as_running(name: str):
+        # An item of the node list. A name DDS keeps after its process ended
+        # (a "ghost", rare but real) is shown apart, as a stale name: allowed.
+        return (
+            page.locator("li").filter(has=page.get_by_text(name, exact=True)).filter(visible=True)
+        )
+
+    expect(listed_as_running("/talker")).to_have_count(0, timeout=15_000)
+    expect(listed_as_running("/listener")).to_have_count(0, timeout=15_000)
+    expect(listed_as_running("/classroom_dashboard")).to_have_count(1)  # the list is still drawn
 
 
 def test_crashed_node_shows_exit_code_and_restarts(page):
