@@ -12,11 +12,23 @@ STAMP := $(VENV)/.classroom-setup
 INTERFACES := interfaces/tutorial_interfaces
 INTERFACE_FILES := $(wildcard $(INTERFACES)/msg/* $(INTERFACES)/srv/* $(INTERFACES)/action/*) \
 	$(INTERFACES)/CMakeLists.txt $(INTERFACES)/package.xml $(INTERFACES)/pyproject.toml
+EDITOR := app/exercises/editor
+EDITOR_STAMP := $(EDITOR)/node_modules/.classroom-setup
 ARGS ?=
 
 .PHONY: setup run test browser lint bench clean
 
-setup: $(STAMP)
+setup: $(STAMP) $(EDITOR_STAMP)
+
+# The exercise code editor (Ace), from the npm registry at the version the lock file pins.
+$(EDITOR_STAMP): $(EDITOR)/package.json $(EDITOR)/package-lock.json
+	@command -v npm >/dev/null 2>&1 || { \
+		echo "== installing Debian's npm for the exercise editor"; \
+		SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+		$$SUDO apt-get update -q && $$SUDO apt-get install -y -q npm; }
+	@echo "== installing the exercise editor (ace-builds from npm)"
+	npm ci --prefix $(EDITOR) --no-audit --no-fund --loglevel=error
+	@touch $(EDITOR_STAMP)
 
 $(STAMP): pyproject.toml $(INTERFACE_FILES)
 	@test -n "$(PYTHON)" || { echo "error: ROS 2 Jazzy wheels need CPython 3.10, 3.11 or 3.12; none found" >&2; exit 1; }
@@ -57,4 +69,4 @@ bench: setup browser
 	$(VPY) tests/run.py --bench $(ARGS)
 
 clean:
-	rm -rf $(VENV) $(INTERFACES)/build .mypy_cache .import_linter_cache
+	rm -rf $(VENV) $(EDITOR)/node_modules $(INTERFACES)/build .mypy_cache .import_linter_cache

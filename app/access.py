@@ -21,10 +21,10 @@ import http
 import re
 import secrets
 import threading
-from collections.abc import Callable, Iterator
+from collections.abc import Awaitable, Callable, Iterator
 from contextlib import contextmanager
 from http.cookies import SimpleCookie
-from typing import Any
+from typing import Any, Protocol
 from urllib.parse import parse_qs, urlsplit
 
 import viser
@@ -37,6 +37,7 @@ _TOKEN_SHAPE = re.compile(r"^[A-Za-z0-9_-]{16,128}$")
 _PATCH_LOCK = threading.Lock()
 
 ProcessRequest = Callable[[ServerConnection, Request], Response | None]
+Handler = Callable[[ServerConnection], Awaitable[None]]
 
 
 class AccessError(ValueError):
@@ -115,14 +116,29 @@ def _same_origin(request: Request) -> bool:
     return urlsplit(origin).netloc == request.headers.get("Host", "")
 
 
+class ServerExtension(Protocol):
+    """Extra HTTP routes and websocket paths on viser's server (the exercise editor)."""
+
+    def wrap_http(self, inner: ProcessRequest | None) -> ProcessRequest: ...
+
+    def wrap_handler(self, inner: Handler) -> Handler: ...
+
+
 @contextmanager
-def _gated_serve(gate: TokenGate) -> Iterator[None]:
+def _extended_serve(gate: TokenGate | None, extension: ServerExtension | None) -> Iterator[None]:
+    """While viser builds its server: our routes behind the gate, the gate in front of all."""
     original = ws_server.serve
 
-    def serve(*args: Any, **kwargs: Any) -> Any:
-        kwargs["process_request"] = gate.wrap(kwargs.get("process_request"))
-        gate.installed = True
-        return original(*args, **kwargs)
+    def serve(handler: Handler, *args: Any, **kwargs: Any) -> Any:
+        process_request = kwargs.get("process_request")
+        if extension is not None:
+            process_request = extension.wrap_http(process_request)
+            handler = extension.wrap_handler(handler)
+        if gate is not None:
+            process_request = gate.wrap(process_request)
+            gate.installed = True
+        kwargs["process_request"] = process_request
+        return original(handler, *args, **kwargs)
 
     with _PATCH_LOCK:
         ws_server.serve = serve  # type: ignore[assignment,misc]
@@ -133,15 +149,15 @@ def _gated_serve(gate: TokenGate) -> Iterator[None]:
 
 
 def make_server(
-    host: str, port: int, token: str | None
+    host: str, port: int, token: str | None, extension: ServerExtension | None = None
 ) -> tuple[viser.ViserServer, TokenGate | None]:
     """A viser server; with a token, every request must carry it (fails closed)."""
-    if token is None:
+    if token is None and extension is None:
         return viser.ViserServer(host=host, port=port, verbose=False), None
-    gate = TokenGate(token, port)
-    with _gated_serve(gate):
+    gate = TokenGate(token, port) if token is not None else None
+    with _extended_serve(gate, extension):
         server = viser.ViserServer(host=host, port=port, verbose=False)
-    if not gate.installed:
+    if gate is not None and not gate.installed:
         server.stop()
         raise RuntimeError("could not install the access token gate in this viser version")
     return server, gate

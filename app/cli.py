@@ -16,6 +16,7 @@ import sys
 import threading
 import time
 from pathlib import Path
+from typing import Any
 
 from app import catalog
 from app.dds import configure_this_process, validate_domain_id
@@ -83,6 +84,23 @@ def _access_token(args: argparse.Namespace) -> str | None:
         raise CliError(str(exc)) from None
 
 
+def _run_policy(args: argparse.Namespace, progress_dir: Path, workspace: Any) -> Any:
+    """Learner code: as the user on loopback; served to others, only contained and allowed."""
+    from app.exercises.runner import RunPolicy
+
+    if _is_loopback(args.host):
+        return RunPolicy()
+    own = workspace.scratch.resolve()
+
+    def holds_own(path: Path) -> bool:
+        return own == path.resolve() or own.is_relative_to(path.resolve())
+
+    # Our progress, the other learners' (siblings in a classroom) and their scratch folders.
+    candidates = [progress_dir, *progress_dir.parent.glob("*"), *workspace.scratch_root.glob("*")]
+    hidden = tuple(p for p in candidates if p.is_dir() and not holds_own(p))
+    return RunPolicy(allowed=args.allow_learner_code, contained=True, hidden=hidden)
+
+
 def cmd_serve(args: argparse.Namespace) -> int:
     token = _access_token(args)
     configure_this_process(domain_id=args.domain_id, network=args.network)
@@ -91,6 +109,9 @@ def cmd_serve(args: argparse.Namespace) -> int:
     # Heavy imports only for the command that needs them.
     from app.access import make_server
     from app.dashboard import Dashboard
+    from app.exercises.editor_server import EditorHub
+    from app.exercises.panel import ExerciseSettings
+    from app.exercises.workspace import Workspace
     from app.lessons.progress import DEFAULT_DIR, ProgressStore
     from app.ros.runtime import RosRuntime
     from app.supervisor import Supervisor
@@ -104,13 +125,18 @@ def cmd_serve(args: argparse.Namespace) -> int:
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: stop_requested.set())
 
-    server, _gate = make_server(args.host, args.port, token)
+    editor_hub = EditorHub()
+    server, _gate = make_server(args.host, args.port, token, editor_hub)
     if server.get_port() != args.port:
         server.stop()
         raise CliError(f"port {args.port} on {args.host} became busy; pick another with --port")
     runtime = RosRuntime()
     supervisor = Supervisor(os.environ)
-    dashboard = Dashboard(server, runtime, supervisor, progress)
+    workspace = Workspace(progress, args.scratch_dir or DEFAULT_DIR.parent / "scratch")
+    settings = ExerciseSettings(
+        _run_policy(args, progress.path.parent, workspace), args.reveal_solution_after
+    )
+    dashboard = Dashboard(server, runtime, supervisor, progress, editor_hub, workspace, settings)
     dashboard.start()
     domain = os.environ.get("ROS_DOMAIN_ID", "0")
     scope = "network (opt-in)" if args.network else "loopback only"
@@ -196,6 +222,15 @@ def cmd_launch(args: argparse.Namespace) -> int:
     return launch_in_foreground(args.group, os.environ)
 
 
+def cmd_exercise(args: argparse.Namespace) -> int:
+    """Exercises from a terminal (app/exercises/cli.py)."""
+    from app.exercises.cli import main as exercise_main
+
+    if args.verb == "check":
+        configure_this_process(domain_id=args.domain_id, network=args.network)
+    return exercise_main(args.verb, args.slug, args.file)
+
+
 ROS2_GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface")
 
 
@@ -241,6 +276,24 @@ def build_parser() -> argparse.ArgumentParser:
     )
     serve.add_argument("--learner", default="default", help="whose lesson progress to keep")
     serve.add_argument(
+        "--allow-learner-code",
+        action="store_true",
+        help="with --allow-remote: let learners run their exercise code (always contained)",
+    )
+    serve.add_argument(
+        "--reveal-solution-after",
+        type=int,
+        default=None,
+        metavar="N",
+        help="failed checks before an exercise's reference solution may be shown",
+    )
+    serve.add_argument(
+        "--scratch-dir",
+        type=Path,
+        default=None,
+        help="where learner code runs (default var/scratch)",
+    )
+    serve.add_argument(
         "--progress-dir",
         type=Path,
         default=None,
@@ -281,6 +334,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     dds_options(launch)
     launch.set_defaults(func=cmd_launch)
+
+    exercise = sub.add_parser("exercise", help="list, print or grade the exercises")
+    exercise.add_argument("verb", choices=("list", "starter", "solution", "check"))
+    exercise.add_argument("slug", nargs="?", help="the exercise (see `exercise list`)")
+    exercise.add_argument("file", nargs="?", type=Path, help="check: the file to grade")
+    dds_options(exercise)
+    exercise.set_defaults(func=cmd_exercise)
 
     # ros2-like verbs (app/ros2cli): `ros2-classroom topic list -t` is `ros2 topic list -t`.
     for group in ROS2_GROUPS:

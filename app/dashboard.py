@@ -14,6 +14,11 @@ from collections.abc import Callable
 
 import viser
 
+from app.exercises.editor_server import EditorHub
+from app.exercises.grader import Grader
+from app.exercises.model import load_exercises
+from app.exercises.panel import ExercisePanel, ExerciseSettings
+from app.exercises.workspace import Workspace
 from app.lessons.panel import LessonsPanel
 from app.lessons.progress import ProgressStore
 from app.lessons.runtime import LessonRuntime
@@ -42,7 +47,8 @@ UI_PERIOD_SEC = 0.2  # panels refresh at 5 Hz
 GRAPH_CHECK_SEC = 0.02  # ...and within 20 ms of a node joining/leaving or an intent
 
 _ICONS = {
-    "Lessons": viser.Icon.SCHOOL, "Nodes": viser.Icon.CPU, "Graph": viser.Icon.SITEMAP,
+    "Lessons": viser.Icon.SCHOOL, "Exercise": viser.Icon.PENCIL, "Nodes": viser.Icon.CPU,
+    "Graph": viser.Icon.SITEMAP,
     "Echo": viser.Icon.MESSAGE, "3D view": viser.Icon.CUBE, "Topics": viser.Icon.LIST_DETAILS,
     "Parameters": viser.Icon.ADJUSTMENTS, "Console": viser.Icon.TERMINAL,
     "Services": viser.Icon.ARROWS_EXCHANGE, "Actions": viser.Icon.ROCKET,
@@ -57,11 +63,18 @@ class Dashboard:
         runtime: RosRuntime,
         supervisor: Supervisor,
         progress: ProgressStore,
+        editor_hub: EditorHub,
+        workspace: Workspace,
+        exercise_settings: ExerciseSettings | None = None,
     ):
         self.server = server
         self.runtime = runtime
         self.supervisor = supervisor
         self.progress = progress
+        self.editor_hub = editor_hub
+        self.workspace = workspace
+        self.exercise_settings = exercise_settings or ExerciseSettings()
+        self.exercises = load_exercises()
         self.ui = UiLoop()
         self.lessons = LessonRuntime(runtime.node, supervisor)
         self.rosout = RosoutLog(runtime.node)
@@ -85,8 +98,31 @@ class Dashboard:
             f"Domain id **{os.environ.get('ROS_DOMAIN_ID', '0')}** · "
             "this dashboard is the ROS node `/classroom_dashboard`."
         )
+        # One window docked on the left: the lesson's code and the learner's own.
+        side_window = gui.add_panel()
+        side_window.dock_left()
+        side_window.set_width(560)
         builders: dict[str, Callable[[], Panel]] = {
-            "Lessons": lambda: LessonsPanel(gui, ui, load_course(), self.lessons, self.progress),
+            "Lessons": lambda: LessonsPanel(
+                gui,
+                ui,
+                load_course(),
+                self.lessons,
+                self.progress,
+                side_window,
+                self._exercise_marks,
+            ),
+            "Exercise": lambda: ExercisePanel(
+                gui,
+                ui,
+                self.exercises,
+                self.workspace,
+                self.supervisor,
+                Grader(node, self.supervisor),
+                self.editor_hub,
+                side_window,
+                self.exercise_settings,
+            ),
             "Nodes": lambda: NodesPanel(gui, ui, self.supervisor),
             "Graph": lambda: GraphPanel(gui, node),
             "Echo": lambda: EchoPanel(gui, node),
@@ -106,6 +142,11 @@ class Dashboard:
             with tabs.add_tab(name, _ICONS[name]):
                 panels.append(builders[name]())
         return panels
+
+    def _exercise_marks(self, lesson_id: str) -> str:
+        """The outline's exercise column: ✓ for each exercise passed, ○ for each open."""
+        exercises = self.exercises.for_lesson(lesson_id)
+        return " ".join("✓" if self.workspace.passed(e) else "○" for e in exercises)
 
     def start(self) -> None:
         self._ui_thread.start()

@@ -29,6 +29,7 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from concurrent.futures import TimeoutError as FutureTimeout  # not TimeoutError on 3.10
 from dataclasses import dataclass
 from enum import Enum
+from pathlib import Path
 
 from app import PROJECT_ROOT
 from app.catalog import CatalogEntry, lookup
@@ -45,6 +46,22 @@ class NodeState(str, Enum):
     EXITED = "exited"  # ended on its own with exit code 0 (e.g. a client)
     CRASHED = "crashed"  # ended on its own with a non-zero code or a signal
 
+
+@dataclass(frozen=True)
+class LearnerProgram:
+    """A learner's own node: their file, started like a catalog node.
+
+    The dashboard builds ``argv`` from a file *it* chose (the learner's saved
+    exercise); nothing typed in the page reaches it.
+    """
+
+    name: str  # the supervisor's key, e.g. "exercise:counter_publisher"
+    node_name: str  # the ROS node the program is expected to create
+    argv: tuple[str, ...]
+    cwd: Path
+
+
+Program = CatalogEntry | LearnerProgram
 
 ACTIVE_STATES = frozenset({NodeState.STARTING, NodeState.RUNNING, NodeState.STOPPING})
 
@@ -84,7 +101,7 @@ class NodeStatus:
 class _Process:
     """Book-keeping for one child; mutated only under the supervisor's lock."""
 
-    def __init__(self, entry: CatalogEntry, popen: subprocess.Popen[bytes], max_lines: int):
+    def __init__(self, entry: Program, popen: subprocess.Popen[bytes], max_lines: int):
         self.entry = entry
         self.popen = popen
         self.state = NodeState.STARTING
@@ -141,8 +158,15 @@ class Supervisor:
 
     # -- queries -----------------------------------------------------------
 
+    def _known(self, name: str) -> None:
+        """Unknown names are an error, not "stopped"."""
+        with self._lock:
+            if name in self._procs:
+                return
+        lookup(name)
+
     def status(self, name: str) -> NodeStatus:
-        lookup(name)  # unknown names are an error, not "stopped"
+        self._known(name)
         with self._lock:
             proc = self._procs.get(name)
             return proc.status() if proc else NodeStatus(name, NodeState.STOPPED)
@@ -184,7 +208,11 @@ class Supervisor:
 
     def start(self, name: str, extra_ros_args: Iterable[str] = ()) -> NodeStatus:
         """Start a catalog node; a no-op if it is running, done after the reap if stopping."""
-        entry = lookup(name)
+        return self.start_program(lookup(name), extra_ros_args)
+
+    def start_program(self, entry: Program, extra_ros_args: Iterable[str] = ()) -> NodeStatus:
+        """Start a catalog entry or a learner's program (same rules as ``start``)."""
+        name = entry.name
         while True:
             with self._start_lock:
                 with self._lock:
@@ -204,7 +232,7 @@ class Supervisor:
 
     def stop(self, name: str) -> Future[NodeStatus]:
         """Ask a node to stop; the future resolves once it has been reaped."""
-        lookup(name)
+        self._known(name)
         future: Future[NodeStatus] = Future()
         with self._lock:
             proc = self._procs.get(name)
@@ -251,13 +279,17 @@ class Supervisor:
 
     # -- internals ---------------------------------------------------------
 
-    def _spawn(self, entry: CatalogEntry, extra_ros_args: tuple[str, ...]) -> NodeStatus:
-        argv = [sys.executable, "-m", f"nodes.{entry.module}", *entry.argv_tail()]
-        if extra_ros_args:
-            argv += ([] if entry.ros_args else ["--ros-args"]) + list(extra_ros_args)
+    def _spawn(self, entry: Program, extra_ros_args: tuple[str, ...]) -> NodeStatus:
+        if isinstance(entry, LearnerProgram):
+            argv, cwd = list(entry.argv), entry.cwd
+        else:
+            argv = [sys.executable, "-m", f"nodes.{entry.module}", *entry.argv_tail()]
+            if extra_ros_args:
+                argv += ([] if entry.ros_args else ["--ros-args"]) + list(extra_ros_args)
+            cwd = PROJECT_ROOT
         popen = subprocess.Popen(
             argv,
-            cwd=PROJECT_ROOT,
+            cwd=cwd,
             env=self._env,
             stdin=subprocess.DEVNULL,
             stdout=subprocess.PIPE,

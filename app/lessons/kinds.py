@@ -21,34 +21,34 @@ class Kind:
     optional: frozenset[str] = frozenset()
 
 
-def _kind(required: str, optional: str = "") -> Kind:
+def make_kind(required: str, optional: str = "") -> Kind:
     return Kind(frozenset(required.split()), frozenset(optional.split()))
 
 
 ACTION_KINDS: dict[str, Kind] = {
-    "start": _kind("catalog_node", "label"),
-    "stop": _kind("catalog_node", "label"),
-    "start_group": _kind("group", "label"),
-    "stop_group": _kind("group", "label"),
-    "lifecycle": _kind("node transition", "label"),
-    "set_param": _kind("node name value", "label"),
-    "call_service": _kind("service type request", "label"),
-    "send_goal": _kind("action type goal", "label cancel_after_feedback"),
-    "open_panel": _kind("panel", "label"),
+    "start": make_kind("catalog_node", "label"),
+    "stop": make_kind("catalog_node", "label"),
+    "start_group": make_kind("group", "label"),
+    "stop_group": make_kind("group", "label"),
+    "lifecycle": make_kind("node transition", "label"),
+    "set_param": make_kind("node name value", "label"),
+    "call_service": make_kind("service type request", "label"),
+    "send_goal": make_kind("action type goal", "label cancel_after_feedback"),
+    "open_panel": make_kind("panel", "label"),
 }
 CHECK_KINDS: dict[str, Kind] = {
-    "node_running": _kind("node"),
-    "node_absent": _kind("node"),
-    "topic_messages": _kind("topic type at_least", "field contains"),
-    "topic_rate": _kind("topic type min_hz max_hz"),
-    "topic_subscribers": _kind("topic at_least"),
-    "log_contains": _kind("catalog_node text", "at_least"),
-    "lifecycle_state": _kind("node state"),
-    "parameter_equals": _kind("node name value"),
-    "service_returns": _kind("service type request field equals"),
-    "action_result": _kind("action status"),
-    "pointcloud_points": _kind("topic at_least"),
-    "arm_reached": _kind("tolerance"),
-    "interface_exists": _kind("type"),
-    "quiz": _kind("question options answer"),
+    "node_running": make_kind("node"),
+    "node_absent": make_kind("node"),
+    "topic_messages": make_kind("topic type at_least", "field contains"),
+    "topic_rate": make_kind("topic type min_hz max_hz"),
+    "topic_subscribers": make_kind("topic at_least"),
+    "log_contains": make_kind("catalog_node text", "at_least"),
+    "lifecycle_state": make_kind("node state"),
+    "parameter_equals": make_kind("node name value"),
+    "service_returns": make_kind("service type request field equals"),
+    "action_result": make_kind("action status"),
+    "pointcloud_points": make_kind("topic at_least"),
+    "arm_reached": make_kind("tolerance"),
+    "interface_exists": make_kind("type"),
+    "quiz": make_kind("question options answer"),
 }

@@ -6,6 +6,7 @@ clicks happen in the order made; everything else runs on the UI thread.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import viser
@@ -40,12 +41,15 @@ class LessonsPanel:
         course: Course,
         live: LessonRuntime,
         progress: ProgressStore,
+        side_window: Any,
+        exercise_marks: Callable[[str], str] = lambda _lesson_id: "",
     ) -> None:
         self._gui = gui
         self._ui = ui
         self._course = course
         self._live = live
         self._progress = progress
+        self._exercise_marks = exercise_marks
         self._dynamic: list[Any] = []
         by_label = {_label(lesson): lesson for lesson in course.lessons}
         self._by_label = by_label
@@ -65,13 +69,10 @@ class LessonsPanel:
         with gui.add_folder("Course outline", expand_by_default=False):
             self._outline = MarkdownView(gui)
             self._reset = gui.add_button("Reset my progress", color="gray")
-        # The code the lesson talks about sits beside the text, in its own
+        # The code the lesson talks about sits beside the text, in the side
         # window docked on the left (the learner can minimise or move it).
-        self._code_window = gui.add_panel()
-        with self._code_window.add_tab("Code of this lesson", viser.Icon.CODE):
+        with side_window.add_tab("Code of this lesson", viser.Icon.CODE):
             self._code = MarkdownView(gui)
-        self._code_window.dock_left()
-        self._code_window.set_width(520)
         self._lesson = current
         self._step = min(progress.lesson(current.id)["step"], len(current.steps) - 1)
         self._selector.on_update(ui.callback(self._on_lesson_picked))
@@ -114,8 +115,7 @@ class LessonsPanel:
         )
         self._text.show(_without_title(current.text))
         self._command.show(f"In a terminal: `{current.command}`" if current.command else "")
-        self._code.show(self._source_listing(lesson))
-        self._code_window.visible = bool(lesson.code)
+        self._code.show(self._source_listing(lesson) or "_This lesson shows no code._")
         self._message.show("")
         self._rebuild_step_widgets()
         self._back.disabled = step == 0
@@ -190,10 +190,16 @@ class LessonsPanel:
             total = len(lesson.steps)
             mark = "✓" if passed >= total else f"{passed}/{total}"
             title = f"**{lesson.title}**" if lesson is current else lesson.title
-            rows.append(f"| {lesson.unit} | {title} | {mark} |")
+            exercise = self._exercise_marks(lesson.id) or "–"
+            rows.append(f"| {lesson.unit} | {title} | {mark} | {exercise} |")
         warning = f"⚠ {self._progress.warning}\n\n" if self._progress.warning else ""
         errors = "".join(f"\n\n⚠ {error}" for error in self._course.errors)
-        return warning + "| unit | lesson | done |\n|---|---|---|\n" + "\n".join(rows) + errors
+        return (
+            warning
+            + "| unit | lesson | done | exercise |\n|---|---|---|---|\n"
+            + "\n".join(rows)
+            + errors
+        )
 
     def close(self) -> None:
         """The dashboard owns the lesson runtime and closes it; nothing else is held."""

@@ -24,6 +24,13 @@ DEFAULT_DIR = PROJECT_ROOT / "var" / "progress"
 _NAME = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
 
 
+class Added:
+    """``update_exercise(slug, attempts=Added(1))``: a counter increment."""
+
+    def __init__(self, amount: int) -> None:
+        self.amount = amount
+
+
 class ProgressStore:
     def __init__(self, learner: str = "default", directory: Path = DEFAULT_DIR) -> None:
         if not _NAME.match(learner):
@@ -72,6 +79,25 @@ class ProgressStore:
             entry["passed"] = sorted({*entry["passed"], step})
             self._save()
             return True
+
+    def exercise(self, slug: str) -> dict[str, Any]:
+        """An exercise's record: attempts, failed checks, first opened, passed at."""
+        with self._lock:
+            return dict(self._data.get("exercises", {}).get(slug, {}))
+
+    def update_exercise(self, slug: str, **changes: Any) -> dict[str, Any]:
+        """Merge ``changes`` into the exercise's record (numbers given as +N are added)."""
+        with self._lock:
+            record = self._data.setdefault("exercises", {}).setdefault(slug, {})
+            for key, value in changes.items():
+                if isinstance(value, Added):
+                    record[key] = record.get(key, 0) + value.amount
+                elif value is None:
+                    record.pop(key, None)
+                else:
+                    record[key] = value
+            self._save()
+            return dict(record)
 
     def reset(self) -> None:
         with self._lock:

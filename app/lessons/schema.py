@@ -29,6 +29,10 @@ LESSONS_DIR = PROJECT_ROOT / "lessons"
 _DIR_PATTERN = re.compile(r"^(\d{2})_[a-z0-9_]+$")
 
 
+# In an exercise's checks, the catalog name of the learner's own program.
+LEARNER_PROGRAM = "learner"
+
+
 class LessonError(ValueError):
     """A lesson file that does not follow the schema; the message names file and field."""
 
@@ -98,8 +102,15 @@ _GROUP_NAMES = frozenset(group.name for group in GROUPS)
 _ROS_NODE_NAMES = frozenset({entry.node_name for entry in ENTRIES} | {f"/{DASHBOARD_NODE_NAME}"})
 
 
-def _check_names(kind: str, fields: dict[str, Any], where: str) -> None:
-    """Names a lesson uses must exist in the product it runs in."""
+def _check_names(kind: str, fields: dict[str, Any], where: str, learner_node: str | None) -> None:
+    """Names a lesson uses must exist in the product it runs in.
+
+    In an exercise, ``learner_node`` is the ROS node the learner's program
+    creates, and ``catalog_node = "learner"`` names that program.
+    """
+    if learner_node is not None:
+        if fields.get("catalog_node") == LEARNER_PROGRAM or fields.get("node") == learner_node:
+            return
     if "catalog_node" in fields and fields["catalog_node"] not in _CATALOG_NAMES:
         raise LessonError(
             f"{where}: no catalog node '{fields['catalog_node']}' (see the Nodes tab)"
@@ -117,7 +128,10 @@ def _check_names(kind: str, fields: dict[str, Any], where: str) -> None:
         )
 
 
-def _spec(raw: Any, table: dict[str, Kind], where: str) -> Spec:
+def parse_spec(
+    raw: Any, table: dict[str, Kind], where: str, learner_node: str | None = None
+) -> Spec:
+    """One action or check table, validated against the registry and the product."""
     if not isinstance(raw, dict):
         raise LessonError(f"{where}: must be a table, got {type(raw).__name__}")
     kind = _require(raw, "kind", str, where)
@@ -131,13 +145,13 @@ def _spec(raw: Any, table: dict[str, Kind], where: str) -> Spec:
     unknown = fields.keys() - required - optional
     if unknown:
         raise LessonError(f"{where}: kind '{kind}' has unknown field '{sorted(unknown)[0]}'")
-    _check_names(kind, fields, where)
+    _check_names(kind, fields, where, learner_node)
     if kind == "quiz" and fields["answer"] not in fields["options"]:
         raise LessonError(f"{where}: quiz answer must be one of its options")
     return Spec(kind, fields)
 
 
-def _inside(base: Path, relative: str, where: str) -> Path:
+def inside(base: Path, relative: str, where: str) -> Path:
     """Resolve a path from a lesson file, refusing any that leaves ``base``."""
     candidate = (base / relative).resolve()
     if not candidate.is_relative_to(base.resolve()):
@@ -166,7 +180,7 @@ def load_lesson(directory: Path) -> Lesson:
     for i, source in enumerate(code):
         if not isinstance(source, str):
             raise LessonError(f"{where}: code[{i}] must be a string")
-        _inside(PROJECT_ROOT, source, f"{where}: code[{i}]")
+        inside(PROJECT_ROOT, source, f"{where}: code[{i}]")
     raw_steps = _require(data, "steps", list, where)
     if not raw_steps:
         raise LessonError(f"{where}: field 'steps' must list at least one step")
@@ -176,13 +190,13 @@ def load_lesson(directory: Path) -> Lesson:
         if not isinstance(raw, dict):
             raise LessonError(f"{step_where}: must be a table")
         text_file = _require(raw, "text", str, step_where)
-        text = _inside(directory, text_file, f"{step_where}.text").read_text(encoding="utf-8")
+        text = inside(directory, text_file, f"{step_where}.text").read_text(encoding="utf-8")
         actions = [
-            _spec(a, ACTION_KINDS, f"{step_where}.actions[{j}]")
+            parse_spec(a, ACTION_KINDS, f"{step_where}.actions[{j}]")
             for j, a in enumerate(_require(raw, "actions", list, step_where))
         ] if "actions" in raw else []  # fmt: skip
         checks = [
-            _spec(c, CHECK_KINDS, f"{step_where}.checks[{j}]")
+            parse_spec(c, CHECK_KINDS, f"{step_where}.checks[{j}]")
             for j, c in enumerate(_require(raw, "checks", list, step_where))
         ] if "checks" in raw else []  # fmt: skip
         command = _require(raw, "command", str, step_where) if "command" in raw else ""

@@ -27,7 +27,7 @@ from app.ros.graph import GraphSnapshot
 # The dashboard's tabs, in order. Lessons name them ("Open the Lifecycle tab")
 # and are checked against this list when they load.
 TAB_NAMES = (
-    "Lessons", "Nodes", "Graph", "Echo", "3D view", "Topics", "Parameters",
+    "Lessons", "Exercise", "Nodes", "Graph", "Echo", "3D view", "Topics", "Parameters",
     "Console", "Services", "Actions", "Lifecycle", "Logs",
 )  # fmt: skip
 

@@ -1,0 +1,83 @@
+"""``ros2-classroom exercise list|starter|solution|check``: the grading from a terminal.
+
+For learners who prefer their own editor, for teachers, and for the tests:
+``check SLUG FILE`` runs FILE as the exercise's node through the supervisor,
+grades it exactly as the dashboard's Check button does, prints one line per
+check and exits 0 only when all pass.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+from app.exercises.model import ExerciseError, load_exercises
+
+EXIT_FAILED = 1
+
+
+def cmd_list(_slug: str | None, _file: Path | None) -> int:
+    book = load_exercises()
+    width = max((len(e.slug) for e in book.exercises), default=4)
+    for exercise in book.exercises:
+        print(f"{exercise.slug:<{width}}  unit {exercise.unit:>2}  {exercise.title}")
+    for error in book.errors:
+        print(f"broken exercise: {error}", file=sys.stderr)
+    return 0
+
+
+def cmd_starter(slug: str | None, _file: Path | None) -> int:
+    print(load_exercises().get(slug or "").starter, end="")
+    return 0
+
+
+def cmd_solution(slug: str | None, _file: Path | None) -> int:
+    print(load_exercises().get(slug or "").reference, end="")
+    return 0
+
+
+def cmd_check(slug: str | None, file: Path | None) -> int:
+    from app.exercises import runner
+    from app.exercises.grader import Grader
+    from app.exercises.lint import lint, refuses_to_run
+    from app.ros.runtime import RosRuntime
+    from app.supervisor import Supervisor
+
+    exercise = load_exercises().get(slug or "")
+    assert file is not None
+    try:
+        code = file.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ExerciseError(f"cannot read {file}: {exc}") from None
+    problems = lint(code, file.name)
+    for problem in problems:
+        print(f"{file}:{problem.line}:{problem.column + 1}: {problem.message}")
+    if refuses_to_run(problems):
+        print(f"FAIL  {exercise.slug}: not run, fix the syntax error first")
+        return EXIT_FAILED
+    runtime = RosRuntime("classroom_grader")
+    supervisor = Supervisor(os.environ)
+    try:
+        runner.start(supervisor, exercise, file.resolve())
+        report = Grader(runtime.node, supervisor).grade(
+            exercise, file.resolve(), on_result=lambda r: print(r.line(), flush=True)
+        )
+    finally:
+        supervisor.shutdown(timeout=3.0)
+        runtime.shutdown()
+    if report.problem:
+        print(f"FAIL  {exercise.slug}: {report.problem}")
+    print(report.summary())
+    return 0 if report.passed else EXIT_FAILED
+
+
+VERBS = {"list": cmd_list, "starter": cmd_starter, "solution": cmd_solution, "check": cmd_check}
+
+
+def main(verb: str, slug: str | None, file: Path | None) -> int:
+    if verb in ("starter", "solution", "check") and not slug:
+        raise ExerciseError(f"`exercise {verb}` needs an exercise name (see `exercise list`)")
+    if verb == "check" and file is None:
+        raise ExerciseError("`exercise check SLUG FILE` needs the file to grade")
+    return VERBS[verb](slug, file)

@@ -1,0 +1,136 @@
+"""Grades a learner's running node: the lessons' checks, then the exercise's probes.
+
+The learner's program must already run (the Run button, or ``exercise
+check`` which starts it). The grader starts the exercise's setup nodes,
+waits for the learner's node on the graph, evaluates each check until it
+passes or its time runs out, then runs each probe. Blocking: call it from a
+job thread, never a viser callback or the executor thread. Results are
+handed to ``on_result`` as they come, so a page can show progress.
+"""
+
+from __future__ import annotations
+
+import random
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from rclpy.node import Node
+
+from app.exercises import runner
+from app.exercises.model import Exercise
+from app.exercises.probes import ProbeContext, run_probe
+from app.exercises.report import Report, Result
+from app.lessons.runtime import PASS, LessonRuntime
+from app.lessons.schema import LEARNER_PROGRAM, Spec
+from app.ros.context import CallContext, Limits
+from app.ros.errors import Cancelled
+from app.ros.graph import snapshot
+from app.supervisor import Supervisor
+
+CHECK_WAIT_SEC = 6.0  # a check that has not passed by then fails with its last reason
+NODE_WAIT_SEC = 10.0  # a fresh process needs a few seconds to import rclpy and join
+POLL_SEC = 0.2
+PROBE_LIMITS = Limits(service_timeout=3.0, action_timeout=30.0)
+
+
+def _check_name(check: Spec) -> str:
+    subject = next(
+        (
+            check.get(k)
+            for k in ("node", "topic", "service", "action", "name", "type")
+            if k in check.fields
+        ),
+        "",
+    )
+    return f"{check.kind.replace('_', ' ')} {subject}".strip()
+
+
+class Grader:
+    def __init__(self, node: Node, supervisor: Supervisor) -> None:
+        self.node = node
+        self.supervisor = supervisor
+
+    def grade(
+        self,
+        exercise: Exercise,
+        script: Path,
+        on_result: Callable[[Result], None] | None = None,
+        ctx: CallContext | None = None,
+        seed: int | None = None,
+    ) -> Report:
+        report = Report(exercise.slug)
+        call = ctx or CallContext(self.node, limits=PROBE_LIMITS)
+        lessons = LessonRuntime(self.node, self.supervisor)
+
+        def record(result: Result) -> None:
+            report.results.append(result)
+            if on_result is not None:
+                on_result(result)
+
+        def wait_check(spec: Spec, timeout: float) -> tuple[bool, str]:
+            if spec.get("catalog_node") == LEARNER_PROGRAM:
+                spec = Spec(spec.kind, {**spec.fields, "catalog_node": exercise.program_name})
+            deadline = time.monotonic() + timeout
+            while True:
+                lessons.graph = snapshot(self.node)
+                outcome = lessons.evaluate(spec)
+                if outcome.state == PASS:
+                    return True, outcome.reason
+                if time.monotonic() > deadline:
+                    return False, outcome.reason
+                call.sleep(POLL_SEC)
+
+        try:
+            report.problem = self._wait_for_learner(exercise, script, call)
+            if report.problem:
+                return report
+            for check in exercise.checks:
+                passed, detail = wait_check(check, CHECK_WAIT_SEC)
+                record(Result(_check_name(check), passed, detail))
+            probe_ctx = ProbeContext(call, exercise.node, wait_check, random.Random(seed))
+            for probe in exercise.probes:
+                record(run_probe(probe_ctx, probe))
+                if not self._alive(exercise):
+                    report.problem = self._crash_text(exercise, script, "during the probes")
+                    break
+        except Cancelled:
+            report.problem = "grading was stopped"
+        finally:
+            lessons.close()
+        return report
+
+    def _alive(self, exercise: Exercise) -> bool:
+        status = runner.status(self.supervisor, exercise)
+        return status is not None and status.active
+
+    def _crash_text(self, exercise: Exercise, script: Path, when: str) -> str:
+        status = runner.status(self.supervisor, exercise)
+        state = status.describe() if status else "not started"
+        crash = runner.last_crash(
+            runner.output(self.supervisor, exercise), script, script.read_text(encoding="utf-8")
+        )
+        text = f"your program ended {when}: {state}"
+        return text + (f"\n{crash.describe()}" if crash else "")
+
+    def _wait_for_learner(self, exercise: Exercise, script: Path, call: CallContext) -> str:
+        """'' once the learner's node is on the graph, else why grading cannot start."""
+        if runner.status(self.supervisor, exercise) is None:
+            return "your program is not running: click Run first"
+        for name in exercise.setup:
+            self.supervisor.start(name)
+        deadline = time.monotonic() + NODE_WAIT_SEC
+        while True:
+            if not self._alive(exercise):
+                return self._crash_text(exercise, script, "before it could be graded")
+            graph = snapshot(self.node)
+            setup_nodes = [self.supervisor.status(n) for n in exercise.setup]
+            if graph.has_node(exercise.node) and all(s.active for s in setup_nodes):
+                return ""
+            if time.monotonic() > deadline:
+                seen = ", ".join(n for n in graph.nodes) or "none"
+                return (
+                    f"your program runs, but no node {exercise.node} joined the graph within "
+                    f"{NODE_WAIT_SEC:g} s (nodes seen: {seen}). Check the name you give Node()."
+                )
+            call.sleep(POLL_SEC)

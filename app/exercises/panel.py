@@ -1,0 +1,367 @@
+"""Exercise tab: the task, Run / Stop / Check, results, hints, diff, reset, solution.
+
+The code itself is edited in the side window's "Your code" tab (an Ace
+editor in an iframe, see ``editor_server``). Run and Check first ask the
+editor to save, so they always use what is on screen. Run, Stop and Check
+are jobs in one lane: clicks happen in the order made. Check results arrive
+one by one, so a learner sees progress during a slow probe.
+"""
+
+from __future__ import annotations
+
+import html
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import viser
+
+from app.exercises import runner
+from app.exercises.editor_server import EditorHub, editor_url
+from app.exercises.grader import Grader
+from app.exercises.lint import Problem, lint, refuses_to_run
+from app.exercises.model import Exercise, ExerciseBook
+from app.exercises.report import Report, Result
+from app.exercises.runner import RunPolicy
+from app.exercises.workspace import Workspace
+from app.ros.graph import GraphSnapshot
+from app.supervisor import Supervisor
+from app.ui import MarkdownView, assign
+from app.ui.loop import UiLoop
+
+LOG_LINES = 12
+LANE = "exercise"
+
+
+@dataclass(frozen=True)
+class ExerciseSettings:
+    """What the teacher decides: whether and how code runs, when solutions show."""
+
+    policy: RunPolicy = RunPolicy()
+    reveal_after: int | None = None  # None: each exercise's own number
+
+
+@dataclass(frozen=True)
+class RunOutcome:
+    problems: list[Problem]
+    started: bool
+    script: Path | None = None
+
+
+def _label(exercise: Exercise, passed: bool) -> str:
+    return f"{exercise.unit:02d} · {exercise.title}" + ("  ✓" if passed else "")
+
+
+def _problem_lines(problems: list[Problem]) -> str:
+    if not problems:
+        return ""
+    shown = "\n".join(f"- {'✗' if p.fatal else '⚠'} {p.text()}" for p in problems[:12])
+    more = f"\n- … and {len(problems) - 12} more" if len(problems) > 12 else ""
+    return "**Problems in your code**\n\n" + shown + more
+
+
+def _result_line(result: Result) -> str:
+    mark = "✓" if result.passed else "✗"
+    return f"- {mark} **{result.name}**: {result.detail}"
+
+
+class ExercisePanel:
+    def __init__(
+        self,
+        gui: viser.GuiApi,
+        ui: UiLoop,
+        book: ExerciseBook,
+        workspace: Workspace,
+        supervisor: Supervisor,
+        grader: Grader,
+        hub: EditorHub,
+        side_window: Any,
+        settings: ExerciseSettings | None = None,
+    ) -> None:
+        self._gui, self._ui, self._book = gui, ui, book
+        self._workspace, self._supervisor, self._grader = workspace, supervisor, grader
+        self._hub, self._settings = hub, settings or ExerciseSettings()
+        hub.attach(self._load_code, self._save_code)
+        self._exercise: Exercise | None = book.exercises[0] if book.exercises else None
+        if not book.exercises:
+            gui.add_markdown("No exercises could be loaded.\n\n" + "\n".join(book.errors))
+            return
+        self._hints_shown = 0
+        self._results: list[Result] = []
+        self._verdict = ""
+        self._checking = False
+        self._problems: list[Problem] = []
+        self._message = ""
+        self._labels: dict[str, Exercise] = {}
+
+        self._selector = gui.add_dropdown("Exercise", self._options(), initial_value=None)
+        self._header = MarkdownView(gui)
+        with gui.add_folder("Task", expand_by_default=True):
+            self._statement = MarkdownView(gui)
+        self._run = gui.add_button("Run my node", icon=viser.Icon.PLAYER_PLAY, color="green")
+        self._stop = gui.add_button("Stop (Ctrl+C)", icon=viser.Icon.PLAYER_STOP, color="gray")
+        self._check = gui.add_button("Check my node", icon=viser.Icon.CHECKLIST, color="blue")
+        self._status = MarkdownView(gui)
+        self._results_view = MarkdownView(gui)
+        with gui.add_folder("Output of your node", expand_by_default=False):
+            self._log = MarkdownView(gui)
+        with gui.add_folder("Help", expand_by_default=False):
+            self._hint_button = gui.add_button("Show a hint", icon=viser.Icon.BULB)
+            self._hints = MarkdownView(gui)
+            self._diff_button = gui.add_button("What did I change?", icon=viser.Icon.GIT_COMPARE)
+            self._diff = MarkdownView(gui)
+            self._reset = gui.add_button("Reset to starter", icon=viser.Icon.RESTORE, color="red")
+            self._confirm = gui.add_button("Yes: throw my code away", color="red", visible=False)
+            self._cancel = gui.add_button("No, keep my code", visible=False)
+            self._solution_button = gui.add_button("Show the reference solution", disabled=True)
+            self._solution = MarkdownView(gui)
+        with side_window.add_tab("Your code", viser.Icon.PENCIL):
+            self._editor = gui.add_html("")
+
+        self._selector.on_update(ui.callback(self._on_pick))
+        self._run.on_click(ui.callback(self._on_run))
+        self._stop.on_click(ui.callback(self._on_stop))
+        self._check.on_click(ui.callback(self._on_check))
+        self._hint_button.on_click(ui.callback(self._on_hint))
+        self._diff_button.on_click(ui.callback(self._on_diff))
+        self._reset.on_click(ui.callback(self._ask_reset, True))
+        self._cancel.on_click(ui.callback(self._ask_reset, False))
+        self._confirm.on_click(ui.callback(self._on_reset))
+        self._solution_button.on_click(ui.callback(self._on_solution))
+        self._show(book.exercises[0])
+
+    # -- the editor's code source and sink (viser's asyncio thread) -----------
+
+    def _load_code(self, slug: str) -> str:
+        return self._workspace.code(self._book.get(slug))
+
+    def _save_code(self, slug: str, code: str) -> None:
+        self._workspace.save(self._book.get(slug), code)
+
+    # -- UI thread --------------------------------------------------------------
+
+    def _options(self) -> list[str]:
+        self._labels = {_label(e, self._workspace.passed(e)): e for e in self._book.exercises}
+        return list(self._labels)
+
+    def _on_pick(self) -> None:
+        exercise = self._labels.get(self._selector.value)
+        if exercise is not None and exercise is not self._exercise:
+            self._show(exercise)
+
+    def _show(self, exercise: Exercise) -> None:
+        self._exercise = exercise
+        self._hints_shown = 0
+        self._results, self._verdict, self._problems, self._message = [], "", [], ""
+        assign(self._selector, next(k for k, e in self._labels.items() if e is exercise))
+        self._statement.show(exercise.statement)
+        self._hints.show("")
+        self._diff.show("")
+        self._solution.show("")
+        self._editor.content = (
+            f'<iframe title="Code editor for {html.escape(exercise.slug)}" '
+            f'src="{editor_url(exercise.slug)}" '
+            'style="width:100%;height:calc(100vh - 140px);min-height:420px;'
+            'border:1px solid #d1d5db;border-radius:4px"></iframe>'
+        )
+
+    def _on_run(self) -> None:
+        exercise = self._exercise
+        if exercise is None:
+            return
+        self._message = "Saving and checking your code…"
+        self._ui.run_job(lambda: self._run_work(exercise), self._ran, self._failed, lane=LANE)
+
+    def _run_work(self, exercise: Exercise) -> RunOutcome:
+        self._hub.flush(exercise.slug)
+        code = self._workspace.code(exercise)
+        problems = lint(code, f"{exercise.slug}.py")
+        self._hub.show_problems(
+            exercise.slug,
+            [
+                {
+                    "row": p.line - 1,
+                    "column": p.column,
+                    "text": p.message,
+                    "type": "error" if p.fatal else "warning",
+                }
+                for p in problems
+            ],
+        )
+        if refuses_to_run(problems):
+            return RunOutcome(problems, started=False)
+        script = self._workspace.script_for_run(exercise)
+        runner.start(self._supervisor, exercise, script, self._settings.policy)
+        return RunOutcome(problems, started=True, script=script)
+
+    def _ran(self, outcome: RunOutcome) -> None:
+        self._problems = outcome.problems
+        if outcome.started:
+            self._message = "▶ Started your node. Click **Check my node** when it is ready."
+        else:
+            self._message = "✗ Not started: fix the syntax error first (line shown below)."
+
+    def _failed(self, text: str) -> None:
+        self._checking = False
+        self._message = f"⚠ {text}"
+
+    def _on_stop(self) -> None:
+        exercise = self._exercise
+        if exercise is None:
+            return
+        self._message = "Stopping (Ctrl+C)…"
+
+        def stopped(status: Any) -> None:
+            self._message = "■ Stopped." if status else "Your node was not running."
+
+        self._ui.run_job(
+            lambda: runner.stop(self._supervisor, exercise), stopped, self._failed, lane=LANE
+        )
+
+    def _on_check(self) -> None:
+        exercise = self._exercise
+        if exercise is None or self._checking:
+            return
+        self._checking = True
+        self._results, self._verdict = [], ""
+        self._message = "Checking… (results appear one by one)"
+
+        def on_result(result: Result) -> None:
+            self._ui.post(lambda: self._results.append(result))
+
+        def work() -> tuple[Report, bool]:
+            self._hub.flush(exercise.slug)
+            script = self._workspace.scratch / f"{exercise.slug}.py"
+            report = self._grader.grade(exercise, script, on_result)
+            if not report.problem:
+                self._workspace.record_check(exercise, report.passed)
+            ran = script.read_text(encoding="utf-8") if script.is_file() else ""
+            return report, ran != self._workspace.code(exercise)
+
+        self._ui.run_job(work, self._checked, self._failed, lane=LANE)
+
+    def _checked(self, outcome: tuple[Report, bool]) -> None:
+        report, edited_since_run = outcome
+        self._checking = False
+        self._results = list(report.results)
+        exercise = self._exercise
+        if report.problem:
+            self._verdict = f"✗ {report.problem}"
+        elif report.passed:
+            self._verdict = "✓ **All checks pass. Exercise done!**"
+        else:
+            self._verdict = (
+                f"**{report.summary()}** Read the ✗ lines, change your code, Run, Check."
+            )
+        self._message = (
+            "⚠ You changed the code after Run: these results are for the code that runs. "
+            "Click **Run my node** again to check your edits."
+            if edited_since_run and not report.problem
+            else ""
+        )
+        if exercise is not None:
+            self._selector.options = self._options()
+            assign(self._selector, next(k for k, e in self._labels.items() if e is exercise))
+
+    def _on_hint(self) -> None:
+        exercise = self._exercise
+        if exercise is None:
+            return
+        self._hints_shown = min(self._hints_shown + 1, len(exercise.hints))
+        shown = exercise.hints[: self._hints_shown]
+        more = len(exercise.hints) - len(shown)
+        tail = f"\n\n_{more} more hint{'s' if more > 1 else ''}._" if more else ""
+        self._hints.show("\n".join(f"{i}. {hint}" for i, hint in enumerate(shown, 1)) + tail)
+
+    def _on_diff(self) -> None:
+        exercise = self._exercise
+        if exercise is None:
+            return
+
+        def done(diff: str) -> None:
+            self._diff.show(f"```diff\n{diff}\n```" if diff else "_No changes yet._")
+
+        def work() -> str:
+            self._hub.flush(exercise.slug)
+            return self._workspace.diff(exercise)
+
+        self._ui.run_job(work, done, self._failed, lane=LANE)
+
+    def _ask_reset(self, asking: bool) -> None:
+        self._confirm.visible = asking
+        self._cancel.visible = asking
+        self._reset.visible = not asking
+
+    def _on_reset(self) -> None:
+        exercise = self._exercise
+        self._ask_reset(False)
+        if exercise is None:
+            return
+
+        def work() -> None:
+            starter = self._workspace.reset(exercise)
+            self._hub.push_code(exercise.slug, starter, note="reset to the starter code")
+
+        def done(_none: None) -> None:
+            self._message = "Your code is back to the starter code."
+            self._diff.show("")
+
+        self._ui.run_job(work, done, self._failed, lane=LANE)
+
+    def _on_solution(self) -> None:
+        exercise = self._exercise
+        if exercise is None or not self._may_see_solution(exercise):
+            return
+        self._solution.show(f"```python\n{exercise.reference}\n```")
+
+    def _may_see_solution(self, exercise: Exercise) -> bool:
+        return self._workspace.may_see_solution(exercise, self._settings.reveal_after)
+
+    # -- refresh ----------------------------------------------------------------
+
+    def refresh(self, graph: GraphSnapshot) -> None:
+        exercise = self._exercise
+        if exercise is None:
+            return
+        record = self._workspace.progress.exercise(exercise.slug)
+        passed = "passed_at" in record
+        attempts = record.get("attempts", 0)
+        self._header.show(
+            f"### {exercise.title}\nUnit {exercise.unit} · your node: `{exercise.node}` · "
+            + ("✓ **done**" if passed else f"{attempts} check{'s' if attempts != 1 else ''} so far")
+        )
+        status = runner.status(self._supervisor, exercise)
+        state = status.describe() if status else "not started"
+        on_graph = " · on the graph ✓" if graph.has_node(exercise.node) else ""
+        lines = runner.output(self._supervisor, exercise, LOG_LINES)
+        parts = [f"**Your node:** {state}{on_graph}"]
+        if self._message:
+            parts.append(self._message)
+        if status is not None and not status.active:
+            script = self._workspace.scratch / f"{exercise.slug}.py"
+            all_lines = runner.output(self._supervisor, exercise)
+            source = script.read_text(encoding="utf-8") if script.is_file() else ""
+            crash = runner.last_crash(all_lines, script, source)
+            if crash is not None:
+                parts.append(f"**It crashed:**\n```\n{crash.describe()}\n```")
+        problems = _problem_lines(self._problems)
+        if problems:
+            parts.append(problems)
+        self._status.show("\n\n".join(parts))
+        results = "\n".join(_result_line(r) for r in self._results)
+        if self._checking:
+            results = f"**Checking…** {len(self._results)} done so far\n\n" + results
+        self._results_view.show("\n\n".join(p for p in (self._verdict, results) if p))
+        self._log.show(f"```\n{chr(10).join(lines) or '(no output yet)'}\n```")
+        allowed = self._may_see_solution(exercise)
+        self._solution_button.disabled = not allowed
+        limit = self._settings.reveal_after or exercise.reveal_after
+        self._solution_button.label = (
+            "Show the reference solution"
+            if allowed
+            else f"Reference solution: after passing or {limit} failed checks"
+        )
+        self._run.disabled = self._check.disabled = self._checking
+
+    def close(self) -> None:
+        """The learner's process belongs to the supervisor, which stops it on shutdown."""

@@ -1,0 +1,72 @@
+"""What every probe shares: its context, the author's formulas, comparisons.
+
+Every probe is bounded in time and runs on the grader's worker thread (never
+the executor thread): calls go through ``app.ros.calls``. A probe's result
+says what was tried and what came back, e.g. "/multiply answered sum=8 for
+a=3, b=5; expected 15".
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from app.exercises.report import Result
+from app.lessons.schema import Spec
+from app.ros.context import CallContext
+
+# Names an ``expect`` expression may use besides the request's own fields.
+_SAFE_FUNCTIONS = {"abs": abs, "min": min, "max": max, "round": round, "sum": sum, "len": len}
+
+
+@dataclass
+class ProbeContext:
+    """What a probe works with: a node to call through, and the lessons' checks."""
+
+    call: CallContext
+    learner_node: str
+    # Evaluates a lesson check until it passes or ``timeout`` runs out.
+    wait_check: Callable[[Spec, float], tuple[bool, str]]
+    rng: random.Random
+
+
+def expected_value(expression: str, names: dict[str, Any]) -> Any:
+    """Evaluate an exercise author's formula ("a * b") on the request's fields."""
+    return eval(expression, {"__builtins__": {}}, {**_SAFE_FUNCTIONS, **names})
+
+
+def values_text(values: dict[str, Any]) -> str:
+    return ", ".join(f"{k}={v!r}" for k, v in values.items())
+
+
+def random_inputs(rng: random.Random, ranges: dict[str, list[Any]]) -> dict[str, Any]:
+    values: dict[str, Any] = {}
+    for name, (low, high) in ranges.items():
+        if isinstance(low, int) and isinstance(high, int):
+            values[name] = rng.randint(low, high)
+        else:
+            values[name] = round(rng.uniform(float(low), float(high)), 3)
+    return values
+
+
+def same(actual: Any, expected: Any, tolerance: float) -> bool:
+    """Equal, numbers within ``tolerance``; nested dicts and lists (messages) compared deeply."""
+    if isinstance(actual, dict) and isinstance(expected, dict):
+        return all(k in actual and same(actual[k], v, tolerance) for k, v in expected.items())
+    if isinstance(actual, (list, tuple)) and isinstance(expected, (list, tuple)):
+        return len(actual) == len(expected) and all(
+            same(a, b, tolerance) for a, b in zip(actual, expected, strict=True)
+        )
+    if isinstance(actual, (int, float)) and isinstance(expected, (int, float)):
+        return math.isclose(actual, expected, rel_tol=tolerance, abs_tol=tolerance)
+    return bool(actual == expected)
+
+
+def without_kind(table: dict[str, Any]) -> dict[str, Any]:
+    return {k: v for k, v in table.items() if k != "kind"}
+
+
+Probe = Callable[[ProbeContext, Spec], Result]

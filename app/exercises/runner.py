@@ -1,0 +1,118 @@
+"""Runs a learner's file as a real ROS 2 process, through the supervisor.
+
+Same DDS profile and domain, same start/stop/crash handling as a catalog
+node: the supervisor owns the process. Stop is Ctrl+C (SIGINT first). When
+the dashboard serves other machines, the file runs contained
+(``app.exercises.sandbox``) or, unless the teacher allowed learner code, not
+at all.
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+from app.exercises.model import Exercise
+from app.supervisor import LearnerProgram, NodeStatus, Supervisor
+
+_FILE_LINE = re.compile(r'^\s*File "(?P<file>[^"]+)", line (?P<line>\d+)')
+
+
+class RunRefused(RuntimeError):
+    """Learner code may not run here (remote dashboard without the teacher's consent)."""
+
+
+@dataclass(frozen=True)
+class RunPolicy:
+    """Where and how learner code may run."""
+
+    allowed: bool = True
+    contained: bool = False
+    hidden: tuple[Path, ...] = ()  # directories contained code must not read
+
+    def refusal(self) -> str:
+        return (
+            "This dashboard serves other machines, so learner code runs only when the "
+            "teacher starts it with --allow-learner-code (it then runs contained)."
+        )
+
+
+LOOPBACK_POLICY = RunPolicy()
+
+
+def program_for(exercise: Exercise, script: Path, policy: RunPolicy) -> LearnerProgram:
+    if not policy.allowed:
+        raise RunRefused(policy.refusal())
+    scratch = script.parent
+    if policy.contained:
+        from app.exercises.sandbox import contained_argv
+
+        argv = contained_argv(script, scratch, policy.hidden)
+    else:
+        argv = [sys.executable, str(script)]
+    return LearnerProgram(exercise.program_name, exercise.node, tuple(argv), scratch)
+
+
+def start(
+    supervisor: Supervisor, exercise: Exercise, script: Path, policy: RunPolicy = LOOPBACK_POLICY
+) -> NodeStatus:
+    """(Re)start the learner's program from ``script``: a running one is stopped first."""
+    name = exercise.program_name
+    if name in supervisor.statuses() and supervisor.status(name).active:
+        supervisor.stop(name).result()
+    return supervisor.start_program(program_for(exercise, script, policy))
+
+
+def stop(supervisor: Supervisor, exercise: Exercise) -> NodeStatus | None:
+    """Ctrl+C (then SIGTERM, SIGKILL) and wait for the reap; None if it never ran."""
+    if exercise.program_name not in supervisor.statuses():
+        return None
+    return supervisor.stop(exercise.program_name).result()
+
+
+def status(supervisor: Supervisor, exercise: Exercise) -> NodeStatus | None:
+    return supervisor.statuses().get(exercise.program_name)
+
+
+def output(supervisor: Supervisor, exercise: Exercise, last: int | None = None) -> list[str]:
+    if exercise.program_name not in supervisor.statuses():
+        return []
+    return supervisor.output(exercise.program_name, last)
+
+
+@dataclass(frozen=True)
+class Crash:
+    """The last traceback of the learner's program, pointed at their own file."""
+
+    line: int | None  # line in the learner's file, if the traceback passes through it
+    code: str  # that line's text
+    error: str  # the last line: "NameError: name 'x' is not defined"
+
+    def describe(self) -> str:
+        where = f"line {self.line}: {self.code.strip()}\n" if self.line else ""
+        return where + self.error
+
+
+def last_crash(lines: list[str], script: Path, source: str) -> Crash | None:
+    """Find the newest traceback in ``lines`` and the deepest frame in ``script``."""
+    start = None
+    for i, line in enumerate(lines):
+        if line.startswith("Traceback (most recent call last):"):
+            start = i
+    if start is None:
+        return None
+    block = lines[start + 1 :]
+    line_no = None
+    error = ""
+    for text in block:
+        match = _FILE_LINE.match(text)
+        if match and Path(match["file"]).name == script.name:
+            line_no = int(match["line"])
+        elif text and not text.startswith((" ", "\t")):
+            error = text.strip()
+            break
+    source_lines = source.splitlines()
+    code = source_lines[line_no - 1] if line_no and line_no <= len(source_lines) else ""
+    return Crash(line_no, code, error or block[-1].strip() if block else "")

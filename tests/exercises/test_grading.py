@@ -1,0 +1,86 @@
+"""Grading every exercise on the live graph: the reference passes, the starter and
+each recorded mistake fail, and a mistake's failure names what is wrong.
+
+One ROS participant and one supervisor serve the whole module (each exercise
+runs as a real process, as the Run button starts it). Exercises use distinct
+node names, and every learner process is stopped after its case.
+"""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from app.exercises import runner
+from app.exercises.grader import Grader
+from app.exercises.model import Exercise, load_exercises
+from app.exercises.report import Report
+
+BOOK = load_exercises()
+
+
+def _cases():
+    for exercise in BOOK.exercises:
+        yield pytest.param(exercise, "reference", None, id=f"{exercise.slug}-reference")
+        yield pytest.param(exercise, "starter", None, id=f"{exercise.slug}-starter")
+        for mistake in exercise.mistakes:
+            yield pytest.param(
+                exercise, "mistake", mistake, id=f"{exercise.slug}-{mistake.path.stem}"
+            )
+
+
+@pytest.fixture(scope="module")
+def grading_env(tmp_path_factory):
+    from tests.conftest import in_private_netns
+
+    if not in_private_netns():
+        pytest.fail("run through tests/run.py: DDS tests need the private network namespace")
+    from app.dds import configure_dds_env
+    from app.ros.runtime import RosRuntime
+    from app.supervisor import Supervisor
+
+    saved = dict(os.environ)
+    configure_dds_env(os.environ, domain_id=77, network=False)
+    runtime = RosRuntime("exercise_grader_test")
+    supervisor = Supervisor(os.environ)
+    yield Grader(runtime.node, supervisor), supervisor, tmp_path_factory.mktemp("code")
+    supervisor.shutdown()
+    runtime.shutdown()
+    os.environ.clear()
+    os.environ.update(saved)
+
+
+def _grade(grading_env, exercise: Exercise, code: str) -> Report:
+    grader, supervisor, scratch = grading_env
+    script = scratch / f"{exercise.slug}.py"
+    script.write_text(code, encoding="utf-8")
+    runner.start(supervisor, exercise, script)
+    try:
+        return grader.grade(exercise, script, seed=7)
+    finally:
+        runner.stop(supervisor, exercise)
+        for name in exercise.setup:
+            supervisor.stop(name).result()
+
+
+def _text(report: Report) -> str:
+    return "\n".join([report.problem, *(r.line() for r in report.results)])
+
+
+@pytest.mark.parametrize(("exercise", "which", "mistake"), list(_cases()))
+def test_grading(grading_env, exercise, which, mistake):
+    if which == "reference":
+        report = _grade(grading_env, exercise, exercise.reference)
+        assert report.passed, _text(report)
+    elif which == "starter":
+        report = _grade(grading_env, exercise, exercise.starter)
+        assert not report.passed, "the starter code passes: the exercise asks for nothing"
+    else:
+        report = _grade(grading_env, exercise, mistake.path.read_text(encoding="utf-8"))
+        assert not report.passed, f"{mistake.path.name} passes:\n{_text(report)}"
+        failing = "\n".join([report.problem, *(r.detail for r in report.failures())])
+        assert mistake.reason in failing, (
+            f"{mistake.path.name} fails, but not for the recorded reason {mistake.reason!r}:\n"
+            + _text(report)
+        )
