@@ -132,7 +132,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
         raise CliError(f"port {args.port} on {args.host} became busy; pick another with --port")
     runtime = RosRuntime()
     supervisor = Supervisor(os.environ)
-    workspace = Workspace(progress, args.scratch_dir or DEFAULT_DIR.parent / "scratch")
+    scratch_root = args.scratch_dir or (args.progress_dir or DEFAULT_DIR).parent / "scratch"
+    workspace = Workspace(progress, scratch_root)
     settings = ExerciseSettings(
         _run_policy(args, progress.path.parent, workspace), args.reveal_solution_after
     )
@@ -291,7 +292,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--scratch-dir",
         type=Path,
         default=None,
-        help="where learner code runs (default var/scratch)",
+        help="where learner code runs (default: scratch/ beside the progress folder)",
     )
     serve.add_argument(
         "--progress-dir",

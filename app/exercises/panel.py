@@ -82,7 +82,11 @@ class ExercisePanel:
         self._workspace, self._supervisor, self._grader = workspace, supervisor, grader
         self._hub, self._settings = hub, settings or ExerciseSettings()
         hub.attach(self._load_code, self._save_code)
-        self._exercise: Exercise | None = book.exercises[0] if book.exercises else None
+        # Open on the exercise of the lesson the learner is in.
+        current = workspace.progress.current_lesson() or ""
+        mine = book.for_lesson(current)
+        first = mine[0] if mine else (book.exercises[0] if book.exercises else None)
+        self._exercise: Exercise | None = first
         if not book.exercises:
             gui.add_markdown("No exercises could be loaded.\n\n" + "\n".join(book.errors))
             return
@@ -94,7 +98,7 @@ class ExercisePanel:
         self._message = ""
         self._labels: dict[str, Exercise] = {}
 
-        self._selector = gui.add_dropdown("Exercise", self._options(), initial_value=None)
+        self._selector = gui.add_dropdown("Exercise", self._options())
         self._header = MarkdownView(gui)
         with gui.add_folder("Task", expand_by_default=True):
             self._statement = MarkdownView(gui)
@@ -128,7 +132,7 @@ class ExercisePanel:
         self._cancel.on_click(ui.callback(self._ask_reset, False))
         self._confirm.on_click(ui.callback(self._on_reset))
         self._solution_button.on_click(ui.callback(self._on_solution))
-        self._show(book.exercises[0])
+        self._show(first)
 
     # -- the editor's code source and sink (viser's asyncio thread) -----------
 

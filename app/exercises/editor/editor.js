@@ -20,6 +20,9 @@
     fontFamily: "'DejaVu Sans Mono', 'Liberation Mono', monospace",
     readOnly: true, // until the saved code has arrived
   });
+  // Some monospace fonts draw "_" below the line box Ace measures: give lines room.
+  editor.container.style.lineHeight = "1.45";
+  editor.renderer.updateFontSize();
   window.classroomEditor = editor; // for tests and the curious
 
   let socket = null;
