@@ -132,7 +132,8 @@ class ExercisePanel:
         self._cancel.on_click(ui.callback(self._ask_reset, False))
         self._confirm.on_click(ui.callback(self._on_reset))
         self._solution_button.on_click(ui.callback(self._on_solution))
-        self._show(first)
+        if first is not None:
+            self._show(first)
 
     # -- the editor's code source and sink (viser's asyncio thread) -----------
 

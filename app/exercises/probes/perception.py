@@ -9,19 +9,15 @@ grade does not depend on timing or on what else runs.
 
 from __future__ import annotations
 
-import math
 import time
-from collections.abc import Callable
 from typing import Any
 
-import numpy as np
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 from app.exercises.probes.base import Probe, ProbeContext
 from app.exercises.report import Result
 from app.lessons.kinds import make_kind
 from app.lessons.schema import Spec
-from app.ros.convert import import_type
 from app.ros.monitor import TopicMonitor
 
 # Hears reliable and best-effort publishers alike.
@@ -115,8 +111,7 @@ def publisher_count(ctx: ProbeContext, p: Spec) -> Result:
             return Result(
                 f"publishers of {target}",
                 False,
-                f"{target} {'still ' if got > want else ''}has {got} publisher(s) on "
-                f"{topic}{after}; expected {want}",
+                f"{target} has {got} publisher(s) on {topic}{after}; expected {want}",
             )
         ctx.call.sleep(0.2)
 
