@@ -16,7 +16,7 @@ EDITOR := app/exercises/editor
 EDITOR_STAMP := $(EDITOR)/node_modules/.classroom-setup
 ARGS ?=
 
-.PHONY: setup run test browser lint bench clean
+.PHONY: setup run test browser lint bench screenshots clean
 
 setup: $(STAMP) $(EDITOR_STAMP)
 
@@ -67,6 +67,10 @@ lint: setup
 
 bench: setup browser
 	$(VPY) tests/run.py --bench $(ARGS)
+
+# The README's pictures, from the real product in headless Chromium (docs/screenshots.py).
+screenshots: setup browser
+	$(VPY) tests/run.py --script docs/screenshots.py
 
 clean:
 	rm -rf $(VENV) $(EDITOR)/node_modules $(INTERFACES)/build .mypy_cache .import_linter_cache

@@ -6,7 +6,8 @@ gives this process tree its own network stack with only ``lo``, which we
 bring up. If that is impossible the run fails: it never falls back to the
 real network.
 
-Usage: ``python tests/run.py [pytest args]`` (``make test`` does this).
+Usage: ``python tests/run.py [pytest args]`` (``make test`` does this);
+``--bench [names]`` runs the benchmarks, ``--script FILE [args]`` one program.
 """
 
 from __future__ import annotations
@@ -52,6 +53,8 @@ def main() -> int:
     if interfaces() != ["lo"]:
         print(f"tests/run.py: error: not isolated, interfaces: {interfaces()}", file=sys.stderr)
         return 1
+    if args[:1] == ["--script"]:  # e.g. docs/screenshots.py: a program that needs DDS
+        os.execv(sys.executable, [sys.executable, *args[1:]])
     if args[:1] == ["--bench"]:
         os.execv(sys.executable, [sys.executable, "-m", "bench", *args[1:]])
     os.execv(sys.executable, [sys.executable, "-m", "pytest", *args])

@@ -17,6 +17,7 @@
     tabSize: 4,
     useSoftTabs: true,
     showPrintMargin: false,
+    wrap: true, // the side window is narrow: long lines fold, line numbers stay true
     fontFamily: "'DejaVu Sans Mono', 'Liberation Mono', monospace",
     readOnly: true, // until the saved code has arrived
   });

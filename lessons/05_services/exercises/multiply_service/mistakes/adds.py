@@ -1,4 +1,4 @@
-"""Reference solution: a service server that multiplies two integers."""
+"""A plausible mistake: the server adds instead of multiplying."""
 
 import rclpy
 from rclpy.executors import ExternalShutdownException

@@ -1,4 +1,4 @@
-"""Reference solution: a service server that multiplies two integers."""
+"""A plausible mistake: the service gets another name than the one asked for."""
 
 import rclpy
 from rclpy.executors import ExternalShutdownException
