@@ -177,8 +177,14 @@ def cmd_classroom(args: argparse.Namespace) -> int:
     )
     for learner in learners:
         _check_port_free(args.host, learner.port)
-    chosen = (("--allow-remote", args.allow_remote), ("--network", args.network))
+    chosen = (
+        ("--allow-remote", args.allow_remote),
+        ("--network", args.network),
+        ("--allow-learner-code", args.allow_learner_code),
+    )
     flags = tuple(flag for flag, on in chosen if on)
+    if args.reveal_solution_after is not None:
+        flags += ("--reveal-solution-after", str(args.reveal_solution_after))
     stop_requested = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: stop_requested.set())
@@ -317,6 +323,18 @@ def build_parser() -> argparse.ArgumentParser:
         "--progress-dir", type=Path, default=None, help="parent of each learner's progress"
     )
     room.add_argument("--network", action="store_true", help="let DDS use the network cards")
+    room.add_argument(
+        "--allow-learner-code",
+        action="store_true",
+        help="with --allow-remote: learners may run their exercise code (always contained)",
+    )
+    room.add_argument(
+        "--reveal-solution-after",
+        type=int,
+        default=None,
+        metavar="N",
+        help="failed checks before an exercise's reference solution may be shown",
+    )
     room.set_defaults(func=cmd_classroom)
 
     run = sub.add_parser("run", help="run one catalog node in the foreground, like `ros2 run`")
