@@ -60,8 +60,8 @@ test: setup browser lint
 # Style, the layer contracts of pyproject.toml (import-linter) and types (mypy).
 # PYTHONPATH: check this checkout's app/, whatever the editable install points at.
 lint: setup
-	$(VENV)/bin/ruff check app nodes tests bench
-	$(VENV)/bin/ruff format --check app nodes tests bench
+	$(VENV)/bin/ruff check app nodes tests bench lessons docs
+	$(VENV)/bin/ruff format --check app nodes tests bench lessons docs
 	PYTHONPATH=$(CURDIR) $(VENV)/bin/lint-imports
 	PYTHONPATH=$(CURDIR) $(VPY) -m mypy
 

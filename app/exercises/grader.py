@@ -43,6 +43,9 @@ def _check_name(check: Spec) -> str:
         ),
         "",
     )
+    if check.kind == "log_contains":
+        who = check.get("catalog_node")
+        subject = f"{'your node' if who == LEARNER_PROGRAM else who}: {subject!r}"
     return f"{check.kind.replace('_', ' ')} {subject}".strip()
 
 

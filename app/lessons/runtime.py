@@ -222,7 +222,9 @@ class LessonRuntime:
             return CheckResult(PASS, f"{len(lines)} log lines contain {c['text']!r}")
         if not self.supervisor.status(name).active:
             return CheckResult(FAIL, f"{name} is not running")
-        return CheckResult(WAITING, f"{len(lines)} of {needed} log lines so far")
+        return CheckResult(
+            WAITING, f"{len(lines)} of {needed} log lines contain {c['text']!r} so far"
+        )
 
     def _check_lifecycle_state(self, c: Spec) -> CheckResult:
         if not self.graph.has_node(c["node"]):

@@ -187,14 +187,14 @@ def qos_match(ctx: ProbeContext, p: Spec) -> Result:
     for sub in subs:
         for pub in pubs:
             publisher = node_fqn(pub.node_name, pub.node_namespace)
-            check = qos_check_compatible(pub.qos_profile, sub.qos_profile)
-            if check.compatibility == QoSCompatibility.ERROR:
+            compatibility, reason = qos_check_compatible(pub.qos_profile, sub.qos_profile)
+            if compatibility == QoSCompatibility.ERROR:
                 return Result(
                     name,
                     False,
                     f"{target} requests {_profile_text(sub.qos_profile)} on {topic}, but "
                     f"{publisher} offers {_profile_text(pub.qos_profile)}: incompatible, "
-                    f"nothing is delivered ({check.reason.strip()})",
+                    f"nothing is delivered ({reason.strip()})",
                 )
     offered = ", ".join(
         f"{node_fqn(i.node_name, i.node_namespace)} ({_profile_text(i.qos_profile)})" for i in pubs

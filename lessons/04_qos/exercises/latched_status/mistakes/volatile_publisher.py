@@ -1,0 +1,30 @@
+"""A plausible mistake: the default (volatile) publisher: whoever joins later gets nothing."""
+
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from std_msgs.msg import String
+
+
+class StatusAnnouncer(Node):
+    def __init__(self):
+        super().__init__("status_announcer")
+        self.publisher = self.create_publisher(String, "robot_status", 10)
+        self.publisher.publish(String(data="ready"))
+        self.get_logger().info("status published")
+
+
+def main():
+    rclpy.init()
+    node = StatusAnnouncer()
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,53 @@
+"""A plausible mistake: no cancel_callback, so rclpy refuses every cancel request."""
+
+import time
+
+import rclpy
+from rclpy.action import ActionServer
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.node import Node
+from tutorial_interfaces.action import Fibonacci
+
+STEP_SEC = 0.2  # pause after each number
+
+
+class FibServer(Node):
+    def __init__(self):
+        super().__init__("fib_server")
+        # Reentrant: the cancel callback may run while execute() is still busy.
+        self.action_server = ActionServer(
+            self,
+            Fibonacci,
+            "fibonacci_exercise",
+            execute_callback=self.execute,
+            callback_group=ReentrantCallbackGroup(),
+        )
+
+    def execute(self, goal_handle):
+        order = goal_handle.request.order
+        sequence = [0, 1][: order + 1]
+        while len(sequence) < order + 1:
+            sequence.append(sequence[-1] + sequence[-2])
+            goal_handle.publish_feedback(Fibonacci.Feedback(partial_sequence=sequence))
+            time.sleep(STEP_SEC)
+        goal_handle.succeed()
+        self.get_logger().info(f"Done: {sequence}")
+        return Fibonacci.Result(sequence=sequence)
+
+
+def main():
+    rclpy.init()
+    node = FibServer()
+    try:
+        # Several threads: one runs execute(), another can take the cancel request.
+        rclpy.spin(node, executor=MultiThreadedExecutor())
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == "__main__":
+    main()
