@@ -87,6 +87,7 @@ class ExercisePanel:
         mine = book.for_lesson(current)
         first = mine[0] if mine else (book.exercises[0] if book.exercises else None)
         self._exercise: Exercise | None = first
+        self._lesson_seen = current
         if not book.exercises:
             gui.add_markdown("No exercises could be loaded.\n\n" + "\n".join(book.errors))
             return
@@ -324,10 +325,21 @@ class ExercisePanel:
 
     # -- refresh ----------------------------------------------------------------
 
-    def refresh(self, graph: GraphSnapshot) -> None:
-        exercise = self._exercise
-        if exercise is None:
+    def _follow_the_lesson(self) -> None:
+        """When the learner moves to another unit, its exercise is the one shown."""
+        current = self._workspace.progress.current_lesson() or ""
+        if current == self._lesson_seen or self._checking:
             return
+        self._lesson_seen = current
+        exercises = self._book.for_lesson(current)
+        if exercises and self._exercise not in exercises:
+            self._show(exercises[0])
+
+    def refresh(self, graph: GraphSnapshot) -> None:
+        if self._exercise is None:
+            return
+        self._follow_the_lesson()
+        exercise = self._exercise
         record = self._workspace.progress.exercise(exercise.slug)
         passed = "passed_at" in record
         attempts = record.get("attempts", 0)
