@@ -16,7 +16,7 @@ EDITOR := app/exercises/editor
 EDITOR_STAMP := $(EDITOR)/node_modules/.classroom-setup
 ARGS ?=
 
-.PHONY: setup run test browser lint bench screenshots clean
+.PHONY: setup run test browser sandbox lint bench screenshots clean
 
 setup: $(STAMP) $(EDITOR_STAMP)
 
@@ -52,9 +52,19 @@ browser:
 		SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
 		$$SUDO apt-get update -q && $$SUDO apt-get install -y -q chromium; }
 
+# Contained learner code runs under uids of its own (app/exercises/contain.py).
+# When Python lives under a private /root, those uids must be able to pass
+# through it: o+x lets them reach the interpreter, not list or read /root.
+sandbox: setup
+	@real=$$($(VPY) -c 'import os, sys; print(os.path.realpath(sys.base_prefix))'); \
+	case "$$real" in /root/*) \
+		if [ "$$(id -u)" = 0 ] && [ $$(( 0$$(stat -c %a /root) & 1 )) -eq 0 ]; then \
+			echo "== chmod o+x /root: contained learner code must reach $$real"; \
+			chmod o+x /root; fi;; esac
+
 # Every test runs inside a private network namespace with only loopback
 # (tests/run.py sets it up): DDS traffic cannot leave the machine.
-test: setup browser lint
+test: setup browser sandbox lint
 	$(VPY) tests/run.py $(ARGS)
 
 # Style, the layer contracts of pyproject.toml (import-linter) and types (mypy).

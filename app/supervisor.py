@@ -17,6 +17,7 @@ node make one process, never two with the first one lost.
 from __future__ import annotations
 
 import ctypes
+import logging
 import os
 import signal
 import subprocess
@@ -24,10 +25,10 @@ import sys
 import threading
 import time
 from collections import deque
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from concurrent.futures import Future, ThreadPoolExecutor
 from concurrent.futures import TimeoutError as FutureTimeout  # not TimeoutError on 3.10
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
 
@@ -59,6 +60,8 @@ class LearnerProgram:
     node_name: str  # the ROS node the program is expected to create
     argv: tuple[str, ...]
     cwd: Path
+    # Called with the pid once the process is reaped (contained code: end its forks too).
+    after_exit: Callable[[int], object] | None = field(default=None, compare=False)
 
 
 Program = CatalogEntry | LearnerProgram
@@ -316,6 +319,12 @@ class Supervisor:
                     proc.dropped_lines += 1
                 proc.output.append(line)
         code = proc.popen.wait()
+        entry = proc.entry
+        if isinstance(entry, LearnerProgram) and entry.after_exit is not None:
+            try:
+                entry.after_exit(proc.popen.pid)
+            except Exception:  # cleaning up after a learner's program must not stop the reap
+                logging.getLogger(__name__).exception("after_exit of %s failed", entry.name)
         with self._lock:
             proc.exit_code = code
             proc.ended_at = time.time()

@@ -44,7 +44,10 @@ def main() -> int:
             print("tests/run.py: error: `unshare` (util-linux) is needed", file=sys.stderr)
             return 1
         os.environ[MARKER] = "1"
-        os.execv(unshare, [unshare, "--net", "--map-root-user", sys.executable, *sys.argv])
+        # Real root keeps its own uids: the sandbox tests switch to unprivileged
+        # ones, which a user namespace that maps only uid 0 cannot do.
+        as_user = [] if os.geteuid() == 0 else ["--map-root-user"]
+        os.execv(unshare, [unshare, "--net", *as_user, sys.executable, *sys.argv])
     try:
         bring_loopback_up()
     except OSError as exc:

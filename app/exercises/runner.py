@@ -46,13 +46,22 @@ def program_for(exercise: Exercise, script: Path, policy: RunPolicy) -> LearnerP
     if not policy.allowed:
         raise RunRefused(policy.refusal())
     scratch = script.parent
-    if policy.contained:
-        from app.exercises.sandbox import contained_argv
-
-        argv = contained_argv(script, scratch, policy.hidden)
-    else:
+    if not policy.contained:
         argv = [sys.executable, str(script)]
-    return LearnerProgram(exercise.program_name, exercise.node, tuple(argv), scratch)
+        return LearnerProgram(exercise.program_name, exercise.node, tuple(argv), scratch)
+    from app.exercises import sandbox
+
+    missing = sandbox.sandbox_available()
+    if missing:
+        raise RunRefused(f"learner code must run contained here, and cannot: {missing}")
+    argv = sandbox.contained_argv(script, scratch, policy.hidden)
+    return LearnerProgram(
+        exercise.program_name,
+        exercise.node,
+        tuple(argv),
+        scratch,
+        after_exit=sandbox.kill_leftovers,
+    )
 
 
 def start(
