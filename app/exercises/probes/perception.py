@@ -423,6 +423,39 @@ def _cloud_slips(
     ]
 
 
+def _same_in_another_order(
+    got: np.ndarray,
+    depth: np.ndarray,
+    fx: float,
+    fy: float,
+    cx: float,
+    cy: float,
+    tolerance: float,
+) -> bool:
+    """Whether ``got`` holds each valid pixel's point once, in whatever order.
+
+    Each point is projected back to its pixel (u = fx x / z + cx, ...), so a
+    right point finds its own pixel; sorting would pair up near-equal points
+    wrongly.
+    """
+    height, width = depth.shape
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z = got[:, 2].astype(float)
+        u = np.rint(got[:, 0] * fx / z + cx)
+        v = np.rint(got[:, 1] * fy / z + cy)
+    inside = np.isfinite(u) & np.isfinite(v) & (u >= 0) & (u < width) & (v >= 0) & (v < height)
+    if not inside.all():
+        return False
+    u, v = u.astype(int), v.astype(int)
+    if len(np.unique(v * width + u)) != len(got):
+        return False
+    d = depth[v, u].astype(float)
+    if not (np.isfinite(d) & (d > 0)).all():
+        return False
+    want = np.stack([(u - cx) * d / fx, (v - cy) * d / fy, d], axis=1)
+    return _max_error(got, want) <= tolerance
+
+
 def _cloud_verdict(cloud: Any, depth: np.ndarray, p: Spec, index: int) -> str:
     """'' when the cloud holds exactly the back-projected valid pixels, else what differs."""
     from nodes.common.pointcloud import pointcloud2_to_xyz_rgb
@@ -449,9 +482,7 @@ def _cloud_verdict(cloud: Any, depth: np.ndarray, p: Spec, index: int) -> str:
             text += "; pixels with depth 0 or NaN have no reading and must be left out"
         return text
     if _max_error(got, want) > tolerance:
-        # Another order is fine: compare the points sorted.
-        order_got, order_want = np.lexsort(got.T[::-1]), np.lexsort(want.T[::-1])
-        if _max_error(got[order_got], want[order_want]) <= tolerance:
+        if _same_in_another_order(got, depth, fx, fy, cx, cy, tolerance):
             return ""
         k = int(np.argmax(np.nan_to_num(np.abs(got - want), nan=np.inf).max(axis=1)))
         text = (

@@ -1,0 +1,48 @@
+"""Reference solution: a service that calls another service, without deadlocking."""
+
+import rclpy
+from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.node import Node
+from tutorial_interfaces.srv import AddTwoInts
+
+
+class RelayServer(Node):
+    def __init__(self):
+        super().__init__("relay_server")
+        # The client's answers are handled in a group of their own, so they
+        # can run while the service callback (default group) is still waiting.
+        self.client_group = MutuallyExclusiveCallbackGroup()
+        self.client = self.create_client(
+            AddTwoInts, "add_two_ints", callback_group=self.client_group
+        )
+        self.service = self.create_service(AddTwoInts, "relay_add", self.on_request)
+
+    def on_request(self, request, response):
+        if not self.client.wait_for_service(timeout_sec=2.0):
+            self.get_logger().error("/add_two_ints is not available")
+            return response
+        forwarded = AddTwoInts.Request(a=request.a, b=request.b)
+        answer = self.client.call(forwarded)  # blocks this thread only
+        response.sum = answer.sum
+        self.get_logger().info(f"relayed {request.a} + {request.b} = {response.sum}")
+        return response
+
+
+def main():
+    rclpy.init()
+    node = RelayServer()
+    executor = MultiThreadedExecutor()
+    executor.add_node(node)
+    try:
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,46 @@
+"""Exercise: a service that calls another service, without deadlocking.
+
+As written, this node hangs on the first request: run it, call /relay_add,
+and see. Fix it with a callback group and a multi-threaded executor.
+"""
+
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from tutorial_interfaces.srv import AddTwoInts
+
+
+class RelayServer(Node):
+    def __init__(self):
+        super().__init__("relay_server")
+        # TODO 1: give the client a callback group of its own
+        #         (callback_group=... when you create it).
+        self.client = self.create_client(AddTwoInts, "add_two_ints")
+        self.service = self.create_service(AddTwoInts, "relay_add", self.on_request)
+
+    def on_request(self, request, response):
+        if not self.client.wait_for_service(timeout_sec=2.0):
+            self.get_logger().error("/add_two_ints is not available")
+            return response
+        forwarded = AddTwoInts.Request(a=request.a, b=request.b)
+        answer = self.client.call(forwarded)  # waits for /add_two_ints to answer
+        response.sum = answer.sum
+        self.get_logger().info(f"relayed {request.a} + {request.b} = {response.sum}")
+        return response
+
+
+def main():
+    rclpy.init()
+    node = RelayServer()
+    # TODO 2: spin the node on a MultiThreadedExecutor instead of rclpy.spin.
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == "__main__":
+    main()
