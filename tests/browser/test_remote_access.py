@@ -98,3 +98,38 @@ def test_a_browser_needs_the_token_url(browser, remote_dashboard):
         expect_text(page, "Catalog node")
     finally:
         context.close()
+
+
+def test_the_exercise_editor_is_behind_the_token_too(remote_dashboard):
+    import json
+
+    from websockets.sync.client import connect
+
+    url = remote_dashboard.url
+    cookie = {"Cookie": f"classroom_token_{remote_dashboard.port}={TOKEN}"}
+    for path in (
+        "/classroom/editor/editor.html?slug=multiply_service",
+        "/classroom/editor/ace/ace.js",
+    ):
+        assert _get(url + path)[0] == 401, path
+        assert _get(url + path, cookie)[0] == 200, path
+    socket_url = url.replace("http://", "ws://") + "/classroom/editor/ws?slug=multiply_service"
+    with pytest.raises(InvalidStatus) as info:
+        connect(socket_url, open_timeout=10)
+    assert info.value.response.status_code == 401
+    with connect(socket_url, additional_headers=cookie, open_timeout=10) as editor:
+        first = json.loads(editor.recv(timeout=10))
+    assert first["type"] == "load" and "class Multiplier(Node)" in first["code"]
+
+
+def test_learner_code_does_not_run_on_a_served_dashboard_without_consent(browser, remote_dashboard):
+    context = browser.new_context()
+    try:
+        page = context.new_page()
+        page.goto(f"{remote_dashboard.url}/?token={TOKEN}")
+        open_tab(page, "Exercise")
+        page.get_by_role("button", name="Run my node", exact=True).click()
+        expect_text(page, "learner code runs only when the teacher starts it")
+    finally:
+        context.close()
+    assert psutil.Process(remote_dashboard.proc.pid).children(recursive=True) == []
