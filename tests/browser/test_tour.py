@@ -11,9 +11,12 @@ from tests.conftest import ARTIFACTS
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
+SIDE_WINDOW_TABS = ("Code of this lesson", "Your code")
+
 # What each tab must show once talker, listener and listener2 run.
 EXPECTED = {
     "Lessons": "Course outline",
+    "Exercise": "Run my node",
     "Nodes": "All catalog nodes",
     "Graph": "ros2 node list",
     "Echo": "data: 'Hello World:",
@@ -36,6 +39,10 @@ def test_every_tab_renders_without_errors(page):
     tabs = page.get_by_role("tab")
     expect(tabs.first).to_be_visible()
     names = [name.strip() for name in tabs.all_inner_texts()]
+    # The side window docked on the left has tabs of its own.
+    side = [name for name in names if name in SIDE_WINDOW_TABS]
+    assert side == list(SIDE_WINDOW_TABS)
+    names = [name for name in names if name not in SIDE_WINDOW_TABS]
     assert tuple(names) == TAB_NAMES == tuple(EXPECTED)
     for name in names:
         open_tab(page, name)
