@@ -70,8 +70,8 @@ test: setup browser sandbox lint
 # Style, the layer contracts of pyproject.toml (import-linter) and types (mypy).
 # PYTHONPATH: check this checkout's app/, whatever the editable install points at.
 lint: setup
-	$(VENV)/bin/ruff check app nodes tests bench lessons docs
-	$(VENV)/bin/ruff format --check app nodes tests bench lessons docs
+	$(VENV)/bin/ruff check app nodes tests bench lessons docs tools
+	$(VENV)/bin/ruff format --check app nodes tests bench lessons docs tools
 	PYTHONPATH=$(CURDIR) $(VENV)/bin/lint-imports
 	PYTHONPATH=$(CURDIR) $(VPY) -m mypy
 

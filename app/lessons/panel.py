@@ -6,7 +6,10 @@ clicks happen in the order made; everything else runs on the UI thread.
 
 from __future__ import annotations
 
+import base64
+import html
 from collections.abc import Callable
+from functools import lru_cache
 from typing import Any
 
 import viser
@@ -14,7 +17,7 @@ import viser
 from app import PROJECT_ROOT
 from app.lessons.progress import ProgressStore
 from app.lessons.runtime import FAIL, PASS, LessonRuntime
-from app.lessons.schema import Course, Lesson, Spec
+from app.lessons.schema import IMAGE_TYPES, STATIC_DIR, Course, Lesson, Spec
 from app.ros.graph import GraphSnapshot
 from app.ui import MarkdownView, assign
 from app.ui.loop import UiLoop
@@ -27,6 +30,43 @@ def _without_title(markdown: str) -> str:
     """Drop a leading '# Title' line: the step title is already shown above."""
     first, _, rest = markdown.lstrip().partition("\n")
     return rest.lstrip() if first.startswith("# ") else markdown
+
+
+@lru_cache(maxsize=32)
+def picture_html(image: str, alt: str) -> str:
+    """A diagram from static/ as an <img> with its alt text, inlined as a data URI.
+
+    viser's image widget takes pixel arrays; an HTML widget shows the SVG
+    itself, sharp at any panel width.
+    """
+    path = STATIC_DIR / image
+    data = base64.b64encode(path.read_bytes()).decode("ascii")
+    mime = IMAGE_TYPES[path.suffix.lower()]
+    # Nearly the panel's full width (it keeps clear of the scroll bar): the
+    # diagrams' smallest text stays about 12 px in the side panel.
+    return (
+        '<div style="padding:2px 10px 10px 4px">'
+        f'<img src="data:{mime};base64,{data}" alt="{html.escape(alt, quote=True)}" '
+        'style="display:block;width:100%;height:auto"></div>'
+    )
+
+
+class _HtmlView:
+    """An HTML handle re-sent only when its content changes, hidden while empty."""
+
+    def __init__(self, gui: viser.GuiApi) -> None:
+        self._content = ""
+        self.handle = gui.add_html("", visible=False)
+
+    def show(self, content: str) -> None:
+        if content != self._content:
+            self._content = content
+            self.handle.content = content
+            self.handle.visible = bool(content)
+
+    @property
+    def content(self) -> str:
+        return self._content
 
 
 def _label(lesson: Lesson) -> str:
@@ -60,6 +100,7 @@ class LessonsPanel:
         self._selector = gui.add_dropdown("Lesson", list(by_label), initial_value=_label(current))
         self._header = MarkdownView(gui)
         self._text = MarkdownView(gui)
+        self._picture = _HtmlView(gui)
         self._command = MarkdownView(gui)
         self._actions = gui.add_folder("Do this step")
         self._checks = MarkdownView(gui)
@@ -114,6 +155,7 @@ class LessonsPanel:
             f"**Step {step + 1} of {len(lesson.steps)}: {current.title}**"
         )
         self._text.show(_without_title(current.text))
+        self._picture.show(picture_html(current.image, current.image_alt) if current.image else "")
         self._command.show(f"In a terminal: `{current.command}`" if current.command else "")
         self._code.show(self._source_listing(lesson) or "_This lesson shows no code._")
         self._message.show("")

@@ -26,6 +26,9 @@ from app.ros.runtime import DASHBOARD_NODE_NAME
 from app.ui import TAB_NAMES
 
 LESSONS_DIR = PROJECT_ROOT / "lessons"
+# The course's diagrams (drawn by tools/make_diagrams.py); a step names one by file name.
+STATIC_DIR = PROJECT_ROOT / "static"
+IMAGE_TYPES = {".svg": "image/svg+xml", ".png": "image/png"}
 _DIR_PATTERN = re.compile(r"^(\d{2})_[a-z0-9_]+$")
 
 
@@ -63,6 +66,8 @@ class Step:
     command: str = ""  # the `ros2 ...` command for the same step
     actions: tuple[Spec, ...] = ()
     checks: tuple[Spec, ...] = ()
+    image: str = ""  # a file in static/, shown under the text
+    image_alt: str = ""  # what the picture shows, for a screen reader (required with image)
 
 
 @dataclass(frozen=True)
@@ -161,6 +166,24 @@ def inside(base: Path, relative: str, where: str) -> Path:
     return candidate
 
 
+def _step_image(raw: dict, where: str) -> tuple[str, str]:
+    """A step's optional picture: a file in static/ and the alt text it needs."""
+    if "image" not in raw:
+        if "image_alt" in raw:
+            raise LessonError(f"{where}: field 'image_alt' given without 'image'")
+        return "", ""
+    image = _require(raw, "image", str, where)
+    if Path(image).suffix.lower() not in IMAGE_TYPES:
+        raise LessonError(
+            f"{where}: field 'image' must name a {' or '.join(IMAGE_TYPES)} file, got '{image}'"
+        )
+    inside(STATIC_DIR, image, f"{where}.image")
+    alt = _require(raw, "image_alt", str, where) if "image_alt" in raw else ""
+    if not alt.strip():
+        raise LessonError(f"{where}: field 'image_alt' must describe the picture '{image}'")
+    return image, alt.strip()
+
+
 def load_lesson(directory: Path) -> Lesson:
     toml_path = directory / "lesson.toml"
     where = f"{directory.name}/lesson.toml"
@@ -200,6 +223,7 @@ def load_lesson(directory: Path) -> Lesson:
             for j, c in enumerate(_require(raw, "checks", list, step_where))
         ] if "checks" in raw else []  # fmt: skip
         command = _require(raw, "command", str, step_where) if "command" in raw else ""
+        image, image_alt = _step_image(raw, step_where)
         steps.append(
             Step(
                 title=_require(raw, "title", str, step_where),
@@ -207,6 +231,8 @@ def load_lesson(directory: Path) -> Lesson:
                 command=command,
                 actions=tuple(actions),
                 checks=tuple(checks),
+                image=image,
+                image_alt=image_alt,
             )
         )
     return Lesson(
