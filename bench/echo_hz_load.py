@@ -151,6 +151,8 @@ def dashboard_main(t0: float, t1: float, out: Path) -> None:
     import viser
 
     from app.dashboard import Dashboard
+    from app.exercises.editor_server import EditorHub
+    from app.exercises.workspace import Workspace
     from app.lessons.progress import ProgressStore
     from app.ros.convert import to_yaml
     from app.ros.monitor import TopicMonitor
@@ -162,7 +164,9 @@ def dashboard_main(t0: float, t1: float, out: Path) -> None:
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
     runtime = RosRuntime()
     supervisor = Supervisor({})
-    dashboard = Dashboard(server, runtime, supervisor, ProgressStore("bench", LOGS / "bench-p"))
+    progress = ProgressStore("bench", LOGS / "bench-p")
+    workspace = Workspace(progress, LOGS / "bench-scratch")
+    dashboard = Dashboard(server, runtime, supervisor, progress, EditorHub(), workspace)
     dashboard.start()
     topics = [*SMALL_TOPICS, IMAGE_TOPIC]
     monitors = {
