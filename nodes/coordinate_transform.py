@@ -11,7 +11,8 @@ The camera pose is six parameters, in metres and radians, in the base frame:
 ``camera_yaw`` (roll about x, then pitch about y, then yaw about z, all about
 the fixed base axes; ROS enforces a range, +-10 m and +-2 pi). The default
 puts the camera 0.25 m in front of the arm and 0.7 m above the table, looking
-straight down (roll = pi turns the optical z axis from "forward" to "down").
+straight down (unrotated, the optical z axis is the base's z, pointing up;
+roll = pi about x turns it to point down).
 Change one while the node runs and the next point uses it:
 ``ros2 param set /coordinate_transform camera_z 0.8``.
 
