@@ -20,6 +20,7 @@ from app.lessons.runtime import FAIL, PASS, LessonRuntime
 from app.lessons.schema import IMAGE_TYPES, STATIC_DIR, Course, Lesson, Spec
 from app.ros.graph import GraphSnapshot
 from app.ui import MarkdownView, assign
+from app.ui.code_view import python_listing
 from app.ui.loop import UiLoop
 
 _MARKS = {PASS: "✓", FAIL: "✗", "waiting": "…"}
@@ -113,7 +114,7 @@ class LessonsPanel:
         # The code the lesson talks about sits beside the text, in the side
         # window docked on the left (the learner can minimise or move it).
         with side_window.add_tab("Code of this lesson", viser.Icon.CODE):
-            self._code = MarkdownView(gui)
+            self._code = _HtmlView(gui)
         self._lesson = current
         self._step = min(progress.lesson(current.id)["step"], len(current.steps) - 1)
         self._selector.on_update(ui.callback(self._on_lesson_picked))
@@ -157,17 +158,17 @@ class LessonsPanel:
         self._text.show(_without_title(current.text))
         self._picture.show(picture_html(current.image, current.image_alt) if current.image else "")
         self._command.show(f"In a terminal: `{current.command}`" if current.command else "")
-        self._code.show(self._source_listing(lesson) or "_This lesson shows no code._")
+        self._code.show(self._source_listing(lesson))
         self._message.show("")
         self._rebuild_step_widgets()
         self._back.disabled = step == 0
 
     def _source_listing(self, lesson: Lesson) -> str:
-        parts = []
-        for relative in lesson.code:
-            text = (PROJECT_ROOT / relative).read_text(encoding="utf-8")
-            parts.append(f"`{relative}`\n```python\n{text}\n```")
-        return "\n\n".join(parts) or "(this lesson shows no source file)"
+        parts = [
+            python_listing(relative, (PROJECT_ROOT / relative).read_text(encoding="utf-8"))
+            for relative in lesson.code
+        ]
+        return "".join(parts) or "<p><em>This lesson shows no code.</em></p>"
 
     def _rebuild_step_widgets(self) -> None:
         for handle in self._dynamic:
