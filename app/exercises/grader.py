@@ -110,9 +110,7 @@ class Grader:
     def _crash_text(self, exercise: Exercise, script: Path, when: str) -> str:
         status = runner.status(self.supervisor, exercise)
         state = status.describe() if status else "not started"
-        crash = runner.last_crash(
-            runner.output(self.supervisor, exercise), script, script.read_text(encoding="utf-8")
-        )
+        crash = runner.crash_of(self.supervisor, exercise, script)
         text = f"your program ended {when}: {state}"
         return text + (f"\n{crash.describe()}" if crash else "")
 

@@ -25,7 +25,7 @@ from app.exercises.report import Report, Result
 from app.exercises.runner import RunPolicy
 from app.exercises.workspace import Workspace
 from app.ros.graph import GraphSnapshot
-from app.supervisor import Supervisor
+from app.supervisor import NodeStatus, Supervisor
 from app.ui import MarkdownView, assign
 from app.ui.loop import UiLoop
 
@@ -98,6 +98,8 @@ class ExercisePanel:
         self._problems: list[Problem] = []
         self._message = ""
         self._labels: dict[str, Exercise] = {}
+        self._crash_key: tuple[str, int | None, float | None] | None = None
+        self._crash_text = ""
 
         self._selector = gui.add_dropdown("Exercise", self._options())
         self._header = MarkdownView(gui)
@@ -355,12 +357,9 @@ class ExercisePanel:
         if self._message:
             parts.append(self._message)
         if status is not None and not status.active:
-            script = self._workspace.scratch / f"{exercise.slug}.py"
-            all_lines = runner.output(self._supervisor, exercise)
-            source = script.read_text(encoding="utf-8") if script.is_file() else ""
-            crash = runner.last_crash(all_lines, script, source)
-            if crash is not None:
-                parts.append(f"**It crashed:**\n```\n{crash.describe()}\n```")
+            crash = self._crash_of(exercise, status)
+            if crash:
+                parts.append(f"**It crashed:**\n```\n{crash}\n```")
         problems = _problem_lines(self._problems)
         if problems:
             parts.append(problems)
@@ -379,6 +378,15 @@ class ExercisePanel:
             else f"Reference solution: after passing or {limit} failed checks"
         )
         self._run.disabled = self._check.disabled = self._checking
+
+    def _crash_of(self, exercise: Exercise, status: NodeStatus) -> str:
+        """The ended process's traceback, read once per process (not at every refresh)."""
+        key = (exercise.slug, status.pid, status.ended_at)
+        if key != self._crash_key:
+            script = self._workspace.scratch / f"{exercise.slug}.py"
+            crash = runner.crash_of(self._supervisor, exercise, script)
+            self._crash_key, self._crash_text = key, crash.describe() if crash else ""
+        return self._crash_text
 
     def close(self) -> None:
         """The learner's process belongs to the supervisor, which stops it on shutdown."""

@@ -125,3 +125,9 @@ def last_crash(lines: list[str], script: Path, source: str) -> Crash | None:
     source_lines = source.splitlines()
     code = source_lines[line_no - 1] if line_no and line_no <= len(source_lines) else ""
     return Crash(line_no, code, error or block[-1].strip() if block else "")
+
+
+def crash_of(supervisor: Supervisor, exercise: Exercise, script: Path) -> Crash | None:
+    """The last traceback of the learner's program, read against the file that ran."""
+    source = script.read_text(encoding="utf-8") if script.is_file() else ""
+    return last_crash(output(supervisor, exercise), script, source)
