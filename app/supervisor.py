@@ -318,6 +318,7 @@ class Supervisor:
                 if len(proc.output) == proc.output.maxlen:
                     proc.dropped_lines += 1
                 proc.output.append(line)
+        self._end_group(proc.popen.pid)
         code = proc.popen.wait()
         entry = proc.entry
         if isinstance(entry, LearnerProgram) and entry.after_exit is not None:
@@ -348,6 +349,21 @@ class Supervisor:
         with self._lock:
             status = proc.status()
         future.set_result(status)
+
+    @staticmethod
+    def _end_group(pid: int) -> None:
+        """Once a program's main process has exited, kill what it left in its group.
+
+        A launch file's nodes are its children in its process group; if the
+        launcher dies first (SIGTERM, a crash), they would run on as orphans.
+        Waiting with WNOWAIT leaves the exited process a zombie, so its pid
+        still names the group and cannot have been reused by anyone else.
+        """
+        try:
+            os.waitid(os.P_PID, pid, os.WEXITED | os.WNOWAIT)
+            os.killpg(pid, signal.SIGKILL)
+        except (ChildProcessError, ProcessLookupError, PermissionError):
+            pass  # nothing left in the group
 
     @staticmethod
     def _signal_group(proc: _Process, sig: signal.Signals) -> None:

@@ -100,13 +100,18 @@ def ros_env(monkeypatch: pytest.MonkeyPatch) -> Iterator[dict[str, str]]:
         monkeypatch.setenv(key, env[key])
     monkeypatch.delenv("ROS_AUTOMATIC_DISCOVERY_RANGE", raising=False)
     yield env
+    fail_on_leftover_nodes("the test")
+
+
+def fail_on_leftover_nodes(who: str) -> None:
+    """Fail (and kill them) if catalog node processes outlive ``who`` by 8 s."""
     deadline = time.monotonic() + 8.0
     while (left := leftover_node_processes()) and time.monotonic() < deadline:
         time.sleep(0.2)
     if left:
         for entry in left:  # do not let them spoil later tests either
             os.kill(int(entry.rsplit(" ", 1)[1].rstrip(")")), 9)
-        pytest.fail(f"the test left node processes running: {', '.join(left)}")
+        pytest.fail(f"{who} left node processes running: {', '.join(left)}")
 
 
 @pytest.fixture

@@ -16,6 +16,7 @@ from app.exercises import runner
 from app.exercises.grader import Grader
 from app.exercises.model import Exercise, load_exercises
 from app.exercises.report import Report
+from tests.conftest import fail_on_leftover_nodes
 
 BOOK = load_exercises()
 
@@ -62,6 +63,7 @@ def _grade(grading_env, exercise: Exercise, code: str) -> Report:
         runner.stop(supervisor, exercise)
         for name in exercise.setup:
             supervisor.stop(name).result()
+        fail_on_leftover_nodes("this case")  # e.g. the nodes a launch file started
 
 
 def _text(report: Report) -> str:

@@ -81,6 +81,47 @@ def test_stubborn_process_is_escalated_to_sigkill(ros_env):
         sup.shutdown()
 
 
+def test_a_program_leaves_nothing_of_its_group_behind(ros_env, tmp_path):
+    """A launcher killed by the stop's SIGTERM takes the node it started with it.
+
+    The child ignores SIGINT and SIGTERM (a node hung in start-up); the parent
+    dies of SIGTERM before it can clean up, as a launch file's launcher does.
+    """
+    from app.supervisor import LearnerProgram, Supervisor
+
+    script = textwrap.dedent(
+        """
+        import signal, subprocess, sys, time
+        child = subprocess.Popen([sys.executable, "-c",
+            "import signal, time; signal.signal(signal.SIGINT, signal.SIG_IGN); "
+            "signal.signal(signal.SIGTERM, signal.SIG_IGN); print('ready', flush=True); "
+            "time.sleep(600)"],
+            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)  # its own output, as launch
+        child.stdout.readline()  # both signals ignored from here on
+        print("child", child.pid, flush=True)
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        time.sleep(600)
+        """
+    )
+    program = LearnerProgram("exercise:group", "/group", (sys.executable, "-c", script), tmp_path)
+    sup = Supervisor(ros_env, sigint_timeout=0.5, sigterm_timeout=2.0)
+    child = None
+    try:
+        sup.start_program(program)
+        line = wait_until(
+            lambda: next((s for s in sup.output(program.name) if s.startswith("child")), None),
+            what="the child's pid",
+        )
+        child = psutil.Process(int(line.split()[1]))
+        status = sup.stop(program.name).result(timeout=10)
+        assert status.exit_code == -signal.SIGTERM  # the parent died of the escalation
+        child.wait(timeout=5)  # ...and its child with it, though it ignored both signals
+    finally:
+        sup.shutdown()
+        if child is not None and child.is_running():
+            child.kill()  # a failed run must not leave it to later tests
+
+
 def test_output_buffer_is_bounded(ros_env):
     from app.supervisor import Supervisor
 
