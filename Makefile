@@ -9,9 +9,10 @@ PYTHON ?= $(shell for p in python3.11 python3.12 python3.10 python3; do \
 VENV := .venv
 VPY := $(VENV)/bin/python
 STAMP := $(VENV)/.classroom-setup
-INTERFACES := interfaces/tutorial_interfaces
-INTERFACE_FILES := $(wildcard $(INTERFACES)/msg/* $(INTERFACES)/srv/* $(INTERFACES)/action/*) \
-	$(INTERFACES)/CMakeLists.txt $(INTERFACES)/package.xml $(INTERFACES)/pyproject.toml
+# Every folder of interfaces/ with a package.xml is a rosidl package we build.
+INTERFACES := $(patsubst %/package.xml,%,$(wildcard interfaces/*/package.xml))
+INTERFACE_FILES := $(foreach p,$(INTERFACES),$(wildcard $(p)/msg/* $(p)/srv/* $(p)/action/*) \
+	$(p)/CMakeLists.txt $(p)/package.xml $(p)/pyproject.toml)
 EDITOR := app/exercises/editor
 EDITOR_STAMP := $(EDITOR)/node_modules/.classroom-setup
 ARGS ?=
@@ -37,9 +38,13 @@ $(STAMP): pyproject.toml $(INTERFACE_FILES)
 	$(VPY) -m pip install --quiet --upgrade pip
 	@echo "== installing the dashboard and the ROS 2 Jazzy wheels"
 	$(VPY) -m pip install --quiet -e '.[test,interfaces-build]'
-	@echo "== building the tutorial_interfaces package with rosidl"
-	$(VPY) -m pip install --quiet --no-build-isolation --force-reinstall --no-deps ./$(INTERFACES)
-	$(VPY) -c "from tutorial_interfaces.srv import AddTwoInts; print('tutorial_interfaces OK:', AddTwoInts.__name__)"
+	@for pkg in $(INTERFACES); do \
+		echo "== building the $$(basename $$pkg) interface package with rosidl"; \
+		$(VPY) -m pip install --quiet --no-build-isolation --force-reinstall --no-deps ./$$pkg || exit 1; \
+		kind=$$(basename $$(ls -d $$pkg/srv $$pkg/msg $$pkg/action 2>/dev/null | head -1)); \
+		$(VPY) -c "import importlib, sys; importlib.import_module(sys.argv[1]); print(sys.argv[1], 'OK')" \
+			$$(basename $$pkg).$$kind || exit 1; \
+	done
 	@touch $(STAMP)
 
 run: setup
@@ -83,4 +88,4 @@ screenshots: setup browser
 	$(VPY) tests/run.py --script docs/screenshots.py
 
 clean:
-	rm -rf $(VENV) $(EDITOR)/node_modules $(INTERFACES)/build .mypy_cache .import_linter_cache
+	rm -rf $(VENV) $(EDITOR)/node_modules $(addsuffix /build,$(INTERFACES)) .mypy_cache .import_linter_cache
