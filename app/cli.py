@@ -115,6 +115,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     from app.lessons.progress import DEFAULT_DIR, ProgressStore
     from app.ros.runtime import RosRuntime
     from app.supervisor import Supervisor
+    from app.ui.page_links import PageLinks
 
     # Tracebacks behind the one-line errors of the page go to this process's log.
     logging.basicConfig(
@@ -126,7 +127,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
         signal.signal(sig, lambda *_: stop_requested.set())
 
     editor_hub = EditorHub()
-    server, _gate = make_server(args.host, args.port, token, editor_hub)
+    page_links = PageLinks(editor_hub)  # extra routes on viser's server: links, then the editor
+    server, _gate = make_server(args.host, args.port, token, page_links)
     if server.get_port() != args.port:
         server.stop()
         raise CliError(f"port {args.port} on {args.host} became busy; pick another with --port")
@@ -137,7 +139,9 @@ def cmd_serve(args: argparse.Namespace) -> int:
     settings = ExerciseSettings(
         _run_policy(args, progress.path.parent, workspace), args.reveal_solution_after
     )
-    dashboard = Dashboard(server, runtime, supervisor, progress, editor_hub, workspace, settings)
+    dashboard = Dashboard(
+        server, runtime, supervisor, progress, editor_hub, workspace, settings, page_links
+    )
     dashboard.start()
     domain = os.environ.get("ROS_DOMAIN_ID", "0")
     scope = "network (opt-in)" if args.network else "loopback only"

@@ -40,6 +40,7 @@ from app.ros2cli.console_panel import ConsolePanel
 from app.supervisor import Supervisor
 from app.ui import TAB_NAMES, Panel
 from app.ui.loop import UiLoop
+from app.ui.page_links import PageLinks
 
 log = logging.getLogger(__name__)
 
@@ -66,6 +67,7 @@ class Dashboard:
         editor_hub: EditorHub,
         workspace: Workspace,
         exercise_settings: ExerciseSettings | None = None,
+        page_links: PageLinks | None = None,
     ):
         self.server = server
         self.runtime = runtime
@@ -74,6 +76,8 @@ class Dashboard:
         self.editor_hub = editor_hub
         self.workspace = workspace
         self.exercise_settings = exercise_settings or ExerciseSettings()
+        # Clickable drawings; unless the server was built with these links, they answer 404.
+        self.page_links = page_links or PageLinks()
         self.exercises = load_exercises()
         self.ui = UiLoop()
         self.lessons = LessonRuntime(runtime.node, supervisor)
@@ -132,7 +136,7 @@ class Dashboard:
             "Console": lambda: ConsolePanel(gui, ui, node),
             "Services": lambda: ServicesPanel(gui, ui, node),
             "Actions": lambda: ActionsPanel(gui, ui, node),
-            "Lifecycle": lambda: LifecyclePanel(gui, ui, node, self.rosout),
+            "Lifecycle": lambda: LifecyclePanel(gui, ui, node, self.rosout, self.page_links),
             "Logs": lambda: LogsPanel(gui, self.rosout),
         }
         assert tuple(builders) == TAB_NAMES, "every tab lessons may name has a panel"

@@ -9,6 +9,8 @@ namespace).
 from __future__ import annotations
 
 import os
+import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -18,10 +20,11 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from playwright.sync_api import Page, expect, sync_playwright  # noqa: E402
+from playwright.sync_api import Locator, Page, expect, sync_playwright  # noqa: E402
 
 from app.dds import configure_dds_env  # noqa: E402
 from app.exercises.model import load_exercises  # noqa: E402
+from app.lessons.schema import load_course  # noqa: E402
 
 IMAGES = ROOT / "docs" / "images"
 PORT = 8193
@@ -40,11 +43,85 @@ def _choose(page: Page, label: str, option: str) -> None:
     page.get_by_role("option", name=option, exact=True).click()
 
 
+def _shown(page: Page, text: str) -> Locator:
+    """``text`` where it is on screen (other tabs keep hidden copies)."""
+    return page.get_by_text(text).filter(visible=True).first
+
+
 def _dismiss_toasts(page: Page) -> None:
     """viser warns about software WebGL (no GPU here); close it so it hides nothing."""
     page.wait_for_timeout(1500)
     for button in page.locator(".mantine-Notification-closeButton").all():
         button.click()
+
+
+def _lesson(page: Page, unit: int, step: int) -> None:
+    """Open lesson ``unit`` at step ``step`` (1-based) with Next, as a learner does."""
+    lesson = next(lesson for lesson in load_course().lessons if lesson.unit == unit)
+    page.get_by_role("tab", name="Lessons").click()
+    _choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
+    heading = page.get_by_text(re.compile(r"^Step \d+ of \d+")).filter(visible=True).first
+    for _ in range(len(lesson.steps)):  # the lesson opens where the learner left it
+        match = re.match(r"Step (\d+)", heading.inner_text())
+        at = int(match.group(1)) if match else step
+        if at == step:
+            break
+        page.get_by_role("button", name="Next" if at < step else "Back", exact=True).click()
+        expect(heading).not_to_have_text(re.compile(rf"^Step {at} of"))
+    expect(heading).to_have_text(re.compile(rf"^Step {step} of {len(lesson.steps)}"))
+
+
+def topics_lesson(page: Page) -> None:
+    """The opening picture: mid-way through the topics unit, its checks ticking green."""
+    for step, label in ((1, "Start talker"), (3, "Start listener"), (4, "Start listener2")):
+        _lesson(page, 3, step)
+        page.get_by_role("button", name=label, exact=True).click()
+    expect(page.get_by_text("✓ step done").first).to_be_visible(timeout=60_000)
+    page.wait_for_timeout(800)
+    page.screenshot(path=str(IMAGES / "lesson.png"))
+
+
+def live_graph(page: Page) -> None:
+    """The talker and both listeners as the Graph tab draws them (the nodes keep running)."""
+    page.get_by_role("tab", name="Graph").click()
+    expect(_shown(page, "/listener2")).to_be_visible(timeout=30_000)
+    page.wait_for_timeout(2500)  # a few graph refreshes: rates settle
+    page.screenshot(path=str(IMAGES / "graph.png"))
+
+
+def lifecycle_drawing(page: Page) -> None:
+    """A managed node configured by clicking the drawing's edge."""
+    _start(page, "lifecycle_talker")
+    page.get_by_role("tab", name="Lifecycle").click()
+    edge = page.locator('g.live-edge a[aria-label^="configure:"]')
+    edge.locator("text").click(timeout=30_000)
+    expect(page.get_by_text("Transitioning successful").first).to_be_visible(timeout=30_000)
+    page.wait_for_timeout(2500)
+    page.screenshot(path=str(IMAGES / "lifecycle.png"))
+
+
+def arm_scene(page: Page) -> None:
+    """camera -> coordinate transform -> arm: the 3D view follows the arm by itself."""
+    page.get_by_role("tab", name="Nodes").click()
+    _choose(page, "Launch group", "camera_to_arm")
+    page.get_by_role("button", name="Start group", exact=True).click()
+    page.get_by_role("tab", name="3D view").click()
+    expect(page.get_by_text("gripper at").first).to_be_visible(timeout=60_000)
+    page.mouse.click(551, 8)  # fold the code window away («): the scene gets the room
+    page.wait_for_timeout(500)
+    page.mouse.move(1000, 480)
+    for _ in range(4):  # zoom in towards the arm, as a scroll wheel does
+        page.mouse.wheel(0, -240)
+        page.wait_for_timeout(150)
+    page.wait_for_timeout(4000)  # the arm on its way to the target
+    page.screenshot(path=str(IMAGES / "scene.png"))
+
+
+def _start(page: Page, node: str) -> None:
+    page.get_by_role("tab", name="Nodes").click()
+    _choose(page, "Catalog node", node)
+    page.get_by_role("button", name="Start", exact=True).click()
+    expect(page.get_by_text(f"Started {node}").first).to_be_visible(timeout=30_000)
 
 
 def exercise_graded(page: Page) -> None:
@@ -62,9 +139,9 @@ def exercise_graded(page: Page) -> None:
     editor.locator(".ace_content").click()
     page.keyboard.press("Control+Home")
     page.get_by_role("button", name="Run my node").click()
-    expect(page.get_by_text("on the graph ✓").first).to_be_visible(timeout=30_000)
+    expect(_shown(page, "on the graph ✓")).to_be_visible(timeout=30_000)
     page.get_by_role("button", name="Check my node").click()
-    expect(page.get_by_text("checks passed").first).to_be_visible(timeout=60_000)
+    expect(_shown(page, "checks passed")).to_be_visible(timeout=60_000)
     page.get_by_text("Output of your node").click()  # fold the task away: results in view
     page.get_by_text("Task", exact=True).click()
     page.wait_for_timeout(800)
@@ -94,7 +171,14 @@ def main() -> int:
                     page.goto(f"http://127.0.0.1:{PORT}/")
                     page.get_by_role("tab", name="Lessons").wait_for()
                     _dismiss_toasts(page)
-                    exercise_graded(page)
+                    try:
+                        takes = (topics_lesson, live_graph, lifecycle_drawing, exercise_graded)
+                        for take in (*takes, arm_scene):  # the scene folds the code away
+                            take(page)
+                    except Exception:
+                        page.screenshot(path=str(Path(tmp) / "failed.png"))
+                        shutil.copy(Path(tmp) / "failed.png", ROOT / "test-artifacts")
+                        raise
                     browser.close()
             finally:
                 proc.terminate()

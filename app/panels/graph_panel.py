@@ -17,7 +17,7 @@ from rclpy.node import Node
 from app.panels.graph_svg import graph_picture, legend_html, render_svg, topics_to_measure
 from app.ros.graph import GraphSnapshot, node_endpoints
 from app.ros.rates import RateBoard, rate_text
-from app.ui import MarkdownView
+from app.ui import MarkdownView, topic_item
 
 PICTURE_PERIOD_SEC = 1.0
 
@@ -54,12 +54,10 @@ class GraphPanel:
                 + ", ".join(f"`{name}`" for name in graph.ghosts),
             ]
         parts += ["", f"**Topics ({len(graph.topics)})** · `ros2 topic list -t`", ""]
-        parts += ["| topic | type | pub | sub |", "|---|---|---|---|"]
-        for topic in graph.topics:
-            parts.append(
-                f"| `{topic.name}` | {', '.join(topic.types)} "
-                f"| {topic.publishers} | {topic.subscribers} |"
-            )
+        parts += [
+            topic_item(topic.name, ", ".join(topic.types), topic.publishers, topic.subscribers)
+            for topic in graph.topics
+        ] or ["- (none)"]
         if graph.services or graph.actions:
             parts += ["", f"**Actions ({len(graph.actions)})** · `ros2 action list`", ""]
             parts += [f"- `{name}`" for name in graph.actions] or ["- (none)"]

@@ -8,12 +8,14 @@ Each click runs the same code as ``ros2 lifecycle set`` on a worker thread.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 
 import viser
 from lifecycle_msgs.msg import TransitionEvent
 from rclpy.node import Node
 from rclpy.subscription import Subscription
 
+from app.panels.lifecycle_svg import draw_state_machine
 from app.ros import lifecycle as lc
 from app.ros.context import panel_context
 from app.ros.graph import GraphSnapshot, published_topics
@@ -21,43 +23,18 @@ from app.ros.rates import RateBoard, rate_text
 from app.ros.rosout import RosoutLog, format_record
 from app.ui import MarkdownView, code_block, set_options
 from app.ui.loop import UiLoop
+from app.ui.page_links import SINK_FRAME, PageLinks
 
-EDGES = (
-    ("unconfigured", "configure", "inactive"),
-    ("inactive", "activate", "active"),
-    ("active", "deactivate", "inactive"),
-    ("inactive", "cleanup", "unconfigured"),
-    ("unconfigured / inactive / active", "shutdown", "finalized"),
-)
 NONE = "(no lifecycle node)"
 POLL_SEC = 2.0
 
 
-def draw_state_machine(current: str | None) -> str:
-    """The four primary states in a row, the current one highlighted, and the transitions."""
-    cells = []
-    for state in lc.PRIMARY_STATES:
-        if state == current:
-            cells.append(
-                f'<td style="background:#2f9e44;color:white;font-weight:bold;'
-                f'padding:6px;border-radius:6px">▶ {state}</td>'
-            )
-        else:
-            cells.append(f'<td style="padding:6px;color:#555">{state}</td>')
-    rows = "".join(f"<tr><td>{a}</td><td>—<b>{t}</b>→</td><td>{b}</td></tr>" for a, t, b in EDGES)
-    extra = ""
-    if current and current not in lc.PRIMARY_STATES:
-        extra = f'<div style="color:#e67700"><b>in transition: {current}</b></div>'
-    return (
-        '<div style="font-family:sans-serif;font-size:13px">'
-        f'<table style="width:100%;text-align:center"><tr>{"".join(cells)}</tr></table>{extra}'
-        f'<table style="font-size:12px;color:#333">{rows}</table></div>'
-    )
-
-
 class LifecyclePanel:
-    def __init__(self, gui: viser.GuiApi, ui: UiLoop, node: Node, rosout: RosoutLog) -> None:
+    def __init__(
+        self, gui: viser.GuiApi, ui: UiLoop, node: Node, rosout: RosoutLog, links: PageLinks
+    ) -> None:
         self._ui = ui
+        self._links = links
         self._node = node
         self._rosout = rosout
         self._target: str | None = None
@@ -71,16 +48,24 @@ class LifecyclePanel:
         self._nodes: list[str] = []
         self._rates = RateBoard(node, limit=8)
         self._selector = gui.add_dropdown("Lifecycle node", [NONE], initial_value=NONE)
-        self._diagram = gui.add_html(draw_state_machine(None))
+        self._diagram = gui.add_html("")
         self._diagram_html = ""
         self._buttons = {}
         for label in lc.TRANSITION_LABELS:
             button = gui.add_button(label, disabled=True)
             button.on_click(ui.callback(self._transition, label))
             self._buttons[label] = button
+            # The drawing's edges act as these buttons do (see app/ui/page_links.py).
+            links.register(f"lifecycle.{label}", self._poster(label))
         self._result = MarkdownView(gui, "")
         self._log = MarkdownView(gui, "")
         self._selector.on_update(ui.callback(lambda: self._select(self._selector.value)))
+
+    def _poster(self, label: str) -> Callable[[], None]:
+        return lambda: self._ui.post(lambda: self._transition(label))
+
+    def _edge_link(self, label: str, svg: str, title: str) -> str:
+        return self._links.anchor(f"lifecycle.{label}", svg, title)
 
     # --- selection and state (UI thread) -------------------------------------------
 
@@ -166,7 +151,8 @@ class LifecyclePanel:
         target = self._target
         if target and time.monotonic() - self._last_poll > POLL_SEC:
             self._poll()
-        html = draw_state_machine(self._state)
+        available = set() if self._changing else self._available
+        html = SINK_FRAME + draw_state_machine(self._state, available, self._edge_link)
         if html != self._diagram_html:
             self._diagram_html = html
             self._diagram.content = html

@@ -34,7 +34,7 @@ from app.ros.errors import Ros2Error
 from app.ros.graph import GraphSnapshot
 from app.ros.monitor import TopicMonitor
 from app.ros.qos import matching_qos
-from app.ui import MarkdownView, assign, code_block, set_options
+from app.ui import MarkdownView, assign, code_block, set_options, topic_item
 from app.ui.forms import FormSlot
 from app.ui.loop import UiLoop
 
@@ -293,11 +293,11 @@ class TopicsPanel:
                 )
                 for topic in types
             }
-        rows = ["| topic | type | publishers | subscribers |", "|---|---|---|---|"]
-        for topic, type_text in sorted(types.items()):
-            pubs, subs = self._counts.get(topic, (0, 0))
-            rows.append(f"| `{topic}` | {type_text} | {pubs} | {subs} |")
-        self._table.show("\n".join(rows))
+        rows = [
+            topic_item(topic, type_text, *self._counts.get(topic, (0, 0)))
+            for topic, type_text in sorted(types.items())
+        ]
+        self._table.show("\n".join(rows) or "No topics yet.")
         if types != self._types:
             self._types = types
             # A vanished topic stays selected: it may come back.

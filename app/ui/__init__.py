@@ -60,6 +60,15 @@ def assign(handle: Any, value: Any) -> None:
     handle.value = value
 
 
+def topic_item(name: str, type_text: str, publishers: int, subscribers: int) -> str:
+    """One topic as a Markdown list item, shaped like a line of `ros2 topic list -t`.
+
+    A list, not a table: long type names wrap instead of pushing columns past
+    the panel's right edge.
+    """
+    return f"- `{name}` [{type_text}] · {publishers} pub, {subscribers} sub"
+
+
 def code_block(lines: list[str], empty: str = "(nothing yet)") -> str:
     body = "\n".join(lines) if lines else empty
     return f"```\n{body}\n```"

@@ -14,15 +14,32 @@ from pygments.formatters import HtmlFormatter
 from pygments.lexers import PythonLexer
 
 _FORMATTER = HtmlFormatter(
-    linenos="inline", noclasses=True, style="friendly", nobackground=True, wrapcode=True
+    linenos="inline",
+    linespans="L",  # each line its own span, which we make a block (below)
+    noclasses=True,
+    style="friendly",
+    nobackground=True,
+    wrapcode=True,
+)
+_NUMBER_STYLE = (
+    "color: #666666; background-color: transparent; padding-left: 5px; padding-right: 5px;"
+)
+# A long line wraps under its own code, never under the numbers, and nothing
+# is cut off at the window's edge: a hanging indent as wide as the number column.
+_LINE = '<span style="display:block;white-space:pre-wrap;padding-left:5ch;text-indent:-5ch" id="L-'
+_NUMBER = (
+    'style="color:#868e96;display:inline-block;width:3.5ch;margin-right:1.5ch;'
+    'text-align:right;text-indent:0;user-select:none" class="lineno"'
 )
 
 
 def python_listing(title: str, source: str) -> str:
-    """One file: its name, then its code highlighted with inline line numbers."""
+    """One file: its name, then its code highlighted, numbered, wrapped at the edge."""
     body = highlight(source, PythonLexer(), _FORMATTER)
+    body = body.replace('<span id="L-', _LINE).replace("\n</span>", "</span>")
+    body = body.replace(f'style="{_NUMBER_STYLE}"', _NUMBER)
     return (
         f'<div style="font-weight:600;margin:6px 0 2px">{html.escape(title)}</div>'
-        '<div style="font-size:12px;line-height:1.45;overflow-x:auto;background:#f8f8f8;'
+        '<div style="font-size:12px;line-height:1.45;background:#f8f8f8;'
         f'border:1px solid #e5e7eb;border-radius:4px;padding:4px 6px">{body}</div>'
     )

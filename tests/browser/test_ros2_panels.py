@@ -53,9 +53,12 @@ def test_lifecycle_walk_changes_state_and_rate(page):
         ("shutdown", "finalized"),
     ]
     for transition, state in steps:
-        button = page.get_by_role("button", name=transition, exact=True)
-        expect(button).to_be_enabled(timeout=20_000)
-        button.click()
+        # The drawing's blue edges are the controls here (the buttons are used by
+        # the lifecycle lesson's test); a live edge is a link labelled by its transition.
+        edge = page.locator(f'g.live-edge a[aria-label^="{transition}:"]')
+        expect(edge).to_have_count(1, timeout=20_000)
+        expect(page.get_by_role("button", name=transition, exact=True)).to_be_enabled()
+        edge.locator("text").click()  # its label, as a learner would
         expect_regex(page, rf"Current state of /lifecycle_talker: {state}\b")
         expect_shown(page, f"ros2 lifecycle set /lifecycle_talker {transition}")
         if state == "active":
@@ -65,6 +68,7 @@ def test_lifecycle_walk_changes_state_and_rate(page):
             expect_regex(page, r"/lifecycle_chatter: silent", timeout=20_000)
     for transition in ("configure", "activate", "cleanup"):
         expect(page.get_by_role("button", name=transition, exact=True)).to_be_disabled()
+    expect(page.locator("g.live-edge")).to_have_count(0)  # finalized: no way out
 
 
 def test_fibonacci_goal_feedback_then_result(page):

@@ -31,6 +31,27 @@ EXPECTED = {
 }
 
 
+# Elements of the control panel that stick out past its right edge (clipped text).
+CLIPPED_JS = """() => {
+  const tabs = [...document.querySelectorAll('[role=tab]')];
+  let panel = tabs.find((t) => t.innerText.trim() === 'Lessons');
+  const scrolls = (el) => ['auto', 'scroll'].includes(getComputedStyle(el).overflowY);
+  while (panel && !scrolls(panel)) panel = panel.parentElement;
+  if (!panel) return ['no scrolling control panel found'];
+  const edge = panel.getBoundingClientRect().right;
+  const out = [];
+  for (const el of panel.querySelectorAll('*')) {
+    const box = el.getBoundingClientRect();
+    if (!box.width || !box.height || getComputedStyle(el).visibility === 'hidden') continue;
+    if (box.right > edge + 1) {
+      const text = (el.innerText || el.textContent || '').trim().slice(0, 40);
+      out.push(`${el.tagName} "${text}" ends at ${Math.round(box.right)} > ${Math.round(edge)}`);
+    }
+  }
+  return out.slice(0, 8);
+}"""
+
+
 def test_every_tab_renders_without_errors(page):
     open_tab(page, "Nodes")
     choose(page, "Launch group", "chatter_demo")
@@ -50,3 +71,4 @@ def test_every_tab_renders_without_errors(page):
         page.screenshot(path=str(ARTIFACTS / f"tour-{name.replace(' ', '_')}.png"))
         text = page.locator("body").inner_text()
         assert "Traceback" not in text, name
+        assert page.evaluate(CLIPPED_JS) == [], f"{name}: cut off at the panel's right edge"

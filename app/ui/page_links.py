@@ -1,0 +1,95 @@
+"""Links inside a panel's HTML that act like buttons.
+
+viser's HTML element has no click callback, yet a drawing is often the best
+control: the lifecycle state machine's edges *are* the transitions. A link
+can still reach us. It points at ``/classroom/act/<secret>/<name>`` on
+viser's own web server, which runs the action registered under ``name`` and
+answers ``204 No Content``; the link targets a hidden frame, so the page
+never navigates away whatever the answer.
+
+The secret is random per dashboard and only ever travels inside panels' HTML
+over the dashboard's own websocket, so another web site cannot forge a link
+that acts (cross-site request forgery); the access-token gate, when serving
+other machines, still sits in front of every request.
+"""
+
+from __future__ import annotations
+
+import html
+import http
+import re
+import secrets
+import threading
+from collections.abc import Callable
+from urllib.parse import urlsplit
+
+from websockets.asyncio.server import ServerConnection
+from websockets.http11 import Request, Response
+
+from app.access import Handler, ProcessRequest, ServerExtension
+
+PREFIX = "/classroom/act/"
+SINK = "classroom-link-sink"
+# Put once into any HTML that holds action links: where their empty answers land.
+SINK_FRAME = f'<iframe name="{SINK}" title="link answers" hidden></iframe>'
+_NAME = re.compile(r"^[a-z0-9_.-]{1,64}$")
+
+
+class PageLinks:
+    """Registered actions behind secret links; also a server extension in front of ``inner``.
+
+    ``register`` may be called from any thread; actions run in viser's
+    asyncio thread, so they must only post work (e.g. ``UiLoop.post``).
+    """
+
+    def __init__(self, inner: ServerExtension | None = None) -> None:
+        self._inner = inner
+        self._secret = secrets.token_urlsafe(16)
+        self._lock = threading.Lock()
+        self._actions: dict[str, Callable[[], None]] = {}
+
+    def register(self, name: str, action: Callable[[], None]) -> str:
+        """Make ``action`` reachable by a link; returns the link's address."""
+        if not _NAME.match(name):
+            raise ValueError(f"a page link name needs a-z, 0-9, '_', '.', '-': {name!r}")
+        with self._lock:
+            self._actions[name] = action
+        return self.href(name)
+
+    def href(self, name: str) -> str:
+        return f"{PREFIX}{self._secret}/{name}"
+
+    def anchor(self, name: str, content: str, title: str) -> str:
+        """An SVG or HTML ``<a>`` around ``content`` that runs ``name`` when clicked."""
+        return (
+            f'<a href="{html.escape(self.href(name))}" target="{SINK}" '
+            f'aria-label="{html.escape(title)}"><title>{html.escape(title)}</title>{content}</a>'
+        )
+
+    def _action_for(self, path: str) -> Callable[[], None] | None:
+        secret, _, name = path[len(PREFIX) :].partition("/")
+        if not secrets.compare_digest(secret.encode(), self._secret.encode()):
+            return None
+        with self._lock:
+            return self._actions.get(name)
+
+    # -- server extension (viser's asyncio thread) -------------------------------
+
+    def wrap_http(self, inner: ProcessRequest | None) -> ProcessRequest:
+        if self._inner is not None:
+            inner = self._inner.wrap_http(inner)
+
+        def process_request(connection: ServerConnection, request: Request) -> Response | None:
+            path = urlsplit(request.path).path
+            if not path.startswith(PREFIX):
+                return inner(connection, request) if inner is not None else None
+            action = self._action_for(path)
+            if action is None:
+                return connection.respond(http.HTTPStatus.NOT_FOUND, "Not found.\n")
+            action()
+            return connection.respond(http.HTTPStatus.NO_CONTENT, "")
+
+        return process_request
+
+    def wrap_handler(self, inner: Handler) -> Handler:
+        return self._inner.wrap_handler(inner) if self._inner is not None else inner
