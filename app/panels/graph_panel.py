@@ -54,8 +54,14 @@ class GraphPanel:
                 + ", ".join(f"`{name}`" for name in graph.ghosts),
             ]
         parts += ["", f"**Topics ({len(graph.topics)})** · `ros2 topic list -t`", ""]
+        hide_own = not self._show_self.value  # the dashboard's taps: left out, as in the picture
         parts += [
-            topic_item(topic.name, ", ".join(topic.types), topic.publishers, topic.subscribers)
+            topic_item(
+                topic.name,
+                ", ".join(topic.types),
+                topic.publishers - (topic.own_publishers if hide_own else 0),
+                topic.subscribers - (topic.own_subscribers if hide_own else 0),
+            )
             for topic in graph.topics
         ] or ["- (none)"]
         if graph.services or graph.actions:

@@ -37,6 +37,9 @@ class TopicInfo:
     types: tuple[str, ...]
     publishers: int
     subscribers: int
+    # Of those, the endpoints of the node that looked (the dashboard's own taps).
+    own_publishers: int = 0
+    own_subscribers: int = 0
 
 
 @dataclass(frozen=True)
@@ -80,11 +83,21 @@ def endpoint_owners(node: Node) -> tuple[list[TopicInfo], set[str]]:
     """
     topics: list[TopicInfo] = []
     owners: set[str] = set()
+    me = (node.get_name(), node.get_namespace())
     for name, types in node.get_topic_names_and_types():
         publishers = node.get_publishers_info_by_topic(name)
         subscribers = node.get_subscriptions_info_by_topic(name)
         owners.update(node_fqn(e.node_name, e.node_namespace) for e in (*publishers, *subscribers))
-        topics.append(TopicInfo(name, tuple(types), len(publishers), len(subscribers)))
+        topics.append(
+            TopicInfo(
+                name,
+                tuple(types),
+                len(publishers),
+                len(subscribers),
+                sum(1 for e in publishers if (e.node_name, e.node_namespace) == me),
+                sum(1 for e in subscribers if (e.node_name, e.node_namespace) == me),
+            )
+        )
     return topics, owners
 
 

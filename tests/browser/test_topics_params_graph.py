@@ -134,6 +134,8 @@ def test_graph_shows_services_actions_and_rates(page):
     expect(
         page.locator("svg.ros-graph text.rg-rate", has_text=re.compile(r"[12]\.\d Hz")).first
     ).to_be_visible(timeout=30_000)
+    # The list below counts what learners started, not the dashboard's own rate taps.
+    expect_text(page, re.compile(r"^/chatter \[std_msgs/msg/String\] · 1 pub, 0 sub$"))
 
     for name in ("add_two_ints_server", "fibonacci_action_server"):
         stop(page, name)
