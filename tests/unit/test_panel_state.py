@@ -17,6 +17,7 @@ from app.panels import lifecycle_panel, nodes_panel, parameters_panel
 from app.ros import lifecycle as lc
 from app.ros.graph import GraphSnapshot
 from app.ui.loop import UiLoop
+from app.ui.page_links import PageLinks
 from tests.unit.fake_gui import FakeGui, drain
 
 
@@ -124,7 +125,7 @@ def test_a_double_click_on_a_transition_sends_it_once(monkeypatch):
     )
     monkeypatch.setattr(lc, "change_state", change_state)
     gui, ui = FakeGui(), UiLoop()
-    panel = lifecycle_panel.LifecyclePanel(gui, ui, FakeNode(), rosout=_NoLog())  # type: ignore[arg-type]
+    panel = lifecycle_panel.LifecyclePanel(gui, ui, FakeNode(), rosout=_NoLog(), links=PageLinks())  # type: ignore[arg-type]
     panel.refresh(LIFECYCLE_GRAPH)
     drain(ui, until=lambda: not panel._polling)
     panel.refresh(LIFECYCLE_GRAPH)
