@@ -21,6 +21,7 @@ class CatalogEntry:
     summary: str
     ros_args: tuple[str, ...] = ()
     args: tuple[str, ...] = ()  # program arguments before --ros-args
+    package: str = "tutorial_nodes"  # the ROS package a full installation has it in
 
     def argv_tail(self) -> list[str]:
         """Arguments after ``python -m nodes.<module>``."""
@@ -31,7 +32,7 @@ class CatalogEntry:
 
     def ros2_run_command(self) -> str:
         """The command a learner would type in a full ROS 2 installation."""
-        words = ["ros2", "run", "tutorial_nodes", self.module, *self.argv_tail()]
+        words = ["ros2", "run", self.package, self.module, *self.argv_tail()]
         return " ".join(words)
 
 
@@ -224,6 +225,21 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         "slam_node",
         "/slam_node",
         "Monocular SLAM: map points, camera trajectory and tracked features.",
+    ),
+    # --- turtlesim (issue 15): `ros2 run turtlesim <name>` maps onto these names ---
+    CatalogEntry(
+        "turtlesim_node",
+        "turtlesim_node",
+        "/turtlesim",
+        "The turtlesim of the ROS 2 tutorials: turtle1 in an 11 m world, pose at 62.5 Hz.",
+        package="turtlesim",
+    ),
+    CatalogEntry(
+        "turtle_teleop_key",
+        "turtle_teleop_key",
+        "/teleop_turtle",
+        "Drives turtle1 with arrow keys; G B V C D E R T rotate, F cancels.",
+        package="turtlesim",
     ),
 )
 

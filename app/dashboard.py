@@ -133,7 +133,7 @@ class Dashboard:
             "3D view": lambda: ScenePanel(self.server, ui, node),
             "Topics": lambda: TopicsPanel(gui, ui, node),
             "Parameters": lambda: ParametersPanel(gui, ui, node, self.rosout),
-            "Console": lambda: ConsolePanel(gui, ui, node),
+            "Console": lambda: ConsolePanel(gui, ui, node, self.supervisor),
             "Services": lambda: ServicesPanel(gui, ui, node),
             "Actions": lambda: ActionsPanel(gui, ui, node),
             "Lifecycle": lambda: LifecyclePanel(gui, ui, node, self.rosout, self.page_links),

@@ -115,7 +115,8 @@ def snapshot(node: Node, *, include_hidden: bool = False) -> GraphSnapshot:
     all_topics, owners = endpoint_owners(node)
     nodes, ghosts = _live_and_ghosts(node, owners)
     # Action internals are listed as actions, not topics.
-    topics = [t for t in all_topics if include_hidden or ACTION_MARKER not in t.name]
+    # Action internals and hidden names ('/_...') are listed only on request, as ros2cli does.
+    topics = [t for t in all_topics if include_hidden or not is_internal_topic(t.name)]
     services = []
     actions = set()
     for name, types in node.get_service_names_and_types():
@@ -145,7 +146,7 @@ def topic_types(node: Node, include_hidden: bool = False) -> dict[str, list[str]
     return {
         name: list(types)
         for name, types in node.get_topic_names_and_types()
-        if include_hidden or ACTION_MARKER not in name
+        if include_hidden or not is_internal_topic(name)
     }
 
 

@@ -9,6 +9,7 @@ are bounded here: a few messages or seconds, and a Stop button.
 from __future__ import annotations
 
 import threading
+from typing import Any
 
 import viser
 from rclpy.node import Node
@@ -44,9 +45,10 @@ class _Output:
 
 
 class ConsolePanel:
-    def __init__(self, gui: viser.GuiApi, ui: UiLoop, node: Node) -> None:
+    def __init__(self, gui: viser.GuiApi, ui: UiLoop, node: Node, programs: Any = None) -> None:
         self._ui = ui
         self._node = node
+        self._programs = programs  # the supervisor: `ros2 run` starts catalog nodes through it
         self._output = _Output()
         self._running: CallContext | None = None
         gui.add_markdown(
@@ -68,7 +70,7 @@ class ConsolePanel:
             self._output.write("(a command is still running: press Stop first)")
             return
         self._output.start(f"$ {text.strip()}")
-        ctx = CallContext(self._node, self._output.write, CONSOLE_LIMITS)
+        ctx = CallContext(self._node, self._output.write, CONSOLE_LIMITS, programs=self._programs)
         self._running = ctx
         self._run.disabled = True
         self._stop.disabled = False

@@ -16,7 +16,7 @@ from typing import Any, NoReturn
 
 from app.ros.context import CallContext, Write
 from app.ros.errors import Cancelled, Ros2Error
-from app.ros2cli import graph_verbs, interfaces, lifecycle, param, topic
+from app.ros2cli import graph_verbs, interfaces, lifecycle, param, run, topic
 from app.ros2cli.common import settle_discovery
 
 log = logging.getLogger(__name__)
@@ -260,6 +260,8 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
     p = verb(v, "show", "a definition", _interface_show)
     p.add_argument("type")
     p.add_argument("--no-expand", action="store_true", help="do not expand nested types")
+
+    run.add_command(groups, write)  # `ros2 run PKG EXE`: a command, not a group of verbs
     return parser
 
 

@@ -39,6 +39,20 @@ def test_console_runs_ros2_topic_list(page):
     expect_shown(page, "error: topic '/nowhere' is not on the graph")
 
 
+def test_console_ros2_run_starts_turtlesim_as_the_tutorial_types_it(page):
+    open_tab(page, "Console")
+    field(page, "Command").fill("ros2 run turtlesim turtlesim_node")
+    click(page, "Run")
+    expect_shown(page, "Spawning turtle [turtle1] at x=[5.544445], y=[5.544445]")
+    # Started through the dashboard's supervisor: the Nodes tab knows it and can stop it.
+    open_tab(page, "Nodes")
+    expect_regex(page, r"turtlesim_node\W+running")
+    open_tab(page, "Console")
+    field(page, "Command").fill("ros2 node list")
+    click(page, "Run")
+    expect_shown(page, "/turtlesim")
+
+
 def test_lifecycle_walk_changes_state_and_rate(page):
     start_node(page, "lifecycle_talker")
     open_tab(page, "Lifecycle")

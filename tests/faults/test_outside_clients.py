@@ -50,6 +50,8 @@ FUZZED: dict[str, list[str]] = {
     "object_detector": [],
     "video_publisher": ["-p", "fps:=3.0", "-p", "width:=320", "-p", "height:=240"],
     "slam_node": [],
+    "turtlesim_node": [],
+    "turtle_teleop_key": [],
 }
 
 

@@ -19,13 +19,19 @@ class Endpoint:
 
 
 class RecordedGraph:
-    """Answers the four graph queries app.graph asks, from fixed data."""
+    """Answers the graph queries app.graph asks, from fixed data (it asks as /observer)."""
 
     def __init__(self, names, publishers, subscribers=None, services=()):
         self.names = names
         self.publishers = publishers
         self.subscribers = subscribers or {}
         self.services = list(services)
+
+    def get_name(self):
+        return "observer"
+
+    def get_namespace(self):
+        return "/"
 
     def get_node_names_and_namespaces(self):
         return list(self.names)

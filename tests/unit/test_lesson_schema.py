@@ -129,9 +129,9 @@ def test_names_that_do_not_exist_in_the_product_are_errors(lesson_copy, spec, me
 
 def test_a_check_naming_a_node_nobody_starts_is_an_error(lesson_copy):
     directory, data = lesson_copy
-    data["steps"][0]["checks"] = [{"kind": "node_running", "node": "/turtlesim"}]
+    data["steps"][0]["checks"] = [{"kind": "node_running", "node": "/warp_drive"}]
     _dump(data, directory / "lesson.toml")
-    with pytest.raises(LessonError, match="no catalog entry creates the ROS node '/turtlesim'"):
+    with pytest.raises(LessonError, match="no catalog entry creates the ROS node '/warp_drive'"):
         load_lesson(directory)
 
 
