@@ -5,6 +5,14 @@ port, own ROS domain id (so nobody's nodes show up in anybody else's graph),
 own learner name and progress directory. Isolation comes from DDS domains
 and separate processes, not from new machinery. The children die with this
 process (parent-death signal) and are stopped in parallel on Ctrl+C.
+
+The teacher sees every learner on one page (``app.teacher``), served by this
+command on its own port with its own token. Each dashboard reports its
+progress on the *classroom domain*, a ROS domain that all learners and the
+teacher share (a second, small participant per dashboard; the learners' own
+domains stay isolated). With ``--network`` that domain reaches other
+machines, so a class spread over several hosts (each running ``classroom``
+with its own ``--site`` and base domain id) shows on any host's teacher page.
 """
 
 from __future__ import annotations
@@ -20,9 +28,14 @@ import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from app import PROJECT_ROOT
 from app.dds import MAX_DOMAIN_ID
+
+if TYPE_CHECKING:
+    from app.teacher.page import TeacherPage
+    from app.teacher.roster import Roster
 
 _PR_SET_PDEATHSIG = 1
 _libc = ctypes.CDLL(None, use_errno=True)
@@ -37,6 +50,8 @@ class Learner:
     domain_id: int
     progress_dir: Path
     token: str | None = None
+    site: str = "local"
+    classroom_domain: int | None = None  # where progress goes (None: nowhere)
 
     def url(self, host: str) -> str:
         # 0.0.0.0 is every address: show the name other machines can use.
@@ -52,6 +67,8 @@ def plan(
     base_domain: int,
     progress_root: Path,
     tokens: bool = False,
+    site: str = "local",
+    classroom_domain: int | None = None,
 ) -> list[Learner]:
     """Who gets which port, domain and directory; raises ValueError on an impossible plan."""
     from app.access import new_token
@@ -64,6 +81,11 @@ def plan(
         raise ValueError(
             f"domain ids {base_domain}..{base_domain + learners - 1} must lie in 0..{MAX_DOMAIN_ID}"
         )
+    if classroom_domain is not None and base_domain <= classroom_domain < base_domain + learners:
+        raise ValueError(
+            f"the classroom domain {classroom_domain} is also a learner's domain "
+            f"({base_domain}..{base_domain + learners - 1}); pick another --classroom-domain-id"
+        )
     return [
         Learner(
             name=f"learner{i + 1}",
@@ -71,9 +93,60 @@ def plan(
             domain_id=base_domain + i,
             progress_dir=progress_root / f"learner{i + 1}",
             token=new_token() if tokens else None,
+            site=site,
+            classroom_domain=classroom_domain,
         )
         for i in range(learners)
     ]
+
+
+@dataclass(frozen=True)
+class TeacherPlan:
+    """The teacher page: its port and token, and the domain it listens on."""
+
+    port: int
+    token: str
+    classroom_domain: int
+    progress_root: Path  # where `classroom status` finds the page
+    reveal_after: int | None = None
+
+    def url(self, host: str) -> str:
+        # By name, so the learners' 127.0.0.1 URLs stay the only ones of that form.
+        shown = {"0.0.0.0": socket.gethostname(), "127.0.0.1": "localhost"}.get(host, host)
+        return f"http://{shown}:{self.port}/?token={self.token}"
+
+
+class TeacherView:
+    """The teacher page and the roster behind it, in this process."""
+
+    def __init__(self, plan: TeacherPlan, host: str) -> None:
+        from app.teacher.page import TeacherPage
+        from app.teacher.roster import Roster
+        from app.teacher.status import write_teacher_file
+
+        self.plan = plan
+        self.roster: Roster = Roster(plan.classroom_domain)
+        self.page: TeacherPage | None = None
+        try:
+            self.page = TeacherPage(
+                host, plan.port, plan.token, self.roster, reveal_after=plan.reveal_after
+            )
+            if self.page.port != plan.port:
+                raise ValueError(f"port {plan.port} became busy; pick another with --teacher-port")
+        except BaseException:
+            self.close()
+            raise
+        self.page.start()
+        local = "127.0.0.1" if host == "0.0.0.0" else host
+        write_teacher_file(plan.progress_root, f"http://{local}:{plan.port}/", plan.token)
+
+    def close(self) -> None:
+        from app.teacher.status import remove_teacher_file
+
+        if self.page is not None:
+            self.page.close()
+            remove_teacher_file(self.plan.progress_root)
+        self.roster.close()
 
 
 def _die_with_parent() -> None:
@@ -112,6 +185,10 @@ class Classroom:
                 "--progress-dir", str(learner.progress_dir),
                 *self._flags,
             ]  # fmt: skip
+            if learner.classroom_domain is not None:
+                argv += [
+                    "--classroom-domain-id", str(learner.classroom_domain), "--site", learner.site
+                ]  # fmt: skip
             env = {**self._env, "PYTHONUNBUFFERED": "1"}
             env.pop("CLASSROOM_TOKEN", None)
             if learner.token:  # through the environment: a token on argv shows in `ps`
@@ -186,9 +263,31 @@ def run(
     classroom: Classroom,
     stop_requested: threading.Event,
     say: Callable[[str], None] = print,
+    teacher: TeacherPlan | None = None,
 ) -> int:
-    """Start everyone, print the URLs, report dashboards that end, stop on request."""
+    """Start everyone and the teacher page, print the URLs, stop on request."""
     classroom.start()
+    view = None
+    if teacher is not None:  # while the dashboards boot
+        try:
+            view = TeacherView(teacher, classroom.host)
+        except (OSError, ValueError, RuntimeError) as exc:
+            say(f"ros2-classroom: error: could not start the teacher page: {exc}")
+            classroom.stop()
+            return 1
+    try:
+        return _serve(classroom, stop_requested, say, teacher)
+    finally:
+        if view is not None:
+            view.close()
+
+
+def _serve(
+    classroom: Classroom,
+    stop_requested: threading.Event,
+    say: Callable[[str], None],
+    teacher: TeacherPlan | None,
+) -> int:
     failed = classroom.wait_ready()
     if failed:
         say(f"ros2-classroom: error: could not start the dashboard of {', '.join(failed)}")
@@ -200,6 +299,11 @@ def run(
         say(
             f"  {learner.name:<{width}}  {learner.url(classroom.host)}  "
             f"(ROS domain {learner.domain_id}, progress in {learner.progress_dir})"
+        )
+    if teacher is not None:
+        say(
+            f"  Teacher page: {teacher.url(classroom.host)}  (own token; progress on ROS "
+            f"domain {teacher.classroom_domain}; `ros2-classroom classroom status` prints it)"
         )
     say("Press Ctrl+C to stop every dashboard.")
     reported: set[str] = set()

@@ -143,6 +143,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         server, runtime, supervisor, progress, editor_hub, workspace, settings, page_links
     )
     dashboard.start()
+    beacon = _progress_beacon(args, dashboard)
     domain = os.environ.get("ROS_DOMAIN_ID", "0")
     scope = "network (opt-in)" if args.network else "loopback only"
     query = f"/?token={token}" if token else ""
@@ -154,6 +155,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
     stop_requested.wait()
     print("Shutting down…", flush=True)
     started = time.monotonic()
+    if beacon is not None:
+        beacon.close()
     dashboard.stop()
     runtime.shutdown()
     supervisor.shutdown(timeout=2.5)
@@ -162,25 +165,92 @@ def cmd_serve(args: argparse.Namespace) -> int:
     return 0
 
 
+def _progress_beacon(args: argparse.Namespace, dashboard: Any) -> Any:
+    """In a classroom: report this learner's progress to the teacher (app/teacher/beacon.py)."""
+    if args.classroom_domain_id is None:
+        return None
+    from app.lessons.schema import load_course
+    from app.teacher.beacon import LearnerSources, ProgressBeacon
+
+    sources = LearnerSources(
+        load_course(),
+        dashboard.lessons,
+        dashboard.exercises,
+        dashboard.workspace,
+        dashboard.supervisor,
+        dashboard.exercise_settings,
+    )
+    beacon = ProgressBeacon(
+        dashboard.ui,
+        sources,
+        dashboard.notice,
+        site=args.site,
+        learner=args.learner,
+        domain_id=int(os.environ.get("ROS_DOMAIN_ID", "0")),
+        classroom_domain=args.classroom_domain_id,
+    )
+    beacon.start()
+    return beacon
+
+
+def cmd_classroom_status(args: argparse.Namespace) -> int:
+    """The teacher page's table in a terminal (app/teacher/status.py)."""
+    from app.lessons.progress import DEFAULT_DIR
+    from app.teacher.status import StatusError, status
+
+    try:
+        print(status(args.progress_dir or DEFAULT_DIR / "classroom"))
+    except StatusError as exc:
+        raise CliError(str(exc)) from None
+    return 0
+
+
 def cmd_classroom(args: argparse.Namespace) -> int:
     """N isolated learner dashboards (app/classroom.py); URLs printed, Ctrl+C stops all."""
     from app import classroom
+    from app.access import AccessError, check_token, new_token
     from app.lessons.progress import DEFAULT_DIR
 
+    if args.verb == "status":
+        return cmd_classroom_status(args)
+    if args.learners is None:
+        raise CliError("say how many learners: `ros2-classroom classroom --learners N`")
     if not _is_loopback(args.host) and not args.allow_remote:
         raise CliError(
             f"refusing to serve on {args.host}: add --allow-remote (each learner then gets "
             "an access token in their URL)"
         )
+    progress_root = args.progress_dir or DEFAULT_DIR / "classroom"
     learners = classroom.plan(
         args.learners,
         base_port=args.base_port,
         base_domain=args.base_domain_id,
-        progress_root=args.progress_dir or DEFAULT_DIR / "classroom",
+        progress_root=progress_root,
         tokens=args.allow_remote,
+        site=args.site,
+        classroom_domain=args.classroom_domain_id,
+    )
+    teacher_port = args.teacher_port or (
+        args.base_port - 1 if args.base_port > 1 else args.base_port + args.learners
+    )
+    if teacher_port in [learner.port for learner in learners]:
+        raise CliError(f"--teacher-port {teacher_port} is also a learner's port")
+    try:
+        teacher_token = check_token(args.teacher_token) if args.teacher_token else new_token()
+    except AccessError as exc:
+        raise CliError(f"--teacher-token: {exc}") from None
+    if any(teacher_token == learner.token for learner in learners):
+        raise CliError("the teacher's token must differ from every learner's")
+    teacher = classroom.TeacherPlan(
+        teacher_port,
+        teacher_token,
+        args.classroom_domain_id,
+        progress_root,
+        args.reveal_solution_after,
     )
     for learner in learners:
         _check_port_free(args.host, learner.port)
+    _check_port_free(args.host, teacher_port)
     chosen = (
         ("--allow-remote", args.allow_remote),
         ("--network", args.network),
@@ -193,7 +263,8 @@ def cmd_classroom(args: argparse.Namespace) -> int:
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: stop_requested.set())
     room = classroom.Classroom(learners, os.environ, host=args.host, serve_flags=flags)
-    return classroom.run(room, stop_requested, lambda line: print(line, flush=True))
+    configure_this_process(network=args.network)  # the teacher page's DDS participant
+    return classroom.run(room, stop_requested, lambda line: print(line, flush=True), teacher)
 
 
 def cmd_run(args: argparse.Namespace) -> int:
@@ -310,11 +381,29 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         help="where progress is saved (default var/progress)",
     )
+    serve.add_argument(
+        "--classroom-domain-id",
+        type=_domain_id,
+        default=None,
+        help="in a classroom: report progress to the teacher page on this shared ROS domain",
+    )
+    serve.add_argument(
+        "--site", default=socket.gethostname(), help="in a classroom: this machine's name"
+    )
     dds_options(serve)
     serve.set_defaults(func=cmd_serve)
 
-    room = sub.add_parser("classroom", help="start N isolated learner dashboards")
-    room.add_argument("--learners", type=int, required=True, help="how many learners")
+    room = sub.add_parser(
+        "classroom", help="start N isolated learner dashboards and the teacher page"
+    )
+    room.add_argument(
+        "verb",
+        nargs="?",
+        choices=("start", "status"),
+        default="start",
+        help="status: print the running classroom's table (default: start one)",
+    )
+    room.add_argument("--learners", type=int, default=None, help="how many learners")
     room.add_argument("--base-port", type=_port, default=8080, help="first learner's port")
     room.add_argument(
         "--base-domain-id", type=_domain_id, default=10, help="first learner's ROS domain id"
@@ -338,6 +427,29 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         metavar="N",
         help="failed checks before an exercise's reference solution may be shown",
+    )
+    room.add_argument(
+        "--teacher-port",
+        type=_port,
+        default=None,
+        help="the teacher page's port (default: one below --base-port)",
+    )
+    room.add_argument(
+        "--teacher-token",
+        default=os.environ.get("CLASSROOM_TEACHER_TOKEN"),
+        help="the teacher page's token (default: $CLASSROOM_TEACHER_TOKEN, else a random one)",
+    )
+    room.add_argument(
+        "--classroom-domain-id",
+        type=_domain_id,
+        default=101,
+        help="ROS domain shared by every learner and the teacher page, for progress only "
+        "(default 101; the same on every host of one class)",
+    )
+    room.add_argument(
+        "--site",
+        default=socket.gethostname(),
+        help="this host's name on the teacher page (default: the hostname)",
     )
     room.set_defaults(func=cmd_classroom)
 

@@ -38,7 +38,7 @@ from app.ros.rosout import RosoutLog
 from app.ros.runtime import RosRuntime
 from app.ros2cli.console_panel import ConsolePanel
 from app.supervisor import Supervisor
-from app.ui import TAB_NAMES, Panel
+from app.ui import TAB_NAMES, MarkdownView, Panel
 from app.ui.loop import UiLoop
 from app.ui.page_links import PageLinks
 
@@ -102,6 +102,7 @@ class Dashboard:
             f"Domain id **{os.environ.get('ROS_DOMAIN_ID', '0')}** · "
             "this dashboard is the ROS node `/classroom_dashboard`."
         )
+        self.notice = MarkdownView(gui)  # in a classroom: the teacher's latest message
         # One window docked on the left: the lesson's code and the learner's own.
         side_window = gui.add_panel()
         side_window.dock_left()

@@ -33,9 +33,14 @@ LOG_LINES = 12
 LANE = "exercise"
 
 
-@dataclass(frozen=True)
+@dataclass
 class ExerciseSettings:
-    """What the teacher decides: whether and how code runs, when solutions show."""
+    """What the teacher decides: whether and how code runs, when solutions show.
+
+    ``policy`` is fixed for the dashboard's life. ``reveal_after`` may change
+    while it serves (the teacher's page sets it); the UI thread owns it: only
+    the UI thread reads or writes it.
+    """
 
     policy: RunPolicy = RunPolicy()
     reveal_after: int | None = None  # None: each exercise's own number

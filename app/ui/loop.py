@@ -29,7 +29,7 @@ class UiLoop:
     """Intents are applied in order by one thread (see the threading model in app.ui)."""
 
     def __init__(self) -> None:
-        self._intents: queue.SimpleQueue[Intent] = queue.SimpleQueue()
+        self._intents: queue.SimpleQueue[tuple[Intent, bool]] = queue.SimpleQueue()
         self._wake = threading.Event()
         self._lanes: dict[str, ThreadPoolExecutor] = {}
         self._lanes_lock = threading.Lock()
@@ -37,10 +37,16 @@ class UiLoop:
 
     # -- any thread ------------------------------------------------------------
 
-    def post(self, intent: Intent) -> None:
-        """Ask the UI thread to run ``intent`` soon; returns at once."""
-        self._intents.put(intent)
-        self._wake.set()
+    def post(self, intent: Intent, *, refresh: bool = True) -> None:
+        """Ask the UI thread to run ``intent`` soon; returns at once.
+
+        A ``refresh=False`` intent only reads state (e.g. the teacher's progress
+        snapshot): it runs at the next pass without waking the loop or making
+        every panel redraw.
+        """
+        self._intents.put((intent, refresh))
+        if refresh:
+            self._wake.set()
 
     def callback(self, intent: Callable[..., None], *args: Any) -> Callable[[Any], None]:
         """A viser callback that posts ``intent(*args)`` when a browser changed the widget.
@@ -110,14 +116,17 @@ class UiLoop:
         return woken
 
     def apply_pending(self) -> int:
-        """Run every posted intent in order; one failing intent stops no other."""
+        """Run every posted intent in order; one failing intent stops no other.
+
+        Returns how many of them asked for a refresh.
+        """
         applied = 0
         while True:
             try:
-                intent = self._intents.get_nowait()
+                intent, refresh = self._intents.get_nowait()
             except queue.Empty:
                 return applied
-            applied += 1
+            applied += refresh
             try:
                 intent()
             except Exception:  # a bug in one panel (or a forged widget value) freezes nothing

@@ -208,3 +208,14 @@ def test_jobs_of_one_lane_run_in_the_order_posted():
         time.sleep(0.01)
     assert order == list(range(20))
     ui.close()
+
+
+def test_a_read_only_intent_runs_without_waking_the_loop_or_asking_a_redraw():
+    ui = UiLoop()
+    seen: list[str] = []
+    ui.post(lambda: seen.append("snapshot"), refresh=False)
+    assert ui.wait(0.05) is False  # nothing woke the loop early
+    assert ui.apply_pending() == 0 and seen == ["snapshot"]  # ran, and asks no refresh
+    ui.post(lambda: seen.append("click"))
+    assert ui.wait(0.05) is True
+    assert ui.apply_pending() == 1 and seen == ["snapshot", "click"]

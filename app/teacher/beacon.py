@@ -1,0 +1,245 @@
+"""Inside a learner's dashboard: publish where the learner is; show what the teacher says.
+
+Threads, following the dashboard's model (app.ui):
+
+- The beacon's own thread asks the UI thread, twice a second, for a
+  ``LearnerRecord`` (``ui.post``): lesson position, the step's checks and the
+  panels' other state belong to the UI thread, so only it reads them. The
+  record comes back through a queue; the beacon thread alone keeps the
+  "last activity" stamps and publishes on change, or every
+  ``HEARTBEAT_SEC`` so the teacher page can tell a quiet learner from a
+  dashboard that is gone.
+- Notices and settings arrive on the side participant's executor thread and
+  are posted to the UI thread, which shows or applies them.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import queue
+import threading
+import time
+from dataclasses import dataclass, replace
+
+from app.exercises import runner
+from app.exercises.model import Exercise, ExerciseBook
+from app.exercises.panel import ExerciseSettings
+from app.exercises.workspace import Workspace
+from app.lessons.runtime import LessonRuntime
+from app.lessons.schema import Course
+from app.ros.side_participant import SideParticipant
+from app.supervisor import Supervisor
+from app.teacher import wire
+from app.teacher.record import MAX_CODE, MAX_ERROR, LearnerRecord, clip, plain_markdown
+from app.ui import MarkdownView
+from app.ui.loop import UiLoop
+
+log = logging.getLogger(__name__)
+
+COLLECT_SEC = 0.5  # how stale the teacher's view of this learner may get
+HEARTBEAT_SEC = 10.0
+
+
+@dataclass(frozen=True)
+class LearnerSources:
+    """What the dashboard knows about its learner (read on the UI thread only)."""
+
+    course: Course
+    lessons: LessonRuntime
+    book: ExerciseBook
+    workspace: Workspace
+    supervisor: Supervisor
+    settings: ExerciseSettings
+
+
+class ProgressBeacon:
+    """One learner dashboard's link to the teacher, on the classroom domain."""
+
+    def __init__(
+        self,
+        ui: UiLoop,
+        sources: LearnerSources,
+        notice_view: MarkdownView,
+        *,
+        site: str,
+        learner: str,
+        domain_id: int,
+        classroom_domain: int,
+    ) -> None:
+        self._ui = ui
+        self._sources = sources
+        self._notice_view = notice_view
+        self._site, self._learner, self._domain_id = site, learner, domain_id
+        self._key = f"{site}/{learner}"
+        self._records: queue.SimpleQueue[LearnerRecord | None] = queue.SimpleQueue()
+        self._stop = threading.Event()
+        self._crash_key: tuple | None = None  # UI thread: the crash text read once per process
+        self._crash_text = ""
+        self._side = SideParticipant(wire.node_name_for(site, learner), classroom_domain)
+        node = self._side.node
+        self._publisher = node.create_publisher(
+            wire.LearnerProgress, wire.PROGRESS_TOPIC, wire.PROGRESS_PUB_QOS
+        )
+        node.create_subscription(
+            wire.TeacherNotice, wire.NOTICES_TOPIC, self._on_notice, wire.NOTICES_QOS
+        )
+        node.create_subscription(
+            wire.ClassroomSettings, wire.SETTINGS_TOPIC, self._on_settings, wire.SETTINGS_QOS
+        )
+        self._thread = threading.Thread(target=self._run, name="progress-beacon", daemon=True)
+
+    def start(self) -> None:
+        self._thread.start()
+
+    def close(self) -> None:
+        self._stop.set()
+        self._records.put(None)  # wake the beacon thread now
+        self._thread.join(timeout=2.0)
+        self._side.shutdown()
+
+    # -- the beacon thread --------------------------------------------------------
+
+    def _run(self) -> None:
+        last: LearnerRecord | None = None
+        activity = progress = time.time()
+        sent_at = 0.0
+        while not self._stop.wait(COLLECT_SEC):
+            self._ui.post(self._collect, refresh=False)  # reads only: no redraw
+            try:
+                record = self._records.get(timeout=COLLECT_SEC * 4)
+                while not self._records.empty():  # only the newest counts
+                    record = self._records.get_nowait()
+            except queue.Empty:  # the UI thread is busy; try again next round
+                continue
+            if record is None:  # closing
+                return
+            now = time.time()
+            changed = last is None or (
+                record.what_changed_ignoring_stamps() != last.what_changed_ignoring_stamps()
+            )
+            if last is not None and changed:
+                activity = now
+                if record.position() != last.position():
+                    progress = now
+            if changed or now - sent_at >= HEARTBEAT_SEC:
+                stamped = _with_stamps(record, activity, progress)
+                try:
+                    self._publisher.publish(wire.to_message(stamped))
+                    sent_at = now
+                except Exception:  # shutting down, or a bug: the dashboard keeps going
+                    log.exception("publishing progress failed")
+            last = record
+
+    # -- the UI thread --------------------------------------------------------------
+
+    def _collect(self) -> None:
+        try:
+            self._records.put(self._snapshot())
+        except Exception:  # a half-loaded course or a file read error: skip this round
+            log.exception("collecting progress failed")
+
+    def _snapshot(self) -> LearnerRecord:
+        s = self._sources
+        progress = s.workspace.progress
+        lessons = s.course.lessons
+        lesson = s.course.lesson(progress.current_lesson() or "") or (
+            lessons[0] if lessons else None
+        )
+        fields: dict = {}
+        if lesson is not None:
+            index = max(0, min(progress.lesson(lesson.id)["step"], len(lesson.steps) - 1))
+            step = lesson.steps[index]
+            results = [s.lessons.evaluate(check) for check in step.checks]
+            fields = dict(
+                lesson_id=lesson.id,
+                unit=lesson.unit,
+                lesson_title=lesson.title,
+                step=index + 1,
+                steps=len(lesson.steps),
+                step_title=step.title,
+                check_states=tuple(r.state for r in results),
+                check_reasons=tuple(r.reason for r in results),
+            )
+        records = {e.slug: progress.exercise(e.slug) for e in s.book.exercises}
+        exercise = self._current_exercise(lesson.id if lesson else "", records)
+        if exercise is not None:
+            here = records[exercise.slug]
+            fields.update(
+                exercise=exercise.slug,
+                exercise_attempts_here=here.get("attempts", 0),
+                exercise_failed_here=here.get("failed_checks", 0),
+                exercise_passed_here="passed_at" in here,
+                code_excerpt=clip(s.workspace.code(exercise), MAX_CODE),
+                last_error=clip(self._last_error(exercise, here), MAX_ERROR),
+            )
+        return LearnerRecord(
+            site=self._site,
+            learner=self._learner,
+            domain_id=self._domain_id,
+            steps_passed=sum(len(progress.lesson(each.id)["passed"]) for each in lessons),
+            exercises_passed=sum("passed_at" in r for r in records.values()),
+            exercise_attempts=sum(r.get("attempts", 0) for r in records.values()),
+            nodes_running=tuple(
+                sorted(name for name, st in s.supervisor.statuses().items() if st.active)
+            ),
+            **fields,
+        )
+
+    def _current_exercise(self, lesson_id: str, records: dict[str, dict]) -> Exercise | None:
+        """The exercise touched last (code saved or checked); the lesson's own come first."""
+        book = self._sources.book
+        mine = book.for_lesson(lesson_id)
+        candidates = mine or list(book.exercises)
+        touched = [(self._touched_at(e, records[e.slug]), e) for e in candidates]
+        touched = [(t, e) for t, e in touched if t > 0]
+        if touched:
+            return max(touched, key=lambda pair: pair[0])[1]
+        return mine[0] if mine else None
+
+    def _touched_at(self, exercise: Exercise, record: dict) -> float:
+        try:
+            saved = os.stat(self._sources.workspace.code_dir / f"{exercise.slug}.py").st_mtime
+        except OSError:
+            saved = 0.0
+        return max(saved, record.get("last_checked", 0.0), record.get("first_opened", 0.0))
+
+    def _last_error(self, exercise: Exercise, record: dict) -> str:
+        s = self._sources
+        status = runner.status(s.supervisor, exercise)
+        if status is not None and not status.active:
+            key = (exercise.slug, status.pid, status.ended_at)
+            if key != self._crash_key:
+                script = s.workspace.scratch / f"{exercise.slug}.py"
+                crash = runner.crash_of(s.supervisor, exercise, script)
+                self._crash_key = key
+                self._crash_text = f"{status.describe()}: {crash.describe()}" if crash else ""
+            if self._crash_text:
+                return self._crash_text
+        failed = record.get("failed_checks", 0)
+        if failed and "passed_at" not in record:
+            return f"{failed} failed check{'s' if failed != 1 else ''}, not passed yet"
+        return ""
+
+    # -- the side participant's executor thread -------------------------------------
+
+    def _on_notice(self, msg: wire.TeacherNotice) -> None:
+        if msg.to not in ("", self._key):
+            return
+        when = time.strftime("%H:%M", time.localtime(wire.seconds(msg.stamp)))
+        to = "to you" if msg.to else "to the class"
+        text = f"📣 **Message from your teacher** ({to}, {when}): {plain_markdown(msg.text)}"
+        self._ui.post(lambda: self._notice_view.show(text))
+
+    def _on_settings(self, msg: wire.ClassroomSettings) -> None:
+        limit = msg.reveal_solution_after or None
+        self._ui.post(lambda: _set_reveal_after(self._sources.settings, limit))
+
+
+def _with_stamps(record: LearnerRecord, activity: float, progress: float) -> LearnerRecord:
+    return replace(record, last_activity=activity, last_progress=progress)
+
+
+def _set_reveal_after(settings: ExerciseSettings, limit: int | None) -> None:
+    """The teacher's number, live; runs on the UI thread, which owns the settings."""
+    settings.reveal_after = limit

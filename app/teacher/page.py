@@ -1,0 +1,285 @@
+"""The teacher page: one row per learner, live; their code; messages; the class's settings.
+
+A viser page of its own, served by the ``classroom`` command on its own port
+and always behind its own token (``app.access``): a learner's URL never
+opens it and the teacher's token opens no learner's dashboard. viser gives
+the same look, widgets and token gate as the learners' dashboards; two plain
+HTTP routes on the same server serve the CSV export and the JSON table that
+``classroom status`` prints.
+
+Threads, as in the dashboard (app.ui): one UI thread owns every widget and
+the teacher's choices; viser callbacks post intents; the routes run on
+viser's asyncio thread and read only the roster's copies and the current
+(immutable) stuck rule.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import http
+import io
+import json
+import logging
+import threading
+import time
+from urllib.parse import urlsplit
+
+import viser
+from websockets.asyncio.server import ServerConnection
+from websockets.datastructures import Headers
+from websockets.http11 import Request, Response
+
+from app.access import Handler, ProcessRequest, make_server
+from app.teacher.record import (
+    COLUMNS,
+    MAX_NOTICE,
+    LearnerRecord,
+    StuckRule,
+    checks_text,
+    plain_markdown,
+    table,
+    to_csv,
+)
+from app.teacher.roster import Roster
+from app.ui import MarkdownView, assign, set_options
+from app.ui.loop import UiLoop
+
+log = logging.getLogger(__name__)
+
+REFRESH_SEC = 0.5
+ROUTES = "/classroom/teacher/"
+CSV_PATH = ROUTES + "progress.csv"
+JSON_PATH = ROUTES + "progress.json"
+EVERYONE = "everyone"
+NOBODY = "(choose a learner)"
+
+
+def _cell(value: str) -> str:
+    return plain_markdown(str(value))
+
+
+def markdown_table(rows: list) -> str:
+    head = "| " + " | ".join(COLUMNS) + " |\n|" + "---|" * len(COLUMNS) + "\n"
+    return head + "\n".join("| " + " | ".join(_cell(v) for v in row) + " |" for row in rows)
+
+
+def _fenced(text: str, language: str = "") -> str:
+    """A code block whose fence is longer than any run of backticks inside it."""
+    longest, run = 0, 0
+    for char in text:
+        run = run + 1 if char == "`" else 0
+        longest = max(longest, run)
+    fence = "`" * max(3, longest + 1)
+    return f"{fence}{language}\n{text}\n{fence}"
+
+
+def learner_detail(record: LearnerRecord) -> str:
+    """One learner, read-only: where they are, why checks fail, their code, their last error."""
+    reasons = "\n".join(
+        f"- **{plain_markdown(state)}**: {plain_markdown(reason)}"
+        for state, reason in zip(record.check_states, record.check_reasons, strict=False)
+    )
+    parts = [
+        f"### {record.learner} ({record.site}, ROS domain {record.domain_id})",
+        f"Unit {record.unit} · {record.lesson_title} · step {record.step}/{record.steps}: "
+        f"{record.step_title}",
+        f"**Checks** {checks_text(record)}\n\n{reasons}" if reasons else "**Checks** none",
+    ]
+    if record.exercise:
+        mark = "✓ passed" if record.exercise_passed_here else "not passed yet"
+        parts.append(
+            f"**Exercise `{record.exercise}`**: {mark}, {record.exercise_attempts_here} checks, "
+            f"{record.exercise_failed_here} failed"
+        )
+        if record.last_error:
+            parts.append("**Last error**\n\n" + _fenced(record.last_error))
+        parts.append("**Their code** (read-only)\n\n" + _fenced(record.code_excerpt, "python"))
+    else:
+        parts.append("_No exercise in this unit._")
+    return "\n\n".join(p for p in parts if p)
+
+
+class TeacherRoutes:
+    """``progress.csv`` and ``progress.json`` on the page's server (behind its token)."""
+
+    def __init__(self, roster: Roster) -> None:
+        self.roster = roster
+        self.rule = StuckRule()  # replaced (never mutated) by the page's UI thread
+
+    def wrap_http(self, inner: ProcessRequest | None) -> ProcessRequest:
+        def process_request(connection: ServerConnection, request: Request) -> Response | None:
+            path = urlsplit(request.path).path
+            if path == CSV_PATH:
+                body = to_csv(self.roster.records(), self.rule).encode()
+                return _ok(body, "text/csv; charset=utf-8", "classroom-progress.csv")
+            if path == JSON_PATH:
+                rows = table(self.roster.records(), self.rule)
+                body = json.dumps({"columns": COLUMNS, "rows": rows}).encode()
+                return _ok(body, "application/json")
+            return inner(connection, request) if inner is not None else None
+
+        return process_request
+
+    def wrap_handler(self, inner: Handler) -> Handler:
+        return inner
+
+
+def _ok(body: bytes, content_type: str, filename: str | None = None) -> Response:
+    headers = Headers(
+        {
+            "Content-Type": content_type,
+            "Content-Length": str(len(body)),
+            "Cache-Control": "no-store",
+        }
+    )
+    if filename:
+        headers["Content-Disposition"] = f'attachment; filename="{filename}"'
+    return Response(http.HTTPStatus.OK, "OK", headers, body)
+
+
+class TeacherPage:
+    def __init__(
+        self,
+        host: str,
+        port: int,
+        token: str,
+        roster: Roster,
+        *,
+        reveal_after: int | None = None,
+        rule: StuckRule | None = None,
+    ) -> None:
+        self.roster = roster
+        self.routes = TeacherRoutes(roster)
+        if rule is not None:
+            self.routes.rule = rule
+        with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: our command prints
+            self.server, _gate = make_server(host, port, token, self.routes)
+        self.port = self.server.get_port()
+        self.ui = UiLoop()
+        self._stop = threading.Event()
+        self._build(reveal_after)
+        self._thread = threading.Thread(target=self._loop, name="teacher-ui", daemon=True)
+
+    def _build(self, reveal_after: int | None) -> None:
+        gui, ui = self.server.gui, self.ui
+        gui.configure_theme(titlebar_content=None, control_width="large", show_share_button=False)
+        self.server.scene.configure_environment_map(None)
+        gui.add_markdown(
+            f"## ROS 2 Classroom: teacher's view\n[Download the class's progress (CSV)]({CSV_PATH})"
+        )
+        # The class table is wide: it gets the big window docked on the left.
+        window = gui.add_panel()
+        window.dock_left()
+        window.set_width(1100)
+        with window.add_tab("Class", viser.Icon.USERS):
+            self._summary = MarkdownView(gui)
+            self._table = MarkdownView(gui, "_Waiting for the learners' dashboards…_")
+        with window.add_tab("Learner's code", viser.Icon.CODE):
+            self._detail = MarkdownView(gui, "_Choose a learner on the right._")
+
+        self._learner = gui.add_dropdown("Learner", [NOBODY])
+        with gui.add_folder("Message to learners"):
+            self._to = gui.add_dropdown("To", [EVERYONE])
+            self._text = gui.add_text("Message", "", hint=f"at most {MAX_NOTICE} characters")
+            self._send = gui.add_button("Send", icon=viser.Icon.SEND)
+            self._sent = MarkdownView(gui)
+        with gui.add_folder("Class settings"):
+            self._reveal = gui.add_number(
+                "Solution after N failed checks (0: each exercise's own)",
+                reveal_after or 0,
+                min=0,
+                max=100,
+                step=1,
+            )
+            self._apply = gui.add_button("Apply to every learner", icon=viser.Icon.CHECK)
+            rule = self.routes.rule
+            self._stuck_min = gui.add_number(
+                "Stuck: minutes without progress while a check fails",
+                round(rule.no_progress_sec / 60, 1),
+                min=0.1,
+                max=240,
+                step=0.1,
+            )
+            self._stuck_fails = gui.add_number(
+                "Stuck: failed checks of one exercise", rule.failed_checks, min=1, max=100, step=1
+            )
+            self._applied = MarkdownView(gui)
+        self._learner.on_update(ui.callback(self._show_detail))
+        self._send.on_click(ui.callback(self._on_send))
+        self._apply.on_click(ui.callback(self._on_apply))
+        self._stuck_min.on_update(ui.callback(self._on_rule))
+        self._stuck_fails.on_update(ui.callback(self._on_rule))
+
+    # -- the UI thread ---------------------------------------------------------------
+
+    def start(self) -> None:
+        self._thread.start()
+
+    def _loop(self) -> None:
+        while not self._stop.is_set():
+            self.ui.wait(REFRESH_SEC)
+            self.ui.apply_pending()
+            try:
+                self._refresh()
+            except Exception:  # keep the page going; the traceback goes to the log
+                log.exception("teacher page refresh failed")
+            self.server.flush()
+
+    def _refresh(self) -> None:
+        records = self.roster.records()
+        now = time.time()
+        rows = table(records, self.routes.rule, now)
+        if rows:
+            stuck = sum(1 for row in rows if row[-1])
+            self._summary.show(
+                f"**{len(rows)} learner{'s' if len(rows) != 1 else ''}**"
+                + (f" · **⚠ {stuck} stuck**" if stuck else "")
+                + f" · updated {time.strftime('%H:%M:%S')}"
+            )
+            self._table.show(markdown_table(rows))
+        keys = sorted(r.key for r in records)
+        set_options(self._learner, [NOBODY, *keys])
+        set_options(self._to, [EVERYONE, *keys])
+        self._show_detail(records)
+
+    def _show_detail(self, records: list[LearnerRecord] | None = None) -> None:
+        chosen = self._learner.value
+        if chosen == NOBODY:
+            self._detail.show("_Choose a learner on the right._")
+            return
+        by_key = {r.key: r for r in (records or self.roster.records())}
+        record = by_key.get(chosen)
+        self._detail.show(learner_detail(record) if record else f"_{chosen}: no news yet._")
+
+    def _on_send(self) -> None:
+        text = self._text.value.strip()
+        to = self._to.value
+        if not text:
+            self._sent.show("⚠ Write a message first.")
+            return
+        if len(text) > MAX_NOTICE:
+            self._sent.show(f"⚠ At most {MAX_NOTICE} characters ({len(text)} now).")
+            return
+        target = "" if to == EVERYONE else to
+        self.roster.send_notice(target, text)
+        assign(self._text, "")
+        self._sent.show(f"Sent to {to} at {time.strftime('%H:%M:%S')}.")
+
+    def _on_apply(self) -> None:
+        value = int(self._reveal.value)
+        self.roster.set_reveal_after(value)
+        what = "each exercise's own number" if value == 0 else f"{value} failed checks"
+        self._applied.show(f"Reference solutions now show after {what}.")
+
+    def _on_rule(self) -> None:
+        self.routes.rule = StuckRule(
+            no_progress_sec=max(6.0, float(self._stuck_min.value) * 60),
+            failed_checks=max(1, int(self._stuck_fails.value)),
+        )
+
+    def close(self) -> None:
+        self._stop.set()
+        self.ui.post(lambda: None)
+        self._thread.join(timeout=2.0)
+        self.ui.close()
+        self.server.stop()

@@ -1,0 +1,207 @@
+"""One learner's progress as plain data, the "stuck" rule, and the class table.
+
+Everything here is pure: the dashboard fills a ``LearnerRecord``, the wire
+module turns it into a message and back, and the teacher page, the CSV
+export and ``classroom status`` all render the same ``table`` rows.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import re
+import time
+from collections.abc import Iterable
+from dataclasses import dataclass, field, fields
+
+# Bounds of the message (interfaces/classroom_interfaces/msg/LearnerProgress.msg).
+MAX_NAME = 64
+MAX_TITLE = 120
+MAX_CHECKS = 16
+MAX_REASON = 160
+MAX_CODE = 4000
+MAX_ERROR = 1000
+MAX_NODES = 32
+MAX_NOTICE = 280
+
+_MARKS = {"pass": "✓", "fail": "✗", "waiting": "…"}
+
+
+def clip(text: str, limit: int) -> str:
+    """At most ``limit`` characters; a cut string ends in an ellipsis."""
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+_MARKDOWN_SPECIAL = re.compile(r"([\\`*_{}\[\]()<>#+!|~])")
+
+
+def plain_markdown(text: str) -> str:
+    """Text shown as itself on a page: no links, images, HTML or emphasis from it.
+
+    Anyone on the classroom domain can publish (DDS has no sender check here),
+    so what arrives over it is shown, never interpreted.
+    """
+    return _MARKDOWN_SPECIAL.sub(r"\\\1", " ".join(text.split()))
+
+
+@dataclass(frozen=True)
+class LearnerRecord:
+    """What the teacher sees of one learner (immutable: safe to hand to any thread)."""
+
+    site: str
+    learner: str
+    domain_id: int = 0
+    lesson_id: str = ""
+    unit: int = 0
+    lesson_title: str = ""
+    step: int = 0  # 1-based
+    steps: int = 0
+    step_title: str = ""
+    steps_passed: int = 0
+    check_states: tuple[str, ...] = ()
+    check_reasons: tuple[str, ...] = ()
+    exercises_passed: int = 0
+    exercise_attempts: int = 0
+    exercise: str = ""
+    exercise_attempts_here: int = 0
+    exercise_failed_here: int = 0
+    exercise_passed_here: bool = False
+    code_excerpt: str = ""
+    last_error: str = ""
+    nodes_running: tuple[str, ...] = ()
+    last_activity: float = 0.0  # wall-clock seconds
+    last_progress: float = 0.0
+    received_at: float = field(default=0.0, compare=False)  # set by the teacher side
+
+    @property
+    def key(self) -> str:
+        return f"{self.site}/{self.learner}"
+
+    def what_changed_ignoring_stamps(self) -> tuple:
+        """Everything a learner can change; equal tuples mean nothing happened."""
+        skip = {"last_activity", "last_progress", "received_at"}
+        return tuple(getattr(self, f.name) for f in fields(self) if f.name not in skip)
+
+    def position(self) -> tuple:
+        """Moving to another step, passing one or passing an exercise is progress."""
+        return (self.lesson_id, self.step, self.steps_passed, self.exercises_passed)
+
+
+@dataclass(frozen=True)
+class StuckRule:
+    """When the teacher page marks a learner stuck (both limits are the teacher's)."""
+
+    no_progress_sec: float = 300.0  # ...with a failing check of the step
+    failed_checks: int = 3  # ...of the same exercise, not yet passed
+
+    def reason(self, record: LearnerRecord, now: float) -> str:
+        """Why this learner looks stuck, or '' when they do not."""
+        idle = now - record.last_progress
+        if "fail" in record.check_states and idle >= self.no_progress_sec:
+            return f"no progress for {_age(idle)} while a check fails"
+        if (
+            record.exercise
+            and not record.exercise_passed_here
+            and record.exercise_failed_here >= self.failed_checks
+        ):
+            return f"{record.exercise} failed {record.exercise_failed_here} times"
+        return ""
+
+
+def _age(seconds: float) -> str:
+    seconds = max(0.0, seconds)
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
+def checks_text(record: LearnerRecord) -> str:
+    """'✓✓✗ 2/3' (marks in the step's order, then passed of total)."""
+    if not record.check_states:
+        return "–"
+    marks = "".join(_MARKS.get(state, "?") for state in record.check_states)
+    passed = sum(state == "pass" for state in record.check_states)
+    return f"{marks} {passed}/{len(record.check_states)}"
+
+
+COLUMNS = (
+    "learner", "where", "unit · step", "checks", "exercises", "nodes", "last activity", "stuck",
+)  # fmt: skip
+OFFLINE_AFTER_SEC = 30.0  # three missed heartbeats
+
+
+def table(records: Iterable[LearnerRecord], rule: StuckRule, now: float | None = None) -> list:
+    """The class table as rows of display strings (``COLUMNS``), sorted by learner."""
+    now = time.time() if now is None else now
+    rows = []
+    for r in sorted(records, key=lambda r: (r.site, _natural(r.learner))):
+        stuck = rule.reason(r, now)
+        seen = now - r.received_at if r.received_at else 0.0
+        activity = f"{_age(now - r.last_activity)} ago"
+        if seen > OFFLINE_AFTER_SEC:
+            activity += f" (offline {_age(seen)})"
+        rows.append(
+            (
+                r.learner,
+                f"{r.site} · domain {r.domain_id}",
+                f"{r.unit} · {r.step}/{r.steps}" if r.steps else "–",
+                checks_text(r),
+                f"{r.exercises_passed} passed · {r.exercise_attempts} attempts",
+                ", ".join(r.nodes_running) or "–",
+                activity,
+                f"⚠ {stuck}" if stuck else "",
+            )
+        )
+    return rows
+
+
+def _natural(name: str) -> tuple:
+    """learner2 before learner10."""
+    head = name.rstrip("0123456789")
+    tail = name[len(head) :]
+    return (head, int(tail) if tail else -1)
+
+
+def text_table(rows: list, columns: tuple[str, ...] = COLUMNS) -> str:
+    """Fixed-width columns for a terminal."""
+    widths = [max([len(c), *(len(str(row[i])) for row in rows)]) for i, c in enumerate(columns)]
+    lines = ["  ".join(c.ljust(w) for c, w in zip(columns, widths, strict=True)).rstrip()]
+    lines.append("  ".join("-" * w for w in widths))
+    lines += [
+        "  ".join(str(v).ljust(w) for v, w in zip(row, widths, strict=True)).rstrip()
+        for row in rows
+    ]
+    return "\n".join(lines)
+
+
+CSV_FIELDS = (
+    "site", "learner", "domain_id", "lesson_id", "unit", "lesson_title", "step", "steps",
+    "step_title", "steps_passed", "checks", "exercises_passed", "exercise_attempts", "exercise",
+    "exercise_attempts_here", "exercise_failed_here", "exercise_passed_here", "nodes_running",
+    "last_activity", "last_progress", "stuck",
+)  # fmt: skip
+
+
+def _iso(stamp: float) -> str:
+    return time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime(stamp)) if stamp else ""
+
+
+def to_csv(records: Iterable[LearnerRecord], rule: StuckRule, now: float | None = None) -> str:
+    """The class's progress for a spreadsheet: one row per learner, raw values."""
+    now = time.time() if now is None else now
+    out = io.StringIO()
+    writer = csv.writer(out)
+    writer.writerow(CSV_FIELDS)
+    for r in sorted(records, key=lambda r: (r.site, _natural(r.learner))):
+        writer.writerow(
+            [
+                r.site, r.learner, r.domain_id, r.lesson_id, r.unit, r.lesson_title, r.step,
+                r.steps, r.step_title, r.steps_passed, " ".join(r.check_states),
+                r.exercises_passed, r.exercise_attempts, r.exercise, r.exercise_attempts_here,
+                r.exercise_failed_here, r.exercise_passed_here, ";".join(r.nodes_running),
+                _iso(r.last_activity), _iso(r.last_progress), rule.reason(r, now),
+            ]
+        )  # fmt: skip
+    return out.getvalue()
