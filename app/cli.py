@@ -108,6 +108,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
 
     # Heavy imports only for the command that needs them.
     from app.access import make_server
+    from app.bags import folder as bag_folder
     from app.dashboard import Dashboard
     from app.exercises.editor_server import EditorHub
     from app.exercises.panel import ExerciseSettings
@@ -122,6 +123,11 @@ def cmd_serve(args: argparse.Namespace) -> int:
         level=logging.INFO, format="%(asctime)s %(levelname)s %(name)s: %(message)s"
     )
     progress = ProgressStore(args.learner, args.progress_dir or DEFAULT_DIR)
+    # Bags typed in the browser stay in this learner's bags folder (beside progress).
+    os.environ.setdefault(
+        bag_folder.ENV_VAR, str((args.progress_dir or DEFAULT_DIR).parent / "bags" / args.learner)
+    )
+    bag_folder.confine_to_folder()
     stop_requested = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: stop_requested.set())
@@ -313,7 +319,7 @@ def cmd_exercise(args: argparse.Namespace) -> int:
     return exercise_main(args.verb, args.slug, args.file)
 
 
-ROS2_GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface")
+ROS2_GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface", "bag")
 
 
 def cmd_ros2(args: argparse.Namespace) -> int:

@@ -36,6 +36,7 @@ RUNS: tuple[tuple[str, list[str]], ...] = (
     ("startup", ["--rounds", "2"]),
     ("cloud_to_browser", ["--quick"]),
     ("slam_accuracy", ["--frames", "120"]),
+    ("bag_record", ["--seconds", "10"]),
 )
 
 # (figure, benchmark, key ("a|b" shows both), unit, aim text, aim test)
@@ -271,6 +272,23 @@ ROWS: tuple[tuple[str, str, str, str, str, Any], ...] = (
     ),
     ("SLAM ATE (synthetic loop)", "slam_accuracy", "ate_percent", "% of path", "", None),
     ("SLAM speed", "slam_accuracy", "fps", "frames/s", "", None),
+    (
+        "Bag record 10×1 kHz + 30 Hz image: recorded rate ours / plain rosbags writer",
+        "bag_record",
+        "bag_record_ratio",
+        "x",
+        "≥ 0.95",
+        lambda v: v >= 0.95,
+    ),
+    ("Bag record: messages lost", "bag_record", "bag_lost", "msgs", "0", lambda v: v == 0),
+    (
+        "Bag replay at rate 1: inter-message interval error p95",
+        "bag_record",
+        "replay_interval_error_p95_ms",
+        "ms",
+        "< 1",
+        lambda v: v < 1.0,
+    ),
 )
 
 HEADLINE = {
@@ -288,6 +306,8 @@ HEADLINE = {
     "startup_page_s": ("startup", "startup_page_s"),
     "cloud_p95_ms": ("cloud_to_browser", "dashboard_p95_ms_100k_20hz"),
     "cloud_worker_p95_ms": ("cloud_to_browser", "dashboard_worker_p95_ms_100k_20hz"),
+    "bag_record_ratio": ("bag_record", "bag_record_ratio"),
+    "bag_lost": ("bag_record", "bag_lost"),
 }
 
 

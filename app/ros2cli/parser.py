@@ -16,12 +16,12 @@ from typing import Any, NoReturn
 
 from app.ros.context import CallContext, Write
 from app.ros.errors import Cancelled, Ros2Error
-from app.ros2cli import graph_verbs, interfaces, lifecycle, param, run, topic
+from app.ros2cli import bag, graph_verbs, interfaces, lifecycle, param, run, topic
 from app.ros2cli.common import settle_discovery
 
 log = logging.getLogger(__name__)
 
-GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface")
+GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface", "bag")
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
 
@@ -261,11 +261,14 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
     p.add_argument("type")
     p.add_argument("--no-expand", action="store_true", help="do not expand nested types")
 
+    bag.add_verbs(group("bag", "record, inspect and replay topics"), verb)
     run.add_command(groups, write)  # `ros2 run PKG EXE`: a command, not a group of verbs
     return parser
 
 
-_NO_DDS = {("interface", v) for v in ("list", "packages", "package", "show")}
+_NO_DDS = {("interface", v) for v in ("list", "packages", "package", "show")} | {
+    ("bag", v) for v in bag.NO_DDS_VERBS
+}
 
 
 def needs_ros(argv: list[str]) -> bool:
