@@ -30,7 +30,6 @@ from __future__ import annotations
 import argparse
 import json
 import shutil
-import signal
 import sys
 import threading
 import time
@@ -48,21 +47,13 @@ from bench._common import (
     stop,
     wait_for_text,
 )
+from bench._load import load_types, publish_load
 
 SMALL_TOPICS = tuple(f"/bench/bag_{k}" for k in range(10))
 IMAGE_TOPIC = "/bench/bag_image"
 TOPICS = (*SMALL_TOPICS, IMAGE_TOPIC)
-SMALL_HZ = 1000.0
-IMAGE_HZ = 30.0
 WARMUP_SEC = 5.0
 MARGIN_SEC = 1.0  # recording starts this long before the window and ends this long after
-
-
-def _types() -> tuple[type, type]:
-    from sensor_msgs.msg import Image
-    from std_msgs.msg import Int64
-
-    return Int64, Image
 
 
 def _record_qos() -> Any:
@@ -75,44 +66,7 @@ def _record_qos() -> Any:
 
 
 def publisher_main(out: Path) -> None:
-    """Publish until SIGINT; then write when every tick and image was sent."""
-    import rclpy
-    from rclpy.node import Node
-
-    Int64, Image = _types()
-    rclpy.init()
-    node = Node("bench_bag_publisher")
-    small = [node.create_publisher(Int64, t, 10) for t in SMALL_TOPICS]
-    image_pub = node.create_publisher(Image, IMAGE_TOPIC, 10)
-    image = Image(height=480, width=640, encoding="rgb8", step=640 * 3)
-    image.data = bytes(640 * 480 * 3)
-    msg = Int64()
-    ticks: list[float] = []
-    images: list[float] = []
-    stopping = threading.Event()
-    signal.signal(signal.SIGINT, lambda *_: stopping.set())
-    print("PUBLISHER READY", flush=True)
-    start = time.monotonic()
-    k = 0
-    next_image = start
-    while not stopping.is_set():
-        due = start + k / SMALL_HZ
-        now = time.monotonic()
-        if due > now:
-            time.sleep(due - now)
-        msg.data = k
-        for pub in small:
-            pub.publish(msg)
-        ticks.append(time.monotonic())
-        k += 1
-        if ticks[-1] >= next_image:
-            image.header.frame_id = str(len(images))
-            image_pub.publish(image)
-            images.append(time.monotonic())
-            next_image += 1.0 / IMAGE_HZ
-    out.write_text(json.dumps({"ticks": ticks, "images": images}))
-    node.destroy_node()
-    rclpy.try_shutdown()
+    publish_load("bench_bag_publisher", SMALL_TOPICS, IMAGE_TOPIC, out)
 
 
 def _wait_for_publishers(node: Any) -> None:
@@ -133,7 +87,7 @@ def baseline_main(bag: Path, t0: float, t1: float) -> None:
 
     from app.bags.definitions import definition
 
-    Int64, Image = _types()
+    Int64, Image = load_types()
     rclpy.init()
     node = Node("bench_bag_plain")
     _wait_for_publishers(node)
@@ -186,7 +140,7 @@ def listener_main(out: Path, seconds: float) -> None:
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.node import Node
 
-    Int64, _Image = _types()
+    Int64, _Image = load_types()
     rclpy.init()
     node = Node("bench_bag_listener")
     got: list[tuple[int, float]] = []

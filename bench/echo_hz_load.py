@@ -34,7 +34,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import signal
 import subprocess
 import sys
 import threading
@@ -53,19 +52,11 @@ from bench._common import (
     stop,
     wait_for_text,
 )
+from bench._load import load_types, publish_load
 
 SMALL_TOPICS = tuple(f"/bench/load_{k}" for k in range(10))
 IMAGE_TOPIC = "/bench/image"
-SMALL_HZ = 1000.0
-IMAGE_HZ = 30.0
 WARMUP_SEC = 6.0
-
-
-def _types() -> tuple[type, type]:
-    from sensor_msgs.msg import Image
-    from std_msgs.msg import Int64
-
-    return Int64, Image
 
 
 def _measure_qos() -> Any:
@@ -78,43 +69,7 @@ def _measure_qos() -> Any:
 
 
 def publisher_main(out: Path) -> None:
-    """Publish until SIGINT; then write the monotonic time of every 1 kHz tick and image."""
-    import rclpy
-    from rclpy.node import Node
-
-    Int64, Image = _types()
-    rclpy.init()
-    node = Node("bench_load_publisher")
-    small = [node.create_publisher(Int64, t, 10) for t in SMALL_TOPICS]
-    image_pub = node.create_publisher(Image, IMAGE_TOPIC, 10)
-    image = Image(height=480, width=640, encoding="rgb8", step=640 * 3)
-    image.data = bytes(640 * 480 * 3)
-    msg = Int64()
-    ticks: list[float] = []
-    images: list[float] = []
-    stopping = threading.Event()
-    signal.signal(signal.SIGINT, lambda *_: stopping.set())
-    print("PUBLISHER READY", flush=True)
-    start = time.monotonic()
-    k = 0
-    next_image = start
-    while not stopping.is_set():
-        due = start + k / SMALL_HZ
-        now = time.monotonic()
-        if due > now:
-            time.sleep(due - now)
-        msg.data = k
-        for pub in small:
-            pub.publish(msg)
-        ticks.append(time.monotonic())
-        k += 1
-        if ticks[-1] >= next_image:
-            image_pub.publish(image)
-            images.append(time.monotonic())
-            next_image += 1.0 / IMAGE_HZ
-    out.write_text(json.dumps({"ticks": ticks, "images": images}))
-    node.destroy_node()
-    rclpy.try_shutdown()
+    publish_load("bench_load_publisher", SMALL_TOPICS, IMAGE_TOPIC, out)
 
 
 def baseline_main(topic: str, t0: float, t1: float, out: Path) -> None:
@@ -123,7 +78,7 @@ def baseline_main(topic: str, t0: float, t1: float, out: Path) -> None:
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.node import Node
 
-    Int64, Image = _types()
+    Int64, Image = load_types()
     rclpy.init()
     node = Node(f"bench_plain_{topic.rsplit('/', 1)[-1]}")
     stamps: list[float] = []
@@ -160,7 +115,7 @@ def dashboard_main(t0: float, t1: float, out: Path) -> None:
     from app.supervisor import Supervisor
     from app.ui import MarkdownView, code_block
 
-    Int64, Image = _types()
+    Int64, Image = load_types()
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
     runtime = RosRuntime()
     supervisor = Supervisor({})

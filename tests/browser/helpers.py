@@ -39,3 +39,28 @@ def start_group(page: Page, group: str) -> None:
 def expect_text(page: Page, text: str | re.Pattern[str], timeout: float = 20_000) -> None:
     """``text`` is on screen: hidden copies (other tabs, closed folders) do not count."""
     expect(page.get_by_text(text).filter(visible=True).first).to_be_visible(timeout=timeout)
+
+
+# Elements of the control panel that stick out past its right edge (clipped text).
+_CUT_OFF_JS = """([selector, text]) => {
+  let panel = [...document.querySelectorAll(selector)].find((e) => e.innerText.trim() === text);
+  const scrolls = (el) => ['auto', 'scroll'].includes(getComputedStyle(el).overflowY);
+  while (panel && !scrolls(panel)) panel = panel.parentElement;
+  if (!panel) return ['no scrolling control panel found'];
+  const edge = panel.getBoundingClientRect().right;
+  const out = [];
+  for (const el of panel.querySelectorAll('*')) {
+    const box = el.getBoundingClientRect();
+    if (!box.width || !box.height || getComputedStyle(el).visibility === 'hidden') continue;
+    if (box.right > edge + 1) {
+      const text = (el.innerText || el.textContent || '').trim().slice(0, 40);
+      out.push(`${el.tagName} "${text}" ends at ${Math.round(box.right)} > ${Math.round(edge)}`);
+    }
+  }
+  return out.slice(0, 8);
+}"""
+
+
+def cut_off_at_panel_edge(page: Page, selector: str, text: str) -> list[str]:
+    """What sticks out of the scrolling panel that holds ``selector`` with ``text`` (none: [])."""
+    return page.evaluate(_CUT_OFF_JS, [selector, text])

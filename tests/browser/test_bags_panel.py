@@ -14,32 +14,10 @@ from app.panels.bags_panel import BagsPanel
 from app.ros.graph import GraphSnapshot
 from app.ros.monitor import TopicMonitor
 from app.ui.loop import UiLoop
-from tests.browser.helpers import click, expect_text
+from tests.browser.helpers import click, cut_off_at_panel_edge, expect_text
 from tests.conftest import free_port, wait_until
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
-
-
-# Elements that stick out past the control panel's right edge (as the tour checks every tab).
-CLIPPED_JS = """() => {
-  const buttons = [...document.querySelectorAll('button')];
-  let panel = buttons.find((b) => b.innerText.trim() === 'Record');
-  const scrolls = (el) => ['auto', 'scroll'].includes(getComputedStyle(el).overflowY);
-  while (panel && !scrolls(panel)) panel = panel.parentElement;
-  if (!panel) return ['no scrolling control panel found'];
-  const edge = panel.getBoundingClientRect().right;
-  const out = [];
-  for (const el of panel.querySelectorAll('*')) {
-    const box = el.getBoundingClientRect();
-    const hidden = getComputedStyle(el).visibility === 'hidden';
-    if (box.width === 0 || box.height === 0 || hidden) continue;
-    if (box.right > edge + 1 && !el.closest('[data-allow-overflow]')) {
-      const text = (el.innerText || '').trim().slice(0, 40);
-      out.push(`${el.tagName.toLowerCase()} "${text}" ends at ${Math.round(box.right)}`);
-    }
-  }
-  return out.slice(0, 8);
-}"""
 
 
 @pytest.fixture
@@ -82,7 +60,9 @@ def test_record_stop_inspect_and_replay_in_the_panel(bags_page, supervisor, prob
     click(page, "Stop recording")
     expect_text(page, re.compile(r"Saved rosbag2_.*: \d+ messages"))
     expect_text(page, re.compile(r"Topic: /chatter \| Type: std_msgs/msg/String \| Count: \d+"))
-    assert page.evaluate(CLIPPED_JS) == [], "cut off at the panel's right edge"
+    assert cut_off_at_panel_edge(page, "button", "Record") == [], (
+        "cut off at the panel's right edge"
+    )
     assert supervisor.stop("talker").result(timeout=15).exit_code == 0
     (bag,) = [p for p in folder.iterdir() if p.is_dir()]
     assert (bag / "metadata.yaml").exists()
