@@ -29,16 +29,35 @@ DASHBOARD_NODE_NAME = "classroom_dashboard"
 
 
 class RosRuntime:
-    def __init__(self, node_name: str = DASHBOARD_NODE_NAME) -> None:
+    """``node`` in a context of its own, spun by one executor thread until ``shutdown``.
+
+    ``domain_id`` None: the environment's domain. ``quiet``: the node serves no
+    parameters and writes no /rosout (a side participant, see side_participant).
+    """
+
+    def __init__(
+        self,
+        node_name: str = DASHBOARD_NODE_NAME,
+        *,
+        domain_id: int | None = None,
+        quiet: bool = False,
+    ) -> None:
         # Our node serves parameters too: a client sending an unknown parameter
         # type must get a refusal, not end the dashboard (rclpy 7.1.6 bug).
         guard_parameter_services()
         self.context = Context()
-        rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO)
-        self.node = Node(node_name, context=self.context)
+        rclpy.init(
+            context=self.context, domain_id=domain_id, signal_handler_options=SignalHandlerOptions.NO
+        )
+        self.node = Node(
+            node_name,
+            context=self.context,
+            start_parameter_services=not quiet,
+            enable_rosout=not quiet,
+        )
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
-        self._thread = threading.Thread(target=self._spin, name="ros-executor", daemon=True)
+        self._thread = threading.Thread(target=self._spin, name=f"ros-{node_name}", daemon=True)
         self._thread.start()
 
     def _spin(self) -> None:

@@ -182,8 +182,11 @@ def test_teacher_follows_three_learners_on_two_hosts(ros_env, two_hosts, tmp_pat
     host_a, host_b = two_hosts
     env = configure_dds_env(dict(ros_env), network=True)
     env["FASTDDS_BUILTIN_TRANSPORTS"] = "UDPv4"  # no shared-memory shortcut between "hosts"
-    classroom_domain = int(env["ROS_DOMAIN_ID"])
     base_a, base_b = 40, 50  # learners' own domains: A 40-41, B 50
+    # This test's own domain, unless it is one of the learners' (then one that is not).
+    classroom_domain = int(env["ROS_DOMAIN_ID"])
+    if classroom_domain in (40, 41, 50):
+        classroom_domain += 20
     ARTIFACTS.mkdir(exist_ok=True)
     progress_a, progress_b = tmp_path / "A", tmp_path / "B"
     room_a, log_a = _start_classroom(
