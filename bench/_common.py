@@ -192,3 +192,26 @@ def machine() -> dict[str, Any]:
         "python": platform.python_version(),
         "os": os_name,
     }
+
+
+def sample(pids: dict[str, int], seconds: float) -> dict[str, dict[str, float]]:
+    """CPU % of one core and memory (RSS, USS, PSS in MB) of each process over ``seconds``."""
+    import psutil
+
+    procs = {name: psutil.Process(pid) for name, pid in pids.items()}
+    before = {name: p.cpu_times() for name, p in procs.items()}
+    t0 = time.monotonic()
+    time.sleep(seconds)
+    elapsed = time.monotonic() - t0
+    out = {}
+    for name, proc in procs.items():
+        after = proc.cpu_times()
+        busy = (after.user - before[name].user) + (after.system - before[name].system)
+        memory = proc.memory_full_info()
+        out[name] = {
+            "cpu_percent": 100.0 * busy / elapsed,
+            "rss_mb": memory.rss / 2**20,
+            "uss_mb": memory.uss / 2**20,
+            "pss_mb": memory.pss / 2**20,
+        }
+    return out

@@ -33,6 +33,7 @@ from bench._common import (
     free_port,
     require_private_netns,
     rounded,
+    sample,
     spawn,
     start_dashboard,
     stop,
@@ -40,28 +41,6 @@ from bench._common import (
 )
 
 SETTLE_SEC = 4.0  # start-up work and the first page's traffic are not idle
-
-
-def sample(pids: dict[str, int], seconds: float) -> dict[str, dict[str, float]]:
-    """CPU % of one core and memory of each process over the same ``seconds``."""
-    import psutil
-
-    procs = {name: psutil.Process(pid) for name, pid in pids.items()}
-    before = {name: p.cpu_times() for name, p in procs.items()}
-    t0 = time.monotonic()
-    time.sleep(seconds)
-    elapsed = time.monotonic() - t0
-    out = {}
-    for name, proc in procs.items():
-        after = proc.cpu_times()
-        busy = (after.user - before[name].user) + (after.system - before[name].system)
-        memory = proc.memory_full_info()
-        out[name] = {
-            "cpu_percent": 100.0 * busy / elapsed,
-            "rss_mb": memory.rss / 2**20,
-            "pss_mb": memory.pss / 2**20,
-        }
-    return out
 
 
 def _free_block(count: int) -> int:

@@ -24,6 +24,7 @@ from bench._common import (
     open_dashboard,
     require_private_netns,
     rounded,
+    sample,
     spawn,
     start_dashboard,
     stop,
@@ -44,27 +45,6 @@ except (KeyboardInterrupt, ExternalShutdownException):
 finally:
     rclpy.try_shutdown()
 """
-
-
-def sample(pids: dict[str, int], seconds: float) -> dict[str, dict[str, float]]:
-    import psutil
-
-    procs = {name: psutil.Process(pid) for name, pid in pids.items()}
-    before = {name: p.cpu_times() for name, p in procs.items()}
-    t0 = time.monotonic()
-    time.sleep(seconds)
-    elapsed = time.monotonic() - t0
-    out = {}
-    for name, proc in procs.items():
-        after = proc.cpu_times()
-        busy = (after.user - before[name].user) + (after.system - before[name].system)
-        memory = proc.memory_full_info()
-        out[name] = {
-            "cpu_percent": 100.0 * busy / elapsed,
-            "rss_mb": memory.rss / 2**20,
-            "uss_mb": memory.uss / 2**20,
-        }
-    return out
 
 
 def run(seconds: float) -> dict[str, Any]:
