@@ -55,7 +55,8 @@ class ConsolePanel:
             "Type a command as the tutorials write it, e.g. `ros2 topic list -t`, "
             "`ros2 lifecycle get /lifecycle_talker`, `ros2 interface show std_msgs/msg/String`. "
             "Streams stop after "
-            f"{CONSOLE_LIMITS.max_messages} messages or {CONSOLE_LIMITS.max_seconds:g} s."
+            f"{CONSOLE_LIMITS.max_messages} messages or {CONSOLE_LIMITS.max_seconds:g} s; "
+            "`ros2 bag record` and `ros2 bag play` run until you press Stop."
         )
         self._command = gui.add_text("Command", "ros2 topic list -t")
         self._run = gui.add_button("Run", icon=viser.Icon.PLAYER_PLAY)
