@@ -15,12 +15,14 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from playwright.sync_api import Locator, Page, expect, sync_playwright  # noqa: E402
+from playwright.sync_api import Browser, Locator, Page, expect, sync_playwright  # noqa: E402
 
 from app.dds import configure_dds_env  # noqa: E402
 from app.exercises.model import load_exercises  # noqa: E402
@@ -28,11 +30,12 @@ from app.lessons.schema import load_course  # noqa: E402
 
 IMAGES = ROOT / "docs" / "images"
 PORT = 8193
+CLASS_PORT = 8311  # the teacher page one below
 
 
-def _wait_ready(log: Path, proc: subprocess.Popen) -> None:
-    deadline = time.monotonic() + 60
-    while "is ready" not in log.read_text(errors="replace"):
+def _wait_ready(log: Path, proc: subprocess.Popen, ready: str) -> None:
+    deadline = time.monotonic() + 90
+    while ready not in log.read_text(errors="replace"):
         if proc.poll() is not None or time.monotonic() > deadline:
             raise SystemExit(f"the dashboard did not start:\n{log.read_text(errors='replace')}")
         time.sleep(0.2)
@@ -148,41 +151,85 @@ def exercise_graded(page: Page) -> None:
     page.screenshot(path=str(IMAGES / "exercise.png"))
 
 
+@contextmanager
+def _running(argv: list[str], env: dict[str, str], log: Path, ready: str) -> Iterator[None]:
+    """``python -m app <argv>`` until the block ends; it is ready once ``ready`` is logged."""
+    with open(log, "wb") as out:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "app", *argv],
+            cwd=ROOT, env=env, stdout=out, stderr=subprocess.STDOUT,
+        )  # fmt: skip
+        try:
+            _wait_ready(log, proc, ready)
+            yield
+        finally:
+            proc.terminate()
+            proc.wait(30)
+
+
+def _open(browser: Browser, url: str, width: int = 1500) -> Page:
+    page = browser.new_page(viewport={"width": width, "height": 900})
+    page.goto(url)
+    page.get_by_role("tab").first.wait_for()
+    _dismiss_toasts(page)
+    return page
+
+
+def _on_failure_keep(page: Page, tmp: str) -> None:
+    page.screenshot(path=str(Path(tmp) / "failed.png"))
+    shutil.copy(Path(tmp) / "failed.png", ROOT / "test-artifacts")
+
+
+def learner_dashboard(browser: Browser, env: dict[str, str], tmp: str) -> None:
+    argv = ["serve", "--port", str(PORT), "--progress-dir", str(Path(tmp) / "progress")]
+    with _running(argv, env, Path(tmp) / "dashboard.log", "is ready"):
+        page = _open(browser, f"http://127.0.0.1:{PORT}/")
+        try:
+            takes = (topics_lesson, live_graph, lifecycle_drawing, exercise_graded)
+            for take in (*takes, arm_scene):  # the scene folds the code away
+                take(page)
+        except Exception:
+            _on_failure_keep(page, tmp)
+            raise
+        page.close()
+
+
+def teacher_page(browser: Browser, env: dict[str, str], tmp: str) -> None:
+    """A class of three: one mid-lesson with a node running, one stuck on a quiz, one idle."""
+    token = "screenshots-teacher-token"
+    argv = [
+        "classroom", "--learners", "3", "--base-port", str(CLASS_PORT), "--base-domain-id", "60",
+        "--classroom-domain-id", "94", "--teacher-port", str(CLASS_PORT - 1),
+        "--teacher-token", token, "--progress-dir", str(Path(tmp) / "class"),
+    ]  # fmt: skip
+    with _running(argv, env, Path(tmp) / "classroom.log", "Teacher page"):
+        first = _open(browser, f"http://127.0.0.1:{CLASS_PORT}/")
+        _start(first, "talker")
+        _lesson(first, 1, 3)
+        second = _open(browser, f"http://127.0.0.1:{CLASS_PORT + 1}/")
+        _lesson(second, 1, 2)
+        teacher = _open(browser, f"http://localhost:{CLASS_PORT - 1}/?token={token}", 1700)
+        try:
+            expect(_shown(teacher, "3 learners")).to_be_visible(timeout=30_000)
+            expect(_shown(teacher, "talker")).to_be_visible(timeout=30_000)
+            teacher.wait_for_timeout(1500)
+            teacher.screenshot(path=str(IMAGES / "teacher.png"))
+        except Exception:
+            _on_failure_keep(teacher, tmp)
+            raise
+
+
 def main() -> int:
     IMAGES.mkdir(parents=True, exist_ok=True)
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     configure_dds_env(env, domain_id=93, network=False)
-    with tempfile.TemporaryDirectory() as tmp:
-        log = Path(tmp) / "dashboard.log"
-        with open(log, "wb") as out:
-            proc = subprocess.Popen(
-                [sys.executable, "-m", "app", "serve", "--port", str(PORT),
-                 "--progress-dir", str(Path(tmp) / "progress")],
-                cwd=ROOT, env=env, stdout=out, stderr=subprocess.STDOUT,
-            )  # fmt: skip
-            try:
-                _wait_ready(log, proc)
-                with sync_playwright() as playwright:
-                    browser = playwright.chromium.launch(
-                        executable_path="/usr/bin/chromium",
-                        args=["--no-sandbox", "--disable-dev-shm-usage"],
-                    )
-                    page = browser.new_page(viewport={"width": 1500, "height": 900})
-                    page.goto(f"http://127.0.0.1:{PORT}/")
-                    page.get_by_role("tab", name="Lessons").wait_for()
-                    _dismiss_toasts(page)
-                    try:
-                        takes = (topics_lesson, live_graph, lifecycle_drawing, exercise_graded)
-                        for take in (*takes, arm_scene):  # the scene folds the code away
-                            take(page)
-                    except Exception:
-                        page.screenshot(path=str(Path(tmp) / "failed.png"))
-                        shutil.copy(Path(tmp) / "failed.png", ROOT / "test-artifacts")
-                        raise
-                    browser.close()
-            finally:
-                proc.terminate()
-                proc.wait(15)
+    with tempfile.TemporaryDirectory() as tmp, sync_playwright() as playwright:
+        browser = playwright.chromium.launch(
+            executable_path="/usr/bin/chromium", args=["--no-sandbox", "--disable-dev-shm-usage"]
+        )
+        learner_dashboard(browser, env, tmp)
+        teacher_page(browser, env, tmp)
+        browser.close()
     for image in sorted(IMAGES.glob("*.png")):
         print(f"wrote {image.relative_to(ROOT)}")
     return 0
