@@ -241,6 +241,43 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         "Drives turtle1 with arrow keys; G B V C D E R T rotate, F cancels.",
         package="turtlesim",
     ),
+    CatalogEntry(
+        "turtle_mimic",
+        "turtlesim_mimic",
+        "/turtle_mimic",
+        "Copies a turtle's velocities from input/pose onto output/cmd_vel (turtlesim's mimic).",
+        package="turtlesim",
+    ),
+    # multisim.launch.py: turtlesim twice, in the namespaces /turtlesim1 and /turtlesim2.
+    CatalogEntry(
+        "multisim_turtlesim1",
+        "turtlesim_node",
+        "/turtlesim1/turtlesim",
+        "The first turtlesim of multisim.launch.py, in the namespace /turtlesim1.",
+        ros_args=("-r", "__ns:=/turtlesim1"),
+        package="turtlesim",
+    ),
+    CatalogEntry(
+        "multisim_turtlesim2",
+        "turtlesim_node",
+        "/turtlesim2/turtlesim",
+        "The second turtlesim of multisim.launch.py, in the namespace /turtlesim2.",
+        ros_args=("-r", "__ns:=/turtlesim2"),
+        package="turtlesim",
+    ),
+    CatalogEntry(
+        "turtle_mimic_multisim",
+        "turtlesim_mimic",
+        "/turtle_mimic",
+        "mimic wired between the multisim turtlesims: turtlesim2's turtle copies turtlesim1's.",
+        ros_args=(
+            "-r",
+            "input/pose:=turtlesim1/turtle1/pose",
+            "-r",
+            "output/cmd_vel:=turtlesim2/turtle1/cmd_vel",
+        ),
+        package="turtlesim",
+    ),
 )
 
 GROUPS: tuple[LaunchGroup, ...] = (
@@ -295,6 +332,12 @@ GROUPS: tuple[LaunchGroup, ...] = (
         "slam",
         "video_publisher + slam_node: monocular SLAM on a synthetic room",
         ("video_publisher", "slam_node"),
+    ),
+    # --- turtlesim groups (issue 15) ---
+    LaunchGroup(
+        "multisim",
+        "two turtlesims in the namespaces /turtlesim1 and /turtlesim2 (multisim.launch.py)",
+        ("multisim_turtlesim1", "multisim_turtlesim2"),
     ),
 )
 

@@ -319,7 +319,9 @@ def cmd_exercise(args: argparse.Namespace) -> int:
     return exercise_main(args.verb, args.slug, args.file)
 
 
-ROS2_GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface", "bag")
+ROS2_GROUPS = (
+    "node", "topic", "service", "action", "param", "lifecycle", "interface", "bag", "pkg",
+)  # fmt: skip
 
 
 def cmd_ros2(args: argparse.Namespace) -> int:

@@ -50,5 +50,8 @@ CHECK_KINDS: dict[str, Kind] = {
     "pointcloud_points": make_kind("topic at_least"),
     "arm_reached": make_kind("tolerance"),
     "interface_exists": make_kind("type"),
+    "moved_from": make_kind("topic type x y at_least"),
+    "moves_like": make_kind("topic type like"),
+    "rosout_contains": make_kind("node text", "at_least"),
     "quiz": make_kind("question options answer"),
 }

@@ -17,7 +17,7 @@ from typing import Any
 from lifecycle_msgs.srv import ChangeState, GetState
 from rcl_interfaces.srv import GetParameters, SetParameters
 from rclpy.node import Node
-from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from app import catalog
 from app.lessons.kinds import ACTION_KINDS, CHECK_KINDS
@@ -39,6 +39,13 @@ GOAL_LIMITS = Limits(service_timeout=3.0, action_timeout=60.0)
 # are usually best effort); a reliable tap would hear only the former.
 TAP_QOS = QoSProfile(depth=50, reliability=ReliabilityPolicy.BEST_EFFORT)
 TAP_KEEP = 50  # messages a check can look back on
+# /rosout keeps each node's recent log for late joiners (transient local, 10 s
+# lifespan): a reliable, transient-local tap also reads what was logged just
+# before the check first looked, e.g. right after the step's button.
+ROSOUT_QOS = QoSProfile(
+    depth=1000, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+)
+ROSOUT_KEEP = 500
 
 
 @dataclass(frozen=True)
@@ -67,12 +74,17 @@ class LessonRuntime:
         self._goals: dict[str, GoalRun] = {}
         self.quiz_answers: dict[str, str] = {}
 
-    def tap(self, topic: str, type_name: str) -> TopicMonitor:
+    def tap(self, topic: str, type_name: str, history: bool = False) -> TopicMonitor:
+        """A kept subscription; ``history``: the reliable, transient-local /rosout kind."""
         with self._lock:
-            key = (topic, type_name)
+            key = (topic, type_name + (" (history)" if history else ""))
             if key not in self._taps:
                 self._taps[key] = TopicMonitor(
-                    self.node, topic, import_type(type_name), keep=TAP_KEEP, qos=TAP_QOS
+                    self.node,
+                    topic,
+                    import_type(type_name),
+                    keep=ROSOUT_KEEP if history else TAP_KEEP,
+                    qos=ROSOUT_QOS if history else TAP_QOS,
                 )
             return self._taps[key]
 
@@ -314,6 +326,63 @@ class LessonRuntime:
     def _check_interface_exists(self, c: Spec) -> CheckResult:
         import_type(c["type"])  # an unknown type raises -> fail with the reason
         return CheckResult(PASS, f"{c['type']} is installed")
+
+    def _check_moved_from(self, c: Spec) -> CheckResult:
+        """The newest pose (any message with x and y) is far enough from a start point."""
+        tap = self.tap(c["topic"], c["type"])
+        newest = tap.message()
+        if newest is None:
+            if not self._publishers(c["topic"]):
+                return CheckResult(FAIL, f"no publisher on {c['topic']}")
+            return CheckResult(WAITING, f"waiting for a message on {c['topic']}")
+        msg = newest[1]
+        distance = math.dist((msg.x, msg.y), (c["x"], c["y"]))
+        where = f"({c['x']:g}, {c['y']:g})"
+        if distance >= c["at_least"]:
+            return CheckResult(PASS, f"{c['topic']} is {distance:.2f} m from {where}")
+        return CheckResult(
+            WAITING, f"{c['topic']} is {distance:.2f} m from {where}; {c['at_least']:g} m needed"
+        )
+
+    def _check_moves_like(self, c: Spec) -> CheckResult:
+        """``topic``'s newest pose moves with the velocities of ``like``'s, and is not still."""
+        follower, leader = self.tap(c["topic"], c["type"]), self.tap(c["like"], c["type"])
+        for tap in (follower, leader):
+            if not self._publishers(tap.topic):
+                return CheckResult(FAIL, f"no publisher on {tap.topic}")
+        newest_follower, newest_leader = follower.message(), leader.message()
+        if newest_follower is None or newest_leader is None:
+            return CheckResult(WAITING, f"waiting for poses on {c['topic']} and {c['like']}")
+        f, lead = newest_follower[1], newest_leader[1]
+        speeds = f"{lead.linear_velocity:.2f} m/s, {lead.angular_velocity:.2f} rad/s"
+        if abs(lead.linear_velocity) + abs(lead.angular_velocity) < 0.01:
+            return CheckResult(WAITING, f"{c['like']} is standing still; make it move")
+        if math.isclose(f.linear_velocity, lead.linear_velocity, abs_tol=0.05) and math.isclose(
+            f.angular_velocity, lead.angular_velocity, abs_tol=0.05
+        ):
+            return CheckResult(PASS, f"{c['topic']} moves like {c['like']} ({speeds})")
+        return CheckResult(
+            WAITING,
+            f"{c['topic']} at {f.linear_velocity:.2f} m/s, {f.angular_velocity:.2f} rad/s; "
+            f"{c['like']} at {speeds}",
+        )
+
+    def _check_rosout_contains(self, c: Spec) -> CheckResult:
+        """A node's log message reached /rosout (what rqt_console and the Logs tab read)."""
+        if not self.graph.has_node(c["node"]):
+            return CheckResult(FAIL, f"{c['node']} is not on the graph")
+        logger = c["node"].strip("/").replace("/", ".")  # rcl names a node's logger so
+        tap = self.tap("/rosout", "rcl_interfaces/msg/Log", history=True)
+        needed = c.get("at_least", 1)
+        count = 0
+        for _, log in tap.newest():
+            count += log.name == logger and c["text"] in log.msg
+            if count >= needed:
+                return CheckResult(PASS, f"{c['node']} logged {c['text']!r} on /rosout")
+        return CheckResult(
+            WAITING,
+            f"{count} of {needed} messages from {c['node']} on /rosout contain {c['text']!r}",
+        )
 
     def _check_quiz(self, c: Spec) -> CheckResult:
         answer = self.quiz_answers.get(c.key)

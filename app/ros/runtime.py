@@ -46,9 +46,8 @@ class RosRuntime:
         # type must get a refusal, not end the dashboard (rclpy 7.1.6 bug).
         guard_parameter_services()
         self.context = Context()
-        rclpy.init(
-            context=self.context, domain_id=domain_id, signal_handler_options=SignalHandlerOptions.NO
-        )
+        no_signals = SignalHandlerOptions.NO  # the CLI owns SIGINT and SIGTERM
+        rclpy.init(context=self.context, domain_id=domain_id, signal_handler_options=no_signals)
         self.node = Node(
             node_name,
             context=self.context,

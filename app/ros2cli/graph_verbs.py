@@ -68,6 +68,22 @@ def service_type(ctx: CallContext, name: str) -> int:
     return 0
 
 
+def service_find(ctx: CallContext, type_text: str) -> int:
+    services = _visible(ctx.node.get_service_names_and_types())
+    return write_names(ctx, [name for name, types in services if type_text in types])
+
+
+def service_info(ctx: CallContext, name: str) -> int:
+    """Type and how many clients and servers, as Jazzy's `ros2 service info` prints them."""
+    types = dict(ctx.node.get_service_names_and_types()).get(name)
+    if not types:
+        raise Ros2Error(f"unknown service '{name}' (see `ros2 service list`)")
+    ctx.write(f"Type: {', '.join(types)}")
+    ctx.write(f"Clients count: {ctx.node.count_clients(name)}")
+    ctx.write(f"Services count: {ctx.node.count_services(name)}")
+    return 0
+
+
 def service_call(ctx: CallContext, name: str, type_text: str, values: str = "") -> int:
     srv_type = import_type(type_text, "srv")
     request = from_yaml(srv_type.Request, values)
@@ -86,6 +102,14 @@ def service_call(ctx: CallContext, name: str, type_text: str, values: str = "") 
 def action_list(ctx: CallContext, show_types: bool = False, count: bool = False) -> int:
     actions = sorted(get_action_names_and_types(ctx.node))
     return write_names(ctx, _with_types(actions, show_types), count)
+
+
+def action_type(ctx: CallContext, name: str) -> int:
+    action_type = action_type_of(ctx.node, name)
+    if action_type is None:
+        raise Ros2Error(f"unknown action '{name}' (see `ros2 action list`)")
+    ctx.write(action_type)
+    return 0
 
 
 def action_info(ctx: CallContext, name: str, show_types: bool = False) -> int:

@@ -1,7 +1,8 @@
-"""`ros2 param list/get/set/dump` (the parameter services themselves: app.ros.params)."""
+"""`ros2 param list/get/set/dump/load` (the parameter services themselves: app.ros.params)."""
 
 from __future__ import annotations
 
+import yaml
 from rcl_interfaces.msg import ParameterType
 
 from app.ros.context import CallContext
@@ -19,6 +20,7 @@ from app.ros.params import (
     python_value,
     set_value,
 )
+from app.ros2cli.run import params_file
 
 
 def param_list(ctx: CallContext, fqn: str | None = None, show_types: bool = False) -> int:
@@ -70,3 +72,36 @@ def param_dump(ctx: CallContext, fqn: str) -> int:
     for line in text.rstrip().splitlines():
         ctx.write(line)
     return 0
+
+
+def _flatten(values: dict, prefix: str = "") -> dict:
+    """Nested YAML maps -> dotted parameter names, as a dump nests them."""
+    flat: dict = {}
+    for key, value in values.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            flat.update(_flatten(value, f"{name}."))
+        else:
+            flat[name] = value
+    return flat
+
+
+def param_load(ctx: CallContext, fqn: str, file_text: str) -> int:
+    """Set every parameter a dump file holds for this node (or for every node: ``/**``)."""
+    target = require_node(ctx, fqn)
+    data = yaml.safe_load(params_file(file_text).read_text(encoding="utf-8"))
+    sections = [
+        section["ros__parameters"]
+        for key, section in data.items()
+        if key in ("/**", target, target.lstrip("/"))
+    ]
+    if not sections:
+        raise Ros2Error(f"{file_text!r} has no parameters for {target} (nor for /**)")
+    failed = False
+    for section in sections:
+        for name, value in _flatten(section or {}).items():
+            ok, reason = set_value(ctx, target, name, value)
+            failed |= not ok
+            outcome = "successful" if ok else "failed"
+            ctx.write(f"Set parameter {name} {outcome}" + (f": {reason}" if reason else ""))
+    return 1 if failed else 0

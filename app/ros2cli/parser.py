@@ -16,12 +16,12 @@ from typing import Any, NoReturn
 
 from app.ros.context import CallContext, Write
 from app.ros.errors import Cancelled, Ros2Error
-from app.ros2cli import bag, graph_verbs, interfaces, lifecycle, param, run, topic
+from app.ros2cli import bag, graph_verbs, interfaces, launch_verb, lifecycle, param, run, topic
 from app.ros2cli.common import settle_discovery
 
 log = logging.getLogger(__name__)
 
-GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface", "bag")
+GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface", "bag", "pkg")
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
 
@@ -129,6 +129,10 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
     )
     p.add_argument("topic_name")
     p.add_argument("-v", "--verbose", action="store_true", help="endpoints with their QoS")
+    p = verb(v, "type", "a topic's type", lambda c, a: topic.topic_type(c, a.topic_name))
+    p.add_argument("topic_name")
+    p = verb(v, "find", "topics of a type", lambda c, a: topic.find(c, a.topic_type))
+    p.add_argument("topic_type")
     p = verb(
         v,
         "echo",
@@ -175,6 +179,10 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
         v, "type", "a service's type", lambda c, a: graph_verbs.service_type(c, a.service_name)
     )
     p.add_argument("service_name")
+    p = verb(v, "find", "services of a type", lambda c, a: graph_verbs.service_find(c, a.type_name))
+    p.add_argument("type_name")
+    p = verb(v, "info", "type and counts", lambda c, a: graph_verbs.service_info(c, a.service_name))
+    p.add_argument("service_name")
     p = verb(
         v,
         "call",
@@ -188,6 +196,8 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
     # action
     v = group("action", "actions")
     typed_list(v, "action", graph_verbs.action_list)
+    p = verb(v, "type", "an action's type", lambda c, a: graph_verbs.action_type(c, a.action_name))
+    p.add_argument("action_name")
     p = verb(
         v,
         "info",
@@ -230,6 +240,14 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
     p.add_argument("value")
     p = verb(v, "dump", "all values as YAML", lambda c, a: param.param_dump(c, a.node_name))
     p.add_argument("node_name")
+    p = verb(
+        v,
+        "load",
+        "set values from a YAML file",
+        lambda c, a: param.param_load(c, a.node_name, a.parameter_file),
+    )
+    p.add_argument("node_name")
+    p.add_argument("parameter_file")
 
     # lifecycle
     v = group("lifecycle", "managed (lifecycle) nodes")
@@ -262,19 +280,29 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
     p.add_argument("--no-expand", action="store_true", help="do not expand nested types")
 
     bag.add_verbs(group("bag", "record, inspect and replay topics"), verb)
+    v = group("pkg", "packages")
+    p = verb(v, "executables", "what `ros2 run` can start", _pkg_executables)
+    p.add_argument("package_name", nargs="?")
     run.add_command(groups, write)  # `ros2 run PKG EXE`: a command, not a group of verbs
+    launch_verb.add_command(groups, write)  # `ros2 launch PKG FILE`: the same
     return parser
 
 
-_NO_DDS = {("interface", v) for v in ("list", "packages", "package", "show")} | {
-    ("bag", v) for v in bag.NO_DDS_VERBS
-}
+_NO_DDS = (
+    {("interface", v) for v in ("list", "packages", "package", "show")}
+    | {("pkg", "executables")}
+    | {("bag", v) for v in bag.NO_DDS_VERBS}
+)
 
 
 def needs_ros(argv: list[str]) -> bool:
     """False for verbs that only read files (interface ...): the CLI skips DDS for them."""
     words = [w for w in argv if not w.startswith("-")]
     return tuple(words[:2]) not in _NO_DDS
+
+
+def _pkg_executables(ctx: CallContext, args: argparse.Namespace) -> int:
+    return run.pkg_executables(ctx, args.package_name)
 
 
 def _interface_list(ctx: CallContext, args: argparse.Namespace) -> int:

@@ -43,6 +43,7 @@ from app.ros.errors import Ros2Error
 _UPSTREAM: dict[tuple[str, str], str] = {
     ("turtlesim", "turtlesim_node"): "turtlesim_node",
     ("turtlesim", "turtle_teleop_key"): "turtle_teleop_key",
+    ("turtlesim", "mimic"): "turtle_mimic",
     ("demo_nodes_py", "talker"): "talker",
     ("demo_nodes_py", "listener"): "listener",
     ("demo_nodes_cpp", "talker"): "talker",
@@ -123,6 +124,23 @@ def resolve(package: str, executable: str) -> CatalogEntry:
         )
     packages = sorted({pkg for pkg, _exe in EXECUTABLES})
     raise Ros2Error(f"Package '{package}' not found (known here: {', '.join(packages)})")
+
+
+def executables(package: str | None = None) -> list[tuple[str, str]]:
+    """(package, executable) pairs as `ros2 pkg executables` lists them.
+
+    An upstream package lists the tutorial names it maps (turtlesim: mimic,
+    turtle_teleop_key, turtlesim_node), not the catalog's variants of them.
+    """
+    upstream = {pkg for pkg, _exe in _UPSTREAM}
+    pairs = [
+        (pkg, exe) for pkg, exe in EXECUTABLES if (pkg, exe) in _UPSTREAM or pkg not in upstream
+    ]
+    if package is not None:
+        pairs = [(pkg, exe) for pkg, exe in pairs if pkg == package]
+        if not pairs:
+            raise Ros2Error(f"Package '{package}' not found")
+    return sorted(pairs)
 
 
 def split_ros_args(words: list[str]) -> tuple[list[str], list[str]]:
@@ -217,7 +235,7 @@ def run(ctx: CallContext, package: str, executable: str, words: list[str]) -> in
     # The catalog name when the node keeps its name (the Nodes tab then shows it).
     key = entry.name if fqn == entry.node_name else f"{entry.name}:{fqn}"
     if _active(programs, key) or any(
-        _running_as(programs, other) == fqn for other in programs.statuses()
+        running_as(programs, other) == fqn for other in programs.statuses()
     ):
         raise Ros2Error(
             f"a node named {fqn} is already running; give this one another name "
@@ -231,7 +249,7 @@ def run(ctx: CallContext, package: str, executable: str, words: list[str]) -> in
 def stop(ctx: CallContext, fqn: str) -> int:
     programs = programs_of(ctx)
     fqn = fqn if fqn.startswith("/") else f"/{fqn}"
-    keys = [key for key in programs.statuses() if _running_as(programs, key) == fqn]
+    keys = [key for key in programs.statuses() if running_as(programs, key) == fqn]
     if not keys:
         raise Ros2Error(f"no running node named {fqn} was started here")
     for key in keys:
@@ -247,7 +265,7 @@ def _active(programs: Programs, key: str) -> bool:
         return False
 
 
-def _running_as(programs: Programs, key: str) -> str | None:
+def running_as(programs: Programs, key: str) -> str | None:
     """The node name of an active supervisor key: 'entry:/fqn', or a catalog name."""
     if not _active(programs, key):
         return None
@@ -296,6 +314,12 @@ def add_command(groups: Any, write: Any) -> None:
     p.add_argument("executable", nargs="?")
     p.add_argument("arguments", nargs=argparse.REMAINDER, help="program and --ros-args words")
     p.set_defaults(handler=_handle)
+
+
+def pkg_executables(ctx: CallContext, package: str | None) -> int:
+    for pkg, exe in executables(package):
+        ctx.write(f"{pkg} {exe}")
+    return 0
 
 
 def _handle(ctx: CallContext, args: argparse.Namespace) -> int:

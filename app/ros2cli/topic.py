@@ -1,4 +1,4 @@
-"""`ros2 topic ...`: list, info, echo, hz, bw, pub (the monitor lives in app.ros.monitor)."""
+"""`ros2 topic ...`: list, info, type, find, echo, hz, bw, pub (monitoring: app.ros.monitor)."""
 
 from __future__ import annotations
 
@@ -10,9 +10,11 @@ from app.ros.context import CallContext
 from app.ros.convert import (
     dump_yaml,
     field_value,
-    from_yaml,
+    fields_of,
+    fill,
     import_type,
     message_repr,
+    parse_yaml,
     to_plain,
     to_yaml,
 )
@@ -60,6 +62,23 @@ def topic_info(ctx: CallContext, topic: str, verbose: bool = False) -> int:
             ctx.write(f"GID: {gid}")
             for line in qos_lines(info.qos_profile):
                 ctx.write(line)
+    return 0
+
+
+def topic_type(ctx: CallContext, topic: str) -> int:
+    types = topic_types(ctx.node, include_hidden=True).get(topic)
+    if not types:
+        raise Ros2Error(f"unknown topic '{topic}' (see `ros2 topic list`)")
+    for type_text in types:
+        ctx.write(type_text)
+    return 0
+
+
+def find(ctx: CallContext, type_text: str) -> int:
+    """The topics that carry a type (the full name, as `ros2 topic list -t` prints it)."""
+    for name, types in sorted(topic_types(ctx.node).items()):
+        if type_text in types:
+            ctx.write(name)
     return 0
 
 
@@ -158,6 +177,25 @@ def bw(ctx: CallContext, topic: str, type_text: str | None = None, window: int =
     return _measure(ctx, topic, type_text, window, report)
 
 
+def with_stamps(cls: type, data: dict[str, Any], stamp: dict[str, int]) -> dict[str, Any]:
+    """`ros2 topic pub`'s keywords: a Header given as "auto", a Time given as "now"."""
+    filled = dict(data)
+    for name, ros_type, _slot in fields_of(cls):
+        value = filled.get(name)
+        if value == "auto" and ros_type == "std_msgs/Header":
+            filled[name] = {"stamp": stamp, "frame_id": ""}
+        elif value == "now" and ros_type == "builtin_interfaces/Time":
+            filled[name] = stamp
+        elif isinstance(value, dict) and ros_type.count("/") == 1:  # a nested message
+            filled[name] = with_stamps(import_type(ros_type), value, stamp)
+    return filled
+
+
+def _stamped(ctx: CallContext, msg_type: type, data: dict[str, Any]) -> Any:
+    now = ctx.node.get_clock().now().to_msg()
+    return fill(msg_type, with_stamps(msg_type, data, {"sec": now.sec, "nanosec": now.nanosec}))
+
+
 def pub(
     ctx: CallContext,
     topic: str,
@@ -170,7 +208,9 @@ def pub(
     wait_matching: int | None = None,
 ) -> int:
     msg_type = import_type(type_text, "msg")
-    msg = from_yaml(msg_type, values)
+    data = parse_yaml(values)
+    stamps = with_stamps(msg_type, data, {"sec": 0, "nanosec": 0}) != data
+    msg = _stamped(ctx, msg_type, data)
     if not rate > 0 or not math.isfinite(rate):
         raise Ros2Error(f"rate must be a positive number of Hz, got {rate}")
     if once:
@@ -195,6 +235,8 @@ def pub(
         start = time.monotonic()
         sent = 0
         while times is None or sent < times:
+            if stamps:  # "auto"/"now": the time of each message, as ros2 topic pub does
+                msg = _stamped(ctx, msg_type, data)
             publisher.publish(msg)
             sent += 1
             ctx.write(f"publishing #{sent}: {message_repr(msg)}")

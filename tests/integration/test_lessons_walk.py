@@ -115,6 +115,12 @@ FAILING_CHECKS = [
     Spec("pointcloud_points", {"topic": "/no_cloud", "at_least": 1}),
     Spec("arm_reached", {"tolerance": 0.01}),
     Spec("interface_exists", {"type": "no_such_pkg/msg/Nothing"}),
+    Spec(
+        "moved_from",
+        {"topic": "/silent", "type": "turtlesim/msg/Pose", "x": 0, "y": 0, "at_least": 1},
+    ),
+    Spec("rosout_contains", {"node": "/nobody_here", "text": "hello"}),
+    Spec("moves_like", {"topic": "/silent", "type": "turtlesim/msg/Pose", "like": "/silent2"}),
     Spec("quiz", {"question": "2+2?", "options": ["3", "4"], "answer": "4"}),
 ]
 

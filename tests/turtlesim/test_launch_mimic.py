@@ -1,0 +1,133 @@
+"""`ros2 launch turtlesim multisim.launch.py` and turtlesim's `mimic`, through the Console.
+
+The commands are the "Launching nodes" tutorial's, typed verbatim, plus the
+mimic line of the launch-file tutorial: turtlesim2's turtle must copy what
+turtlesim1's turtle does, on real processes.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+import yaml
+
+from app.ros.context import CONSOLE_LIMITS, CallContext
+from app.ros2cli import run_text
+from tests.conftest import wait_until
+from tests.integration.core_helpers import DISCOVERY_TIMEOUT, node_names
+from tests.turtlesim.test_ros2_run import console  # noqa: F401  (the Console fixture)
+
+pytestmark = pytest.mark.ros
+
+CENTRE = 5.544445
+
+
+def ok(console, text: str) -> list[str]:  # noqa: F811
+    code, out = console(text)
+    assert code == 0, (text, out)
+    return out
+
+
+def pose_of(console, topic: str) -> dict:  # noqa: F811
+    out = ok(console, f"ros2 topic echo --once {topic}")
+    return yaml.safe_load("\n".join(out[: out.index("---")]))
+
+
+def test_multisim_runs_two_turtlesims_and_mimic_couples_them(console, probe, supervisor):  # noqa: F811
+    out = ok(console, "ros2 launch turtlesim multisim.launch.py")
+    assert out[0] == "[INFO] [launch]: Default logging verbosity is set to INFO", out
+    assert out[1].startswith("[INFO] [turtlesim_node-1]: process started with pid ["), out
+    assert out[2].startswith("[INFO] [turtlesim_node-2]: process started with pid ["), out
+    for label, ns in (("turtlesim_node-1", "turtlesim1"), ("turtlesim_node-2", "turtlesim2")):
+        assert any(
+            line.startswith(f"[{label}] ")
+            and line.endswith(f"Starting turtlesim with node name /{ns}/turtlesim")
+            for line in out
+        ), out
+    wait_until(
+        lambda: {"/turtlesim1/turtlesim", "/turtlesim2/turtlesim"} <= set(node_names(probe)),
+        timeout=DISCOVERY_TIMEOUT,
+        what="both turtlesims",
+    )
+    out = ok(console, "ros2 topic list")
+    assert {"/turtlesim1/turtle1/cmd_vel", "/turtlesim2/turtle1/pose"} <= set(out), out
+    # The same file twice would give the graph two nodes of one name: refused.
+    code, out = console("ros2 launch turtlesim multisim.launch.py")
+    assert code == 1 and out[-1].startswith("error: /turtlesim1/turtlesim, /turtlesim2/turtlesim")
+
+    out = ok(
+        console,
+        "ros2 run turtlesim mimic --ros-args --remap input/pose:=turtlesim1/turtle1/pose "
+        "--remap output/cmd_vel:=turtlesim2/turtle1/cmd_vel",
+    )
+    assert out[-1].startswith("(/turtle_mimic keeps running"), out
+    wait_until(
+        lambda: probe.node.count_publishers("/turtlesim2/turtle1/cmd_vel") == 1,
+        timeout=DISCOVERY_TIMEOUT,
+        what="mimic publishing on turtlesim2's cmd_vel",
+    )
+    out = ok(console, "ros2 node info /turtle_mimic")
+    assert "    /turtlesim1/turtle1/pose: turtlesim/msg/Pose" in out, out
+    assert "    /turtlesim2/turtle1/cmd_vel: geometry_msgs/msg/Twist" in out, out
+
+    # Drive turtlesim1 only; turtlesim2's turtle follows the same circle.
+    ok(
+        console,
+        "ros2 topic pub  /turtlesim1/turtle1/cmd_vel geometry_msgs/msg/Twist "
+        '"{linear: {x: 2.0, y: 0.0, z: 0.0}, angular: {x: 0.0, y: 0.0, z: 1.8}}"',
+    )
+    leader = pose_of(console, "/turtlesim1/turtle1/pose")
+    follower = pose_of(console, "/turtlesim2/turtle1/pose")
+    # Both moved; their speeds are not compared: 1 s after the 5 s pub ends, turtlesim
+    # stops the leader, and a loaded machine may read the poses after that.
+    for pose in (leader, follower):
+        assert math.dist((pose["x"], pose["y"]), (CENTRE, CENTRE)) > 0.5, (leader, follower)
+    # Same commands from the same start: the two turtles stay close together.
+    assert math.dist((leader["x"], leader["y"]), (follower["x"], follower["y"])) < 0.5
+
+    out = ok(console, "ros2 launch --stop turtlesim multisim.launch.py")  # (ours) Ctrl+C
+    assert out[0] == "[WARNING] [launch]: user interrupted with ctrl-c (SIGINT)", out
+    assert out[1:] == [
+        "[INFO] [turtlesim_node-1]: stopped (exit code 0)",
+        "[INFO] [turtlesim_node-2]: stopped (exit code 0)",
+    ], out
+    ok(console, "ros2 run --stop /turtle_mimic")
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("ros2 launch turtlesim nope.launch.py", "'nope.launch.py' was not found"),
+        ("ros2 launch no_pkg x.launch.py", "Package 'no_pkg' not found"),
+        ("ros2 launch turtlesim multisim.launch.py world:=city", "takes no launch arguments"),
+        ("ros2 launch --stop turtlesim multisim.launch.py", "is not running here"),
+        ("ros2 launch turtlesim", "the following arguments are required: launch_file"),
+    ],
+)
+def test_bad_launch_commands_give_one_error_line(console, supervisor, text, message):  # noqa: F811
+    code, out = console(text)
+    assert code != 0
+    errors = [line for line in out if line.startswith("error:")]
+    assert len(errors) == 1 and message in errors[0], out
+    assert not supervisor.statuses()  # nothing was started
+
+
+def test_without_the_supervisor_the_verb_names_the_terminal_command(probe):
+    lines: list[str] = []
+    ctx = CallContext(probe.node, lines.append, CONSOLE_LIMITS)
+    assert run_text(ctx, "ros2 launch turtlesim multisim.launch.py") == 1
+    assert lines == [
+        "error: `ros2 launch` starts nodes through the dashboard's supervisor, which this "
+        "console was not given; in a terminal use `ros2-classroom launch multisim`"
+    ]
+
+
+def test_every_launch_group_is_a_tutorial_nodes_launch_file(console, supervisor):  # noqa: F811
+    out = ok(console, "ros2 launch tutorial_nodes minimal_nodes.launch.py")
+    assert out[1].startswith("[INFO] [minimal_node-1]: process started with pid ["), out
+    assert out[2].startswith("[INFO] [minimal_node_procedural-2]: process started"), out
+    assert supervisor.status("minimal_node").active
+    assert supervisor.status("minimal_node_procedural").active
+    out = ok(console, "ros2 launch --stop tutorial_nodes minimal_nodes.launch.py")
+    assert len(out) == 3 and all("stopped" in line for line in out[1:]), out
