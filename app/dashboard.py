@@ -24,6 +24,7 @@ from app.lessons.progress import ProgressStore
 from app.lessons.runtime import LessonRuntime
 from app.lessons.schema import load_course
 from app.panels.actions_panel import ActionsPanel
+from app.panels.bags_panel import BagsPanel
 from app.panels.echo_panel import EchoPanel
 from app.panels.graph_panel import GraphPanel
 from app.panels.lifecycle_panel import LifecyclePanel
@@ -33,6 +34,7 @@ from app.panels.parameters_panel import ParametersPanel
 from app.panels.scene_panel import ScenePanel
 from app.panels.services_panel import ServicesPanel
 from app.panels.topics_panel import TopicsPanel
+from app.panels.turtlesim_panel import TurtlesimPanel
 from app.ros.graph import GraphSnapshot, snapshot
 from app.ros.rosout import RosoutLog
 from app.ros.runtime import RosRuntime
@@ -49,11 +51,12 @@ GRAPH_CHECK_SEC = 0.02  # ...and within 20 ms of a node joining/leaving or an in
 
 _ICONS = {
     "Lessons": viser.Icon.SCHOOL, "Exercise": viser.Icon.PENCIL, "Nodes": viser.Icon.CPU,
+    "Turtlesim": viser.Icon.PAW,
     "Graph": viser.Icon.SITEMAP,
     "Echo": viser.Icon.MESSAGE, "3D view": viser.Icon.CUBE, "Topics": viser.Icon.LIST_DETAILS,
     "Parameters": viser.Icon.ADJUSTMENTS, "Console": viser.Icon.TERMINAL,
     "Services": viser.Icon.ARROWS_EXCHANGE, "Actions": viser.Icon.ROCKET,
-    "Lifecycle": viser.Icon.PROGRESS, "Logs": viser.Icon.FILE_TEXT,
+    "Lifecycle": viser.Icon.PROGRESS, "Logs": viser.Icon.FILE_TEXT, "Bags": viser.Icon.DATABASE,
 }  # fmt: skip
 
 
@@ -129,6 +132,7 @@ class Dashboard:
                 self.exercise_settings,
             ),
             "Nodes": lambda: NodesPanel(gui, ui, self.supervisor),
+            "Turtlesim": lambda: TurtlesimPanel(gui, ui, node, self.supervisor, self.page_links),
             "Graph": lambda: GraphPanel(gui, node),
             "Echo": lambda: EchoPanel(gui, node),
             "3D view": lambda: ScenePanel(self.server, ui, node),
@@ -139,6 +143,7 @@ class Dashboard:
             "Actions": lambda: ActionsPanel(gui, ui, node),
             "Lifecycle": lambda: LifecyclePanel(gui, ui, node, self.rosout, self.page_links),
             "Logs": lambda: LogsPanel(gui, self.rosout),
+            "Bags": lambda: BagsPanel(gui, ui, node),
         }
         assert tuple(builders) == TAB_NAMES, "every tab lessons may name has a panel"
         tabs = gui.add_tab_group()

@@ -37,6 +37,7 @@ RUNS: tuple[tuple[str, list[str]], ...] = (
     ("cloud_to_browser", ["--quick"]),
     ("slam_accuracy", ["--frames", "120"]),
     ("bag_record", ["--seconds", "10"]),
+    ("turtlesim_rate", ["--seconds", "8"]),
 )
 
 # (figure, benchmark, key ("a|b" shows both), unit, aim text, aim test)
@@ -291,6 +292,33 @@ ROWS: tuple[tuple[str, str, str, str, str, Any], ...] = (
     ),
 )
 
+ROWS += (
+    (
+        "Turtlesim, 10 turtles driven: pose rate at a plain subscriber, worst turtle off 62.5 Hz",
+        "turtlesim_rate",
+        "pose_rate_error_percent",
+        "%",
+        "≤ 2",
+        lambda v: v <= 2.0,
+    ),
+    (
+        "Turtlesim, 10 turtles: frames drawn in the browser / sent by the dashboard",
+        "turtlesim_rate",
+        "browser_frames_per_s|server_frames_per_s",
+        "frames/s",
+        "",
+        None,
+    ),
+    (
+        "Turtlesim view: one frame on the server",
+        "turtlesim_rate",
+        "server_frame_ms",
+        "ms",
+        "",
+        None,
+    ),
+)
+
 HEADLINE = {
     "start_ratio": ("start_to_visible", "start_ratio"),
     "start_extra_ms": ("start_to_visible", "start_extra_ms"),
@@ -308,6 +336,8 @@ HEADLINE = {
     "cloud_worker_p95_ms": ("cloud_to_browser", "dashboard_worker_p95_ms_100k_20hz"),
     "bag_record_ratio": ("bag_record", "bag_record_ratio"),
     "bag_lost": ("bag_record", "bag_lost"),
+    "turtlesim_pose_error_percent": ("turtlesim_rate", "pose_rate_error_percent"),
+    "turtlesim_browser_fps": ("turtlesim_rate", "browser_frames_per_s"),
 }
 
 

@@ -26,6 +26,14 @@ Per turtle, e.g. ``turtle1/``
   at 1 rad/s until within 0.02 rad of the goal, with feedback at every
   update; a new goal or a ``cmd_vel`` aborts it; cancel is honoured.
 
+One addition for viewers: the hidden topic ``~/_trails``
+(``/turtlesim/_trails``, ``std_msgs/msg/UInt8MultiArray``; ``ros2 topic
+list`` hides it as it hides every name with a ``_`` token) carries the pen
+trails as compact packets (see ``turtlesim_world.decode_trails``): the new
+segments after every update that drew some, and the whole canvas after
+``clear``/``reset`` or when a viewer publishes ``std_msgs/msg/Empty`` on
+``~/_trails_request``. The browser's Turtlesim tab draws from it.
+
 All topics are reliable, keep-last 7, as upstream. Everything runs on one
 thread (a single-threaded executor): service and topic callbacks change the
 world between two updates, exactly as upstream's ``spin_some`` + update loop.
@@ -38,6 +46,7 @@ Try it: ``ros2 run turtlesim turtlesim_node`` in the Console, then
 from __future__ import annotations
 
 import math
+import secrets
 import time
 from dataclasses import dataclass, field
 
@@ -48,11 +57,13 @@ from rclpy.action.server import ServerGoalHandle
 from rclpy.exceptions import InvalidTopicNameException
 from rclpy.node import Node
 from rclpy.publisher import Publisher
-from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.service import Service
 from rclpy.subscription import Subscription
 from rclpy.task import Future
 from rclpy.validate_topic_name import validate_topic_name
+from std_msgs.msg import Empty as EmptyMsg
+from std_msgs.msg import UInt8MultiArray
 from std_srvs.srv import Empty
 from turtlesim.action import RotateAbsolute
 from turtlesim.msg import Color, Pose
@@ -69,11 +80,18 @@ from nodes.common.turtlesim_world import (
     RotationUpdate,
     TurtleReport,
     TurtleWorld,
+    encode_segments,
+    encode_snapshot,
 )
 
 # Upstream's topic QoS for every pose, colour and cmd_vel topic.
 TOPIC_QOS = QoSProfile(depth=7, reliability=ReliabilityPolicy.RELIABLE)
 MAX_CATCH_UP = 15  # steps run at once after a late timer (240 ms); beyond, time is let go
+# Trails: reliable, and a late viewer still gets the last packets (a snapshot, if the
+# picture has not changed since); 50 packets (0.8 s of updates) ride out a slow reader.
+TRAILS_QOS = QoSProfile(
+    depth=50, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+)
 RETIRE_AFTER = 1.0  # seconds a killed turtle's action server lingers to deliver results
 
 
@@ -137,6 +155,13 @@ class Turtlesim(Node):
         # two servers never answer one action name.
         self.retired: dict[str, tuple[float, ActionServer]] = {}
 
+        # Trails for viewers: a random session tells a restarted sim from the old one.
+        self.trails_session = secrets.randbits(32)
+        self.trails_sent = 0  # the world's segment_count at the last packet
+        self.trails = self.create_publisher(UInt8MultiArray, "~/_trails", TRAILS_QOS)
+        self.trails_requests = self.create_subscription(
+            EmptyMsg, "~/_trails_request", lambda _msg: self.publish_snapshot(), 10
+        )
         self.create_service(Empty, "clear", self.on_clear)
         self.create_service(Empty, "reset", self.on_reset)
         self.create_service(Spawn, "spawn", self.on_spawn)
@@ -147,6 +172,7 @@ class Turtlesim(Node):
         self.spawn_turtle("", CENTRE, CENTRE, 0.0)
         self.next_step = time.monotonic() + UPDATE_PERIOD
         self.timer = self.create_timer(UPDATE_PERIOD, self.on_update)
+        self.publish_snapshot()  # kept for viewers that join later (transient local)
 
     # -- time and parameters ---------------------------------------------------
 
@@ -224,6 +250,7 @@ class Turtlesim(Node):
     def on_clear(self, _request: Empty.Request, response: Empty.Response) -> Empty.Response:
         self.get_logger().info("Clearing turtlesim.")
         self.world.clear()
+        self.publish_snapshot()
         return response
 
     def on_reset(self, _request: Empty.Request, response: Empty.Response) -> Empty.Response:
@@ -239,6 +266,7 @@ class Turtlesim(Node):
                 f"Spawning turtle [{name}] at x=[{turtle.x:f}], y=[{turtle.y:f}], "
                 f"theta=[{turtle.theta:f}]"
             )
+        self.publish_snapshot()
         return response
 
     def on_spawn(self, request: Spawn.Request, response: Spawn.Response) -> Spawn.Response:
@@ -371,6 +399,7 @@ class Turtlesim(Node):
                 self.world.cancel_rotation(name, goal_id)
         for report in self.world.step(now):
             self.publish(report)
+        self.publish_new_segments()
 
     def publish(self, report: TurtleReport) -> None:
         parts = self.interfaces.get(report.name)
@@ -396,6 +425,24 @@ class Turtlesim(Node):
         )
         r, g, b = report.color
         parts.color.publish(Color(r=r, g=g, b=b))
+
+    # -- trails for viewers ----------------------------------------------------------
+
+    def publish_new_segments(self) -> None:
+        count = self.world.segment_count
+        if count == self.trails_sent:
+            return
+        segments = self.world.segments_since(self.trails_sent)
+        data = encode_segments(
+            self.trails_session, self.world.clear_count, count - len(segments), segments
+        )
+        self.trails.publish(UInt8MultiArray(data=data))
+        self.trails_sent = count
+
+    def publish_snapshot(self) -> None:
+        """The whole picture; segments sent after it continue from its index."""
+        self.trails.publish(UInt8MultiArray(data=encode_snapshot(self.trails_session, self.world)))
+        self.trails_sent = self.world.segment_count
 
     def destroy_retired(self) -> None:
         if not self.retired:

@@ -18,11 +18,22 @@ anew here):
 - Pens draw 3-pixel lines into a transparent canvas; the colour sensor reads
   that canvas under the turtle. As upstream, unpainted ground reads
   (255, 255, 255), the canvas's transparent white, whatever the background.
+
+Trails for viewers (the browser's Turtlesim tab) travel as packets of bytes
+(``encode_segments``, ``encode_snapshot``, ``decode_trails``): a 20-byte
+header (kind, the sim's session, its clear count, the index of the first
+segment), then either 20 bytes per new segment (four float32 coordinates, r,
+g, b, width) or the whole canvas and its painted mask, zlib-compressed. A
+viewer applies segments whose index follows the last one it has, and asks for
+a snapshot whenever it has not (opened late, missed a packet, the sim
+restarted).
 """
 
 from __future__ import annotations
 
 import math
+import struct
+import zlib
 from collections import deque
 from dataclasses import dataclass, field
 from enum import Enum
@@ -333,34 +344,18 @@ class TurtleWorld:
         self._paint(segment)
 
     def _paint(self, seg: Segment) -> None:
-        """Fill the pixels within half the pen width of the segment (in window pixels)."""
-        ax, ay = seg.x0 * METER, (WORLD_SIZE - seg.y0) * METER
-        bx, by = seg.x1 * METER, (WORLD_SIZE - seg.y1) * METER
-        # Round to the pixel grid as the sensor does, so a 1-pixel pen still covers it.
-        reach = max(seg.width / 2.0, 0.75)
-        lo_c = max(int(math.floor(min(ax, bx) - reach)), 0)
-        hi_c = min(int(math.ceil(max(ax, bx) + reach)), PIXELS - 1)
-        lo_r = max(int(math.floor(min(ay, by) - reach)), 0)
-        hi_r = min(int(math.ceil(max(ay, by) + reach)), PIXELS - 1)
-        if lo_c > hi_c or lo_r > hi_r:
-            return
-        cols = np.arange(lo_c, hi_c + 1, dtype=float)[None, :]
-        rows = np.arange(lo_r, hi_r + 1, dtype=float)[:, None]
-        dx, dy = bx - ax, by - ay
-        length2 = dx * dx + dy * dy
-        t = 0.0 if length2 == 0 else np.clip(((cols - ax) * dx + (rows - ay) * dy) / length2, 0, 1)
-        dist2 = (cols - (ax + t * dx)) ** 2 + (rows - (ay + t * dy)) ** 2
-        mask = dist2 <= reach * reach
-        self.canvas[lo_r : hi_r + 1, lo_c : hi_c + 1][mask] = seg.color
-        self.painted[lo_r : hi_r + 1, lo_c : hi_c + 1] |= mask
+        paint_segment(self.canvas, self.painted, seg)
 
     def segments_since(self, count: int) -> list[Segment]:
         """Trail pieces drawn after a viewer's last ``segment_count`` (all it still has)."""
         new = self.segment_count - count
         if new <= 0:
             return []
-        kept = list(self.segments)
-        return kept[-new:] if new < len(kept) else kept
+        kept = self.segments
+        if new >= len(kept):
+            return list(kept)
+        # Index from the right end: cheap on a deque, where a full copy of 200k is not.
+        return [kept[i] for i in range(-new, 0)]
 
 
 def _pixel(x: float, y: float) -> tuple[int, int]:
@@ -368,3 +363,99 @@ def _pixel(x: float, y: float) -> tuple[int, int]:
     col = int(math.floor(x * METER + 0.5))
     row = int(math.floor((WORLD_SIZE - y) * METER + 0.5))
     return min(max(col, 0), PIXELS - 1), min(max(row, 0), PIXELS - 1)
+
+
+def paint_segment(canvas: np.ndarray, painted: np.ndarray, seg: Segment) -> None:
+    """Fill the pixels within half the pen width of the segment (in window pixels)."""
+    ax, ay = seg.x0 * METER, (WORLD_SIZE - seg.y0) * METER
+    bx, by = seg.x1 * METER, (WORLD_SIZE - seg.y1) * METER
+    # Round to the pixel grid as the sensor does, so a 1-pixel pen still covers it.
+    reach = max(seg.width / 2.0, 0.75)
+    lo_c = max(int(math.floor(min(ax, bx) - reach)), 0)
+    hi_c = min(int(math.ceil(max(ax, bx) + reach)), PIXELS - 1)
+    lo_r = max(int(math.floor(min(ay, by) - reach)), 0)
+    hi_r = min(int(math.ceil(max(ay, by) + reach)), PIXELS - 1)
+    if lo_c > hi_c or lo_r > hi_r:
+        return
+    cols = np.arange(lo_c, hi_c + 1, dtype=float)[None, :]
+    rows = np.arange(lo_r, hi_r + 1, dtype=float)[:, None]
+    dx, dy = bx - ax, by - ay
+    length2 = dx * dx + dy * dy
+    t = 0.0 if length2 == 0 else np.clip(((cols - ax) * dx + (rows - ay) * dy) / length2, 0, 1)
+    dist2 = (cols - (ax + t * dx)) ** 2 + (rows - (ay + t * dy)) ** 2
+    mask = dist2 <= reach * reach
+    canvas[lo_r : hi_r + 1, lo_c : hi_c + 1][mask] = seg.color
+    painted[lo_r : hi_r + 1, lo_c : hi_c + 1] |= mask
+
+
+# -- trails for viewers ---------------------------------------------------------------
+
+TRAILS_VERSION = 1
+SEGMENTS, SNAPSHOT = 0, 1  # packet kinds
+# version, kind, (2 spare), session, clear count, index of the first segment
+_HEADER = struct.Struct("<BBxxIIQ")
+_SEGMENT = np.dtype(
+    [("x0", "<f4"), ("y0", "<f4"), ("x1", "<f4"), ("y1", "<f4"), ("rgbw", "u1", (4,))]
+)
+
+
+@dataclass(frozen=True)
+class TrailsPacket:
+    """One decoded packet: new segments from ``start`` on, or the whole canvas at ``start``."""
+
+    kind: int
+    session: int
+    clear_count: int
+    start: int
+    segments: tuple[Segment, ...] = ()
+    canvas: np.ndarray | None = None  # (PIXELS, PIXELS, 3) uint8, for a snapshot
+    painted: np.ndarray | None = None  # (PIXELS, PIXELS) bool, for a snapshot
+
+
+def encode_segments(session: int, clear_count: int, start: int, segments: list[Segment]) -> bytes:
+    records = np.zeros(len(segments), _SEGMENT)
+    for i, seg in enumerate(segments):
+        records[i] = (seg.x0, seg.y0, seg.x1, seg.y1, (*seg.color, min(seg.width, 255)))
+    return _HEADER.pack(TRAILS_VERSION, SEGMENTS, session, clear_count, start) + records.tobytes()
+
+
+def encode_snapshot(session: int, world: TurtleWorld) -> bytes:
+    """The whole picture (a few kB once compressed): what a late viewer starts from."""
+    header = _HEADER.pack(TRAILS_VERSION, SNAPSHOT, session, world.clear_count, world.segment_count)
+    body = world.canvas.tobytes() + np.packbits(world.painted).tobytes()
+    return header + zlib.compress(body, 1)
+
+
+def decode_trails(data: bytes) -> TrailsPacket:
+    """A packet from ``encode_*``; ValueError if it is not one."""
+    if len(data) < _HEADER.size:
+        raise ValueError("trails packet too short")
+    version, kind, session, clear_count, start = _HEADER.unpack_from(data)
+    if version != TRAILS_VERSION or kind not in (SEGMENTS, SNAPSHOT):
+        raise ValueError(f"unknown trails packet (version {version}, kind {kind})")
+    body = data[_HEADER.size :]
+    if kind == SEGMENTS:
+        if len(body) % _SEGMENT.itemsize:
+            raise ValueError("trails packet cut in the middle of a segment")
+        records = np.frombuffer(body, _SEGMENT)
+        segments = tuple(
+            Segment(
+                float(x0),
+                float(y0),
+                float(x1),
+                float(y1),
+                (int(c[0]), int(c[1]), int(c[2])),
+                int(c[3]),
+            )
+            for x0, y0, x1, y1, c in records
+        )
+        return TrailsPacket(kind, session, clear_count, start, segments)
+    raw = zlib.decompress(body)
+    size = PIXELS * PIXELS
+    if len(raw) != size * 3 + size // 8:
+        raise ValueError("trails snapshot of the wrong size")
+    canvas = np.frombuffer(raw[: size * 3], np.uint8).reshape(PIXELS, PIXELS, 3).copy()
+    painted = np.unpackbits(np.frombuffer(raw[size * 3 :], np.uint8)).astype(bool)
+    return TrailsPacket(
+        kind, session, clear_count, start, canvas=canvas, painted=painted.reshape(PIXELS, PIXELS)
+    )

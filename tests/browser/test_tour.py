@@ -6,7 +6,7 @@ import pytest
 from playwright.sync_api import expect
 
 from app.ui import TAB_NAMES
-from tests.browser.helpers import choose, click, expect_text, open_tab
+from tests.browser.helpers import choose, click, cut_off_at_panel_edge, expect_text, open_tab
 from tests.conftest import ARTIFACTS
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -18,6 +18,7 @@ EXPECTED = {
     "Lessons": "Course outline",
     "Exercise": "Run my node",
     "Nodes": "All catalog nodes",
+    "Turtlesim": "ros2 run turtlesim turtlesim_node",
     "Graph": "ros2 node list",
     "Echo": "data: 'Hello World:",
     "3D view": "draws live topics",
@@ -28,28 +29,8 @@ EXPECTED = {
     "Actions": "No action on the graph",
     "Lifecycle": "Start lifecycle_talker in the Nodes tab",
     "Logs": "records seen",
+    "Bags": "Record topics into a bag",
 }
-
-
-# Elements of the control panel that stick out past its right edge (clipped text).
-CLIPPED_JS = """() => {
-  const tabs = [...document.querySelectorAll('[role=tab]')];
-  let panel = tabs.find((t) => t.innerText.trim() === 'Lessons');
-  const scrolls = (el) => ['auto', 'scroll'].includes(getComputedStyle(el).overflowY);
-  while (panel && !scrolls(panel)) panel = panel.parentElement;
-  if (!panel) return ['no scrolling control panel found'];
-  const edge = panel.getBoundingClientRect().right;
-  const out = [];
-  for (const el of panel.querySelectorAll('*')) {
-    const box = el.getBoundingClientRect();
-    if (!box.width || !box.height || getComputedStyle(el).visibility === 'hidden') continue;
-    if (box.right > edge + 1) {
-      const text = (el.innerText || el.textContent || '').trim().slice(0, 40);
-      out.push(`${el.tagName} "${text}" ends at ${Math.round(box.right)} > ${Math.round(edge)}`);
-    }
-  }
-  return out.slice(0, 8);
-}"""
 
 
 def test_every_tab_renders_without_errors(page):
@@ -71,4 +52,6 @@ def test_every_tab_renders_without_errors(page):
         page.screenshot(path=str(ARTIFACTS / f"tour-{name.replace(' ', '_')}.png"))
         text = page.locator("body").inner_text()
         assert "Traceback" not in text, name
-        assert page.evaluate(CLIPPED_JS) == [], f"{name}: cut off at the panel's right edge"
+        assert cut_off_at_panel_edge(page, "[role=tab]", "Lessons") == [], (
+            f"{name}: cut off at the panel's right edge"
+        )

@@ -1,0 +1,321 @@
+"""Turtlesim panel: the turtlesim window drawn live, and turtle_teleop_key driven from the page.
+
+The drawing is ``TurtlesimView``; this panel finds the sim on the graph, feeds
+the view from ROS (trails, poses, background parameters) and turns buttons
+and keys into key names for ``/teleop_turtle`` (``std_msgs/String`` on its
+hidden ``/teleop_turtle/_key``), the node that drives the turtle, as in the
+tutorial.
+
+Keys: viser sends no keyboard events, so a hidden same-origin frame (its
+page is a ``srcdoc`` inside this panel's HTML) listens to ``keydown`` on the
+dashboard page and fetches a secret page link (``app.ui.page_links``) per key
+name. Only the fixed names below are registered, so the page can send
+nothing but those; keys typed into an input field, or pressed while another
+tab is shown, are left alone.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+from typing import Any
+
+import viser
+from rcl_interfaces.msg import ParameterEvent
+from rclpy.node import Node
+from rclpy.publisher import Publisher
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.subscription import Subscription
+from std_msgs.msg import Empty, String, UInt8MultiArray
+from turtlesim.msg import Pose
+
+from app.panels.turtlesim_view import TurtlesimView
+from app.ros.context import panel_context
+from app.ros.graph import GraphSnapshot
+from app.ros.params import get_values, python_value
+from app.supervisor import Supervisor
+from app.ui import MarkdownView, set_options
+from app.ui.loop import UiLoop
+from app.ui.page_links import PageLinks
+
+NONE = "(no turtlesim)"
+TRAILS_SUFFIX = "/_trails"
+TRAILS_TYPE = "std_msgs/msg/UInt8MultiArray"
+POSE_TYPE = "turtlesim/msg/Pose"
+KEY_TOPIC = "/teleop_turtle/_key"
+TELEOP_NODE = "/teleop_turtle"
+BACKGROUND = ("background_r", "background_g", "background_b")
+# Browser key (KeyboardEvent.key, lower-cased) -> the key name turtle_teleop_key takes.
+KEYS = {
+    "arrowup": "up", "arrowdown": "down", "arrowleft": "left", "arrowright": "right",
+    **{letter: letter for letter in "gbvcdertf"},
+}  # fmt: skip
+DRIVE = {"↑": "up", "↓": "down", "←": "left", "→": "right"}
+HEADINGS = "G B V C D E R T"
+TRAILS_QOS = QoSProfile(
+    depth=50, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+)
+# A viewer needs only the newest pose: best effort, one deep (no queue to work through).
+POSE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT)
+
+INTRO = (
+    "Turtlesim's window, drawn live from ROS: the background from the node's "
+    "`background_r/g/b` parameters, the pen trails, and every turtle from its "
+    "`/<name>/pose` topic."
+)
+NOT_RUNNING = (
+    "_turtlesim_node is not running._ Type `ros2 run turtlesim turtlesim_node` "
+    "in the **Console** tab, or press **Start turtlesim_node**."
+)
+KEY_HELP = (
+    "**Drive turtle1** with the buttons, or with the arrow keys while this tab is "
+    "open (not while typing in a field). G B V C D E R T turn it to 0°, -45°, -90°, "
+    "-135°, 180°, 135°, 90°, 45° (a `rotate_absolute` goal); F cancels the goal."
+)
+
+
+def key_listener(links: dict[str, str]) -> str:
+    """A hidden same-origin frame that turns key presses on the page into page-link fetches."""
+    script = f"""
+const links = {json.dumps(links)};
+const keys = {json.dumps(KEYS)};
+const shown = () => {{
+  const box = window.frameElement && window.frameElement.parentElement;
+  return !!box && box.getClientRects().length > 0;
+}};
+const onKey = (event) => {{
+  const target = event.target;
+  if (event.ctrlKey || event.metaKey || event.altKey || !shown()) return;
+  const typing = /^(INPUT|TEXTAREA|SELECT)$/.test(target.tagName) || target.isContentEditable;
+  if (typing || (target.closest && target.closest("[role=slider]"))) return;
+  const name = keys[event.key.toLowerCase()];
+  if (!name) return;
+  event.preventDefault();  // no scrolling, and the tab list does not take the arrows
+  event.stopPropagation();
+  fetch(new URL(links[name], parent.location.href), {{cache: "no-store"}}).catch(() => {{}});
+}};
+if (parent.__turtleKeysOff) parent.__turtleKeysOff();
+parent.addEventListener("keydown", onKey, true);
+parent.__turtleKeysOff = () => parent.removeEventListener("keydown", onKey, true);
+window.addEventListener("pagehide", () => parent.__turtleKeysOff && parent.__turtleKeysOff());
+"""
+    document = f"<!doctype html><script>{script}</script>"
+    return (
+        f'<iframe hidden title="turtlesim keys" data-turtlesim-keys '
+        f'srcdoc="{html.escape(document, quote=True)}"></iframe>'
+    )
+
+
+def pose_topics(graph: GraphSnapshot, sim_fqn: str) -> dict[str, str]:
+    """The sim's turtles by name -> pose topic: ``<sim namespace>/<name>/pose``."""
+    namespace = sim_fqn.rsplit("/", 1)[0]  # '' for a node at the root
+    found = {}
+    for topic in graph.topics:
+        if POSE_TYPE not in topic.types or not topic.name.startswith(namespace + "/"):
+            continue
+        name, _, tail = topic.name[len(namespace) + 1 :].partition("/")
+        if tail == "pose" and name:
+            found[name] = topic.name
+    return found
+
+
+class TurtlesimPanel:
+    def __init__(
+        self,
+        gui: viser.GuiApi,
+        ui: UiLoop,
+        node: Node,
+        supervisor: Supervisor,
+        page_links: PageLinks,
+    ) -> None:
+        self._ui = ui
+        self._node = node
+        self._supervisor = supervisor
+        self._started: dict[str, str] = {}  # program -> what its Start button did
+        self._nodes: tuple[str, ...] | None = None
+        self._sims: list[str] = []
+        self._sim: str | None = None  # the followed node's full name
+        self._trails: Subscription | None = None
+        self._events: Subscription | None = None
+        self._requests: Publisher | None = None
+        self._poses: dict[str, tuple[str, Subscription]] = {}  # turtle -> (topic, subscription)
+        self._keys = node.create_publisher(String, KEY_TOPIC, 10)
+
+        gui.add_markdown(INTRO)
+        self._selector = gui.add_dropdown("Turtlesim node", [NONE], initial_value=NONE)
+        self._status = MarkdownView(gui, NOT_RUNNING)
+        self._start_sim = gui.add_button("Start turtlesim_node", icon=viser.Icon.PLAYER_PLAY)
+        self.view = TurtlesimView(gui, self._ask_snapshot)
+        self._teleop_hint = MarkdownView(gui, "")
+        self._start_teleop = gui.add_button("Start turtle_teleop_key", icon=viser.Icon.KEYBOARD)
+        gui.add_markdown(KEY_HELP)
+        self._drive = gui.add_button_group("Drive", list(DRIVE))
+        self._rotate = gui.add_button_group("Rotate", HEADINGS.split())
+        self._cancel = gui.add_button("Cancel rotation (F)", icon=viser.Icon.X)
+        links = {
+            name: page_links.register(f"turtlesim-key-{name}", self._key_action(name))
+            for name in sorted(set(KEYS.values()))
+        }
+        gui.add_html(key_listener(links))
+
+        self._selector.on_update(ui.callback(self._follow_selected))
+        self._start_sim.on_click(ui.callback(self._start, "turtlesim_node"))
+        self._start_teleop.on_click(ui.callback(self._start, "turtle_teleop_key"))
+        self._drive.on_click(lambda event: self._post_key(DRIVE.get(event.target.value, "")))
+        self._rotate.on_click(lambda event: self._post_key(str(event.target.value).lower()))
+        self._cancel.on_click(lambda _event: self._post_key("f"))
+
+    # -- keys (viser's threads post; the UI thread publishes) ------------------
+
+    def _key_action(self, name: str) -> Any:
+        return lambda: self._post_key(name)
+
+    def _post_key(self, name: str) -> None:
+        if name in KEYS.values():  # only the fixed names ever leave the page
+            self._ui.post(lambda: self._keys.publish(String(data=name)))
+
+    def _start(self, program: str) -> None:
+        def work() -> str:
+            return self._supervisor.start(program).describe()
+
+        def show(text: str) -> None:
+            self._started[program] = text
+
+        self._ui.run_job(work, show, show, lane="nodes")
+
+    def _start_note(self, program: str) -> str:
+        text = self._started.get(program)
+        return f"\n\n{program}: {text}" if text else ""
+
+    # -- following one sim -------------------------------------------------------
+
+    def _ask_snapshot(self) -> None:
+        """From the view's thread: the trails are out of step, ask the sim for a snapshot."""
+        publisher = self._requests
+        if publisher is not None:
+            try:
+                publisher.publish(Empty())
+            except Exception:  # swapped for another sim's just now: the view asks again
+                pass
+
+    def _follow_selected(self) -> None:
+        wanted = self._selector.value if self._selector.value in self._sims else None
+        if wanted == self._sim:
+            return
+        self._unfollow()
+        self._sim = wanted
+        self.view.follow(wanted is not None)
+        if wanted is None:
+            return
+        node, view = self._node, self.view
+        self._requests = node.create_publisher(Empty, wanted + "/_trails_request", 10)
+
+        def on_trails(msg: UInt8MultiArray) -> None:
+            view.offer_trails(bytes(msg.data))
+
+        self._trails = node.create_subscription(
+            UInt8MultiArray, wanted + TRAILS_SUFFIX, on_trails, TRAILS_QOS
+        )
+        self._events = node.create_subscription(
+            ParameterEvent, "/parameter_events", lambda msg: self._on_event(wanted, msg), 100
+        )
+        ctx = panel_context(node)
+
+        def work() -> list[Any]:
+            return [python_value(v) for v in get_values(ctx, wanted, list(BACKGROUND))]
+
+        def done(values: list[Any]) -> None:
+            if self._sim == wanted and all(isinstance(v, int) for v in values):
+                view.set_background((values[0], values[1], values[2]))
+
+        self._ui.run_job(work, done, lambda _text: None)
+
+    def _on_event(self, sim: str, event: ParameterEvent) -> None:
+        """Executor thread: a background channel changed on the followed sim."""
+        if event.node != sim:
+            return
+        rgb = list(self.view.background)
+        for parameter in (*event.new_parameters, *event.changed_parameters):
+            if parameter.name in BACKGROUND:
+                value = python_value(parameter.value)
+                if isinstance(value, int):
+                    rgb[BACKGROUND.index(parameter.name)] = value
+        self.view.set_background((rgb[0], rgb[1], rgb[2]))
+
+    def _unfollow(self) -> None:
+        for subscription in (self._trails, self._events):
+            if subscription is not None:
+                self._node.destroy_subscription(subscription)
+        if self._requests is not None:
+            requests, self._requests = self._requests, None
+            self._node.destroy_publisher(requests)
+        self._trails = self._events = None
+        self._sync_turtles({})
+
+    def _sync_turtles(self, topics: dict[str, str]) -> None:
+        for name, (topic, subscription) in list(self._poses.items()):
+            if topics.get(name) != topic:
+                self._node.destroy_subscription(subscription)
+                del self._poses[name]
+        view = self.view
+        for name, topic in topics.items():
+            if name not in self._poses:
+
+                def on_pose(msg: Pose, name: str = name) -> None:
+                    view.offer_pose(name, msg.x, msg.y, msg.theta)
+
+                subscription = self._node.create_subscription(Pose, topic, on_pose, POSE_QOS)
+                self._poses[name] = (topic, subscription)
+        view.keep_turtles(set(topics))
+
+    def _find_sims(self) -> list[str]:
+        """Nodes publishing a trails topic (hidden names are not in the snapshot: ask DDS)."""
+        return sorted(
+            name[: -len(TRAILS_SUFFIX)]
+            for name, types in self._node.get_topic_names_and_types()
+            if name.endswith(TRAILS_SUFFIX)
+            and TRAILS_TYPE in types
+            and self._node.count_publishers(name) > 0
+        )
+
+    # -- the UI thread's refresh ---------------------------------------------------
+
+    def refresh(self, graph: GraphSnapshot) -> None:
+        if graph.nodes != self._nodes or not self._sims:
+            self._nodes = graph.nodes
+            sims = [s for s in self._find_sims() if graph.has_node(s)]
+            if sims != self._sims:
+                self._sims = sims
+                set_options(self._selector, sims or [NONE], keep_current=False)
+        self._follow_selected()
+        sim = self._sim
+        self._sync_turtles(pose_topics(graph, sim) if sim else {})
+        self._start_sim.visible = sim is None
+        self._status.show(self._status_text(sim))
+        teleop = graph.has_node(TELEOP_NODE)
+        self._start_teleop.visible = not teleop
+        self._teleop_hint.show(
+            f"`{TELEOP_NODE}` is running: the keys below go to it."
+            if teleop
+            else "_turtle_teleop_key is not running: the keys below need it._ Type "
+            "`ros2 run turtlesim turtle_teleop_key` in the Console, or press the button."
+            + self._start_note("turtle_teleop_key")
+        )
+
+    def _status_text(self, sim: str | None) -> str:
+        if sim is None:
+            return NOT_RUNNING + self._start_note("turtlesim_node")
+        stats = self.view.stats()
+        turtles = ", ".join(sorted(self._poses)) or "none yet"
+        rate = f"{stats.rate_hz:.0f} frames/s" if stats.rate_hz else "idle"
+        cost = f" · {stats.draw_ms:.1f} ms a frame" if stats.draw_ms is not None else ""
+        trails = "" if stats.in_step else " · waiting for the trails"
+        return (
+            f"Drawing `{sim}` · turtles: {turtles} · {rate}{cost} · "
+            f"{stats.frames} frames drawn{trails}"
+        )
+
+    def close(self) -> None:
+        self.view.close()
+        self._unfollow()
+        self._node.destroy_publisher(self._keys)
