@@ -86,7 +86,9 @@ from nodes.common.turtlesim_world import (
 
 # Upstream's topic QoS for every pose, colour and cmd_vel topic.
 TOPIC_QOS = QoSProfile(depth=7, reliability=ReliabilityPolicy.RELIABLE)
-MAX_CATCH_UP = 15  # steps run at once after a late timer (240 ms); beyond, time is let go
+# Steps run at once after a late timer: 1 s. A loaded machine (dashboard, browser and
+# sim on 2 cores) stalls the timer for up to ~250 ms; beyond 1 s, time is let go.
+MAX_CATCH_UP = 62
 # Trails: reliable, and a late viewer still gets the last packets (a snapshot, if the
 # picture has not changed since); 50 packets (0.8 s of updates) ride out a slow reader.
 TRAILS_QOS = QoSProfile(
