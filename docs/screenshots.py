@@ -120,6 +120,21 @@ def arm_scene(page: Page) -> None:
     page.screenshot(path=str(IMAGES / "scene.png"))
 
 
+def turtlesim_drive(page: Page) -> None:
+    """Turtlesim in its tab: started and driven with the arrow keys, a turn left in the trail."""
+    page.get_by_role("tab", name="Turtlesim").click()
+    page.get_by_role("button", name="Start turtlesim_node", exact=True).click()
+    expect(_shown(page, "turtles: turtle1")).to_be_visible(timeout=30_000)
+    page.get_by_role("button", name="Start turtle_teleop_key", exact=True).click()
+    expect(_shown(page, "is running")).to_be_visible(timeout=30_000)
+    page.get_by_text("TurtleSim", exact=True).click()  # the page, not a field, has the focus
+    for key in ["ArrowUp"] * 3 + ["ArrowLeft"] * 4 + ["ArrowUp"] * 3:
+        page.keyboard.press(key)
+        page.wait_for_timeout(250)
+    page.wait_for_timeout(2500)  # turtlesim stops the turtle 1 s after the last key
+    page.screenshot(path=str(IMAGES / "turtlesim.png"))
+
+
 def _start(page: Page, node: str) -> None:
     page.get_by_role("tab", name="Nodes").click()
     _choose(page, "Catalog node", node)
@@ -185,7 +200,7 @@ def learner_dashboard(browser: Browser, env: dict[str, str], tmp: str) -> None:
     with _running(argv, env, Path(tmp) / "dashboard.log", "is ready"):
         page = _open(browser, f"http://127.0.0.1:{PORT}/")
         try:
-            takes = (topics_lesson, live_graph, lifecycle_drawing, exercise_graded)
+            takes = (topics_lesson, live_graph, lifecycle_drawing, turtlesim_drive, exercise_graded)
             for take in (*takes, arm_scene):  # the scene folds the code away
                 take(page)
         except Exception:
