@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import re
+import time
 
+import pytest
 from playwright.sync_api import Page, expect
+from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
 
 def open_tab(page: Page, name: str) -> None:
@@ -14,6 +17,26 @@ def open_tab(page: Page, name: str) -> None:
 def choose(page: Page, label: str, option: str) -> None:
     page.get_by_label(label).click()
     page.get_by_role("option", name=option, exact=True).click()
+
+
+def choose_when_listed(
+    page: Page, label: str, option: str, timeout: float = 30.0, exact: bool = False
+) -> None:
+    """Pick a dropdown option that may be listed only once discovery has found it."""
+    dropdown = page.get_by_label(label, exact=exact).locator("visible=true").first
+    wanted = page.get_by_role("option", name=option, exact=True)
+    deadline = time.monotonic() + timeout
+    while True:
+        dropdown.click()
+        try:
+            wanted.wait_for(timeout=1_500)
+            break
+        except PlaywrightTimeout:
+            page.keyboard.press("Escape")  # not listed yet: close, let the panel refresh
+            if time.monotonic() > deadline:
+                pytest.fail(f"option {option!r} never appeared in {label!r}")
+            page.wait_for_timeout(500)
+    wanted.click()
 
 
 def click(page: Page, button: str) -> None:

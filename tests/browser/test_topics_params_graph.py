@@ -3,13 +3,11 @@
 from __future__ import annotations
 
 import re
-import time
 
 import pytest
 from playwright.sync_api import Page, expect
-from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
-from tests.browser.helpers import click, expect_text, open_tab, start_node
+from tests.browser.helpers import choose_when_listed, click, expect_text, open_tab, start_node
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
@@ -21,22 +19,8 @@ def stop(page: Page, name: str) -> None:
     expect_text(page, f"Stopping {name}")
 
 
-def choose(page: Page, label: str, option: str, timeout: float = 30.0) -> None:
-    """Pick a dropdown option that may be listed only once discovery has found it."""
-    dropdown = page.get_by_label(label).locator("visible=true").first
-    wanted = page.get_by_role("option", name=option, exact=True)
-    deadline = time.monotonic() + timeout
-    while True:
-        dropdown.click()
-        try:
-            wanted.wait_for(timeout=1_500)
-            break
-        except PlaywrightTimeout:
-            page.keyboard.press("Escape")  # not listed yet: close, let the panel refresh
-            if time.monotonic() > deadline:
-                pytest.fail(f"option {option!r} never appeared in {label!r}")
-            page.wait_for_timeout(500)
-    wanted.click()
+def choose(page: Page, label: str, option: str) -> None:
+    choose_when_listed(page, label, option)
 
 
 def field(page: Page, label: str):

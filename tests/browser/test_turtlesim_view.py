@@ -9,13 +9,11 @@ and leave a pen trail, a turtle spawned from the Services panel appears, and
 from __future__ import annotations
 
 import re
-import time
 
 import pytest
 from playwright.sync_api import Page, expect
-from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
-from tests.browser.helpers import click, open_tab
+from tests.browser.helpers import choose_when_listed, click, open_tab
 from tests.browser.test_topics_params_graph import field
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -63,22 +61,8 @@ def wait_pixels(page: Page, test: str, x: float = 0.0, y: float = 0.0, timeout: 
     return pixels(page, x, y)
 
 
-def choose(page: Page, label: str, option: str, timeout: float = 30.0) -> None:
-    """Pick a dropdown option that may be listed only once discovery has found it."""
-    dropdown = page.get_by_label(label, exact=True).locator("visible=true").first
-    wanted = page.get_by_role("option", name=option, exact=True)
-    deadline = time.monotonic() + timeout
-    while True:
-        dropdown.click()
-        try:
-            wanted.wait_for(timeout=1_500)
-            break
-        except PlaywrightTimeout:
-            page.keyboard.press("Escape")  # not listed yet: close, let the panel refresh
-            if time.monotonic() > deadline:
-                pytest.fail(f"option {option!r} never appeared in {label!r}")
-            page.wait_for_timeout(500)
-    wanted.click()
+def choose(page: Page, label: str, option: str) -> None:
+    choose_when_listed(page, label, option, exact=True)
 
 
 def settled_pen_pixels(page: Page) -> int:
