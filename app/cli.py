@@ -273,8 +273,22 @@ def cmd_classroom(args: argparse.Namespace) -> int:
     return classroom.run(room, stop_requested, lambda line: print(line, flush=True), teacher)
 
 
+def _run_entry(args: argparse.Namespace) -> catalog.CatalogEntry:
+    """``run NAME`` (a catalog name) or, as the tutorials type it, ``run PACKAGE EXECUTABLE``."""
+    extra = args.ros_args
+    if args.node not in catalog.names() and extra and not extra[0].startswith("-"):
+        from app.ros.errors import Ros2Error
+        from app.ros2cli.run import resolve
+
+        try:
+            return resolve(args.node, extra.pop(0))
+        except Ros2Error as exc:
+            raise CliError(str(exc)) from None
+    return catalog.lookup(args.node)
+
+
 def cmd_run(args: argparse.Namespace) -> int:
-    entry = catalog.lookup(args.node)
+    entry = _run_entry(args)
     configure_this_process(domain_id=args.domain_id, network=args.network)
     argv = [sys.executable, "-m", f"nodes.{entry.module}", *entry.argv_tail()]
     extra = list(args.ros_args)
@@ -462,7 +476,7 @@ def build_parser() -> argparse.ArgumentParser:
     room.set_defaults(func=cmd_classroom)
 
     run = sub.add_parser("run", help="run one catalog node in the foreground, like `ros2 run`")
-    run.add_argument("node", help="catalog name (see `ros2-classroom list`)")
+    run.add_argument("node", help="catalog name (see `ros2-classroom list`), or PACKAGE EXECUTABLE")
     run.add_argument("ros_args", nargs=argparse.REMAINDER, help="--ros-args ...")
     dds_options(run)
     run.set_defaults(func=cmd_run)

@@ -137,3 +137,28 @@ def test_a_params_file_and_a_namespace(console, probe, tmp_path):
         timeout=DISCOVERY_TIMEOUT,
         what="the namespaced pose topic",
     )
+
+
+def test_the_command_line_runs_package_and_executable_like_ros2_run(ros_env, probe):
+    """`ros2-classroom run turtlesim turtlesim_node --ros-args ...` in a terminal."""
+    import signal
+    import subprocess
+    import sys
+
+    from app import PROJECT_ROOT
+
+    argv = [sys.executable, "-m", "app", "run", "turtlesim", "turtlesim_node"]
+    argv += ["--ros-args", "-r", "__node:=cli_turtle"]
+    proc = subprocess.Popen(
+        argv, cwd=PROJECT_ROOT, env=ros_env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT
+    )
+    try:
+        wait_until(
+            lambda: "/cli_turtle" in node_names(probe),
+            timeout=DISCOVERY_TIMEOUT,
+            what="the renamed turtlesim",
+        )
+    finally:
+        proc.send_signal(signal.SIGINT)  # Ctrl+C, as in the terminal
+        output = proc.communicate(timeout=15)[0].decode()
+    assert "Starting turtlesim with node name /cli_turtle" in output, output

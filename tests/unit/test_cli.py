@@ -39,3 +39,11 @@ def test_bad_domain_id_is_a_usage_error():
     result = run_cli("serve", "--domain-id", "999")
     assert result.returncode == 2
     assert "between 0 and 101" in result.stderr
+
+
+def test_run_package_and_unknown_executable_is_a_clear_error():
+    result = run_cli("run", "turtlesim", "turtle_rocket")
+    assert result.returncode == 2
+    assert "'turtle_rocket' is not in package 'turtlesim'" in result.stderr
+    assert "turtlesim_node" in result.stderr  # what the package has
+    assert "Traceback" not in result.stderr
