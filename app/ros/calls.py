@@ -124,6 +124,9 @@ class GoalRun:
             handle.cancel_goal_async()
 
 
+GOAL_SETTLE_SEC = 0.3  # after a new action client finds its server (see send_goal)
+
+
 def send_goal(
     ctx: CallContext,
     run: GoalRun,
@@ -145,6 +148,10 @@ def send_goal(
     try:
         timeout = ctx.limits.service_timeout
         wait_for_server(ctx, client.server_is_ready, timeout, f"action server '{run.action}'")
+        # "Ready" is our side's view of discovery. The server may match our fresh
+        # client a moment later, and a goal response sent before that is lost: the
+        # goal then runs (feedback arrives) while we wait for its acceptance in vain.
+        ctx.sleep(GOAL_SETTLE_SEC)
         future = client.send_goal_async(run.goal, feedback_callback=feedback_cb)
         handle = wait_future(ctx, future, timeout, f"action server '{run.action}'")
         if not handle.accepted:
