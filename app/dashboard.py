@@ -151,6 +151,9 @@ class Dashboard:
         for name in TAB_NAMES:
             with tabs.add_tab(name, _ICONS[name]):
                 panels.append(builders[name]())
+        # A lesson's `console` buttons type their command into the Console tab.
+        console = next(p for p in panels if isinstance(p, ConsolePanel))
+        self.lessons.console = console.run_for_lesson
         return panels
 
     def _exercise_marks(self, lesson_id: str) -> str:

@@ -35,6 +35,8 @@ ACTION_KINDS: dict[str, Kind] = {
     "call_service": make_kind("service type request", "label"),
     "send_goal": make_kind("action type goal", "label cancel_after_feedback"),
     "open_panel": make_kind("panel", "label"),
+    # A `ros2 ...` command run in the Console tab, as the learner would type it there.
+    "console": make_kind("command", "label"),
 }
 CHECK_KINDS: dict[str, Kind] = {
     "node_running": make_kind("node"),
@@ -43,6 +45,7 @@ CHECK_KINDS: dict[str, Kind] = {
     "topic_rate": make_kind("topic type min_hz max_hz"),
     "topic_subscribers": make_kind("topic at_least"),
     "log_contains": make_kind("catalog_node text", "at_least"),
+    "bag_contains": make_kind("bag topic at_least"),
     "lifecycle_state": make_kind("node state"),
     "parameter_equals": make_kind("node name value"),
     "service_returns": make_kind("service type request field equals"),

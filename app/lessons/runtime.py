@@ -20,6 +20,9 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from app import catalog
+from app.bags.errors import BagError
+from app.bags.folder import existing_path
+from app.bags.info import read_info
 from app.lessons.kinds import ACTION_KINDS, CHECK_KINDS
 from app.lessons.schema import Spec
 from app.ros import lifecycle, params
@@ -73,6 +76,8 @@ class LessonRuntime:
         self._services = ServicePoller(node, RECALL_PERIOD_SEC)
         self._goals: dict[str, GoalRun] = {}
         self.quiz_answers: dict[str, str] = {}
+        # Runs a `ros2 ...` line in the Console tab (the dashboard wires it; UI thread).
+        self.console: Callable[[str], None] | None = None
 
     def tap(self, topic: str, type_name: str, history: bool = False) -> TopicMonitor:
         """A kept subscription; ``history``: the reliable, transient-local /rosout kind."""
@@ -167,6 +172,13 @@ class LessonRuntime:
     def _open_panel(self, action: Spec) -> str:
         return f"Open the {action['panel']} tab."
 
+    def _console(self, action: Spec) -> str:
+        command = action["command"]
+        if self.console is None:
+            return f"Type it in the Console tab: {command}"
+        self.console(command)
+        return f"Running in the Console tab: {command}"
+
     # -- checks ------------------------------------------------------------
 
     def evaluate(self, check: Spec) -> CheckResult:
@@ -237,6 +249,17 @@ class LessonRuntime:
         return CheckResult(
             WAITING, f"{len(lines)} of {needed} log lines contain {c['text']!r} so far"
         )
+
+    def _check_bag_contains(self, c: Spec) -> CheckResult:
+        """A finished, readable bag in the learner's bags folder holds enough of a topic."""
+        try:
+            info = read_info(existing_path(c["bag"]))
+        except BagError as exc:  # absent, still recording (no metadata yet), or unreadable
+            return CheckResult(FAIL, str(exc))
+        count = next((t.count for t in info.topics if t.name == c["topic"]), 0)
+        if count >= c["at_least"]:
+            return CheckResult(PASS, f"{c['bag']} holds {count} messages of {c['topic']}")
+        return CheckResult(FAIL, f"{c['bag']} holds {count} of {c['at_least']} on {c['topic']}")
 
     def _check_lifecycle_state(self, c: Spec) -> CheckResult:
         if not self.graph.has_node(c["node"]):
@@ -404,6 +427,7 @@ _ACTIONS: dict[str, Callable[[LessonRuntime, Spec], str]] = {
     "call_service": LessonRuntime._call_service,
     "send_goal": LessonRuntime._send_goal,
     "open_panel": LessonRuntime._open_panel,
+    "console": LessonRuntime._console,
 }
 _CHECKS: dict[str, Callable[[LessonRuntime, Spec], CheckResult]] = {
     kind: getattr(LessonRuntime, f"_check_{kind}") for kind in CHECK_KINDS

@@ -127,6 +127,12 @@ def _check_names(kind: str, fields: dict[str, Any], where: str, learner_node: st
             f"{where}: no catalog entry creates the ROS node '{fields['node']}' "
             "(a ROS node name starts with '/'; catalog names go in 'catalog_node')"
         )
+    if kind == "console" and not (
+        isinstance(fields["command"], str)
+        and fields["command"].startswith("ros2 ")
+        and "\n" not in fields["command"]
+    ):
+        raise LessonError(f"{where}: a console command is one line that starts with 'ros2 '")
     if kind == "open_panel" and fields["panel"] not in TAB_NAMES:
         raise LessonError(
             f"{where}: there is no tab '{fields['panel']}' (tabs: {', '.join(TAB_NAMES)})"

@@ -51,6 +51,7 @@ class ConsolePanel:
         self._programs = programs  # the supervisor: `ros2 run` starts catalog nodes through it
         self._output = _Output()
         self._running: CallContext | None = None
+        self._next: str | None = None  # a lesson's command, once the running one has stopped
         gui.add_markdown(
             "Type a command as the tutorials write it, e.g. `ros2 topic list -t`, "
             "`ros2 lifecycle get /lifecycle_talker`, `ros2 interface show std_msgs/msg/String`. "
@@ -77,11 +78,22 @@ class ConsolePanel:
         self._stop.disabled = False
         self._ui.run_job(lambda: run_text(ctx, text), self._finished, self._crashed)
 
+    def run_for_lesson(self, text: str) -> None:
+        """A lesson button's command: what runs now is stopped (as Stop does), then ``text``."""
+        if self._running is None:
+            self.run(text)
+        else:
+            self._next = text
+            self._cancel()
+
     def _finished(self, code: int) -> None:
         self._output.write(f"[exit code {code}]")
         self._running = None
         self._run.disabled = False
         self._stop.disabled = True
+        if self._next is not None:
+            text, self._next = self._next, None
+            self.run(text)
 
     def _crashed(self, text: str) -> None:
         self._output.write(f"error: {text}")  # a verb bug still ends in one line

@@ -67,3 +67,10 @@ def test_complete_a_lesson_and_keep_progress(page, dashboard, ros_env, progress_
 
 def test_complete_the_lifecycle_lesson_by_clicking_transitions(page):
     complete_by_clicking(page, COURSE.lesson("09_lifecycle"))
+
+
+def test_complete_the_bags_lesson_whose_buttons_type_into_the_console(page):
+    """Record, replay with no talker, replay looping at double rate: the Console runs them."""
+    complete_by_clicking(page, COURSE.lesson("16_bags"))
+    open_tab(page, "Console")  # shows the last command, still looping
+    expect_text(page, "$ ros2 bag play talker_bag -r 2 -l")

@@ -11,10 +11,13 @@ import threading
 
 import pytest
 
+from app.bags import folder as bag_folder
 from app.lessons.kinds import CHECK_KINDS
 from app.lessons.runtime import FAIL, PASS, LessonRuntime
 from app.lessons.schema import Spec, load_course
+from app.ros.context import CONSOLE_LIMITS, CallContext
 from app.ros.graph import snapshot
+from app.ros2cli import run_text
 from tests.conftest import wait_until
 
 pytestmark = pytest.mark.ros
@@ -32,9 +35,22 @@ def dashboard_node(ros_env):
 
 
 @pytest.fixture
-def live(dashboard_node, supervisor):
+def live(dashboard_node, supervisor, tmp_path, monkeypatch):
     runtime = LessonRuntime(dashboard_node, supervisor)
     stop = threading.Event()
+    # A lesson's console commands run as the Console tab runs them: one at a time,
+    # the previous one stopped first; bags go to this test's own folder.
+    monkeypatch.setenv(bag_folder.ENV_VAR, str(tmp_path / "bags"))
+    commands: list[CallContext] = []
+
+    def console(text: str) -> None:
+        for earlier in commands:
+            earlier.cancel.set()
+        ctx = CallContext(dashboard_node, limits=CONSOLE_LIMITS, programs=supervisor)
+        commands.append(ctx)
+        threading.Thread(target=run_text, args=(ctx, text), daemon=True).start()
+
+    runtime.console = console
 
     def watch_graph() -> None:  # what the dashboard's UI loop does
         while not stop.wait(0.2):
@@ -51,6 +67,8 @@ def live(dashboard_node, supervisor):
     thread.start()
     runtime.graph_errors = errors  # type: ignore[attr-defined]
     yield runtime
+    for ctx in commands:
+        ctx.cancel.set()
     stop.set()
     thread.join()
 
@@ -91,6 +109,7 @@ def _server_ready(live: LessonRuntime, action: Spec) -> bool:
 
 
 FAILING_CHECKS = [
+    Spec("bag_contains", {"bag": "no_such_bag", "topic": "/chatter", "at_least": 1}),
     Spec("node_running", {"node": "/nobody_here"}),
     Spec("node_absent", {"node": "/classroom_dashboard"}),
     Spec("topic_messages", {"topic": "/silent", "type": "std_msgs/msg/String", "at_least": 1}),
