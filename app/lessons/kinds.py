@@ -37,6 +37,8 @@ ACTION_KINDS: dict[str, Kind] = {
     "open_panel": make_kind("panel", "label"),
     # A `ros2 ...` command run in the Console tab, as the learner would type it there.
     "console": make_kind("command", "label"),
+    # Messages on a topic, ``times`` of them at ``rate_hz`` (e.g. a drive without a keyboard).
+    "publish": make_kind("topic type message", "label times rate_hz"),
 }
 CHECK_KINDS: dict[str, Kind] = {
     "node_running": make_kind("node"),

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import threading
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -75,6 +76,7 @@ class LessonRuntime:
         self._taps: dict[tuple[str, str], TopicMonitor] = {}
         self._services = ServicePoller(node, RECALL_PERIOD_SEC)
         self._goals: dict[str, GoalRun] = {}
+        self._senders: dict[tuple[str, str], Any] = {}  # kept: a fresh one misses subscribers
         self.quiz_answers: dict[str, str] = {}
         # Runs a `ros2 ...` line in the Console tab (the dashboard wires it; UI thread).
         self.console: Callable[[str], None] | None = None
@@ -139,6 +141,25 @@ class LessonRuntime:
         request = params.set_request(action["name"], action["value"])
         self._services.send(f"{action['node']}/set_parameters", SetParameters, request)
         return f"Set {action['name']} = {action['value']!r} on {action['node']}."
+
+    def _publish(self, action: Spec) -> str:
+        msg_type = import_type(action["type"])
+        message = fill(msg_type, action["message"])
+        times, period = int(action.get("times", 1)), 1.0 / float(action.get("rate_hz", 1.0))
+        with self._lock:
+            key = (action["topic"], action["type"])
+            if key not in self._senders:
+                self._senders[key] = self.node.create_publisher(msg_type, action["topic"], 10)
+            publisher = self._senders[key]
+
+        def send() -> None:  # off the UI thread: the burst takes times / rate_hz seconds
+            for index in range(times):
+                if index:
+                    time.sleep(period)
+                publisher.publish(message)
+
+        threading.Thread(target=send, name=f"lesson-publish-{key[0]}", daemon=True).start()
+        return f"Publishing {times} message(s) on {action['topic']}."
 
     def _call_service(self, action: Spec) -> str:
         srv_type = import_type(action["type"])
@@ -428,6 +449,7 @@ _ACTIONS: dict[str, Callable[[LessonRuntime, Spec], str]] = {
     "send_goal": LessonRuntime._send_goal,
     "open_panel": LessonRuntime._open_panel,
     "console": LessonRuntime._console,
+    "publish": LessonRuntime._publish,
 }
 _CHECKS: dict[str, Callable[[LessonRuntime, Spec], CheckResult]] = {
     kind: getattr(LessonRuntime, f"_check_{kind}") for kind in CHECK_KINDS

@@ -152,3 +152,11 @@ def test_schema_and_runtime_share_one_registry_of_kinds():
 
     assert set(runtime._ACTIONS) == set(ACTION_KINDS)
     assert set(runtime._CHECKS) == set(CHECK_KINDS)
+
+
+def test_a_console_action_runs_only_a_ros2_command(lesson_copy):
+    directory, data = lesson_copy
+    data["steps"][0]["actions"] = [{"kind": "console", "command": "rm -rf / ; ros2 topic list"}]
+    _dump(data, directory / "lesson.toml")
+    with pytest.raises(LessonError, match="a console command is one line that starts with 'ros2 '"):
+        load_lesson(directory)
