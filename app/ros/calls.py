@@ -16,6 +16,7 @@ from typing import Any
 
 from action_msgs.msg import GoalStatus
 from rclpy.action import ActionClient, get_action_names_and_types
+from rclpy.action.client import ClientGoalHandle
 from rclpy.node import Node
 from rclpy.task import Future
 
@@ -124,7 +125,7 @@ class GoalRun:
             handle.cancel_goal_async()
 
 
-GOAL_SETTLE_SEC = 0.3  # after a new action client finds its server (see send_goal)
+GOAL_SETTLE_SEC = 0.5  # after a new action client finds its server (see send_goal)
 
 
 def send_goal(
@@ -140,7 +141,11 @@ def send_goal(
         raise Ros2Error(f"action '{run.action}' has type {known}, not {type_name(action_cls)}")
     client = ActionClient(ctx.node, action_cls, run.action)
 
+    running_id: list[Any] = []  # the goal's id, once feedback proves it runs
+
     def feedback_cb(message: Any) -> None:
+        if not running_id:
+            running_id.append(message.goal_id)
         run.feedback.append(message.feedback)
         if on_feedback:
             on_feedback(message.feedback)
@@ -153,7 +158,15 @@ def send_goal(
         # goal then runs (feedback arrives) while we wait for its acceptance in vain.
         ctx.sleep(GOAL_SETTLE_SEC)
         future = client.send_goal_async(run.goal, feedback_callback=feedback_cb)
-        handle = wait_future(ctx, future, timeout, f"action server '{run.action}'")
+        try:
+            handle = wait_future(ctx, future, timeout, f"action server '{run.action}'")
+        except Ros2Error:
+            if not running_id:
+                raise
+            # The acceptance was lost on the way (see GOAL_SETTLE_SEC), yet the goal's
+            # feedback arrives: it was accepted and runs. Follow it by its id.
+            accepted = action_cls.Impl.SendGoalService.Response(accepted=True)
+            handle = ClientGoalHandle(client, running_id[0], accepted)
         if not handle.accepted:
             run.status = "REJECTED"
             return run

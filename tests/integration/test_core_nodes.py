@@ -359,3 +359,33 @@ def test_executor_demo_single_thread_starves_multi_thread_does_not(supervisor, p
     wait_for_output(supervisor, "executor_demo_multi", "[multi] fast timer")
     for name in ("executor_demo", "executor_demo_multi"):  # even mid slow callback
         assert supervisor.stop(name).result(timeout=20).exit_code == 0, supervisor.output(name)
+
+
+def test_a_goal_whose_acceptance_is_lost_is_followed_by_its_feedback(
+    supervisor, probe, monkeypatch
+):
+    """Under load DDS may drop the goal's acceptance while the goal runs: follow the feedback."""
+    from app.ros import calls
+    from app.ros.context import CallContext, Limits
+    from app.ros.errors import Ros2Error
+
+    supervisor.start("fibonacci_action_server", ["-p", "step_period:=0.3"])
+    real_wait = calls.wait_future
+    lost = []
+
+    def lose_the_acceptance(ctx, future, timeout, what):
+        if not lost:  # the first wait is the acceptance: it never comes
+            lost.append(what)
+            ctx.sleep(1.5)  # long enough for feedback to arrive
+            future.cancel()
+            raise Ros2Error(f"no answer from {what} within {timeout:g} s")
+        return real_wait(ctx, future, timeout, what)
+
+    monkeypatch.setattr(calls, "wait_future", lose_the_acceptance)
+    run = calls.GoalRun(
+        "/fibonacci", "tutorial_interfaces/action/Fibonacci", Fibonacci.Goal(order=5)
+    )
+    ctx = CallContext(probe.node, limits=Limits(service_timeout=15.0, action_timeout=30.0))
+    calls.send_goal(ctx, run)
+    assert lost == ["action server '/fibonacci'"]
+    assert run.status == "SUCCEEDED" and list(run.result.sequence) == [0, 1, 1, 2, 3, 5]
