@@ -146,8 +146,12 @@ class BagsPanel:
     # ------------------------------------------------------------ playing
 
     def _selected(self) -> Path | None:
+        """The chosen bag; only a bag of the folder's own list (viser does not check a
+        dropdown's value, and a forged one must not reach a file outside the folder)."""
         name = self._selector.value
-        return self._folder / name if name != NONE else None
+        if name == NONE or name not in {p.name for p in list_bags(self._folder)}:
+            return None
+        return self._folder / name
 
     def _start_playing(self) -> None:
         path = self._selected()

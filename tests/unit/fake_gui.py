@@ -86,6 +86,9 @@ class FakeGui:
     def add_text(self, label: str, initial_value: str = "", **props: Any) -> FakeHandle:
         return self._add("text", label, initial_value, disabled=props.get("disabled", False))
 
+    def add_progress_bar(self, value: float, **props: Any) -> FakeHandle:
+        return self._add("progress", "", value, **props)
+
     def add_folder(self, label: str, **_: Any) -> FakeHandle:
         return self._add("folder", label)
 

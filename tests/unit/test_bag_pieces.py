@@ -92,3 +92,21 @@ def test_in_the_dashboard_a_bag_name_never_leaves_the_bags_folder(tmp_path, monk
     for resolve, name in escapes:
         with pytest.raises(BagError, match="bags folder"):
             resolve(name)
+
+
+def test_a_forged_bag_name_in_the_panel_reaches_no_file_outside_the_folder(tmp_path):
+    """viser does not check a dropdown's value: info, play and download must not follow it."""
+    from app.panels.bags_panel import BagsPanel
+    from app.ui.loop import UiLoop
+    from tests.unit.fake_gui import FakeGui
+
+    folder = tmp_path / "bags"
+    (folder / "talker_bag").mkdir(parents=True)
+    (folder / "talker_bag" / "metadata.yaml").write_text("rosbag2_bagfile_information: {}\n")
+    (tmp_path / "secret").mkdir()
+    panel = BagsPanel(FakeGui(), UiLoop(), node=None, folder=folder)  # type: ignore[arg-type]
+    for forged in ("../secret", "/etc", "talker_bag/../../secret"):
+        panel._selector.value = forged
+        assert panel._selected() is None, forged
+    panel._selector.value = "talker_bag"
+    assert panel._selected() == folder / "talker_bag"
