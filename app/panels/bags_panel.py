@@ -146,10 +146,10 @@ class BagsPanel:
     # ------------------------------------------------------------ playing
 
     def _selected(self) -> Path | None:
-        """The chosen bag; only a bag of the folder's own list (viser does not check a
-        dropdown's value, and a forged one must not reach a file outside the folder)."""
+        """The chosen bag; only one the dropdown lists (viser does not check a dropdown's
+        value, and a forged one must not reach a file outside the folder)."""
         name = self._selector.value
-        if name == NONE or name not in {p.name for p in list_bags(self._folder)}:
+        if name == NONE or name not in self._selector.options:
             return None
         return self._folder / name
 

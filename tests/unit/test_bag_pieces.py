@@ -105,6 +105,7 @@ def test_a_forged_bag_name_in_the_panel_reaches_no_file_outside_the_folder(tmp_p
     (folder / "talker_bag" / "metadata.yaml").write_text("rosbag2_bagfile_information: {}\n")
     (tmp_path / "secret").mkdir()
     panel = BagsPanel(FakeGui(), UiLoop(), node=None, folder=folder)  # type: ignore[arg-type]
+    panel._refresh_bags()  # what the UI thread does every few seconds: list the folder
     for forged in ("../secret", "/etc", "talker_bag/../../secret"):
         panel._selector.value = forged
         assert panel._selected() is None, forged
