@@ -17,9 +17,9 @@ EDITOR := app/exercises/editor
 EDITOR_STAMP := $(EDITOR)/node_modules/.classroom-setup
 ARGS ?=
 
-.PHONY: setup run test browser sandbox lint bench screenshots clean
+.PHONY: setup run test browser sandbox lint bench screenshots clean render
 
-setup: $(STAMP) $(EDITOR_STAMP)
+setup: $(STAMP) $(EDITOR_STAMP) render
 
 # The exercise code editor (Ace), from the npm registry at the version the lock file pins.
 $(EDITOR_STAMP): $(EDITOR)/package.json $(EDITOR)/package-lock.json
@@ -58,6 +58,14 @@ browser:
 		echo "== installing Debian's chromium for the browser tests"; \
 		SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
 		$$SUDO apt-get update -q && $$SUDO apt-get install -y -q chromium; }
+
+# Headless rendering for the MuJoCo camera (nodes/sim_world.py): Mesa's EGL, and
+# OSMesa as the fallback; a GPU's own EGL driver is used where one is installed.
+render:
+	@ldconfig -p | grep -q 'libEGL_mesa.so.0' && ldconfig -p | grep -q 'libOSMesa.so' || { \
+		echo "== installing Mesa's EGL and OSMesa for headless camera rendering"; \
+		SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+		$$SUDO apt-get update -q && $$SUDO apt-get install -y -q libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6; }
 
 # Contained learner code runs under uids of its own (app/exercises/contain.py).
 # When Python lives under a private /root, those uids must be able to pass
