@@ -43,7 +43,7 @@ class NodeState(str, Enum):
     STARTING = "starting"  # process spawned, ROS node not yet seen in the graph
     RUNNING = "running"
     STOPPING = "stopping"
-    STOPPED = "stopped"  # stopped on request
+    STOPPED = "stopped"  # stopped on request, or ended by Ctrl+C (even with a traceback)
     EXITED = "exited"  # ended on its own with exit code 0 (e.g. a client)
     CRASHED = "crashed"  # ended on its own with a non-zero code or a signal
 
@@ -126,6 +126,25 @@ class _Process:
             self.ended_at,
             self.dropped_lines,
         )
+
+
+# The last line of a Python traceback when a node ends on Ctrl+C without catching it:
+# rclpy raises one or the other depending on where SIGINT finds it (old tutorials
+# catch only KeyboardInterrupt). That is a stop, not a crash.
+_INTERRUPTS = ("KeyboardInterrupt", "ExternalShutdownException")
+
+
+def ended_state(code: int, stop_requested: bool, output: Iterable[str]) -> NodeState:
+    """How a reaped process ended: stopped (asked to, or on SIGINT), exited, or crashed."""
+    if stop_requested:
+        return NodeState.STOPPED
+    if code == 0:
+        return NodeState.EXITED
+    if code == -signal.SIGINT:
+        return NodeState.STOPPED
+    last = next((line.strip() for line in reversed(list(output)) if line.strip()), "")
+    error = last.split(":", 1)[0].rsplit(".", 1)[-1]
+    return NodeState.STOPPED if code > 0 and error in _INTERRUPTS else NodeState.CRASHED
 
 
 def _set_parent_death_signal() -> None:
@@ -329,10 +348,7 @@ class Supervisor:
         with self._lock:
             proc.exit_code = code
             proc.ended_at = time.time()
-            if proc.stop_requested:
-                proc.state = NodeState.STOPPED
-            else:
-                proc.state = NodeState.EXITED if code == 0 else NodeState.CRASHED
+            proc.state = ended_state(code, proc.stop_requested, list(proc.output)[-5:])
             self._ended.append(proc.status())
         proc.done.set()
 

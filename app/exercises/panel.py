@@ -25,7 +25,7 @@ from app.exercises.report import Report, Result
 from app.exercises.runner import RunPolicy
 from app.exercises.workspace import Workspace
 from app.ros.graph import GraphSnapshot
-from app.supervisor import NodeStatus, Supervisor
+from app.supervisor import NodeState, NodeStatus, Supervisor
 from app.ui import MarkdownView, assign
 from app.ui.loop import UiLoop
 
@@ -364,7 +364,9 @@ class ExercisePanel:
         if status is not None and not status.active:
             crash = self._crash_of(exercise, status)
             if crash:
-                parts.append(f"**It crashed:**\n```\n{crash}\n```")
+                # Ctrl+C with an uncaught KeyboardInterrupt/ExternalShutdownException is a stop.
+                how = "It stopped" if status.state == NodeState.STOPPED else "It crashed"
+                parts.append(f"**{how}:**\n```\n{crash}\n```")
         problems = _problem_lines(self._problems)
         if problems:
             parts.append(problems)
