@@ -46,7 +46,8 @@ ProcessRequest = Callable[[ServerConnection, Request], Response | None]
 
 
 def editor_url(slug: str) -> str:
-    return f"{PREFIX}editor.html?slug={slug}"
+    """Relative to the page, so the editor loads under any base path (e.g. a hub's proxy)."""
+    return f"{PREFIX.lstrip('/')}editor.html?slug={slug}"
 
 
 def _file_for(path: str) -> Path | None:

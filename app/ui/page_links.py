@@ -2,8 +2,8 @@
 
 viser's HTML element has no click callback, yet a drawing is often the best
 control: the lifecycle state machine's edges *are* the transitions. A link
-can still reach us. It points at ``/classroom/act/<secret>/<name>`` on
-viser's own web server, which runs the action registered under ``name`` and
+can still reach us. It points at ``classroom/act/<secret>/<name>`` (relative
+to the page, so it works under any base path) on viser's own web server, which runs the action registered under ``name`` and
 answers ``204 No Content``; the link targets a hidden frame, so the page
 never navigates away whatever the answer.
 
@@ -57,7 +57,9 @@ class PageLinks:
         return self.href(name)
 
     def href(self, name: str) -> str:
-        return f"{PREFIX}{self._secret}/{name}"
+        # Relative to the page: the dashboard may be served under a base path
+        # (a JupyterHub proxy's /user/<name>/ros2-classroom/), never only at /.
+        return f"{PREFIX.lstrip('/')}{self._secret}/{name}"
 
     def anchor(self, name: str, content: str, title: str) -> str:
         """An SVG or HTML ``<a>`` around ``content`` that runs ``name`` when clicked."""
