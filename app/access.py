@@ -4,7 +4,9 @@ viser has no authentication, and its websocket carries everything a page
 shows and every click it sends. So the gate sits in front of both, at the
 HTTP layer of the one ``websockets`` server viser runs: every request (the
 page, and the websocket upgrade) must carry the token, either as
-``?token=...`` in the URL or as the cookie the first good request sets.
+``?token=...`` in the URL, as the cookie the first good request sets, or in
+the ``X-Classroom-Token`` header (a trusted proxy in front, such as
+Jupyter's server proxy, adds it to every request it forwards).
 Without it the answer is ``401`` and no websocket ever opens, so a stranger
 can neither watch nor start, stop, publish or call anything.
 
@@ -33,6 +35,7 @@ from websockets.asyncio.server import ServerConnection
 from websockets.http11 import Request, Response
 
 TOKEN_ENV = "CLASSROOM_TOKEN"
+TOKEN_HEADER = "X-Classroom-Token"
 _TOKEN_SHAPE = re.compile(r"^[A-Za-z0-9_-]{16,128}$")
 _PATCH_LOCK = threading.Lock()
 
@@ -88,7 +91,8 @@ class TokenGate:
 
         def process_request(connection: ServerConnection, request: Request) -> Response | None:
             by_query = self._matches(self._from_query(request))
-            if not (by_query or self._matches(self._from_cookie(request))):
+            by_header = self._matches(request.headers.get(TOKEN_HEADER))
+            if not (by_query or by_header or self._matches(self._from_cookie(request))):
                 self.rejected += 1
                 return connection.respond(
                     http.HTTPStatus.UNAUTHORIZED,

@@ -116,6 +116,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     from app.lessons.progress import DEFAULT_DIR, ProgressStore
     from app.ros.runtime import RosRuntime
     from app.supervisor import Supervisor
+    from app.ui.base_path import BasePathPage
     from app.ui.page_links import PageLinks
 
     # Tracebacks behind the one-line errors of the page go to this process's log.
@@ -133,7 +134,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
         signal.signal(sig, lambda *_: stop_requested.set())
 
     editor_hub = EditorHub()
-    page_links = PageLinks(editor_hub)  # extra routes on viser's server: links, then the editor
+    # Extra routes on viser's server: links, then the page's base-path shim, then the editor.
+    page_links = PageLinks(BasePathPage(editor_hub))
     server, _gate = make_server(args.host, args.port, token, page_links)
     if server.get_port() != args.port:
         server.stop()
@@ -330,7 +332,7 @@ def cmd_exercise(args: argparse.Namespace) -> int:
 
     if args.verb == "check":
         configure_this_process(domain_id=args.domain_id, network=args.network)
-    return exercise_main(args.verb, args.slug, args.file)
+    return exercise_main(args.verb, args.slug, args.file, seed=args.seed)
 
 
 ROS2_GROUPS = (
@@ -493,9 +495,10 @@ def build_parser() -> argparse.ArgumentParser:
     launch.set_defaults(func=cmd_launch)
 
     exercise = sub.add_parser("exercise", help="list, print or grade the exercises")
-    exercise.add_argument("verb", choices=("list", "starter", "solution", "check"))
+    exercise.add_argument("verb", choices=("list", "starter", "solution", "check", "explain"))
     exercise.add_argument("slug", nargs="?", help="the exercise (see `exercise list`)")
     exercise.add_argument("file", nargs="?", type=Path, help="check: the file to grade")
+    exercise.add_argument("--seed", type=int, help="check: replay a grading's random inputs")
     dds_options(exercise)
     exercise.set_defaults(func=cmd_exercise)
 
