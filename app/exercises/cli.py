@@ -1,9 +1,11 @@
-"""``ros2-classroom exercise list|starter|solution|check``: the grading from a terminal.
+"""``ros2-classroom exercise list|starter|solution|check|explain``: grading from a terminal.
 
 For learners who prefer their own editor, for teachers, and for the tests:
 ``check SLUG FILE`` runs FILE as the exercise's node through the supervisor,
 grades it exactly as the dashboard's Check button does, prints one line per
-check and exits 0 only when all pass.
+check and exits 0 only when all pass; ``--seed N`` replays a grading's
+random inputs. ``explain SLUG`` tells a teacher what is checked and probed,
+with the ranges inputs are drawn from, never the values.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from app.exercises.model import ExerciseError, load_exercises
 EXIT_FAILED = 1
 
 
-def cmd_list(_slug: str | None, _file: Path | None) -> int:
+def cmd_list(_slug: str | None, _file: Path | None, _seed: int | None = None) -> int:
     book = load_exercises()
     width = max((len(e.slug) for e in book.exercises), default=4)
     for exercise in book.exercises:
@@ -27,17 +29,24 @@ def cmd_list(_slug: str | None, _file: Path | None) -> int:
     return 0
 
 
-def cmd_starter(slug: str | None, _file: Path | None) -> int:
+def cmd_starter(slug: str | None, _file: Path | None, _seed: int | None = None) -> int:
     print(load_exercises().get(slug or "").starter, end="")
     return 0
 
 
-def cmd_solution(slug: str | None, _file: Path | None) -> int:
+def cmd_solution(slug: str | None, _file: Path | None, _seed: int | None = None) -> int:
     print(load_exercises().get(slug or "").reference, end="")
     return 0
 
 
-def cmd_check(slug: str | None, file: Path | None) -> int:
+def cmd_explain(slug: str | None, _file: Path | None, _seed: int | None = None) -> int:
+    from app.exercises.explain import explain
+
+    print("\n".join(explain(load_exercises().get(slug or ""))))
+    return 0
+
+
+def cmd_check(slug: str | None, file: Path | None, seed: int | None = None) -> int:
     from app.exercises import runner
     from app.exercises.grader import Grader
     from app.exercises.lint import lint, refuses_to_run
@@ -61,7 +70,7 @@ def cmd_check(slug: str | None, file: Path | None) -> int:
     try:
         runner.start(supervisor, exercise, file.resolve())
         report = Grader(runtime.node, supervisor).grade(
-            exercise, file.resolve(), on_result=lambda r: print(r.line(), flush=True)
+            exercise, file.resolve(), on_result=lambda r: print(r.line(), flush=True), seed=seed
         )
     finally:
         supervisor.shutdown(timeout=3.0)
@@ -69,15 +78,23 @@ def cmd_check(slug: str | None, file: Path | None) -> int:
     if report.problem:
         print(f"FAIL  {exercise.slug}: {report.problem}")
     print(report.summary())
+    if report.seed is not None and not report.problem:
+        print(f"replay: exercise check {exercise.slug} {file} --seed {report.seed}")
     return 0 if report.passed else EXIT_FAILED
 
 
-VERBS = {"list": cmd_list, "starter": cmd_starter, "solution": cmd_solution, "check": cmd_check}
+VERBS = {
+    "list": cmd_list,
+    "starter": cmd_starter,
+    "solution": cmd_solution,
+    "check": cmd_check,
+    "explain": cmd_explain,
+}
 
 
-def main(verb: str, slug: str | None, file: Path | None) -> int:
-    if verb in ("starter", "solution", "check") and not slug:
+def main(verb: str, slug: str | None, file: Path | None, seed: int | None = None) -> int:
+    if verb in ("starter", "solution", "check", "explain") and not slug:
         raise ExerciseError(f"`exercise {verb}` needs an exercise name (see `exercise list`)")
     if verb == "check" and file is None:
         raise ExerciseError("`exercise check SLUG FILE` needs the file to grade")
-    return VERBS[verb](slug, file)
+    return VERBS[verb](slug, file, seed)

@@ -62,7 +62,9 @@ class Grader:
         ctx: CallContext | None = None,
         seed: int | None = None,
     ) -> Report:
-        report = Report(exercise.slug)
+        # Hidden inputs: drawn for this grading, from a seed the result shows (replayable).
+        seed = seed if seed is not None else random.SystemRandom().randrange(1, 1_000_000)
+        report = Report(exercise.slug, seed=seed)
         call = ctx or CallContext(self.node, limits=PROBE_LIMITS)
         lessons = LessonRuntime(self.node, self.supervisor)
 
@@ -91,7 +93,7 @@ class Grader:
             for check in exercise.checks:
                 passed, detail = wait_check(check, CHECK_WAIT_SEC)
                 record(Result(_check_name(check), passed, detail))
-            probe_ctx = ProbeContext(call, exercise.node, wait_check, random.Random(seed))
+            probe_ctx = ProbeContext(call, exercise.node, wait_check, random.Random(seed), seed)
             for probe in exercise.probes:
                 record(run_probe(probe_ctx, probe))
                 if not self._alive(exercise):

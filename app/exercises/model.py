@@ -13,7 +13,7 @@ each one. The grading logic lives in ``app.exercises.grader`` and
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -64,6 +64,9 @@ class Exercise:
     timed: bool = False  # has probes that wait on purpose (the bench leaves these out)
     mistakes: tuple[Mistake, ...] = ()
     path: Path = LESSONS_DIR
+    # The statement's example as data (never the tested input): the test suite
+    # generates a solution that replays it, and that solution must fail.
+    example: dict[str, Any] = field(default_factory=dict)
 
     @property
     def program_name(self) -> str:
@@ -160,6 +163,7 @@ def load_exercise(directory: Path) -> Exercise:
         timed=_field(data, "timed", bool, where, False),
         mistakes=tuple(mistakes),
         path=directory,
+        example=dict(_field(data, "example", dict, where, {})),
     )
 
 

@@ -18,6 +18,7 @@ import viser
 
 from app.exercises import runner
 from app.exercises.editor_server import EditorHub, editor_url
+from app.exercises.explain import panel_line
 from app.exercises.grader import Grader
 from app.exercises.lint import Problem, lint, refuses_to_run
 from app.exercises.model import Exercise, ExerciseBook
@@ -167,7 +168,7 @@ class ExercisePanel:
         self._hints_shown = 0
         self._results, self._verdict, self._problems, self._message = [], "", [], ""
         assign(self._selector, next(k for k, e in self._labels.items() if e is exercise))
-        self._statement.show(exercise.statement)
+        self._statement.show(f"{exercise.statement}\n\n*{panel_line(exercise)}*")
         self._hints.show("")
         self._diff.show("")
         self._solution.show("")

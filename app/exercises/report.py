@@ -24,6 +24,7 @@ class Report:
     slug: str
     results: list[Result] = field(default_factory=list)
     problem: str = ""  # why grading could not even start (no process, syntax error, ...)
+    seed: int | None = None  # the probes' inputs were drawn from it: replays the grading
 
     @property
     def passed(self) -> bool:
@@ -37,4 +38,5 @@ class Report:
             return f"Not graded: {self.problem}"
         good = sum(r.passed for r in self.results)
         verdict = "passed" if self.passed else "not yet"
-        return f"{good} of {len(self.results)} checks passed: {verdict}."
+        replay = f" Inputs drawn with seed {self.seed}." if self.seed is not None else ""
+        return f"{good} of {len(self.results)} checks passed: {verdict}.{replay}"

@@ -25,3 +25,50 @@ def test_each_exercise_has_a_plausible_mistake_and_runnable_code():
         for name, code in (("starter", exercise.starter), ("reference", exercise.reference)):
             assert not refuses_to_run(lint(code)), f"{exercise.slug}: {name} does not compile"
         assert "TODO" in exercise.starter, f"{exercise.slug}: the starter marks no part to fill in"
+
+
+def test_every_exercise_that_takes_input_shows_an_example_that_is_not_the_test():
+    """The example (what the statement shows) is data, so a cheat replaying it can be made."""
+    from app.exercises.explain import drawn_fields
+    from tests.exercises.cheats import input_probe
+
+    for exercise in book.exercises:
+        if input_probe(exercise) is None:
+            continue
+        assert exercise.example, f"{exercise.slug}: no example table"
+        for value in exercise.example.values():
+            for item in value if isinstance(value, list) else [value]:
+                shown = f"{item:.2f}" if isinstance(item, float) else str(item)
+                assert shown in exercise.statement or str(item) in exercise.statement, (
+                    f"{exercise.slug}: example value {item!r} is not in the statement"
+                )
+        drawn = [name for p in exercise.probes for name in drawn_fields(p)]
+        assert drawn, f"{exercise.slug}: its probes draw nothing at grading time"
+
+
+def test_a_seed_replays_the_drawn_inputs_and_another_seed_changes_them():
+    import random
+
+    from app.exercises.probes.base import draw
+    from app.exercises.probes.core import lifecycle_walk
+
+    def inputs(seed):
+        rng = random.Random(seed)
+        return [draw(rng, [-1000, 1000]) for _ in range(8)], lifecycle_walk(rng, 8)
+
+    assert inputs(12345) == inputs(12345)
+    assert inputs(12345) != inputs(54321)
+    steps = inputs(12345)[1]
+    assert sum(not s.get("succeeds", True) for s in steps) >= 2
+    assert steps[-1]["state"] == "active"
+
+
+def test_a_teacher_can_read_how_each_exercise_is_graded_without_the_values():
+    from app.exercises.explain import explain, panel_line
+
+    running_sum = book.get("running_sum")
+    text = "\n".join(explain(running_sum))
+    assert "inputs random in [-1000, 1000]" in text and "count random in [6, 9]" in text
+    assert "--seed" in text
+    assert "random" in panel_line(book.get("lifecycle_beacon"))
+    assert "random images" in "\n".join(explain(book.get("red_mask")))

@@ -1,5 +1,6 @@
-"""Grading every exercise on the live graph: the reference passes, the starter and
-each recorded mistake fail, and a mistake's failure names what is wrong.
+"""Grading every exercise on the live graph: the reference passes, the starter,
+each recorded mistake and a generated cheat (it replays the statement's example)
+fail, and a mistake's failure names what is wrong.
 
 One ROS participant and one supervisor serve the whole module (each exercise
 runs as a real process, as the Run button starts it). Exercises use distinct
@@ -17,6 +18,7 @@ from app.exercises.grader import Grader
 from app.exercises.model import Exercise, load_exercises
 from app.exercises.report import Report
 from tests.conftest import fail_on_leftover_nodes
+from tests.exercises.cheats import cheat_code, input_probe
 
 BOOK = load_exercises()
 
@@ -25,6 +27,8 @@ def _cases():
     for exercise in BOOK.exercises:
         yield pytest.param(exercise, "reference", None, id=f"{exercise.slug}-reference")
         yield pytest.param(exercise, "starter", None, id=f"{exercise.slug}-starter")
+        if input_probe(exercise):
+            yield pytest.param(exercise, "cheat", None, id=f"{exercise.slug}-cheat")
         for mistake in exercise.mistakes:
             yield pytest.param(
                 exercise, "mistake", mistake, id=f"{exercise.slug}-{mistake.path.stem}"
@@ -78,6 +82,10 @@ def test_grading(grading_env, exercise, which, mistake):
     elif which == "starter":
         report = _grade(grading_env, exercise, exercise.starter)
         assert not report.passed, "the starter code passes: the exercise asks for nothing"
+    elif which == "cheat":
+        report = _grade(grading_env, exercise, cheat_code(exercise))
+        assert not report.passed, f"replaying the statement's example passes:\n{_text(report)}"
+        assert report.seed == 7 and "seed 7" in report.summary()
     else:
         report = _grade(grading_env, exercise, mistake.path.read_text(encoding="utf-8"))
         assert not report.passed, f"{mistake.path.name} passes:\n{_text(report)}"

@@ -17,13 +17,16 @@ from app.ros.errors import Ros2Error
 
 PROBE_KINDS: dict[str, Kind] = {}
 PROBES: dict[str, Probe] = {}
+# Inputs a kind draws in its own code (not from ranges in the data), in words for teachers.
+PROBE_DRAWS: dict[str, str] = {}
 for _module in (core, perception, behaviour):
     if set(_module.KINDS) != set(_module.PROBES) or set(_module.KINDS) & set(PROBE_KINDS):
         raise RuntimeError(f"{_module.__name__}: probe kinds without code, or defined twice")
     PROBE_KINDS.update(_module.KINDS)
     PROBES.update(_module.PROBES)
+    PROBE_DRAWS.update(getattr(_module, "DRAWS", {}))
 
-__all__ = ["PROBES", "PROBE_KINDS", "ProbeContext", "run_probe"]
+__all__ = ["PROBES", "PROBE_DRAWS", "PROBE_KINDS", "ProbeContext", "run_probe"]
 
 
 def run_probe(ctx: ProbeContext, probe: Spec) -> Result:

@@ -19,7 +19,16 @@ from app.lessons.schema import Spec
 from app.ros.context import CallContext
 
 # Names an ``expect`` expression may use besides the request's own fields.
-_SAFE_FUNCTIONS = {"abs": abs, "min": min, "max": max, "round": round, "sum": sum, "len": len}
+_SAFE_FUNCTIONS = {
+    "abs": abs,
+    "min": min,
+    "max": max,
+    "round": round,
+    "sum": sum,
+    "len": len,
+    "range": range,
+    "list": list,
+}
 
 
 @dataclass
@@ -31,11 +40,40 @@ class ProbeContext:
     # Evaluates a lesson check until it passes or ``timeout`` runs out.
     wait_check: Callable[[Spec, float], tuple[bool, str]]
     rng: random.Random
+    seed: int = 0  # what ``rng`` was seeded with: shown with the result, to replay a grading
 
 
 def expected_value(expression: str, names: dict[str, Any]) -> Any:
-    """Evaluate an exercise author's formula ("a * b") on the request's fields."""
-    return eval(expression, {"__builtins__": {}}, {**_SAFE_FUNCTIONS, **names})
+    """Evaluate an exercise author's formula ("a * b") on the request's fields.
+
+    The names are globals, so a comprehension in the formula sees them too
+    ("[sum(values[: i + 1]) for i in range(len(values))]").
+    """
+    return eval(expression, {"__builtins__": {}, **_SAFE_FUNCTIONS, **names})
+
+
+def is_range(value: Any) -> bool:
+    """``[low, high]`` of two numbers: a range to draw from (exercise data)."""
+    return (
+        isinstance(value, list)
+        and len(value) == 2
+        and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+    )
+
+
+def draw(rng: random.Random, value: Any) -> Any:
+    """A value drawn at grading time: ``[low, high]`` ints or floats; anything else as is."""
+    if not is_range(value):
+        return value
+    low, high = value
+    if isinstance(low, int) and isinstance(high, int):
+        return rng.randint(low, high)
+    return round(rng.uniform(float(low), float(high)), 3)
+
+
+def range_text(value: Any) -> str:
+    """How a teacher reads a drawn field: "random in [-50, 50]", or the fixed value."""
+    return f"random in [{value[0]}, {value[1]}]" if is_range(value) else repr(value)
 
 
 def values_text(values: dict[str, Any]) -> str:
@@ -43,13 +81,7 @@ def values_text(values: dict[str, Any]) -> str:
 
 
 def random_inputs(rng: random.Random, ranges: dict[str, list[Any]]) -> dict[str, Any]:
-    values: dict[str, Any] = {}
-    for name, (low, high) in ranges.items():
-        if isinstance(low, int) and isinstance(high, int):
-            values[name] = rng.randint(low, high)
-        else:
-            values[name] = round(rng.uniform(float(low), float(high)), 3)
-    return values
+    return {name: draw(rng, value) for name, value in ranges.items()}
 
 
 def same(actual: Any, expected: Any, tolerance: float) -> bool:

@@ -21,7 +21,7 @@ from rclpy.qos import (
     qos_check_compatible,
 )
 
-from app.exercises.probes.base import Probe, ProbeContext, expected_value, same
+from app.exercises.probes.base import Probe, ProbeContext, draw, expected_value, same
 from app.exercises.report import Result
 from app.lessons.kinds import Kind, make_kind
 from app.lessons.schema import Spec
@@ -70,7 +70,7 @@ def topic_sequence(ctx: ProbeContext, p: Spec) -> Result:
     """Read ``count`` messages; each one's field must follow from the one before."""
     node = ctx.call.node
     topic, type_text, field = p["topic"], p["type"], p["field"]
-    count, within = p.get("count", 5), p.get("within", 5.0)
+    count, within = int(draw(ctx.rng, p.get("count", 5))), p.get("within", 5.0)
     name = f"sequence on {topic}"
     # As `ros2 topic echo`: match the publishers' QoS, so a reliable stream is read reliably.
     monitor = TopicMonitor(node, topic, import_type(type_text, "msg"), keep=count)

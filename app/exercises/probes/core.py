@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import random
 import threading
 import time
 from typing import Any
@@ -10,6 +11,7 @@ from rclpy.qos import QoSProfile
 
 from app.exercises.probes.base import (
     ProbeContext,
+    draw,
     expected_value,
     random_inputs,
     same,
@@ -56,11 +58,18 @@ def service_random(ctx: ProbeContext, p: Spec) -> Result:
 
 
 def topic_feed(ctx: ProbeContext, p: Spec) -> Result:
-    """Publish input messages, read the node's output, compare the sequence."""
+    """Publish ``count`` values drawn from ``inputs``; compare the node's outputs to a formula.
+
+    ``expect`` is a formula over ``values`` (the drawn list) giving the list
+    of outputs, e.g. the running sums ``[sum(values[: i + 1]) for i in range(len(values))]``.
+    """
     node = ctx.call.node
     in_topic, out_topic = p["publish"], p["output"]
     name = f"feed {in_topic} -> {out_topic}"
     in_type, out_type = import_type(p["type"], "msg"), import_type(p["output_type"], "msg")
+    count = int(draw(ctx.rng, p["count"]))
+    inputs = [draw(ctx.rng, p["inputs"]) for _ in range(count)]
+    want = list(expected_value(p["expect"], {"values": inputs}))
     publisher = node.create_publisher(in_type, in_topic, QoSProfile(depth=50))
     monitor = TopicMonitor(node, out_topic, out_type, keep=200, qos=50)
     try:
@@ -71,29 +80,31 @@ def topic_feed(ctx: ProbeContext, p: Spec) -> Result:
             ctx.call.sleep(0.05)
         ctx.call.sleep(0.3)  # let the learner's publisher match our reader too
         before = monitor.count
-        inputs = p["values"]
         for value in inputs:
-            publisher.publish(fill(in_type, value))
+            publisher.publish(fill(in_type, {p["input_field"]: value}))
             ctx.call.sleep(p.get("period", 0.15))
-        want = p["expect"]
         monitor.wait_for_count(before + len(want), p.get("settle", 2.0))
         field = p["field"]
         got = [to_plain(getattr(msg, field)) for _, msg in monitor.messages_since(before)]
-        shown_in = [next(iter(v.values())) for v in inputs]
         if len(got) < len(want):
             return Result(
                 name,
                 False,
-                f"published {shown_in} on {in_topic}; {out_topic} gave {got}, expected {want}",
+                f"published {inputs} on {in_topic}; {out_topic} gave {got}, expected {want}",
             )
         tail = got[-len(want) :]
         tolerance = p.get("tolerance", 1e-6)
-        if all(same(a, b, tolerance) for a, b in zip(tail, want, strict=True)):
-            return Result(name, True, f"published {shown_in}; {out_topic} gave {tail}")
+        wrong = [
+            i for i, (a, b) in enumerate(zip(tail, want, strict=True)) if not same(a, b, tolerance)
+        ]
+        if not wrong:
+            return Result(name, True, f"published {inputs}; {out_topic} gave {tail}")
         return Result(
             name,
             False,
-            f"published {shown_in} on {in_topic}; {out_topic} gave {tail}, expected {want}",
+            f"published {inputs} on {in_topic}; {out_topic} gave {tail}, expected {want} "
+            f"(first difference at message {wrong[0] + 1}: {tail[wrong[0]]!r}, "
+            f"expected {want[wrong[0]]!r})",
         )
     finally:
         monitor.close()
@@ -105,7 +116,7 @@ def topic_feed(ctx: ProbeContext, p: Spec) -> Result:
 
 def param_set(ctx: ProbeContext, p: Spec) -> Result:
     """Set a parameter; expect it accepted (and its effect seen) or refused with a reason."""
-    target, pname, value = p.get("node", ctx.learner_node), p["name"], p["value"]
+    target, pname, value = p.get("node", ctx.learner_node), p["name"], draw(ctx.rng, p["value"])
     name = f"parameter {pname}={value!r}"
     try:
         ok, reason = params.set_value(ctx.call, target, pname, value)
@@ -127,7 +138,13 @@ def param_set(ctx: ProbeContext, p: Spec) -> Result:
     then = p.get("then")
     if then is None:
         return Result(name, True, f"{target} accepted {pname}={value!r}")
-    passed, detail = ctx.wait_check(Spec(then["kind"], without_kind(then)), p.get("within", 6.0))
+    check = without_kind(then)
+    if "expect_hz" in check:
+        # A rate that follows the drawn value: the window is derived from it.
+        hz = float(expected_value(check.pop("expect_hz"), {"value": value}))
+        spread = float(check.pop("rate_tolerance", 0.1))
+        check["min_hz"], check["max_hz"] = round(hz * (1 - spread), 3), round(hz * (1 + spread), 3)
+    passed, detail = ctx.wait_check(Spec(then["kind"], check), p.get("within", 8.0))
     verdict = "then " + detail
     return Result(name, passed, f"accepted; {verdict}")
 
@@ -142,8 +159,9 @@ def without_kind(table: dict[str, Any]) -> dict[str, Any]:
 def action_goal(ctx: ProbeContext, p: Spec) -> Result:
     """Send a goal (and maybe cancel it); judge status, feedback and result."""
     action, type_text = p["action"], p["type"]
-    goal = fill(import_type(type_text, "action").Goal, p["goal"])
-    cancel_after = p.get("cancel_after_feedback")
+    goal_values = {k: draw(ctx.rng, v) for k, v in p["goal"].items()}
+    goal = fill(import_type(type_text, "action").Goal, goal_values)
+    cancel_after = draw(ctx.rng, p.get("cancel_after_feedback"))
     run = GoalRun(action, type_text, goal)
     name = f"action {action}" + (" (cancel)" if cancel_after else "")
 
@@ -157,7 +175,7 @@ def action_goal(ctx: ProbeContext, p: Spec) -> Result:
         return Result(name, False, str(exc))
     status = run.status.lower()
     want = "canceled" if cancel_after else p.get("status", "succeeded")
-    goal_text = values_text(p["goal"])
+    goal_text = values_text(goal_values)
     if status != want:
         return Result(name, False, f"goal {goal_text}: the action {status}, expected {want}")
     need = p.get("min_feedback", 0)
@@ -169,7 +187,7 @@ def action_goal(ctx: ProbeContext, p: Spec) -> Result:
         )
     if "result_field" in p.fields and not cancel_after:
         got = to_plain(getattr(run.result, p["result_field"]))
-        want_value = expected_value(p["result_expect"], dict(p["goal"]))
+        want_value = expected_value(p["result_expect"], goal_values)
         if not same(got, want_value, 1e-6):
             return Result(
                 name,
@@ -194,8 +212,14 @@ def lifecycle_sequence(ctx: ProbeContext, p: Spec) -> Result:
     if "topic" in p.fields:
         monitor = TopicMonitor(ctx.call.node, p["topic"], import_type(p["type"], "msg"), qos=10)
     done: list[str] = []
+    if "walk" in p.fields:
+        steps = lifecycle_walk(ctx.rng, int(draw(ctx.rng, p["walk"])), p.get("end", "active"))
+    elif "steps" in p.fields:
+        steps = p["steps"]
+    else:
+        raise ValueError("a lifecycle_sequence probe needs 'walk' (random) or 'steps'")
     try:
-        for step in p["steps"]:
+        for step in steps:
             transition, should_succeed = step["transition"], step.get("succeeds", True)
             try:
                 ok, _info = lifecycle.change_state(ctx.call, target, transition)
@@ -217,8 +241,8 @@ def lifecycle_sequence(ctx: ProbeContext, p: Spec) -> Result:
                     False,
                     f"after '{transition}' the node is {state}, expected {step['state']}",
                 )
-            done.append(transition)
-            if monitor is not None:
+            done.append(transition if ok else f"{transition} (refused)")
+            if monitor is not None and (ok or step is steps[-1]):
                 verdict = _publishing_verdict(ctx, monitor, state, p["topic"])
                 if verdict:
                     return Result(name, False, f"after '{transition}' ({state}): {verdict}")
@@ -226,6 +250,57 @@ def lifecycle_sequence(ctx: ProbeContext, p: Spec) -> Result:
     finally:
         if monitor is not None:
             monitor.close()
+
+
+_VALID_TRANSITIONS = {
+    "unconfigured": {"configure": "inactive"},
+    "inactive": {"activate": "active", "cleanup": "unconfigured"},
+    "active": {"deactivate": "inactive"},
+}
+_TRANSITIONS = ("configure", "activate", "deactivate", "cleanup")
+INVALID_SHARE = 0.3  # of a walk's requests, about this many are invalid from the state
+
+
+def _path(start: str, end: str) -> list[tuple[str, str]]:
+    """The shortest list of (transition, state) from ``start`` to ``end``."""
+    paths: dict[str, list[tuple[str, str]]] = {start: []}
+    frontier = [start]
+    while frontier:
+        state = frontier.pop(0)
+        for transition, after in sorted(_VALID_TRANSITIONS[state].items()):
+            if after not in paths:
+                paths[after] = [*paths[state], (transition, after)]
+                frontier.append(after)
+    return paths[end]
+
+
+def lifecycle_walk(rng: random.Random, length: int, end: str = "active") -> list[dict[str, Any]]:
+    """A random order of lifecycle requests from unconfigured, invalid ones among them.
+
+    Every walk has at least two invalid requests, reaches active, has a
+    cleanup later followed by a configure, and ends in ``end``.
+    """
+    if end not in _VALID_TRANSITIONS:
+        raise ValueError(f"end must be one of {sorted(_VALID_TRANSITIONS)}, not {end!r}")
+    for _ in range(500):
+        state, steps = "unconfigured", []
+        for _ in range(length):
+            valid = _VALID_TRANSITIONS[state]
+            if rng.random() < INVALID_SHARE:
+                invalid = [t for t in _TRANSITIONS if t not in valid]
+                steps.append({"transition": rng.choice(invalid), "succeeds": False, "state": state})
+                continue
+            transition = rng.choice(sorted(valid))
+            state = valid[transition]
+            steps.append({"transition": transition, "state": state})
+        for transition, after in _path(state, end):
+            steps.append({"transition": transition, "state": after})
+        labels = [s["transition"] for s in steps if s.get("succeeds", True)]
+        refused = sum(not s.get("succeeds", True) for s in steps)
+        cleaned = "cleanup" in labels and "configure" in labels[labels.index("cleanup") :]
+        if refused >= 2 and cleaned and any(s["state"] == "active" for s in steps):
+            return steps
+    raise ValueError(f"no lifecycle walk of {length} steps meets the rules; use at least 6")
 
 
 def _publishing_verdict(ctx: ProbeContext, monitor: TopicMonitor, state: str, topic: str) -> str:
@@ -284,13 +359,14 @@ def log_rate(ctx: ProbeContext, p: Spec) -> Result:
 KINDS = {
     "service_random": make_kind("service type inputs field expect", "calls tolerance"),
     "topic_feed": make_kind(
-        "publish type values output output_type field expect", "period settle tolerance"
+        "publish type input_field inputs count output output_type field expect",
+        "period settle tolerance",
     ),
     "param_set": make_kind("name value accept", "node reason_contains then within"),
     "action_goal": make_kind(
         "action type goal", "status min_feedback result_field result_expect cancel_after_feedback"
     ),
-    "lifecycle_sequence": make_kind("steps", "node topic type"),
+    "lifecycle_sequence": make_kind("", "steps walk end node topic type"),
     "log_rate": make_kind("min_hz max_hz", "node text window"),
 }
 PROBES = {

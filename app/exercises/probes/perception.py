@@ -540,6 +540,12 @@ def depth_cloud(ctx: ProbeContext, p: Spec) -> Result:
 
 
 # Each kind's fields (the loader validates against them) and its code.
+# What these kinds draw at grading time (from the probe's seed), for `exercise explain`.
+DRAWS = {
+    "image_mask_iou": "random images (background, two other colours, red shapes 35-70 px)",
+    "depth_cloud": "random depth scenes (a box at 0.9-1.4 m, invalid pixels)",
+    "point_transform": "random points (x, y in [-0.3, 0.3] m, z in [0.3, 1.0] m)",
+}
 KINDS = {
     "publisher_count": make_kind("topic count", "node after within"),
     "image_mask_iou": make_kind("publish output", "min_iou"),
