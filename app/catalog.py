@@ -278,6 +278,31 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         ),
         package="turtlesim",
     ),
+    # --- the MuJoCo world (issue 26): `ros2 run sim_world sim_world` ---
+    CatalogEntry(
+        "sim_world",
+        "sim_world",
+        "/sim_world",
+        "A MuJoCo room: a diff-drive robot (/cmd_vel, /odom, /scan, camera, IMU) and an arm.",
+        package="sim_world",
+    ),
+    CatalogEntry(
+        "sim_teleop_key",
+        "turtle_teleop_key",
+        "/sim_teleop_key",
+        "The arrow-key teleop, remapped to drive the sim_world robot on /cmd_vel.",
+        ros_args=(
+            "-r",
+            "__node:=sim_teleop_key",
+            "-r",
+            "turtle1/cmd_vel:=/cmd_vel",
+            "-p",
+            "scale_linear:=0.3",
+            "-p",
+            "scale_angular:=1.5",
+        ),
+        package="sim_world",
+    ),
 )
 
 GROUPS: tuple[LaunchGroup, ...] = (
@@ -338,6 +363,12 @@ GROUPS: tuple[LaunchGroup, ...] = (
         "multisim",
         "two turtlesims in the namespaces /turtlesim1 and /turtlesim2 (multisim.launch.py)",
         ("multisim_turtlesim1", "multisim_turtlesim2"),
+    ),
+    # --- the MuJoCo world (issue 26) ---
+    LaunchGroup(
+        "sim_drive",
+        "the MuJoCo room and the arrow-key teleop on /cmd_vel: drive the robot",
+        ("sim_world", "sim_teleop_key"),
     ),
 )
 

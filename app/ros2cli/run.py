@@ -70,6 +70,7 @@ _UPSTREAM: dict[tuple[str, str], str] = {
     ("action_tutorials_cpp", "fibonacci_action_client"): "fibonacci_action_client",
     ("lifecycle", "lifecycle_talker"): "lifecycle_talker",
     ("lifecycle_py", "lifecycle_talker"): "lifecycle_talker",
+    ("sim_world", "sim_world"): "sim_world",  # issue 26: the MuJoCo world
 }
 # ...and every catalog entry under its own package (`ros2 run tutorial_nodes talker`).
 EXECUTABLES: dict[tuple[str, str], str] = {

@@ -48,7 +48,9 @@ def check_twist(linear: float, angular: float, max_linear: float, max_angular: f
     return TwistCheck(linear, angular)
 
 
-def wheel_speeds(linear: float, angular: float, radius: float, separation: float) -> tuple[float, float]:
+def wheel_speeds(
+    linear: float, angular: float, radius: float, separation: float
+) -> tuple[float, float]:
     """(left, right) wheel speeds in rad/s for a body velocity (m/s, rad/s)."""
     half = angular * separation / 2.0
     return (linear - half) / radius, (linear + half) / radius

@@ -145,10 +145,13 @@ class SimEngine:
         return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
     def base_velocity(self) -> tuple[np.ndarray, np.ndarray]:
-        """Ground-truth (linear, angular) velocity of base_link in its own frame."""
+        """Ground-truth (linear, angular) velocity of base_link in its own frame.
+
+        mjOBJ_XBODY: at the body's origin and axes (mjOBJ_BODY would use its inertial frame).
+        """
         res = np.zeros(6)
         mujoco.mj_objectVelocity(
-            self.model, self.data, mujoco.mjtObj.mjOBJ_BODY, self.base_id, res, 1
+            self.model, self.data, mujoco.mjtObj.mjOBJ_XBODY, self.base_id, res, 1
         )
         return res[3:], res[:3]
 
@@ -156,9 +159,7 @@ class SimEngine:
     def arm_positions(self) -> np.ndarray:
         return self.data.qpos[self._arm_q].copy()
 
-    def command_trajectory(
-        self, names: list[str], points: list[tuple[list[float], float]]
-    ) -> Plan:
+    def command_trajectory(self, names: list[str], points: list[tuple[list[float], float]]) -> Plan:
         """Start following a trajectory now; TrajectoryError says why one is refused."""
         current = self.data.ctrl[self._arm_servos].copy()  # continue from the last setpoint
         plan = check_trajectory(names, points, JOINT_NAMES, ARM_LIMITS, current)
@@ -189,7 +190,11 @@ class SimEngine:
     # --- everything ------------------------------------------------------------------
     def joint_state(self) -> tuple[tuple[str, ...], np.ndarray, np.ndarray]:
         """Names, positions and velocities of every actuated joint (wheels, arm, fingers)."""
-        return self.joint_names, self.data.qpos[self._qadr].copy(), self.data.qvel[self._vadr].copy()
+        return (
+            self.joint_names,
+            self.data.qpos[self._qadr].copy(),
+            self.data.qvel[self._vadr].copy(),
+        )
 
     def body_position(self, name: str) -> np.ndarray:
         return self.data.body(name).xpos.copy()

@@ -32,9 +32,7 @@ class Plan:
         """Positions of ``joints`` ``elapsed`` seconds after the start."""
         times = np.concatenate([[0.0], self.times])
         points = np.vstack([self.start, self.positions])
-        return np.array(
-            [np.interp(elapsed, times, points[:, k]) for k in range(len(self.joints))]
-        )
+        return np.array([np.interp(elapsed, times, points[:, k]) for k in range(len(self.joints))])
 
     @property
     def duration(self) -> float:
@@ -58,7 +56,8 @@ def check_trajectory(
         raise TrajectoryError(f"joint names repeat: {list(names)}")
     if not names or not points:
         raise TrajectoryError("the trajectory has no joint names or no points")
-    times, positions = [], []
+    times: list[float] = []
+    positions: list[list[float]] = []
     for i, (pos, t) in enumerate(points):
         if len(pos) != len(names):
             raise TrajectoryError(

@@ -1,0 +1,485 @@
+"""sim_world: a MuJoCo world with a differential-drive robot and an arm, as Gazebo would run it.
+
+It steps the physics of ``nodes/worlds/<world>/world.xml`` in real time (or
+``real_time_factor`` times faster or slower) and publishes what a real robot's
+drivers publish, stamped with simulation time:
+
+- ``/clock`` (rosgraph_msgs/Clock): run other nodes with ``use_sim_time:=true``;
+- ``/cmd_vel`` in (geometry_msgs/Twist): the base drives at that velocity until
+  ``cmd_vel_timeout`` seconds pass without a new command, then stops;
+- ``/odom`` (nav_msgs/Odometry) and ``odom -> base_link`` on ``/tf``: dead
+  reckoning from the wheel encoders (it drifts, as on a real robot);
+- ``/ground_truth/odom`` (nav_msgs/Odometry, frame ``world``): where the robot
+  really is, for lessons to compare with;
+- ``/scan`` (sensor_msgs/LaserScan, 360 rays at 10 Hz, noisy), ``/imu``
+  (sensor_msgs/Imu), ``/camera/image_raw`` + ``/camera/camera_info`` (320x240
+  at 15 Hz, rendered in a thread of its own so the physics keeps time);
+- ``/joint_states``: the wheels, the arm's joints and its fingers;
+- ``/arm_controller/joint_trajectory`` in (trajectory_msgs/JointTrajectory)
+  and ``/gripper/command`` in (std_msgs/Float64, finger opening in metres);
+- services as Gazebo's: ``/pause_physics``, ``/unpause_physics``,
+  ``/reset_simulation`` (time back to 0), ``/reset_world`` (time goes on), all
+  std_srvs/Empty, and ``/step_simulation`` (std_srvs/Trigger, advances
+  ``step_duration`` seconds while paused);
+- ``/real_time_factor`` (std_msgs/Float64, once a second): simulated seconds
+  per wall-clock second, measured.
+
+Bad input never stops the world: a non-finite velocity is ignored, a too fast
+one clamped, a trajectory with unknown joints refused, each with a log line
+that says why. A world file that does not load stops the node at start with
+the reason.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+
+import numpy as np
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import TransformStamped, Twist
+from nav_msgs.msg import Odometry
+from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParametersResult
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, LaserScan
+from std_msgs.msg import Float64
+from std_srvs.srv import Empty, Trigger
+from tf2_msgs.msg import TFMessage
+from trajectory_msgs.msg import JointTrajectory
+
+from nodes.common.run import spin_node
+from nodes.common.sim import GL_BACKEND
+from nodes.common.sim.camera import SnapshotCamera, intrinsics
+from nodes.common.sim.diff_drive import Odometry as WheelOdometry
+from nodes.common.sim.diff_drive import check_twist, quantize
+from nodes.common.sim.engine import Pose2D, SimEngine
+from nodes.common.sim.trajectory import TrajectoryError
+
+MAX_LAG = 0.25  # s of simulation behind schedule before the world gives up catching up
+CHUNK = 50  # physics steps between two looks at the clock when running flat out
+
+
+def stamp(seconds: float) -> Time:
+    sec = math.floor(seconds)
+    return Time(sec=int(sec), nanosec=int((seconds - sec) * 1e9))
+
+
+def _range(low: float, high: float, text: str) -> ParameterDescriptor:
+    return ParameterDescriptor(
+        description=text,
+        floating_point_range=[FloatingPointRange(from_value=low, to_value=high)],
+    )
+
+
+class SimWorld(Node):
+    def __init__(self) -> None:
+        super().__init__("sim_world")
+        p = self.declare_parameter
+        p("world", "room", ParameterDescriptor(description="nodes/worlds/<name> or an .xml path"))
+        p("x", 0.0, _range(-100.0, 100.0, "start x of the robot (m), used at each reset"))
+        p("y", 0.0, _range(-100.0, 100.0, "start y of the robot (m), used at each reset"))
+        p("yaw", 0.0, _range(-math.pi, math.pi, "start heading (rad), used at each reset"))
+        p("real_time_factor", 1.0, _range(0.0, 100.0, "sim s per wall s; 0: as fast as it can"))
+        p("cmd_vel_timeout", 0.5, _range(0.05, 10.0, "s without /cmd_vel before the base stops"))
+        p("max_linear_velocity", 0.5, _range(0.0, 2.0, "m/s, faster commands are clamped"))
+        p("max_angular_velocity", 2.5, _range(0.0, 10.0, "rad/s, faster commands are clamped"))
+        # The driver's calibration: close to the true 0.033 m and 0.16 m, never equal.
+        p("wheel_radius", 0.0332, _range(0.01, 0.1, "m, as the base driver believes"))
+        p("wheel_separation", 0.163, _range(0.05, 0.5, "m, as the base driver believes"))
+        p("encoder_ticks", 4096)
+        p("odom_rate", 30.0, _range(1.0, 200.0, "Hz of /odom, /tf, /joint_states, ground truth"))
+        p("imu_rate", 50.0, _range(1.0, 500.0, "Hz"))
+        p("scan_rate", 10.0, _range(1.0, 50.0, "Hz"))
+        p("clock_rate", 100.0, _range(10.0, 1000.0, "Hz of /clock in simulation time"))
+        p("camera_rate", 15.0, _range(0.0, 60.0, "Hz; 0 turns the camera off"))
+        p("camera_width", 320)
+        p("camera_height", 240)
+        p("step_duration", 0.1, _range(0.001, 10.0, "s that /step_simulation advances"))
+        p("seed", 0)
+        g = self._param
+        self.engine = SimEngine(
+            str(g("world")),
+            start=self._start_pose(),
+            drive_radius=float(g("wheel_radius")),
+            drive_separation=float(g("wheel_separation")),
+            seed=int(g("seed")),
+        )  # a world that does not load raises WorldError: the node stops with the reason
+        if not self.engine.has_mobile:
+            raise ValueError(
+                f"world {g('world')!r} has no diffbot (joints base_free, *_wheel_joint)"
+            )
+        self.rng = np.random.default_rng(int(g("seed")) + 1)
+        self.ticks = int(g("encoder_ticks"))
+        self.odometry = WheelOdometry(float(g("wheel_radius")), float(g("wheel_separation")))
+        self.odometry.reset(*self._encoders())
+        self.lock = threading.Lock()
+        self.stopping = threading.Event()
+        self.paused = False
+        self.pending_steps = 0
+        self.steps_done = threading.Condition(self.lock)
+        self.rtf_target = float(g("real_time_factor"))
+        self.reanchor = True
+        self.command = (0.0, 0.0)
+        self.command_time = -math.inf
+        self.rtf_measured = 0.0
+        self.cmd_vel_timeout = float(g("cmd_vel_timeout"))
+
+        self.clock_pub = self.create_publisher(Clock, "/clock", 10)
+        self.odom_pub = self.create_publisher(Odometry, "odom", 10)
+        self.truth_pub = self.create_publisher(Odometry, "ground_truth/odom", 10)
+        self.tf_pub = self.create_publisher(TFMessage, "/tf", 100)
+        self.joint_pub = self.create_publisher(JointState, "joint_states", 10)
+        self.imu_pub = self.create_publisher(Imu, "imu", 10)
+        self.scan_pub = self.create_publisher(LaserScan, "scan", 10)
+        self.image_pub = self.create_publisher(Image, "camera/image_raw", 5)
+        self.info_pub = self.create_publisher(CameraInfo, "camera/camera_info", 5)
+        self.rtf_pub = self.create_publisher(Float64, "real_time_factor", 10)
+
+        self.create_subscription(Twist, "cmd_vel", self.on_cmd_vel, 10)
+        self.create_subscription(
+            JointTrajectory, "arm_controller/joint_trajectory", self.on_trajectory, 10
+        )
+        self.create_subscription(Float64, "gripper/command", self.on_gripper, 10)
+        self.create_service(Empty, "pause_physics", self.on_pause)
+        self.create_service(Empty, "unpause_physics", self.on_unpause)
+        self.create_service(Empty, "reset_simulation", self.on_reset_simulation)
+        self.create_service(Empty, "reset_world", self.on_reset_world)
+        self.create_service(Trigger, "step_simulation", self.on_step)
+        self.add_on_set_parameters_callback(self.on_parameters)
+        self.rtf_timer = self.create_timer(1.0, self.on_rtf_timer)
+
+        # Sensor streams, each due at a multiple of its period in simulation time.
+        self.streams: list[list] = []
+        for rate, publish in (
+            (g("clock_rate"), self.publish_clock),
+            (g("odom_rate"), self.publish_odometry),
+            (g("imu_rate"), self.publish_imu),
+            (g("scan_rate"), self.publish_scan),
+        ):
+            self.streams.append([1.0 / float(rate), 0.0, publish])
+        self.camera_request: tuple[float, np.ndarray] | None = None
+        self.camera_wake = threading.Event()
+        self.threads = [threading.Thread(target=self.run_physics, name="physics", daemon=True)]
+        if float(g("camera_rate")) > 0:
+            self.streams.append([1.0 / float(g("camera_rate")), 0.0, self.request_frame])
+            self.threads.append(
+                threading.Thread(target=self.run_camera, name="camera", daemon=True)
+            )
+        self.rtf_wall, self.rtf_sim = time.monotonic(), self.engine.time
+        for thread in self.threads:
+            thread.start()
+        self.get_logger().info(
+            f"world {g('world')!r} loaded: timestep {self.engine.timestep * 1000:g} ms, "
+            f"real_time_factor {self.rtf_target:g}, camera rendering through "
+            f"{GL_BACKEND or 'no OpenGL found'}"
+        )
+
+    def _param(self, name: str):
+        return self.get_parameter(name).value
+
+    def _start_pose(self) -> Pose2D:
+        return Pose2D(float(self._param("x")), float(self._param("y")), float(self._param("yaw")))
+
+    def _encoders(self) -> tuple[float, float]:
+        left, right = self.engine.encoders()
+        return quantize(left, self.ticks), quantize(right, self.ticks)
+
+    # --- the physics thread ------------------------------------------------------------
+    def run_physics(self) -> None:
+        """Step in time with the wall clock (scaled), publishing each stream when it is due."""
+        dt = self.engine.timestep
+        anchor_wall = anchor_sim = 0.0
+        while not self.stopping.is_set():
+            with self.lock:
+                if self.reanchor:
+                    anchor_wall, anchor_sim = time.monotonic(), self.engine.time
+                    self.reanchor = False
+                if self.paused:
+                    count = self.pending_steps
+                elif self.rtf_target <= 0.0:
+                    count = CHUNK
+                else:
+                    behind = anchor_sim + (time.monotonic() - anchor_wall) * self.rtf_target
+                    behind -= self.engine.time
+                    if behind > MAX_LAG:  # cannot keep up: drop the lost time, run on from here
+                        anchor_wall, anchor_sim = time.monotonic(), self.engine.time
+                        behind = 0.0
+                    count = min(int(behind / dt), CHUNK)
+                for _ in range(count):
+                    self.step_once()
+                if self.paused and count:
+                    self.pending_steps = 0
+                    self.steps_done.notify_all()
+            if count == 0 or self.paused:
+                wait = dt / self.rtf_target if self.rtf_target > 0 and not self.paused else 0.005
+                self.stopping.wait(min(wait, 0.005))
+
+    def step_once(self) -> None:
+        engine = self.engine
+        if engine.time - self.command_time > self.cmd_vel_timeout:
+            self.command = (0.0, 0.0)
+        engine.drive(*self.command)
+        engine.step(1)
+        now = engine.time
+        for stream in self.streams:
+            if now + 1e-9 >= stream[1]:
+                period = stream[0]
+                stream[1] = (math.floor(now / period + 1e-6) + 1) * period
+                stream[2](now)
+
+    # --- publishing (physics thread, under the lock) ------------------------------------
+    def publish_clock(self, now: float) -> None:
+        self.clock_pub.publish(Clock(clock=stamp(now)))
+
+    def publish_odometry(self, now: float) -> None:
+        engine, odom = self.engine, self.odometry
+        odom.update(*self._encoders(), dt=self.streams[1][0])
+        header_stamp = stamp(now)
+        msg = Odometry()
+        msg.header.stamp = header_stamp
+        msg.header.frame_id = "odom"
+        msg.child_frame_id = "base_link"
+        msg.pose.pose.position.x, msg.pose.pose.position.y = odom.x, odom.y
+        msg.pose.pose.orientation.z = math.sin(odom.yaw / 2.0)
+        msg.pose.pose.orientation.w = math.cos(odom.yaw / 2.0)
+        msg.twist.twist.linear.x, msg.twist.twist.angular.z = odom.linear, odom.angular
+        msg.pose.covariance[0] = msg.pose.covariance[7] = msg.pose.covariance[35] = 0.001
+        msg.twist.covariance[0] = msg.twist.covariance[35] = 0.001
+        self.odom_pub.publish(msg)
+        tf = TransformStamped()
+        tf.header = msg.header
+        tf.child_frame_id = "base_link"
+        tf.transform.translation.x, tf.transform.translation.y = odom.x, odom.y
+        tf.transform.rotation = msg.pose.pose.orientation
+        self.tf_pub.publish(TFMessage(transforms=[tf]))
+
+        truth = Odometry()
+        truth.header.stamp = header_stamp
+        truth.header.frame_id = "world"
+        truth.child_frame_id = "base_link"
+        position, quat = engine.base_pose()
+        linear, angular = engine.base_velocity()
+        pose = truth.pose.pose
+        pose.position.x, pose.position.y, pose.position.z = (float(v) for v in position)
+        q = pose.orientation
+        q.x, q.y, q.z, q.w = (float(v) for v in quat)
+        tw = truth.twist.twist
+        tw.linear.x, tw.linear.y, tw.linear.z = (float(v) for v in linear)
+        tw.angular.x, tw.angular.y, tw.angular.z = (float(v) for v in angular)
+        self.truth_pub.publish(truth)
+
+        names, positions, velocities = engine.joint_state()
+        joints = JointState(name=list(names), position=positions.tolist())
+        joints.velocity = velocities.tolist()
+        joints.header.stamp = header_stamp
+        self.joint_pub.publish(joints)
+
+    def publish_imu(self, now: float) -> None:
+        quat, gyro, accel = self.engine.imu()
+        gyro = gyro + self.rng.normal(0.0, 0.002, 3)
+        accel = accel + self.rng.normal(0.0, 0.02, 3)
+        msg = Imu()
+        msg.header.stamp = stamp(now)
+        msg.header.frame_id = "imu_link"
+        o = msg.orientation
+        o.x, o.y, o.z, o.w = (float(v) for v in quat)
+        av, la = msg.angular_velocity, msg.linear_acceleration
+        av.x, av.y, av.z = (float(v) for v in gyro)
+        la.x, la.y, la.z = (float(v) for v in accel)
+        for k in (0, 4, 8):
+            msg.orientation_covariance[k] = 1e-4
+            msg.angular_velocity_covariance[k] = 0.002**2
+            msg.linear_acceleration_covariance[k] = 0.02**2
+        self.imu_pub.publish(msg)
+
+    def publish_scan(self, now: float) -> None:
+        lidar = self.engine.lidar
+        assert lidar is not None
+        ranges = lidar.measure(self.engine.data)
+        period = 1.0 / float(self._param("scan_rate"))
+        msg = LaserScan()
+        msg.header.stamp = stamp(now)
+        msg.header.frame_id = "lidar_link"
+        msg.angle_min = float(lidar.angles[0])
+        msg.angle_increment = 2.0 * math.pi / lidar.count
+        msg.angle_max = float(lidar.angles[-1])
+        msg.scan_time = period
+        msg.time_increment = period / lidar.count
+        msg.range_min, msg.range_max = lidar.range_min, lidar.range_max
+        msg.ranges = ranges.astype(np.float32)
+        self.scan_pub.publish(msg)
+
+    def request_frame(self, now: float) -> None:
+        """Hand the camera thread a copy of the state; a frame still rendering makes it skip."""
+        self.camera_request = (now, self.engine.snapshot())
+        self.camera_wake.set()
+
+    # --- the camera thread ---------------------------------------------------------------
+    def run_camera(self) -> None:
+        width, height = int(self._param("camera_width")), int(self._param("camera_height"))
+        try:
+            camera = SnapshotCamera(self.engine.model, "camera", width, height)
+        except Exception as exc:  # no OpenGL here: the world runs on without a camera
+            self.get_logger().error(
+                f"camera disabled, rendering through MUJOCO_GL={GL_BACKEND or '(none)'} "
+                f"failed: {exc} (make setup installs Mesa's EGL and OSMesa)"
+            )
+            return
+        fovy = float(self.engine.model.cam_fovy[self.engine.model.camera("camera").id])
+        info = CameraInfo(width=width, height=height, distortion_model="plumb_bob")
+        k = intrinsics(width, height, fovy)
+        info.k = k.ravel().tolist()
+        info.d = [0.0] * 5
+        info.r = np.eye(3).ravel().tolist()
+        info.p = np.hstack([k, np.zeros((3, 1))]).ravel().tolist()
+        info.header.frame_id = "camera_optical_frame"
+        try:
+            while not self.stopping.is_set():
+                if not self.camera_wake.wait(0.1):
+                    continue
+                self.camera_wake.clear()
+                request, self.camera_request = self.camera_request, None
+                if request is None:
+                    continue
+                now, qpos = request
+                pixels = camera.render(qpos)
+                image = Image(height=height, width=width, encoding="rgb8", step=width * 3)
+                image.header.stamp = info.header.stamp = stamp(now)
+                image.header.frame_id = "camera_optical_frame"
+                image.data = pixels.tobytes()
+                self.image_pub.publish(image)
+                self.info_pub.publish(info)
+        finally:
+            camera.close()
+
+    # --- commands (executor thread) ---------------------------------------------------------
+    def on_cmd_vel(self, msg: Twist) -> None:
+        checked = check_twist(
+            msg.linear.x,
+            msg.angular.z,
+            float(self._param("max_linear_velocity")),
+            float(self._param("max_angular_velocity")),
+        )
+        if checked.problem:
+            self.get_logger().warning(checked.problem, throttle_duration_sec=2.0)
+        if checked.rejected:
+            return
+        with self.lock:
+            self.command = (checked.linear, checked.angular)
+            self.command_time = self.engine.time
+
+    def on_trajectory(self, msg: JointTrajectory) -> None:
+        points = [
+            (list(p.positions), p.time_from_start.sec + p.time_from_start.nanosec * 1e-9)
+            for p in msg.points
+        ]
+        with self.lock:
+            try:
+                plan = self.engine.command_trajectory(list(msg.joint_names), points)
+            except TrajectoryError as exc:
+                self.get_logger().error(f"rejected a joint trajectory: {exc}")
+                return
+        self.get_logger().info(
+            f"following a trajectory of {len(points)} point(s) over {plan.duration:.2f} s"
+        )
+
+    def on_gripper(self, msg: Float64) -> None:
+        if not math.isfinite(msg.data):
+            self.get_logger().warning(f"ignored a gripper command of {msg.data} m")
+            return
+        with self.lock:
+            opening = self.engine.set_gripper(msg.data)
+        if abs(opening - msg.data) > 1e-9:
+            self.get_logger().warning(
+                f"gripper opening {msg.data:g} m is outside 0..0.09 m: set to {opening:g} m"
+            )
+
+    # --- services (executor thread) ---------------------------------------------------------
+    def on_pause(self, request: Empty.Request, response: Empty.Response) -> Empty.Response:
+        with self.lock:
+            self.paused = True
+        return response
+
+    def on_unpause(self, request: Empty.Request, response: Empty.Response) -> Empty.Response:
+        with self.lock:
+            self.paused, self.reanchor = False, True
+        return response
+
+    def _reset(self, keep_time: bool) -> None:
+        with self.lock:
+            self.engine.reset(self._start_pose(), keep_time=keep_time)
+            self.odometry.reset(*self._encoders())
+            self.command, self.command_time = (0.0, 0.0), -math.inf
+            for stream in self.streams:
+                stream[1] = self.engine.time
+            self.reanchor = True
+        what = "world" if keep_time else "simulation (time back to 0)"
+        self.get_logger().info(f"reset the {what}; robot at {self._start_pose()}")
+
+    def on_reset_simulation(self, request: Empty.Request, response: Empty.Response):
+        self._reset(keep_time=False)
+        return response
+
+    def on_reset_world(self, request: Empty.Request, response: Empty.Response):
+        self._reset(keep_time=True)
+        return response
+
+    def on_step(self, request: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
+        with self.lock:
+            if not self.paused:
+                response.success = False
+                response.message = "the simulation is running: call /pause_physics first"
+                return response
+            start = self.engine.time
+            self.pending_steps = max(
+                1, round(float(self._param("step_duration")) / self.engine.timestep)
+            )
+            done = self.steps_done.wait_for(lambda: self.pending_steps == 0, timeout=10.0)
+            now = self.engine.time
+        response.success = bool(done)
+        response.message = f"stepped from t={start:.3f} s to t={now:.3f} s"
+        return response
+
+    def on_parameters(self, params: list[Parameter]) -> SetParametersResult:
+        for param in params:
+            if param.name == "real_time_factor":
+                value = float(param.value)
+                if not math.isfinite(value) or value < 0:
+                    return SetParametersResult(successful=False, reason="must be >= 0")
+                with self.lock:
+                    self.rtf_target, self.reanchor = value, True
+                self.get_logger().info(f"real_time_factor set to {value:g}")
+            elif param.name == "cmd_vel_timeout":
+                self.cmd_vel_timeout = float(param.value)
+        return SetParametersResult(successful=True)
+
+    def on_rtf_timer(self) -> None:
+        now_wall = time.monotonic()
+        with self.lock:
+            now_sim = self.engine.time
+        wall = now_wall - self.rtf_wall
+        self.rtf_measured = max(0.0, (now_sim - self.rtf_sim) / wall) if wall > 0 else 0.0
+        self.rtf_wall, self.rtf_sim = now_wall, now_sim
+        self.rtf_pub.publish(Float64(data=self.rtf_measured))
+
+    def stop(self) -> None:
+        """End the physics and camera threads (spin_node calls it before shutdown)."""
+        self.stopping.set()
+        self.camera_wake.set()
+        for thread in self.threads:
+            thread.join(timeout=5.0)
+
+
+def _stop(node: SimWorld) -> None:
+    node.stop()
+
+
+def main(args: list[str] | None = None) -> None:
+    spin_node(SimWorld, args, before_shutdown=_stop, program="sim_world")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,334 @@
+"""A program written against Gazebo-style robot topics, run against sim_world from outside.
+
+It imports rclpy and message packages only, never the project's code, and is
+started with a clean PYTHONPATH from another folder. It drives ``/sim_world``
+through its interfaces and measures what happens; test_sim_world_ros.py judges
+the numbers. Prints one JSON object (the last line of stdout): one key per
+scenario.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+import threading
+import time
+from typing import Any
+
+import rclpy
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from rcl_interfaces.msg import Log, Parameter, ParameterType, ParameterValue
+from rcl_interfaces.srv import SetParameters
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, LaserScan
+from std_msgs.msg import Float64
+from std_srvs.srv import Empty, Trigger
+from tf2_msgs.msg import TFMessage
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+
+TIMEOUT = 25.0
+ARM = ["base_yaw", "shoulder_pitch", "elbow_pitch", "wrist_pitch"]
+
+
+def wait(predicate, timeout: float = TIMEOUT, what: str = "") -> Any:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(0.01)
+    raise TimeoutError(f"timed out waiting for {what or predicate}")
+
+
+def seconds(stamp) -> float:
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
+class SimClient(Node):
+    def __init__(self) -> None:
+        super().__init__("sim_test_client")
+        self.lock = threading.Lock()
+        self.last: dict[str, Any] = {}
+        self.arrivals: dict[str, list[float]] = {}
+        self.logs: list[str] = []
+        topics = {
+            "/clock": Clock,
+            "/odom": Odometry,
+            "/ground_truth/odom": Odometry,
+            "/tf": TFMessage,
+            "/scan": LaserScan,
+            "/imu": Imu,
+            "/joint_states": JointState,
+            "/camera/image_raw": Image,
+            "/camera/camera_info": CameraInfo,
+            "/real_time_factor": Float64,
+        }
+        for topic, kind in topics.items():
+            self.create_subscription(kind, topic, self._keeper(topic), 10)
+        self.create_subscription(Log, "/rosout", self.on_log, 100)
+        self.cmd = self.create_publisher(Twist, "/cmd_vel", 10)
+        self.traj = self.create_publisher(JointTrajectory, "/arm_controller/joint_trajectory", 10)
+        self.gripper = self.create_publisher(Float64, "/gripper/command", 10)
+        self.params = self.create_client(SetParameters, "/sim_world/set_parameters")
+
+    def _keeper(self, topic: str):
+        def keep(msg) -> None:
+            with self.lock:
+                self.last[topic] = msg
+                self.arrivals.setdefault(topic, []).append(time.monotonic())
+
+        return keep
+
+    def on_log(self, msg: Log) -> None:
+        if msg.name == "sim_world":
+            with self.lock:
+                self.logs.append(msg.msg)
+
+    def get(self, topic: str) -> Any:
+        with self.lock:
+            return self.last.get(topic)
+
+    def sim_time(self) -> float:
+        clock = wait(lambda: self.get("/clock"), what="/clock")
+        return seconds(clock.clock)
+
+    def rate(self, topic: str, window: float) -> float:
+        with self.lock:
+            self.arrivals[topic] = []
+        time.sleep(window)
+        with self.lock:
+            stamps = list(self.arrivals[topic])
+        return (len(stamps) - 1) / (stamps[-1] - stamps[0]) if len(stamps) > 2 else 0.0
+
+    def call(self, kind, name: str, request=None):
+        client = self.create_client(kind, name)
+        try:
+            if not client.wait_for_service(timeout_sec=TIMEOUT):
+                raise TimeoutError(f"service {name} not found")
+            future = client.call_async(request or kind.Request())
+            wait(future.done, what=f"{name} to answer")
+            return future.result()
+        finally:
+            self.destroy_client(client)
+
+    def set_param(self, name: str, value: float) -> bool:
+        wait(lambda: self.params.wait_for_service(timeout_sec=0.1), what="set_parameters")
+        request = SetParameters.Request()
+        request.parameters = [
+            Parameter(
+                name=name,
+                value=ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=value),
+            )
+        ]
+        future = self.params.call_async(request)
+        wait(future.done, what="set_parameters to answer")
+        return bool(future.result().results[0].successful)
+
+    def truth(self) -> tuple[float, float]:
+        msg = self.get("/ground_truth/odom")
+        return msg.pose.pose.position.x, msg.pose.pose.position.y
+
+    def odom(self) -> tuple[float, float]:
+        msg = self.get("/odom")
+        return msg.pose.pose.position.x, msg.pose.pose.position.y
+
+    def wait_sim(self, duration: float) -> None:
+        end = self.sim_time() + duration
+        wait(lambda: self.sim_time() >= end, what=f"{duration} s of simulation time")
+
+    def log_since(self, mark: int, text: str) -> list[str]:
+        with self.lock:
+            return [line for line in self.logs[mark:] if text in line]
+
+
+def twist(linear: float, angular: float = 0.0) -> Twist:
+    msg = Twist()
+    msg.linear.x, msg.angular.z = linear, angular
+    return msg
+
+
+def trajectory(names: list[str], points: list[tuple[list[float], float]]) -> JointTrajectory:
+    msg = JointTrajectory(joint_names=names)
+    for positions, at in points:
+        point = JointTrajectoryPoint(positions=positions)
+        point.time_from_start.sec = int(at)
+        point.time_from_start.nanosec = int((at - int(at)) * 1e9)
+        msg.points.append(point)
+    return msg
+
+
+def start(c: SimClient) -> dict:
+    for topic in ("/clock", "/scan", "/odom", "/camera/image_raw", "/imu", "/tf"):
+        wait(lambda t=topic: c.get(t), what=topic)
+    image, info, scan = c.get("/camera/image_raw"), c.get("/camera/camera_info"), c.get("/scan")
+    wait(lambda: c.get("/real_time_factor"), what="/real_time_factor")
+    joints = c.get("/joint_states")
+    tf = c.get("/tf")
+    return {
+        "image": [image.width, image.height, image.encoding, len(image.data)],
+        "info_k": list(info.k),
+        "scan": [len(scan.ranges), scan.angle_min, scan.angle_increment, scan.header.frame_id],
+        "joint_names": list(joints.name),
+        "tf": [(t.header.frame_id, t.child_frame_id) for t in tf.transforms],
+        "rates": {
+            "scan": c.rate("/scan", 3.0),
+            "camera": c.rate("/camera/image_raw", 3.0),
+        },
+        "rtf": c.get("/real_time_factor").data,
+    }
+
+
+def scan_in_room(c: SimClient) -> dict:
+    c.call(Empty, "/reset_simulation")
+    c.wait_sim(0.5)
+    scan = c.get("/scan")
+    return {
+        "ranges": [float(r) for r in scan.ranges],
+        "angle_min": scan.angle_min,
+        "increment": scan.angle_increment,
+        "truth": c.truth(),
+    }
+
+
+def pause_and_step(c: SimClient) -> dict:
+    c.call(Empty, "/pause_physics")
+    time.sleep(0.5)
+    before = c.sim_time()
+    time.sleep(1.0)
+    still = c.sim_time()
+    refused_running = None
+    answer = c.call(Trigger, "/step_simulation")
+    time.sleep(0.5)
+    after = c.sim_time()
+    c.call(Empty, "/unpause_physics")
+    refused_running = c.call(Trigger, "/step_simulation")
+    return {
+        "before": before,
+        "still": still,
+        "after": after,
+        "step": [answer.success, answer.message],
+        "step_while_running": [refused_running.success, refused_running.message],
+    }
+
+
+def drive(c: SimClient) -> dict:
+    """0.2 m/s for exactly 5 s of simulation time, by stepping a paused world."""
+    c.call(Empty, "/reset_simulation")
+    c.wait_sim(0.3)
+    c.call(Empty, "/pause_physics")
+    assert c.set_param("step_duration", 5.0) and c.set_param("cmd_vel_timeout", 6.0)
+    time.sleep(0.3)
+    truth0, odom0 = c.truth(), c.odom()
+    for _ in range(5):  # the command must have arrived before the world steps
+        c.cmd.publish(twist(0.2))
+        time.sleep(0.1)
+    answer = c.call(Trigger, "/step_simulation")
+    c.cmd.publish(twist(0.0))
+    time.sleep(0.5)
+    truth1, odom1 = c.truth(), c.odom()
+    assert c.set_param("step_duration", 0.1) and c.set_param("cmd_vel_timeout", 0.5)
+    c.call(Empty, "/unpause_physics")
+    return {
+        "step": answer.message,
+        "truth": math.dist(truth0, truth1),
+        "odom": math.dist(odom0, odom1),
+    }
+
+
+def fast_and_timeout(c: SimClient) -> dict:
+    """real_time_factor 3: simulation time runs 3x the wall clock; the command times out."""
+    refused = not c.set_param("real_time_factor", -1.0)
+    assert c.set_param("real_time_factor", 3.0)
+    time.sleep(1.0)
+    wall0, sim0 = time.monotonic(), c.sim_time()
+    time.sleep(2.0)
+    measured = (c.sim_time() - sim0) / (time.monotonic() - wall0)
+    c.cmd.publish(twist(0.1))
+    c.wait_sim(1.5)  # > cmd_vel_timeout (0.5 s): the robot has stopped
+    speed_after_timeout = c.get("/ground_truth/odom").twist.twist.linear.x
+    assert c.set_param("real_time_factor", 1.0)
+    return {"refused_negative": refused, "rtf": measured, "speed": speed_after_timeout}
+
+
+def bad_velocities(c: SimClient) -> dict:
+    c.call(Empty, "/reset_simulation")
+    c.wait_sim(0.3)
+    mark = len(c.logs)
+    t0, start_xy = c.sim_time(), c.truth()
+    for _ in range(10):
+        c.cmd.publish(twist(float("nan"), float("inf")))
+        time.sleep(0.05)
+    c.wait_sim(0.5)
+    moved_after_nan = math.dist(start_xy, c.truth())
+    nan_lines = c.log_since(mark, "non-finite")
+    for _ in range(30):
+        c.cmd.publish(twist(1e9, 0.0))
+        time.sleep(0.05)
+    speed = c.get("/ground_truth/odom").twist.twist.linear.x
+    c.cmd.publish(twist(0.0))
+    return {
+        "clock_advanced": c.sim_time() - t0,
+        "moved_after_nan": moved_after_nan,
+        "nan_log": nan_lines[:1],
+        "clamp_log": c.log_since(mark, "clamped")[:1],
+        "speed_under_huge": speed,
+    }
+
+
+def arm(c: SimClient) -> dict:
+    mark = len(c.logs)
+    c.traj.publish(trajectory(["base_yaw", "shoulder", "elbow_pitch"], [([0.1, 0.2, 0.3], 1.0)]))
+    c.traj.publish(trajectory(ARM, [([0.1, 0.2, 0.3], 1.0)]))
+    goal = [0.5, 0.6, -0.9, -1.2]
+    c.traj.publish(trajectory(ARM, [([0.25, 0.7, -1.2, -1.0], 1.0), (goal, 2.0)]))
+    c.wait_sim(3.5)
+    joints = c.get("/joint_states")
+    reached = {n: p for n, p in zip(joints.name, joints.position, strict=True) if n in ARM}
+    wait(lambda: c.log_since(mark, "rejected"), timeout=5, what="a rejection log line")
+    return {
+        "goal": dict(zip(ARM, goal, strict=True)),
+        "reached": reached,
+        "rejections": c.log_since(mark, "rejected"),
+    }
+
+
+def main() -> int:
+    rclpy.init()
+    client = SimClient()
+    executor = SingleThreadedExecutor()
+    executor.add_node(client)
+    spinner = threading.Thread(target=executor.spin, daemon=True)
+    spinner.start()
+    report: dict[str, Any] = {}
+    try:
+        for name, scenario in (
+            ("start", start),
+            ("scan_in_room", scan_in_room),
+            ("pause_and_step", pause_and_step),
+            ("drive", drive),
+            ("fast_and_timeout", fast_and_timeout),
+            ("bad_velocities", bad_velocities),
+            ("arm", arm),
+        ):
+            try:
+                report[name] = scenario(client)
+            except Exception as exc:  # report it, go on with the next scenario
+                report[name] = {"error": f"{type(exc).__name__}: {exc}"}
+    finally:
+        report["project_modules_imported"] = sorted(
+            m for m in sys.modules if m.split(".")[0] in ("app", "nodes", "tests")
+        )
+        print(json.dumps(report), flush=True)
+        executor.shutdown()
+        spinner.join(5.0)
+        client.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
