@@ -1,0 +1,197 @@
+"""Physics sanity of the MuJoCo world, without ROS: SimEngine and its helpers, in sim time."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from nodes.common.arm_kinematics import JOINT_NAMES, inverse_kinematics
+from nodes.common.sim.assets import ROBOTS_DIR, WorldError, load_world, world_names
+from nodes.common.sim.camera import SnapshotCamera, choose_gl_backend, intrinsics
+from nodes.common.sim.diff_drive import Odometry, check_twist, quantize, wheel_speeds
+from nodes.common.sim.engine import Pose2D, SimEngine
+from nodes.common.sim.trajectory import TrajectoryError, check_trajectory
+
+LIMITS = {name: (-math.pi, math.pi) for name in JOINT_NAMES}
+
+# A teacher's world, written without code: a 3 m x 2 m box room with the diffbot only.
+BOX_ROOM = f"""
+<mujoco model="box_room">
+  <option timestep="0.002" integrator="implicitfast"/>
+  <asset><model name="diffbot" file="{ROBOTS_DIR / "diffbot" / "robot.xml"}"/></asset>
+  <worldbody>
+    <geom name="floor" type="plane" size="3 3 0.1"/>
+    <geom type="box" size="0.05 1.1 0.3" pos="1.55 0 0.3"/>
+    <geom type="box" size="0.05 1.1 0.3" pos="-1.55 0 0.3"/>
+    <geom type="box" size="1.6 0.05 0.3" pos="0 1.05 0.3"/>
+    <geom type="box" size="1.6 0.05 0.3" pos="0 -1.05 0.3"/>
+    <frame><attach model="diffbot" body="base_link" prefix=""/></frame>
+  </worldbody>
+</mujoco>
+"""
+
+
+@pytest.fixture(scope="module")
+def room() -> SimEngine:
+    return SimEngine("room", drive_radius=0.0332, drive_separation=0.163)
+
+
+@pytest.fixture
+def box_room(tmp_path) -> str:
+    path = tmp_path / "box_room.xml"
+    path.write_text(BOX_ROOM)
+    return str(path)
+
+
+def test_0_2_m_per_s_for_5_s_of_sim_time_moves_1_m_by_ground_truth(room):
+    room.reset(Pose2D(0.0, 0.0, 0.0))
+    start = room.base_pose()[0]
+    room.drive(0.2, 0.0)
+    room.step(round(5.0 / room.timestep))
+    room.drive(0.0, 0.0)
+    assert room.time == pytest.approx(5.0)
+    moved = room.base_pose()[0] - start
+    assert math.hypot(moved[0], moved[1]) == pytest.approx(1.0, rel=0.05)
+    assert abs(moved[1]) < 0.02 and abs(room.base_yaw()) < 0.02  # straight ahead
+
+
+def test_odometry_from_the_encoders_drifts_from_the_truth_while_turning(room):
+    room.reset(Pose2D(-0.5, -0.5, 0.3))
+    odom = Odometry(0.0332, 0.163)
+    odom.reset(*(quantize(a, 4096) for a in room.encoders()))
+    start, yaw0 = room.base_pose()[0], room.base_yaw()
+    room.drive(0.2, 0.6)
+    for _ in range(150):  # 6 s at 25 Hz
+        room.step(20)
+        odom.update(*(quantize(a, 4096) for a in room.encoders()), dt=0.04)
+    moved = room.base_pose()[0] - start
+    local = (
+        np.array(  # the truth, in the frame the robot started in (odom's frame)
+            [[math.cos(yaw0), math.sin(yaw0)], [-math.sin(yaw0), math.cos(yaw0)]]
+        )
+        @ moved[:2]
+    )
+    error = math.hypot(local[0] - odom.x, local[1] - odom.y)
+    assert 0.002 < error < 0.2, error  # close, never exact
+    turned = (room.base_yaw() - yaw0 + math.pi) % (2 * math.pi) - math.pi
+    assert odom.yaw == pytest.approx(turned, abs=0.25)
+    assert odom.yaw != pytest.approx(turned, abs=1e-4)
+
+
+def test_a_scan_in_a_known_room_matches_its_walls_within_the_noise(box_room):
+    engine = SimEngine(box_room, start=Pose2D(0.3, -0.2, 0.5))
+    assert engine.has_mobile and not engine.has_arm
+    lidar = engine.lidar
+    assert lidar is not None
+    ranges = lidar.measure(engine.data)
+    origin = engine.data.site_xpos[lidar.site_id]
+    heading = engine.base_yaw() + lidar.angles
+    c, s = np.cos(heading), np.sin(heading)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        to_x = np.where(c > 0, (1.5 - origin[0]) / c, (-1.5 - origin[0]) / c)
+        to_y = np.where(s > 0, (1.0 - origin[1]) / s, (-1.0 - origin[1]) / s)
+    expected = np.minimum(np.where(to_x > 0, to_x, np.inf), np.where(to_y > 0, to_y, np.inf))
+    error = ranges - expected
+    assert len(ranges) == 360 and np.all(np.isfinite(ranges))
+    assert abs(error.mean()) < 0.004
+    assert 0.007 < error.std() < 0.014  # the 0.01 m noise, and nothing more
+    assert np.abs(lidar.true_ranges(engine.data) - expected).max() < 1e-4  # 0.1 mm: tilt
+
+
+def test_a_joint_trajectory_is_reached_within_tolerance(room):
+    room.reset()
+    goal = [0.8, 0.5, -1.0, -0.8]
+    room.command_trajectory(list(JOINT_NAMES), [([0.4, 0.7, -1.4, -0.6], 1.0), (goal, 2.0)])
+    room.step(round(1.0 / room.timestep))
+    halfway = room.arm_positions()
+    assert halfway[0] == pytest.approx(0.4, abs=0.05)  # it follows the waypoints in time
+    room.step(round(1.5 / room.timestep))
+    assert np.abs(room.arm_positions() - goal).max() < 0.01
+
+
+def test_the_grasped_cube_moves_with_the_gripper(room):
+    room.reset()
+    reach = math.hypot(1.15 - 1.4, 1.15 - 1.4)  # the cube, seen from the arm's base
+
+    def move_to(height: float) -> None:
+        joints = inverse_kinematics((reach, 0.0, height))
+        room.command_trajectory(list(JOINT_NAMES), [(list(joints), 1.5)])
+        room.step(round(2.0 / room.timestep))
+
+    cube0 = room.body_position("cube")
+    move_to(0.15)
+    move_to(0.012)
+    room.set_gripper(0.0)
+    room.step(round(1.0 / room.timestep))
+    gripped = room.body_position("cube") - room.tool_position()
+    move_to(0.25)
+    lifted = room.body_position("cube")
+    assert lifted[2] - cube0[2] > 0.2  # off the table with the arm
+    assert np.abs(lifted - room.tool_position() - gripped).max() < 0.01  # held, not dropped
+    room.set_gripper(0.09)  # let go: it falls back onto the table
+    room.step(round(1.0 / room.timestep))
+    assert room.body_position("cube")[2] == pytest.approx(cube0[2], abs=0.01)
+
+
+def test_nan_velocities_are_rejected_and_huge_ones_clamped_with_the_reason():
+    nan = check_twist(float("nan"), 0.0, 0.5, 2.5)
+    assert nan.rejected and "non-finite" in nan.problem
+    huge = check_twist(1e9, -50.0, 0.5, 2.5)
+    assert not huge.rejected and (huge.linear, huge.angular) == (0.5, -2.5)
+    assert "clamped" in huge.problem
+    fine = check_twist(0.2, 0.1, 0.5, 2.5)
+    assert (fine.linear, fine.angular, fine.problem) == (0.2, 0.1, "")
+    left, right = wheel_speeds(0.2, 1.0, 0.033, 0.16)
+    assert (left, right) == pytest.approx(((0.2 - 0.08) / 0.033, (0.2 + 0.08) / 0.033))
+
+
+@pytest.mark.parametrize(
+    ("names", "points", "reason"),
+    [
+        (["base_yaw", "shoulder"], [([0.0, 0.0], 1.0)], "unknown joint name(s) ['shoulder']"),
+        (["base_yaw", "base_yaw"], [([0.0, 0.0], 1.0)], "joint names repeat"),
+        (["base_yaw", "elbow_pitch"], [([0.0], 1.0)], "1 positions for 2 joint names"),
+        (["base_yaw"], [([float("nan")], 1.0)], "non-finite"),
+        (["base_yaw"], [([0.1], 1.0), ([0.2], 0.5)], "must increase"),
+        (["base_yaw"], [([4.0], 1.0)], "outside its limits"),
+        ([], [], "no joint names"),
+    ],
+)
+def test_a_bad_trajectory_is_refused_with_the_reason(names, points, reason):
+    with pytest.raises(TrajectoryError) as caught:
+        check_trajectory(names, points, JOINT_NAMES, LIMITS, [0.0] * 4)
+    assert reason in str(caught.value)
+
+
+def test_a_world_that_does_not_parse_or_exist_is_refused_with_the_reason(tmp_path):
+    broken = tmp_path / "broken.xml"
+    broken.write_text("<mujoco><worldbody><geom type='box'</worldbody></mujoco>")
+    with pytest.raises(WorldError, match=f"world file {broken} does not load: XML parse error"):
+        load_world(str(broken))
+    unknown = tmp_path / "unknown.xml"
+    unknown.write_text("<mujoco><worldbody><geom type='doughnut'/></worldbody></mujoco>")
+    with pytest.raises(WorldError, match="doughnut"):
+        load_world(str(unknown))
+    with pytest.raises(WorldError, match=r"does not exist \(worlds under nodes/worlds: room\)"):
+        load_world("atlantis")
+    with pytest.raises(WorldError, match="neither a world name"):
+        load_world("../../etc/passwd")
+    assert "room" in world_names()
+
+
+def test_the_camera_renders_the_room_headless():
+    assert choose_gl_backend({"MUJOCO_GL": "osmesa"}) == "osmesa"  # a user's choice is kept
+    env: dict[str, str] = {}
+    assert choose_gl_backend(env) in ("egl", "osmesa") and env["MUJOCO_GL"]
+    k = intrinsics(320, 240, 60.0)
+    assert k[0, 0] == pytest.approx(120 / math.tan(math.radians(30)))
+    engine = SimEngine("room")
+    camera = SnapshotCamera(engine.model, "camera", 320, 240)
+    try:
+        image = camera.render(engine.snapshot())
+    finally:
+        camera.close()
+    assert image.shape == (240, 320, 3)
+    assert image.std() > 10  # walls, floor and objects, not a blank frame
