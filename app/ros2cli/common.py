@@ -4,9 +4,43 @@ from __future__ import annotations
 
 import time
 
+from rclpy.topic_or_service_is_hidden import topic_or_service_is_hidden
+
 from app.ros.context import CallContext
+from app.ros.errors import Ros2Error
 
 MIN_DISCOVERY_SEC = 1.5
+
+
+class Ros2cliMessage(Ros2Error):
+    """A failure ros2cli reports with these exact words (no 'error:' prefix), exit code 1.
+
+    ros2cli's verbs return a string (or raise RuntimeError) and the `ros2`
+    entry point prints it and exits with 1: "Unable to find node '/x'",
+    "Unknown topic '/x'", "Node not found".
+    """
+
+
+class SilentFailure(Ros2Error):
+    """ros2cli ends with exit code 1 and prints nothing (`ros2 service type /unknown`)."""
+
+
+def is_hidden_name(name: str) -> bool:
+    """A topic, service or action name with any component starting with '_'."""
+    return topic_or_service_is_hidden(name)
+
+
+def visible(
+    pairs: list[tuple[str, list[str]]], include_hidden: bool = False
+) -> list[tuple[str, list[str]]]:
+    """(name, types) pairs as ros2cli lists them: hidden names left out unless asked for."""
+    return [(n, list(t)) for n, t in pairs if include_hidden or not is_hidden_name(n)]
+
+
+def write_text(ctx: CallContext, text: str) -> None:
+    """What Python's print(text) shows, one line per write (a trailing newline: an empty line)."""
+    for line in text.split("\n"):
+        ctx.write(line)
 
 
 def write_names(ctx: CallContext, lines: list[str], count: bool = False) -> int:

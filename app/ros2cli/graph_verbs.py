@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import math
+import threading
+import time
+from typing import Any
+
 from rclpy.action import (
     get_action_client_names_and_types_by_node,
     get_action_names_and_types,
@@ -10,90 +15,134 @@ from rclpy.action import (
 
 from app.ros.calls import GoalRun, action_type_of, call_service, send_goal
 from app.ros.context import CallContext
-from app.ros.convert import from_yaml, import_type, message_repr, to_yaml
-from app.ros.errors import Ros2Error
-from app.ros.graph import all_nodes, require_node
-from app.ros.names import ACTION_MARKER, split_node_name
-from app.ros2cli.common import write_names
+from app.ros.convert import from_yaml, import_type, message_repr
+from app.ros.graph import all_nodes, wait_for_graph
+from app.ros.names import split_node_name
+from app.ros2cli.common import Ros2cliMessage, SilentFailure, visible, write_names, write_text
+from app.ros2cli.msg_yaml import message_to_yaml
 
 # ------------------------------------------------------------------- node
 
 
 def node_list(ctx: CallContext, all_: bool = False, count: bool = False) -> int:
-    return write_names(ctx, all_nodes(ctx.node, include_hidden=all_), count)
+    names = all_nodes(ctx.node, include_hidden=all_)
+    if not count and len(set(names)) < len(names):
+        ctx.write(
+            "WARNING: Be aware that there are nodes in the graph that share an exact "
+            "name, which can have unintended side effects."
+        )
+    return write_names(ctx, names, count)
 
 
 def _with_types(pairs: list[tuple[str, list[str]]], show_types: bool) -> list[str]:
     return [f"{name} [{', '.join(types)}]" if show_types else name for name, types in pairs]
 
 
-def _visible(pairs: list[tuple[str, list[str]]]) -> list[tuple[str, list[str]]]:
-    return sorted((n, t) for n, t in pairs if ACTION_MARKER not in n)
+def find_node(ctx: CallContext, name: str, include_hidden: bool, message: str) -> str:
+    """``name`` exactly as typed when it is on the graph, else ros2cli's ``message``.
+
+    ros2cli compares the name as given (`ros2 node info talker` finds nothing);
+    the param and lifecycle verbs first add the leading slash.
+    """
+    if not wait_for_graph(ctx, lambda: name in all_nodes(ctx.node, include_hidden=include_hidden)):
+        raise Ros2cliMessage(message)
+    return name
 
 
-def node_info(ctx: CallContext, fqn: str) -> int:
-    target = require_node(ctx, fqn)
+def node_info(ctx: CallContext, fqn: str, include_hidden: bool = False) -> int:
+    """Six sections; an empty one still prints its (empty) list, as one empty line."""
+    target = find_node(ctx, fqn, include_hidden, f"Unable to find node '{fqn}'")
     name, namespace = split_node_name(target)
     node = ctx.node
     sections = [
-        ("Subscribers", _visible(node.get_subscriber_names_and_types_by_node(name, namespace))),
-        ("Publishers", _visible(node.get_publisher_names_and_types_by_node(name, namespace))),
-        ("Service Servers", _visible(node.get_service_names_and_types_by_node(name, namespace))),
-        ("Service Clients", _visible(node.get_client_names_and_types_by_node(name, namespace))),
+        ("Subscribers", node.get_subscriber_names_and_types_by_node(name, namespace)),
+        ("Publishers", node.get_publisher_names_and_types_by_node(name, namespace)),
+        ("Service Servers", node.get_service_names_and_types_by_node(name, namespace)),
+        ("Service Clients", node.get_client_names_and_types_by_node(name, namespace)),
         ("Action Servers", get_action_server_names_and_types_by_node(node, name, namespace)),
         ("Action Clients", get_action_client_names_and_types_by_node(node, name, namespace)),
     ]
     ctx.write(target)
-    for title, entries in sections:
+    for title, pairs in sections:
         ctx.write(f"  {title}:")
-        for entry, types in sorted(entries):
+        entries = sorted(visible(pairs, include_hidden))
+        for entry, types in entries:
             ctx.write(f"    {entry}: {', '.join(types)}")
+        if not entries:
+            ctx.write("")
     return 0
 
 
 # ---------------------------------------------------------------- service
 
 
-def service_list(ctx: CallContext, show_types: bool = False, count: bool = False) -> int:
-    services = _visible(ctx.node.get_service_names_and_types())
-    return write_names(ctx, _with_types(services, show_types), count)
+def _services(ctx: CallContext, include_hidden: bool) -> list[tuple[str, list[str]]]:
+    return visible(ctx.node.get_service_names_and_types(), include_hidden)
 
 
-def service_type(ctx: CallContext, name: str) -> int:
-    types = dict(ctx.node.get_service_names_and_types()).get(name)
+def service_list(
+    ctx: CallContext, show_types: bool = False, count: bool = False, include_hidden: bool = False
+) -> int:
+    return write_names(ctx, _with_types(_services(ctx, include_hidden), show_types), count)
+
+
+def service_type(ctx: CallContext, name: str, include_hidden: bool = False) -> int:
+    types = dict(_services(ctx, include_hidden)).get(name)
     if not types:
-        raise Ros2Error(f"unknown service '{name}' (see `ros2 service list`)")
+        raise SilentFailure(name)  # ros2cli prints nothing and exits with 1
     for type_text in types:
         ctx.write(type_text)
     return 0
 
 
-def service_find(ctx: CallContext, type_text: str) -> int:
-    services = _visible(ctx.node.get_service_names_and_types())
-    return write_names(ctx, [name for name, types in services if type_text in types])
+def service_find(
+    ctx: CallContext, type_text: str, count: bool = False, include_hidden: bool = False
+) -> int:
+    services = _services(ctx, include_hidden)
+    return write_names(ctx, [name for name, types in services if type_text in types], count)
 
 
-def service_info(ctx: CallContext, name: str) -> int:
+def _one_or_list(types: list[str]) -> str:
+    """ros2cli prints a single type as text and several as a Python list."""
+    return types[0] if len(types) == 1 else str(types)
+
+
+def service_info(ctx: CallContext, name: str, include_hidden: bool = False) -> int:
     """Type and how many clients and servers, as Jazzy's `ros2 service info` prints them."""
-    types = dict(ctx.node.get_service_names_and_types()).get(name)
+    types = dict(_services(ctx, include_hidden)).get(name)
     if not types:
-        raise Ros2Error(f"unknown service '{name}' (see `ros2 service list`)")
-    ctx.write(f"Type: {', '.join(types)}")
+        raise Ros2cliMessage(f"Unknown service '{name}'")
+    ctx.write(f"Type: {_one_or_list(types)}")
     ctx.write(f"Clients count: {ctx.node.count_clients(name)}")
     ctx.write(f"Services count: {ctx.node.count_services(name)}")
     return 0
 
 
-def service_call(ctx: CallContext, name: str, type_text: str, values: str = "") -> int:
+def service_call(
+    ctx: CallContext, name: str, type_text: str, values: str = "", rate: float | None = None
+) -> int:
+    """ros2cli's lines: waiting..., the request's repr, an empty line, the response's repr."""
+    if rate is not None and not rate > 0:
+        raise Ros2cliMessage("rate must be greater than zero")
     srv_type = import_type(type_text, "srv")
     request = from_yaml(srv_type.Request, values)
-    ctx.write(f"requester: making request: {message_repr(request)}")
-    ctx.write("")
-    response = call_service(ctx, name, srv_type, request)
-    ctx.write("response:")
-    ctx.write(message_repr(response))
-    ctx.write("")
-    return 0
+    # A fresh `ros2 service call` has never seen the server yet: it always waits first.
+    ctx.write("waiting for service to become available...")
+    deadline = time.monotonic() + ctx.limits.max_seconds if ctx.limits.max_seconds else math.inf
+    while True:
+        ctx.write(f"requester: making request: {message_repr(request)}")
+        ctx.write("")
+        started = time.monotonic()
+        response = call_service(ctx, name, srv_type, request)
+        ctx.write("response:")
+        ctx.write(message_repr(response))
+        ctx.write("")
+        if rate is None:
+            return 0
+        next_call = started + 1.0 / rate
+        if next_call > deadline:
+            return 0
+        ctx.sleep(max(0.0, next_call - time.monotonic()))
 
 
 # ----------------------------------------------------------------- action
@@ -107,16 +156,15 @@ def action_list(ctx: CallContext, show_types: bool = False, count: bool = False)
 def action_type(ctx: CallContext, name: str) -> int:
     action_type = action_type_of(ctx.node, name)
     if action_type is None:
-        raise Ros2Error(f"unknown action '{name}' (see `ros2 action list`)")
+        raise SilentFailure(name)  # ros2cli prints nothing and exits with 1
     ctx.write(action_type)
     return 0
 
 
-def action_info(ctx: CallContext, name: str, show_types: bool = False) -> int:
-    action_type = action_type_of(ctx.node, name)
-    if action_type is None:
-        raise Ros2Error(f"unknown action '{name}' (see `ros2 action list`)")
-    clients, servers = [], []
+def action_info(ctx: CallContext, name: str, show_types: bool = False, count: bool = False) -> int:
+    """Clients and servers of an action (an unknown action simply has none, as in ros2cli)."""
+    clients: list[tuple[str, list[str]]] = []
+    servers: list[tuple[str, list[str]]] = []
     for fqn in all_nodes(ctx.node, include_hidden=True):
         node_name, namespace = split_node_name(fqn)
         try:
@@ -124,52 +172,59 @@ def action_info(ctx: CallContext, name: str, show_types: bool = False) -> int:
             cli = get_action_client_names_and_types_by_node(ctx.node, node_name, namespace)
         except Exception:  # the node left the graph between the two calls
             continue
-        if any(a == name for a, _t in srv):
-            servers.append(fqn)
-        if any(a == name for a, _t in cli):
-            clients.append(fqn)
-    suffix = f" [{action_type}]" if show_types else ""
+        servers += [(fqn, list(t)) for a, t in srv if a == name]
+        clients += [(fqn, list(t)) for a, t in cli if a == name]
     ctx.write(f"Action: {name}")
-    ctx.write(f"Action clients: {len(clients)}")
-    for fqn in clients:
-        ctx.write(f"    {fqn}{suffix}")
-    ctx.write(f"Action servers: {len(servers)}")
-    for fqn in servers:
-        ctx.write(f"    {fqn}{suffix}")
+    for title, found in (("Action clients", clients), ("Action servers", servers)):
+        ctx.write(f"{title}: {len(found)}")
+        for fqn, types in [] if count else found:
+            ctx.write(f"    {fqn} [{', '.join(types)}]" if show_types else f"    {fqn}")
     return 0
 
 
-def _indented(text: str, spaces: int = 4) -> str:
-    return "\n".join(" " * spaces + line for line in text.splitlines())
+def write_message_block(ctx: CallContext, title: str, msg: Any, indent: int) -> None:
+    """ros2cli's "Title:\n<indent><yaml>": only the YAML's first line is indented."""
+    ctx.write(f"{title}:")
+    write_text(ctx, " " * indent + message_to_yaml(msg))
 
 
 def action_send_goal(
     ctx: CallContext, name: str, type_text: str, values: str = "", feedback: bool = False
 ) -> int:
+    """The lines `ros2 action send_goal` prints; its exit code is 0 whatever the goal's fate."""
     action_cls = import_type(type_text, "action")
     goal = from_yaml(action_cls.Goal, values)
     run = GoalRun(name, type_text, goal)
     ctx.write("Waiting for an action server to become available...")
-    ctx.write("Sending goal:")
-    ctx.write(_indented(to_yaml(goal), 5))
-    ctx.write("")
+    write_message_block(ctx, "Sending goal", goal, 5)
+
+    # Feedback runs on the executor thread and may come before we have read the
+    # acceptance: hold it until "Goal accepted" is written, as ros2 prints them.
+    lock = threading.Lock()
+    held: list[Any] | None = []
 
     def on_accepted(run: GoalRun) -> None:
-        ctx.write(f"Goal accepted with ID: {run.goal_id}")
-        ctx.write("")
-
-    def on_feedback(message) -> None:
-        if feedback:
-            ctx.write("Feedback:")
-            ctx.write(_indented(to_yaml(message)))
+        nonlocal held
+        with lock:
+            ctx.write(f"Goal accepted with ID: {run.goal_id}")
             ctx.write("")
+            for message in held or []:
+                write_message_block(ctx, "Feedback", message, 4)
+            held = None
+
+    def on_feedback(message: Any) -> None:
+        if not feedback:
+            return
+        with lock:
+            if held is not None:
+                held.append(message)
+            else:
+                write_message_block(ctx, "Feedback", message, 4)
 
     send_goal(ctx, run, on_feedback, on_accepted)
     if run.status == "REJECTED":
         ctx.write("Goal was rejected.")
-        return 1
-    ctx.write("Result:")
-    ctx.write(_indented(to_yaml(run.result)))
-    ctx.write("")
+        return 0
+    write_message_block(ctx, "Result", run.result, 4)
     ctx.write(f"Goal finished with status: {run.status}")
-    return 0 if run.status == "SUCCEEDED" else 1
+    return 0

@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+from lifecycle_msgs.srv import GetAvailableTransitions
+
+from app.ros.calls import call_service
 from app.ros.context import CallContext
+from app.ros.graph import all_nodes
 from app.ros.lifecycle import (
     available_transitions,
     change_state,
@@ -10,32 +14,63 @@ from app.ros.lifecycle import (
     lifecycle_nodes,
     lifecycle_target,
 )
-from app.ros2cli.common import write_names
+from app.ros2cli.common import Ros2cliMessage, write_names
+from app.ros2cli.param import param_node
 
 
-def verb_nodes(ctx: CallContext, count: bool = False) -> int:
-    return write_names(ctx, lifecycle_nodes(ctx), count)
+def _managed(ctx: CallContext, include_hidden: bool) -> list[str]:
+    """Listed nodes that serve <node>/get_state, as `ros2 lifecycle nodes` finds them."""
+    listed = set(all_nodes(ctx.node, include_hidden=include_hidden))
+    return sorted(n for n in lifecycle_nodes(ctx) if n in listed)
 
 
-def verb_get(ctx: CallContext, fqn: str | None = None) -> int:
-    targets = [lifecycle_target(ctx, fqn)] if fqn else lifecycle_nodes(ctx)
+def _target(ctx: CallContext, fqn: str, include_hidden: bool) -> str:
+    return lifecycle_target(ctx, param_node(ctx, fqn, include_hidden))
+
+
+def verb_nodes(ctx: CallContext, count: bool = False, all_: bool = False) -> int:
+    return write_names(ctx, _managed(ctx, all_), count)
+
+
+def verb_get(ctx: CallContext, fqn: str | None = None, include_hidden: bool = False) -> int:
+    targets = [_target(ctx, fqn, include_hidden)] if fqn else _managed(ctx, include_hidden)
     for target in targets:
         state_id, label = get_state(ctx, target)
         ctx.write(f"{label} [{state_id}]" if fqn else f"{target}: {label} [{state_id}]")
     return 0
 
 
-def verb_list(ctx: CallContext, fqn: str) -> int:
-    target = lifecycle_target(ctx, fqn)
-    for t in available_transitions(ctx, target):
-        ctx.write(f"- {t.label} [{t.id}]")
-        ctx.write(f"\tStart: {t.start}")
-        ctx.write(f"\tGoal: {t.goal}")
+def verb_list(ctx: CallContext, fqn: str, include_hidden: bool = False, all_: bool = False) -> int:
+    target = _target(ctx, fqn, include_hidden)
+    if all_:  # every transition of the state machine, not only those from here
+        response = call_service(
+            ctx,
+            f"{target}/get_transition_graph",
+            GetAvailableTransitions,
+            GetAvailableTransitions.Request(),
+        )
+        rows = [
+            (t.transition.label, t.transition.id, t.start_state.label, t.goal_state.label)
+            for t in response.available_transitions
+        ]
+    else:
+        rows = [(t.label, t.id, t.start, t.goal) for t in available_transitions(ctx, target)]
+    for label, transition_id, start, goal in rows:
+        ctx.write(f"- {label} [{transition_id}]")
+        ctx.write(f"\tStart: {start}")
+        ctx.write(f"\tGoal: {goal}")
     return 0
 
 
-def verb_set(ctx: CallContext, fqn: str, transition: str) -> int:
-    target = lifecycle_target(ctx, fqn)
+def verb_set(ctx: CallContext, fqn: str, transition: str, include_hidden: bool = False) -> int:
+    """A label first, then an id, as ros2cli matches; its exit code is 0 even on failure."""
+    target = _target(ctx, fqn, include_hidden)
+    available = available_transitions(ctx, target)
+    if not any(transition in (t.label, str(t.id)) for t in available):
+        raise Ros2cliMessage(
+            "Unknown transition requested, available ones are:"
+            + "".join(f"\n- {t.label} [{t.id}]" for t in available)
+        )
     ok, _chosen = change_state(ctx, target, transition)
     ctx.write("Transitioning successful" if ok else "Transitioning failed")
-    return 0 if ok else 1
+    return 0

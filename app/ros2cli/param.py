@@ -2,15 +2,15 @@
 
 from __future__ import annotations
 
+import re
+
 import yaml
-from rcl_interfaces.msg import ParameterType
+from rcl_interfaces.msg import ParameterDescriptor, ParameterType
 
 from app.ros.context import CallContext
-from app.ros.convert import dump_yaml
 from app.ros.errors import Ros2Error
-from app.ros.graph import all_nodes, require_node
+from app.ros.graph import all_nodes
 from app.ros.params import (
-    TYPE_NAMES,
     TYPE_WORDS,
     describe,
     dump_dict,
@@ -20,57 +20,132 @@ from app.ros.params import (
     python_value,
     set_value,
 )
+from app.ros2cli.common import Ros2cliMessage, write_text
+from app.ros2cli.graph_verbs import find_node
 from app.ros2cli.run import params_file
 
+# `ros2 param list --param-type` and `ros2 param describe` name the types so.
+TYPE_WORDS_CLI = {
+    ParameterType.PARAMETER_BOOL: "boolean",
+    ParameterType.PARAMETER_INTEGER: "integer",
+    ParameterType.PARAMETER_DOUBLE: "double",
+    ParameterType.PARAMETER_STRING: "string",
+    ParameterType.PARAMETER_BYTE_ARRAY: "byte array",
+    ParameterType.PARAMETER_BOOL_ARRAY: "boolean array",
+    ParameterType.PARAMETER_INTEGER_ARRAY: "integer array",
+    ParameterType.PARAMETER_DOUBLE_ARRAY: "double array",
+    ParameterType.PARAMETER_STRING_ARRAY: "string array",
+    ParameterType.PARAMETER_NOT_SET: "not set",
+}
 
-def param_list(ctx: CallContext, fqn: str | None = None, show_types: bool = False) -> int:
-    targets = [require_node(ctx, fqn)] if fqn else all_nodes(ctx.node)
+
+def param_node(ctx: CallContext, fqn: str, include_hidden: bool = False) -> str:
+    """The node's absolute name if it is on the graph, else ros2cli's 'Node not found'."""
+    target = fqn if fqn.startswith("/") else "/" + fqn
+    return find_node(ctx, target, include_hidden, "Node not found")
+
+
+def param_list(
+    ctx: CallContext,
+    fqn: str | None = None,
+    show_types: bool = False,
+    include_hidden: bool = False,
+    prefixes: list[str] | None = None,
+    regex: str | None = None,
+) -> int:
+    targets = [param_node(ctx, fqn, include_hidden)] if fqn else all_nodes(ctx.node, include_hidden)
+    pattern = re.compile(regex) if regex is not None else None
     for target in targets:
         try:
             names = list_names(ctx, target)
-        except Ros2Error as exc:
+        except Ros2Error:
             if fqn:
                 raise
-            ctx.write(f"{target}: ({exc})")
+            ctx.write(
+                f"Wait for service timed out waiting for parameter services for node {target}"
+            )
             continue
-        if not fqn:
+        if prefixes:
+            names = [n for n in names if any(n == p or n.startswith(p + ".") for p in prefixes)]
+        if pattern is not None:
+            names = [n for n in names if pattern.match(n)]
+        if not fqn and names:
             ctx.write(f"{target}:")
         types = {}
         if show_types and names:
             types = {
-                n: TYPE_NAMES.get(d.type, "?")
+                n: TYPE_WORDS_CLI.get(d.type, "?")
                 for n, d in zip(names, describe(ctx, target, names), strict=False)
             }
         for name in names:
-            ctx.write(f"  {name}" + (f" (type: {types[name]})" if show_types else ""))
+            ctx.write(f"  {name} (type: {types[name]})" if show_types else f"  {name}")
     return 0
 
 
-def param_get(ctx: CallContext, fqn: str, name: str) -> int:
-    target = require_node(ctx, fqn)
+def param_get(
+    ctx: CallContext, fqn: str, name: str, include_hidden: bool = False, hide_type: bool = False
+) -> int:
+    target = param_node(ctx, fqn, include_hidden)
     value = get_values(ctx, target, [name])
-    if not value or value[0].type == ParameterType.PARAMETER_NOT_SET:
-        ctx.write("Parameter not set.")
-        return 1
+    if not value:
+        raise Ros2cliMessage("Parameter not set")
+    if value[0].type == ParameterType.PARAMETER_NOT_SET:
+        ctx.write("None" if hide_type else "Parameter not set.")
+        return 0
     words, _attr = TYPE_WORDS[value[0].type]
-    ctx.write(f"{words}: {python_value(value[0])}")
+    shown = python_value(value[0])
+    if value[0].type == ParameterType.PARAMETER_BYTE_ARRAY:
+        shown = [bytes([b]) for b in shown]  # as rclpy hands byte values to ros2cli
+    ctx.write(str(shown) if hide_type else f"{words}: {shown}")
     return 0
 
 
-def param_set(ctx: CallContext, fqn: str, name: str, text: str) -> int:
-    target = require_node(ctx, fqn)
+def param_set(
+    ctx: CallContext, fqn: str, name: str, text: str, include_hidden: bool = False
+) -> int:
+    target = param_node(ctx, fqn, include_hidden)
     ok, reason = set_value(ctx, target, name, parse_value(text))
-    if ok:
-        ctx.write("Set parameter successful" + (f": {reason}" if reason else ""))
-        return 0
-    ctx.write("Set parameter failed" + (f": {reason}" if reason else ""))
-    return 1
+    words = "Set parameter successful" if ok else "Setting parameter failed"
+    ctx.write(words + (f": {reason}" if reason else ""))
+    return 0  # ros2cli exits with 0 either way
 
 
-def param_dump(ctx: CallContext, fqn: str) -> int:
-    text = dump_yaml(dump_dict(ctx, fqn))
-    for line in text.rstrip().splitlines():
-        ctx.write(line)
+def describe_lines(descriptor: ParameterDescriptor) -> list[str]:
+    """One parameter's descriptor as `ros2 param describe` prints it."""
+    lines = [
+        f"Parameter name: {descriptor.name}",
+        f"  Type: {TYPE_WORDS_CLI.get(descriptor.type, '?')}",
+    ]
+    if descriptor.description:
+        lines.append(f"  Description: {descriptor.description}")
+    lines.append("  Constraints:")
+    if descriptor.read_only:
+        lines.append("    Read only: true")
+    ranges = [*descriptor.floating_point_range, *descriptor.integer_range]
+    if ranges:
+        lines.append(f"    Min value: {ranges[0].from_value}")
+        lines.append(f"    Max value: {ranges[0].to_value}")
+        if ranges[0].step:
+            lines.append(f"    Step: {ranges[0].step}")
+    if descriptor.additional_constraints:
+        lines.append(f"    Additional constraints: {descriptor.additional_constraints}")
+    return lines
+
+
+def param_describe(
+    ctx: CallContext, fqn: str, names: list[str], include_hidden: bool = False
+) -> int:
+    target = param_node(ctx, fqn, include_hidden)
+    for descriptor in describe(ctx, target, names):
+        for line in describe_lines(descriptor):
+            ctx.write(line)
+    return 0
+
+
+def param_dump(ctx: CallContext, fqn: str, include_hidden: bool = False) -> int:
+    """ros2cli's dump: yaml.dump's defaults (sorted keys, block lists), then an empty line."""
+    target = param_node(ctx, fqn, include_hidden)
+    write_text(ctx, yaml.dump(dump_dict(ctx, target), default_flow_style=False))
     return 0
 
 
@@ -86,9 +161,9 @@ def _flatten(values: dict, prefix: str = "") -> dict:
     return flat
 
 
-def param_load(ctx: CallContext, fqn: str, file_text: str) -> int:
+def param_load(ctx: CallContext, fqn: str, file_text: str, include_hidden: bool = False) -> int:
     """Set every parameter a dump file holds for this node (or for every node: ``/**``)."""
-    target = require_node(ctx, fqn)
+    target = param_node(ctx, fqn, include_hidden)
     data = yaml.safe_load(params_file(file_text).read_text(encoding="utf-8"))
     sections = [
         section["ros__parameters"]
@@ -97,11 +172,9 @@ def param_load(ctx: CallContext, fqn: str, file_text: str) -> int:
     ]
     if not sections:
         raise Ros2Error(f"{file_text!r} has no parameters for {target} (nor for /**)")
-    failed = False
     for section in sections:
         for name, value in _flatten(section or {}).items():
             ok, reason = set_value(ctx, target, name, value)
-            failed |= not ok
             outcome = "successful" if ok else "failed"
             ctx.write(f"Set parameter {name} {outcome}" + (f": {reason}" if reason else ""))
-    return 1 if failed else 0
+    return 0  # ros2cli exits with 0 even when a parameter was refused

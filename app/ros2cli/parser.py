@@ -16,8 +16,9 @@ from typing import Any, NoReturn
 
 from app.ros.context import CallContext, Write
 from app.ros.errors import Cancelled, Ros2Error
-from app.ros2cli import bag, graph_verbs, interfaces, launch_verb, lifecycle, param, run, topic
-from app.ros2cli.common import settle_discovery
+from app.ros2cli import bag, interfaces, launch_verb, run
+from app.ros2cli import verbs as verb_args
+from app.ros2cli.common import Ros2cliMessage, SilentFailure, settle_discovery
 
 log = logging.getLogger(__name__)
 
@@ -37,7 +38,8 @@ class _Parser(argparse.ArgumentParser):
     """An ArgumentParser that writes to our output and raises instead of exiting."""
 
     def __init__(self, *args: Any, write: Write, **kwargs: Any) -> None:
-        kwargs.setdefault("exit_on_error", False)
+        # argparse then reports every mistake through error() below, as ros2 does.
+        kwargs.setdefault("exit_on_error", True)
         super().__init__(*args, **kwargs)
         self._write = write
 
@@ -52,7 +54,13 @@ class _Parser(argparse.ArgumentParser):
         raise _HelpShown()
 
     def error(self, message: str) -> NoReturn:
-        raise UsageError(f"{self.prog}: {message}")
+        # As argparse (and so ros2) prints it: the usage, then "PROG: error: MESSAGE".
+        self._print_message(self.format_usage())
+        raise ArgumentUsageError(f"{self.prog}: error: {message}")
+
+
+class ArgumentUsageError(UsageError):
+    """argparse's own complaint, written verbatim (exit code 2, as ros2's)."""
 
 
 def split_command(text: str) -> list[str]:
@@ -69,16 +77,6 @@ def split_command(text: str) -> list[str]:
 Handler = Callable[[CallContext, argparse.Namespace], int]
 
 
-def topic_and_type(p: argparse.ArgumentParser) -> None:
-    """The two positional arguments of echo, hz and bw: a topic, and optionally its type."""
-    p.add_argument("topic_name")
-    p.add_argument("message_type", nargs="?")
-
-
-def _measure_handler(measure: Callable[..., int]) -> Handler:
-    return lambda c, a: measure(c, a.topic_name, a.message_type, a.window)
-
-
 def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
     parser = _Parser(prog=prog, write=write, description="ros2-like verbs")
     groups = parser.add_subparsers(dest="group", metavar="COMMAND", parser_class=_Parser)
@@ -91,180 +89,17 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
         return verbs
 
     def verb(verbs, name: str, help_text: str, handler: Handler) -> argparse.ArgumentParser:
-        p = verbs.add_parser(name, help=help_text, write=write)
+        p = verbs.add_parser(name, help=help_text, description=help_text, write=write)
         p.set_defaults(handler=handler)
         return p
 
-    def typed_list(verbs, noun: str, listing: Callable[..., int]) -> None:
-        """`ros2 service list` and `ros2 action list`, with -t (types) and -c (count)."""
-        p = verb(
-            verbs,
-            "list",
-            f"list {noun}s",
-            lambda c, a: listing(c, a.show_types, getattr(a, f"count_{noun}s")),
-        )
-        p.add_argument("-t", "--show-types", action="store_true")
-        p.add_argument("-c", f"--count-{noun}s", action="store_true")
-
-    # node
-    v = group("node", "nodes on the graph")
-    p = verb(v, "list", "list nodes", lambda c, a: graph_verbs.node_list(c, a.all, a.count_nodes))
-    p.add_argument("-a", "--all", action="store_true", help="include hidden nodes")
-    p.add_argument("-c", "--count-nodes", action="store_true", help="only print the count")
-    p = verb(v, "info", "a node's endpoints", lambda c, a: graph_verbs.node_info(c, a.node_name))
-    p.add_argument("node_name")
-
-    # topic
-    v = group("topic", "topics")
-    p = verb(
-        v,
-        "list",
-        "list topics",
-        lambda c, a: topic.list_topics(c, a.show_types, a.verbose),
-    )
-    p.add_argument("-t", "--show-types", action="store_true")
-    p.add_argument("-v", "--verbose", action="store_true", help="with publisher/subscriber counts")
-    p = verb(
-        v, "info", "type, counts and QoS", lambda c, a: topic.topic_info(c, a.topic_name, a.verbose)
-    )
-    p.add_argument("topic_name")
-    p.add_argument("-v", "--verbose", action="store_true", help="endpoints with their QoS")
-    p = verb(v, "type", "a topic's type", lambda c, a: topic.topic_type(c, a.topic_name))
-    p.add_argument("topic_name")
-    p = verb(v, "find", "topics of a type", lambda c, a: topic.find(c, a.topic_type))
-    p.add_argument("topic_type")
-    p = verb(
-        v,
-        "echo",
-        "print messages",
-        lambda c, a: topic.echo(c, a.topic_name, a.message_type, once=a.once, field=a.field),
-    )
-    topic_and_type(p)
-    p.add_argument("--once", action="store_true", help="print one message and exit")
-    p.add_argument("--field", help="print only this field, e.g. linear.x")
-    for name, help_text, measure, window in (
-        ("hz", "publishing rate", topic.hz, 10_000),
-        ("bw", "bandwidth", topic.bw, 100),
-    ):
-        p = verb(v, name, help_text, _measure_handler(measure))
-        topic_and_type(p)
-        p.add_argument("-w", "--window", type=int, default=window, help="messages in the window")
-    p = verb(
-        v,
-        "pub",
-        "publish",
-        lambda c, a: topic.pub(
-            c,
-            a.topic_name,
-            a.message_type,
-            a.values,
-            once=a.once,
-            rate=a.rate,
-            times=a.times,
-            wait_matching=a.wait_matching_subscriptions,
-        ),
-    )
-    p.add_argument("topic_name")
-    p.add_argument("message_type")
-    p.add_argument("values", nargs="?", default="", help="YAML, e.g. \"{data: 'hi'}\"")
-    p.add_argument("-1", "--once", action="store_true", help="publish one message and exit")
-    p.add_argument("-r", "--rate", type=float, default=1.0, help="Hz (default 1)")
-    p.add_argument("-t", "--times", type=int, default=None, help="publish this many times")
-    p.add_argument("-w", "--wait-matching-subscriptions", type=int, default=None)
-
-    # service
-    v = group("service", "services")
-    typed_list(v, "service", graph_verbs.service_list)
-    p = verb(
-        v, "type", "a service's type", lambda c, a: graph_verbs.service_type(c, a.service_name)
-    )
-    p.add_argument("service_name")
-    p = verb(v, "find", "services of a type", lambda c, a: graph_verbs.service_find(c, a.type_name))
-    p.add_argument("type_name")
-    p = verb(v, "info", "type and counts", lambda c, a: graph_verbs.service_info(c, a.service_name))
-    p.add_argument("service_name")
-    p = verb(
-        v,
-        "call",
-        "call a service",
-        lambda c, a: graph_verbs.service_call(c, a.service_name, a.service_type, a.values),
-    )
-    p.add_argument("service_name")
-    p.add_argument("service_type")
-    p.add_argument("values", nargs="?", default="")
-
-    # action
-    v = group("action", "actions")
-    typed_list(v, "action", graph_verbs.action_list)
-    p = verb(v, "type", "an action's type", lambda c, a: graph_verbs.action_type(c, a.action_name))
-    p.add_argument("action_name")
-    p = verb(
-        v,
-        "info",
-        "clients and servers",
-        lambda c, a: graph_verbs.action_info(c, a.action_name, a.show_types),
-    )
-    p.add_argument("action_name")
-    p.add_argument("-t", "--show-types", action="store_true")
-    p = verb(
-        v,
-        "send_goal",
-        "send a goal",
-        lambda c, a: graph_verbs.action_send_goal(
-            c, a.action_name, a.action_type, a.goal, a.feedback
-        ),
-    )
-    p.add_argument("action_name")
-    p.add_argument("action_type")
-    p.add_argument("goal", nargs="?", default="")
-    p.add_argument("-f", "--feedback", action="store_true", help="print feedback as it arrives")
-
-    # param
-    v = group("param", "parameters")
-    p = verb(
-        v, "list", "parameter names", lambda c, a: param.param_list(c, a.node_name, a.param_type)
-    )
-    p.add_argument("node_name", nargs="?")
-    p.add_argument("--param-type", action="store_true")
-    p = verb(v, "get", "one value", lambda c, a: param.param_get(c, a.node_name, a.parameter_name))
-    p.add_argument("node_name")
-    p.add_argument("parameter_name")
-    p = verb(
-        v,
-        "set",
-        "set one value",
-        lambda c, a: param.param_set(c, a.node_name, a.parameter_name, a.value),
-    )
-    p.add_argument("node_name")
-    p.add_argument("parameter_name")
-    p.add_argument("value")
-    p = verb(v, "dump", "all values as YAML", lambda c, a: param.param_dump(c, a.node_name))
-    p.add_argument("node_name")
-    p = verb(
-        v,
-        "load",
-        "set values from a YAML file",
-        lambda c, a: param.param_load(c, a.node_name, a.parameter_file),
-    )
-    p.add_argument("node_name")
-    p.add_argument("parameter_file")
-
-    # lifecycle
-    v = group("lifecycle", "managed (lifecycle) nodes")
-    p = verb(v, "nodes", "lifecycle nodes", lambda c, a: lifecycle.verb_nodes(c, a.count_nodes))
-    p.add_argument("-c", "--count-nodes", action="store_true")
-    p = verb(v, "get", "current state", lambda c, a: lifecycle.verb_get(c, a.node_name))
-    p.add_argument("node_name", nargs="?")
-    p = verb(v, "list", "available transitions", lambda c, a: lifecycle.verb_list(c, a.node_name))
-    p.add_argument("node_name")
-    p = verb(
-        v,
-        "set",
-        "trigger a transition",
-        lambda c, a: lifecycle.verb_set(c, a.node_name, a.transition),
-    )
-    p.add_argument("node_name")
-    p.add_argument("transition", help="label (configure, activate, ...) or id")
+    # node, topic, service, action, param, lifecycle: arguments as Jazzy's ros2cli has them
+    verb_args.add_node(group("node", "Various node related sub-commands"), verb)
+    verb_args.add_topic(group("topic", "Various topic related sub-commands"), verb)
+    verb_args.add_service(group("service", "Various service related sub-commands"), verb)
+    verb_args.add_action(group("action", "Various action related sub-commands"), verb)
+    verb_args.add_param(group("param", "Various param related sub-commands"), verb)
+    verb_args.add_lifecycle(group("lifecycle", "Various lifecycle related sub-commands"), verb)
 
     # interface
     v = group("interface", "message, service and action definitions")
@@ -366,11 +201,19 @@ def run_argv(ctx: CallContext, argv: list[str], prog: str = "ros2") -> int:
         if needs_ros(argv):
             settle_discovery(ctx)
         return args.handler(ctx, args)
+    except ArgumentUsageError as exc:
+        ctx.write(str(exc))
+        return EXIT_USAGE
     except UsageError as exc:
         ctx.write(f"error: {exc}")
         return EXIT_USAGE
     except Cancelled:
         ctx.write("(stopped)")
+        return EXIT_FAILED
+    except SilentFailure:
+        return EXIT_FAILED
+    except Ros2cliMessage as exc:  # ros2cli's own words, as `ros2` prints them
+        ctx.write(str(exc))
         return EXIT_FAILED
     except Ros2Error as exc:
         ctx.write(f"error: {exc}")

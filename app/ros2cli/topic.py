@@ -6,85 +6,139 @@ import math
 import time
 from typing import Any
 
+import yaml
+
 from app.ros.context import CallContext
 from app.ros.convert import (
-    dump_yaml,
-    field_value,
     fields_of,
     fill,
     import_type,
+    is_message,
     message_repr,
     parse_yaml,
-    to_plain,
-    to_yaml,
 )
 from app.ros.errors import Ros2Error
-from app.ros.graph import resolve_topic_type, topic_types
+from app.ros.graph import resolve_topic_type, topic_types, wait_for_graph
 from app.ros.monitor import TopicMonitor
-from app.ros.qos import MEASURE_QOS, qos_lines
+from app.ros.qos import MEASURE_QOS
+from app.ros2cli.common import (
+    Ros2cliMessage,
+    SilentFailure,
+    visible,
+    write_names,
+    write_text,
+)
+from app.ros2cli.msg_yaml import ECHO_TRUNCATE_LENGTH, message_to_yaml
 
 # ------------------------------------------------------------------ verbs
 
 
-def list_topics(ctx: CallContext, show_types: bool = False, counts: bool = False) -> int:
-    for name, types in sorted(topic_types(ctx.node).items()):
-        line = name
-        if show_types:
-            line += f" [{', '.join(types)}]"
-        if counts:
-            pubs, subs = ctx.node.count_publishers(name), ctx.node.count_subscribers(name)
-            line += f" ({pubs} publisher{'s' * (pubs != 1)}, {subs} subscriber{'s' * (subs != 1)})"
-        ctx.write(line)
+def _topics(ctx: CallContext, include_hidden: bool) -> list[tuple[str, list[str]]]:
+    return sorted(visible(ctx.node.get_topic_names_and_types(), include_hidden))
+
+
+def _counted(topics: list[tuple[str, list[str], int]], noun: str) -> list[str]:
+    """`ros2 topic list -v`'s section: one ' * name [types] N nouns' line per used topic."""
+    lines = [f"{noun.capitalize()} topics:"]
+    for name, types, n in topics:
+        if n:
+            kind = "publisher" if noun == "published" else "subscriber"
+            lines.append(f" * {name} [{', '.join(types)}] {n} {kind}{'s' * (n > 1)}")
+    return lines + [""]
+
+
+def list_topics(
+    ctx: CallContext,
+    show_types: bool = False,
+    verbose: bool = False,
+    count: bool = False,
+    include_hidden: bool = False,
+) -> int:
+    topics = _topics(ctx, include_hidden)
+    if count:
+        ctx.write(str(len(topics)))
+        return 0
+    if verbose and topics:
+        node = ctx.node
+        for noun, counter in (
+            ("published", node.count_publishers),
+            ("subscribed", node.count_subscribers),
+        ):
+            for line in _counted([(n, t, counter(n)) for n, t in topics], noun):
+                ctx.write(line)
+        return 0
+    for name, types in topics:
+        ctx.write(f"{name} [{', '.join(types)}]" if show_types else name)
     return 0
 
 
 def topic_info(ctx: CallContext, topic: str, verbose: bool = False) -> int:
-    types = topic_types(ctx.node, include_hidden=True).get(topic)
+    """As ros2cli: -v adds an empty line after each line and rclpy's text of each endpoint."""
+    types = dict(_topics(ctx, include_hidden=True)).get(topic)
     if not types:
-        raise Ros2Error(f"unknown topic '{topic}' (see `ros2 topic list`)")
-    ctx.write(f"Type: {', '.join(types)}")
-    for label, infos in (
-        ("Publisher", ctx.node.get_publishers_info_by_topic(topic)),
-        ("Subscription", ctx.node.get_subscriptions_info_by_topic(topic)),
+        raise Ros2cliMessage(f"Unknown topic '{topic}'")
+    end = [""] if verbose else []
+    for line in [f"Type: {types[0] if len(types) == 1 else types}", *end]:
+        ctx.write(line)
+    for label, counter, infos in (
+        ("Publisher", ctx.node.count_publishers, ctx.node.get_publishers_info_by_topic),
+        ("Subscription", ctx.node.count_subscribers, ctx.node.get_subscriptions_info_by_topic),
     ):
+        for line in [f"{label} count: {counter(topic)}", *end]:
+            ctx.write(line)
         if verbose:
-            ctx.write("")
-        ctx.write(f"{label} count: {len(infos)}")
-        if not verbose:
-            continue
-        for info in infos:
-            ctx.write("")
-            ctx.write(f"Node name: {info.node_name}")
-            ctx.write(f"Node namespace: {info.node_namespace}")
-            ctx.write(f"Topic type: {info.topic_type}")
-            ctx.write(f"Endpoint type: {getattr(info.endpoint_type, 'name', info.endpoint_type)}")
-            gid = ".".join(f"{b:02x}" for b in info.endpoint_gid)
-            ctx.write(f"GID: {gid}")
-            for line in qos_lines(info.qos_profile):
-                ctx.write(line)
+            for info in infos(topic):
+                # rclpy's TopicEndpointInfo text: names, type, type hash, GID, QoS profile.
+                write_text(ctx, f"{info}\n")
     return 0
 
 
-def topic_type(ctx: CallContext, topic: str) -> int:
-    types = topic_types(ctx.node, include_hidden=True).get(topic)
+def topic_type(ctx: CallContext, topic: str, include_hidden: bool = False) -> int:
+    types = dict(_topics(ctx, include_hidden)).get(topic)
     if not types:
-        raise Ros2Error(f"unknown topic '{topic}' (see `ros2 topic list`)")
+        raise SilentFailure(topic)  # ros2cli prints nothing and exits with 1
     for type_text in types:
         ctx.write(type_text)
     return 0
 
 
-def find(ctx: CallContext, type_text: str) -> int:
+def find(
+    ctx: CallContext, type_text: str, count: bool = False, include_hidden: bool = False
+) -> int:
     """The topics that carry a type (the full name, as `ros2 topic list -t` prints it)."""
-    for name, types in sorted(topic_types(ctx.node).items()):
-        if type_text in types:
-            ctx.write(name)
-    return 0
+    found = [name for name, types in _topics(ctx, include_hidden) if type_text in types]
+    return write_names(ctx, found, count)
 
 
 def _deadline(ctx: CallContext) -> float:
     limit = ctx.limits.max_seconds
     return time.monotonic() + limit if limit else math.inf
+
+
+def _echo_type(ctx: CallContext, topic: str, type_text: str | None) -> type:
+    if type_text:
+        return import_type(type_text, "msg")
+    wait_for_graph(ctx, lambda: topic in topic_types(ctx.node, include_hidden=True))
+    types = topic_types(ctx.node, include_hidden=True).get(topic)
+    if not types:
+        raise Ros2cliMessage("Could not determine the type for the passed topic")
+    return import_type(types[0], "msg")
+
+
+def _selected(msg: Any, field: list[str] | None, field_text: str) -> Any:
+    for part in field or []:
+        try:
+            msg = getattr(msg, part)
+        except AttributeError as exc:
+            raise Ros2cliMessage(f"Invalid field '{field_text}': {exc}") from None
+    return msg
+
+
+def echo_text(value: Any, truncate_length: int | None = ECHO_TRUNCATE_LENGTH) -> str:
+    """One echoed message as ros2cli prints it, up to and with its closing '---'."""
+    if is_message(value):
+        return message_to_yaml(value, truncate_length) + "---"
+    return f"{value}\n---"  # a selected field that is not a message: printed as Python does
 
 
 def echo(
@@ -95,12 +149,21 @@ def echo(
     once: bool = False,
     field: str | None = None,
     count: int | None = None,
+    truncate_length: int | None = ECHO_TRUNCATE_LENGTH,
+    timeout: float | None = None,
 ) -> int:
-    msg_type = resolve_topic_type(ctx, topic, type_text)
+    parts = None
+    if field is not None:
+        parts = [p for p in field.split(".") if p]
+        if not parts:
+            raise Ros2cliMessage(f"Invalid field value '{field}'")
+    msg_type = _echo_type(ctx, topic, type_text)
     limit = 1 if once else count or ctx.limits.max_messages
     monitor = TopicMonitor(ctx.node, topic, msg_type, keep=200, window=16)
     shown = 0
     deadline = _deadline(ctx)
+    if timeout is not None:
+        deadline = min(deadline, time.monotonic() + timeout)
     try:
         while limit is None or shown < limit:
             ctx.check_cancel()
@@ -115,24 +178,14 @@ def echo(
                 if limit is not None and shown >= limit:
                     break
                 shown += 1
-                if field:
-                    value = to_plain(field_value(msg, field))
-                    ctx.write(_field_text(value))
-                else:
-                    ctx.write(to_yaml(msg))
-                ctx.write("---")
+                write_text(ctx, echo_text(_selected(msg, parts, field or ""), truncate_length))
             shown = max(shown, seen)  # messages dropped from the buffer count as shown
     finally:
         monitor.close()
-    if shown == 0:
+    if shown == 0 and timeout is None and ctx.limits.max_seconds:
+        # The Console's own bound (ros2 would keep waiting): say why nothing came.
         ctx.write(f"(no message on {topic} within {ctx.limits.max_seconds:g} s)")
     return 0
-
-
-def _field_text(value: Any) -> str:
-    if isinstance(value, dict | list):
-        return dump_yaml(value)
-    return str(value)
 
 
 def _measure(ctx: CallContext, topic: str, type_text: str | None, window: int, report) -> int:
@@ -196,59 +249,91 @@ def _stamped(ctx: CallContext, msg_type: type, data: dict[str, Any]) -> Any:
     return fill(msg_type, with_stamps(msg_type, data, {"sec": now.sec, "nanosec": now.nanosec}))
 
 
+def _wait_for_subscribers(
+    ctx: CallContext, publisher: Any, wanted: int, max_wait_time: float | None
+) -> None:
+    """ros2cli's wait: a 'Waiting for ...' line each second while too few subscriptions match."""
+    started = time.monotonic()
+    # The Console bounds the wait (ros2 waits endlessly unless --max-wait-time-secs).
+    console_limit = ctx.limits.max_seconds if max_wait_time is None else None
+    checks = 0
+    while publisher.get_subscription_count() < wanted:
+        if checks % 10 == 0:
+            ctx.write(f"Waiting for at least {wanted} matching subscription(s)...")
+        waited = time.monotonic() - started
+        if max_wait_time is not None and waited >= max_wait_time:
+            raise Ros2cliMessage(
+                f"Timed out waiting for subscribers: Expected {wanted} subcribers but only "
+                f"got {publisher.get_subscription_count()} subscribers"
+            )
+        if console_limit and waited >= console_limit:
+            ctx.write("(no subscriber matched; publishing anyway)")
+            return
+        checks += 1
+        ctx.sleep(0.1)
+
+
 def pub(
     ctx: CallContext,
     topic: str,
     type_text: str,
-    values: str = "",
+    values: str = "{}",
     *,
     once: bool = False,
     rate: float = 1.0,
     times: int | None = None,
     wait_matching: int | None = None,
+    print_nth: int = 1,
+    max_wait_time: float | None = None,
+    keep_alive: float = 0.1,
 ) -> int:
+    """`ros2 topic pub`: wait for subscribers if asked, then publish and print as ros2cli."""
+    if not rate > 0 or not math.isfinite(rate):
+        raise Ros2Error(f"rate must be a positive number of Hz, got {rate}")
     msg_type = import_type(type_text, "msg")
+    try:
+        loaded = yaml.safe_load(values or "{}")
+    except yaml.YAMLError:
+        loaded = None  # parse_yaml below names the YAML mistake
+    if loaded is not None and not isinstance(loaded, dict):
+        raise Ros2cliMessage("The passed value needs to be a dictionary in YAML format")
     data = parse_yaml(values)
     stamps = with_stamps(msg_type, data, {"sec": 0, "nanosec": 0}) != data
     msg = _stamped(ctx, msg_type, data)
-    if not rate > 0 or not math.isfinite(rate):
-        raise Ros2Error(f"rate must be a positive number of Hz, got {rate}")
-    if once:
-        times = 1
+    times = 1 if once else (times or 0)
     if wait_matching is None:
-        wait_matching = 1 if times else 0
+        wait_matching = int(times != 0)
+    if wait_matching == 0 and max_wait_time is not None:
+        raise Ros2cliMessage(
+            "--max-wait-time-secs option is only effective with "
+            "--wait-matching-subscriptions, --once or --times"
+        )
     existing = topic_types(ctx.node, include_hidden=True).get(topic)
     if existing and type_text and import_type(existing[0]) is not msg_type:
         raise Ros2Error(f"topic '{topic}' already carries {existing[0]}, not {type_text}")
     publisher = ctx.node.create_publisher(msg_type, topic, 10)
     try:
-        wait_end = time.monotonic() + ctx.limits.service_timeout
-        if wait_matching:
-            ctx.write(f"Waiting for at least {wait_matching} matching subscription(s)...")
-        while publisher.get_subscription_count() < wait_matching:
-            if time.monotonic() > wait_end:
-                ctx.write("(no subscriber matched; publishing anyway)")
-                break
-            ctx.sleep(0.05)
+        _wait_for_subscribers(ctx, publisher, wait_matching, max_wait_time)
         ctx.write("publisher: beginning loop")
         deadline = _deadline(ctx)
         start = time.monotonic()
         sent = 0
-        while times is None or sent < times:
+        while times == 0 or sent < times:
             if stamps:  # "auto"/"now": the time of each message, as ros2 topic pub does
                 msg = _stamped(ctx, msg_type, data)
-            publisher.publish(msg)
             sent += 1
-            ctx.write(f"publishing #{sent}: {message_repr(msg)}")
-            ctx.write("")
-            if times is not None and sent >= times:
+            if print_nth and sent % print_nth == 0:
+                ctx.write(f"publishing #{sent}: {message_repr(msg)}")
+                ctx.write("")
+            publisher.publish(msg)
+            if times and sent >= times:
                 break
             next_time = start + sent / rate
             if next_time > deadline:
                 break
             ctx.sleep(max(0.0, next_time - time.monotonic()))
-        if times == 1:
-            ctx.sleep(0.5)  # let a reliable subscriber receive it before we vanish
+        # Let the last message reach a reliable subscriber before the publisher goes.
+        ctx.sleep(max(keep_alive, 0.5 if times == 1 else 0.0))
     finally:
         ctx.node.destroy_publisher(publisher)
     return 0

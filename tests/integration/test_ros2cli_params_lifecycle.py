@@ -7,7 +7,7 @@ import re
 import pytest
 
 from app.ros.context import Limits
-from tests.integration.conftest import TEST_LIMITS, one_error_line
+from tests.integration.conftest import TEST_LIMITS
 
 pytestmark = pytest.mark.ros
 
@@ -31,7 +31,8 @@ def test_param_list_get_set_dump(supervisor, ros2):
     code, lines = ros2("param get /parameters_node publish_rate_hz")
     assert lines == ["Double value is: 2.0"]
     code, lines = ros2("param get /parameters_node no_such_thing")
-    assert code == 1 and lines == ["Parameter not set."]
+    # rclpy answers an undeclared name with no value: ros2cli's "Parameter not set", 1
+    assert (code, lines) == (1, ["Parameter not set"])
 
     code, lines = ros2("param set /parameters_node publish_rate_hz 10.0")
     assert (code, lines) == (0, ["Set parameter successful"])
@@ -40,10 +41,11 @@ def test_param_list_get_set_dump(supervisor, ros2):
     code, lines = ros2("param get /parameters_node shout")
     assert lines == ["Boolean value is: True"]
 
+    # ros2cli's words and exit code 0 when the node refuses a value
     code, lines = ros2("param set /parameters_node publish_rate_hz 100.0")
-    assert code == 1 and lines[0].startswith("Set parameter failed"), lines
+    assert code == 0 and lines[0].startswith("Setting parameter failed"), lines
     code, lines = ros2("param set /parameters_node greeting '\"  \"'")
-    assert lines == ["Set parameter failed: greeting must not be empty"]
+    assert lines == ["Setting parameter failed: greeting must not be empty"]
 
     code, lines = ros2("param dump /parameters_node")
     assert lines[:2] == ["/parameters_node:", "  ros__parameters:"]
@@ -62,10 +64,10 @@ def test_lifecycle_walk_with_publish_rate(supervisor, ros2):
     assert lines[:3] == ["- configure [1]", "\tStart: unconfigured", "\tGoal: configuring"]
 
     code, lines = ros2("lifecycle set /lifecycle_talker activate")
-    assert code == 1
-    line = one_error_line(lines)
-    assert "'activate' is not available in state 'unconfigured'" in line
-    assert "available: configure, shutdown" in line
+    assert (code, lines) == (
+        1,
+        ["Unknown transition requested, available ones are:", "- configure [1]", "- shutdown [5]"],
+    )
 
     assert ros2("lifecycle set /lifecycle_talker configure")[1] == ["Transitioning successful"]
     assert ros2("lifecycle get /lifecycle_talker")[1] == ["inactive [2]"]
@@ -84,4 +86,4 @@ def test_lifecycle_walk_with_publish_rate(supervisor, ros2):
     assert ros2("lifecycle get /lifecycle_talker")[1] == ["finalized [4]"]
 
     code, lines = ros2("lifecycle get /parameters_node_absent")
-    assert "not on the graph" in one_error_line(lines)
+    assert (code, lines) == (1, ["Node not found"])

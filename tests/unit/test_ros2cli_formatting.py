@@ -1,0 +1,155 @@
+"""Pure formatting of the ros2 verbs, no DDS: texts as Jazzy's ros2cli prints them.
+
+Each expected text below follows what ros2cli's source prints for that shape:
+rosidl_runtime_py's message_to_yaml (PyYAML block style of an ordered mapping,
+width unbounded, sequences cut with a '...' item), `ros2 param describe`'s
+lines, and `print()`'s trailing newline.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from geometry_msgs.msg import Twist
+from rcl_interfaces.msg import (
+    FloatingPointRange,
+    IntegerRange,
+    ParameterDescriptor,
+    ParameterType,
+)
+from std_msgs.msg import Empty, String, UInt8MultiArray
+from tutorial_interfaces.action import Fibonacci
+
+from app.ros.context import CallContext
+from app.ros2cli.common import is_hidden_name, visible, write_text
+from app.ros2cli.msg_yaml import message_to_yaml
+from app.ros2cli.param import describe_lines
+from app.ros2cli.parser import parse
+from app.ros2cli.topic import echo_text
+
+
+def test_sequences_print_in_block_style_not_indented_under_their_key():
+    feedback = Fibonacci.Feedback(partial_sequence=[0, 1, 1, 2])
+    assert message_to_yaml(feedback) == "partial_sequence:\n- 0\n- 1\n- 1\n- 2\n"
+    assert message_to_yaml(Fibonacci.Result()) == "sequence: []\n"
+    assert message_to_yaml(Fibonacci.Goal(order=5)) == "order: 5\n"
+
+
+def test_nested_messages_floats_strings_and_empty_messages():
+    twist = Twist()
+    twist.linear.x = 2.0
+    twist.angular.z = 1.8
+    assert message_to_yaml(twist) == (
+        "linear:\n  x: 2.0\n  y: 0.0\n  z: 0.0\nangular:\n  x: 0.0\n  y: 0.0\n  z: 1.8\n"
+    )
+    assert message_to_yaml(String(data="Hello World: 7")) == "data: 'Hello World: 7'\n"
+    assert message_to_yaml(String(data="héllo")) == "data: héllo\n"  # unicode kept
+    assert message_to_yaml(Empty()) == "{}\n"
+
+
+def test_truncation_as_topic_echo_does():
+    long = UInt8MultiArray(data=list(range(5)))
+    text = message_to_yaml(long, truncate_length=3)
+    assert text.endswith("data:\n- 0\n- 1\n- 2\n- '...'\n"), text
+    assert message_to_yaml(String(data="abcdef"), truncate_length=3) == "data: abc...\n"
+    # no line wrapping, however long the text
+    assert message_to_yaml(String(data="x " * 200)).count("\n") == 1
+
+
+def test_echo_text_ends_with_the_separator():
+    assert echo_text(String(data="hi")) == "data: hi\n---"
+    assert echo_text(2.0) == "2.0\n---"  # a selected primitive field, printed by Python
+
+
+def test_param_describe_lines():
+    turtlesim_b = ParameterDescriptor(
+        name="background_b",
+        type=ParameterType.PARAMETER_INTEGER,
+        description="Blue channel of the background color",
+        integer_range=[IntegerRange(from_value=0, to_value=255, step=1)],
+    )
+    assert describe_lines(turtlesim_b) == [
+        "Parameter name: background_b",
+        "  Type: integer",
+        "  Description: Blue channel of the background color",
+        "  Constraints:",
+        "    Min value: 0",
+        "    Max value: 255",
+        "    Step: 1",
+    ]
+    rate = ParameterDescriptor(
+        name="publish_rate_hz",
+        type=ParameterType.PARAMETER_DOUBLE,
+        read_only=True,
+        floating_point_range=[FloatingPointRange(from_value=0.1, to_value=20.0)],
+        additional_constraints="only on Tuesdays",
+    )
+    assert describe_lines(rate) == [
+        "Parameter name: publish_rate_hz",
+        "  Type: double",
+        "  Constraints:",
+        "    Read only: true",
+        "    Min value: 0.1",
+        "    Max value: 20.0",
+        "    Additional constraints: only on Tuesdays",
+    ]
+    assert describe_lines(ParameterDescriptor(name="x")) == [
+        "Parameter name: x",
+        "  Type: not set",
+        "  Constraints:",
+    ]
+
+
+def test_hidden_names():
+    assert is_hidden_name("/turtlesim/_trails")
+    assert is_hidden_name("/_ros2_classroom_cli_42/describe_parameters")
+    assert is_hidden_name("/fibonacci/_action/send_goal")
+    assert not is_hidden_name("/turtle1/cmd_vel")
+    pairs = [("/a", ["t"]), ("/_b/c", ["t"])]
+    assert visible(pairs) == [("/a", ["t"])]
+    assert visible(pairs, include_hidden=True) == pairs
+
+
+def test_write_text_shows_what_print_shows():
+    lines: list[str] = []
+    ctx = CallContext(node=None, write=lines.append)  # type: ignore[arg-type]
+    write_text(ctx, "    " + message_to_yaml(Fibonacci.Feedback(partial_sequence=[0, 1])))
+    # `print('Feedback:\n    {}'.format(yaml))`: only the first YAML line is indented,
+    # and the YAML's own newline gives an empty line.
+    assert lines == ["    partial_sequence:", "- 0", "- 1", ""]
+
+
+def _help(argv: list[str]) -> list[str]:
+    lines: list[str] = []
+    assert parse(argv, lines.append) is None
+    return lines
+
+
+def test_help_names_upstream_options_and_what_is_not_supported():
+    text = "\n".join(_help(["topic", "pub", "-h"]))
+    for option in ("-r N, --rate N", "-p N, --print N", "-1, --once", "-t TIMES, --times TIMES"):
+        assert option in text, text
+    assert "--wait-matching-subscriptions" in text and "--max-wait-time-secs" in text
+    assert "--keep-alive N" in text
+    assert "Not supported here (Jazzy's ros2 has them): --stdin, -n/--node-name, --qos-profile" in (
+        " ".join(text.split())
+    )
+    text = "\n".join(_help(["node", "info", "-h"]))
+    assert "--include-hidden" in text
+    text = "\n".join(_help(["param", "describe", "-h"]))
+    assert "parameter_names" in text and "--include-hidden-nodes" in text
+    for argv in (
+        ["service", "list", "-h"],
+        ["topic", "list", "-h"],
+        ["topic", "echo", "-h"],
+        ["action", "send_goal", "-h"],
+        ["lifecycle", "set", "-h"],
+    ):
+        assert any(line.startswith("usage: ros2 ") for line in _help(argv)), argv
+
+
+def test_abbreviated_include_hidden_is_accepted_as_ros2_accepts_it():
+    args = parse(["topic", "list", "--include-hidden"], lambda _line: None)
+    assert isinstance(args, argparse.Namespace) and args.include_hidden_topics
+    args = parse(["service", "list", "--include-hidden"], lambda _line: None)
+    assert isinstance(args, argparse.Namespace) and args.include_hidden_services
