@@ -1,0 +1,3 @@
+from . import IfCondition
+
+__all__ = ["IfCondition"]

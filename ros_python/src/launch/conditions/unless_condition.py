@@ -1,0 +1,3 @@
+from . import UnlessCondition
+
+__all__ = ["UnlessCondition"]

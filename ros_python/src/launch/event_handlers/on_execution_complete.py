@@ -1,0 +1,3 @@
+from . import OnExecutionComplete
+
+__all__ = ["OnExecutionComplete"]

@@ -1,0 +1,3 @@
+from . import OnProcessExit
+
+__all__ = ["OnProcessExit"]

@@ -1,0 +1,3 @@
+from . import OnProcessIO
+
+__all__ = ["OnProcessIO"]

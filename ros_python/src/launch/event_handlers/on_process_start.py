@@ -1,0 +1,3 @@
+from . import OnProcessStart
+
+__all__ = ["OnProcessStart"]

@@ -1,0 +1,3 @@
+from . import OnShutdown
+
+__all__ = ["OnShutdown"]

@@ -1,0 +1,3 @@
+from . import AnyLaunchDescriptionSource
+
+__all__ = ["AnyLaunchDescriptionSource"]

@@ -1,0 +1,3 @@
+from . import PythonLaunchDescriptionSource
+
+__all__ = ["PythonLaunchDescriptionSource"]

@@ -1,0 +1,3 @@
+from .scoped import PushRosNamespace
+
+__all__ = ["PushRosNamespace"]

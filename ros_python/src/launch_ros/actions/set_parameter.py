@@ -1,0 +1,3 @@
+from .scoped import SetParameter
+
+__all__ = ["SetParameter"]

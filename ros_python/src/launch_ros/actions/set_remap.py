@@ -1,0 +1,3 @@
+from .scoped import SetRemap
+
+__all__ = ["SetRemap"]

@@ -1,0 +1,3 @@
+from . import FindPackageShare
+
+__all__ = ["FindPackageShare"]
