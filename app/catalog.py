@@ -303,6 +303,27 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         ),
         package="sim_world",
     ),
+    # --- URDF (issue 23): robot_state_publisher, joint_state_publisher, the arm's TF ---
+    CatalogEntry(
+        "robot_state_publisher",
+        "robot_state_publisher",
+        "/robot_state_publisher",
+        "URDF + /joint_states -> /tf, /tf_static, /robot_description (needs robot_description).",
+        package="robot_state_publisher",
+    ),
+    CatalogEntry(
+        "joint_state_publisher",
+        "joint_state_publisher",
+        "/joint_state_publisher",
+        "Publishes /joint_states for every movable joint of /robot_description.",
+        package="joint_state_publisher",
+    ),
+    CatalogEntry(
+        "arm_state_publisher",
+        "arm_state_publisher",
+        "/robot_state_publisher",
+        "robot_state_publisher with robotic_arm's URDF: the arm's joints become /tf.",
+    ),
 )
 
 GROUPS: tuple[LaunchGroup, ...] = (
@@ -369,6 +390,12 @@ GROUPS: tuple[LaunchGroup, ...] = (
         "sim_drive",
         "the MuJoCo room and the arrow-key teleop on /cmd_vel: drive the robot",
         ("sim_world", "sim_teleop_key"),
+    ),
+    # --- URDF (issue 23) ---
+    LaunchGroup(
+        "arm_tf",
+        "robotic_arm + robot_state_publisher with its URDF: the arm on /tf",
+        ("robotic_arm", "arm_state_publisher"),
     ),
 )
 

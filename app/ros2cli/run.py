@@ -71,6 +71,8 @@ _UPSTREAM: dict[tuple[str, str], str] = {
     ("lifecycle", "lifecycle_talker"): "lifecycle_talker",
     ("lifecycle_py", "lifecycle_talker"): "lifecycle_talker",
     ("sim_world", "sim_world"): "sim_world",  # issue 26: the MuJoCo world
+    ("robot_state_publisher", "robot_state_publisher"): "robot_state_publisher",  # issue 23
+    ("joint_state_publisher", "joint_state_publisher"): "joint_state_publisher",
 }
 # ...and every catalog entry under its own package (`ros2 run tutorial_nodes talker`).
 EXECUTABLES: dict[tuple[str, str], str] = {
@@ -222,6 +224,8 @@ def program_args(entry: CatalogEntry, words: list[str]) -> tuple[str, ...]:
     """Words before ``--ros-args``: numbers for a client that takes them (``client 2 3``)."""
     if not words:
         return entry.args
+    if entry.module == "robot_state_publisher" and len(words) == 1 and words[0].endswith(".urdf"):
+        return (str(Path(words[0]).expanduser().resolve()),)  # upstream's URDF-file fallback
     if len(words) != len(entry.args) or not all(re.fullmatch(r"-?\d+", w) for w in words):
         takes = f"{len(entry.args)} whole numbers" if entry.args else "no arguments"
         raise Ros2Error(f"{entry.name} takes {takes} before --ros-args here, got {words}")

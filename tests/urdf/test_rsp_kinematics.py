@@ -150,3 +150,59 @@ def test_ten_megabyte_description_parses_or_fails_cleanly() -> None:
     padding = "<!--" + "x" * (10 * 1024 * 1024) + "-->"
     model = parse_urdf(_robot(padding + LINKS + _joint("j", "a", "b")))
     assert model.root == "a"
+
+
+def test_robotic_arm_urdf_agrees_with_arm_kinematics() -> None:
+    """The unit-13 arm's URDF gives the fingertip pose forward_kinematics computes."""
+    from app import PROJECT_ROOT
+    from nodes.common.arm_kinematics import JOINT_LIMITS, JOINT_NAMES, forward_kinematics
+
+    model = parse_urdf((PROJECT_ROOT / "nodes/robots/robotic_arm/robot.urdf").read_text())
+    assert [j.name for j in model.movable_joints()] == list(JOINT_NAMES)
+    for joint, (lower, upper) in zip(model.movable_joints(), JOINT_LIMITS, strict=True):
+        assert math.isclose(joint.lower or 0.0, lower, abs_tol=1e-6), joint.name
+        assert math.isclose(joint.upper or 0.0, upper, abs_tol=1e-6), joint.name
+    rng = np.random.default_rng(11)
+    for _ in range(50):
+        q = [rng.uniform(lo, hi) for lo, hi in JOINT_LIMITS]
+        pose = np.eye(4)
+        frame = model.root
+        positions = dict(zip(JOINT_NAMES, q, strict=True))
+        while frame != "tool0":
+            joint = next(j for j in model.joints.values() if j.parent == frame)
+            pose = pose @ joint_transform(
+                joint.origin, joint.type, joint.axis, positions.get(joint.name, 0.0)
+            )
+            frame = joint.child
+        expected = forward_kinematics(q)
+        assert np.allclose(pose[:3, 3], expected.position, atol=1e-9)
+        assert np.allclose(pose[:3, :3], expected.rotation, atol=1e-9)
+
+
+def test_tutorial_models_parse() -> None:
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from urdf_tutorial import share_directory
+
+    folder = share_directory() / "urdf"
+    movable = {}
+    for path in sorted(folder.glob("*.urdf")):
+        movable[path.name] = len(parse_urdf(path.read_text()).movable_joints())
+    assert movable == {
+        "01-myfirst.urdf": 0,
+        "02-multipleshapes.urdf": 0,
+        "03-origins.urdf": 0,
+        "04-materials.urdf": 0,
+        "05-visual.urdf": 0,
+        "06-flexible.urdf": 8,
+    }
+    xacro = subprocess.run(
+        [str(Path(sys.executable).with_name("xacro")), str(folder / "08-macroed.urdf.xacro")],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    model = parse_urdf(xacro.stdout)
+    assert len(model.links) == 14 and len(model.movable_joints()) == 8

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Iterable, Sequence
+from typing import Any
 
 import numpy as np
 import rclpy
@@ -91,8 +92,9 @@ def joint_positions_with_mimics(model: RobotModel, positions: dict[str, float]) 
 
 
 class RobotStatePublisher(Node):
-    def __init__(self, program_args: Sequence[str] = ()) -> None:
-        super().__init__("robot_state_publisher")
+    def __init__(self, program_args: Sequence[str] = (), **node_options: Any) -> None:
+        """``program_args``: argv without ROS arguments; ``node_options`` go to ``Node``."""
+        super().__init__("robot_state_publisher", **node_options)
         urdf_xml = str(self.declare_parameter("robot_description", "").value or "")
         if not urdf_xml:
             urdf_xml = self._description_from_file(program_args)
