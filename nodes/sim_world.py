@@ -35,6 +35,7 @@ from __future__ import annotations
 import math
 import threading
 import time
+from collections.abc import Callable
 
 import numpy as np
 from builtin_interfaces.msg import Time
@@ -58,7 +59,7 @@ from nodes.common.sim.diff_drive import check_twist, quantize
 from nodes.common.sim.engine import Pose2D, SimEngine
 from nodes.common.sim.trajectory import TrajectoryError
 
-MAX_LAG = 0.25  # s of simulation behind schedule before the world gives up catching up
+MAX_LAG = 1.0  # s of simulation behind schedule before the world gives up catching up
 CHUNK = 50  # physics steps between two looks at the clock when running flat out
 
 
@@ -189,6 +190,17 @@ class SimWorld(Node):
 
     # --- the physics thread ------------------------------------------------------------
     def run_physics(self) -> None:
+        self._quietly_at_shutdown(self.physics_loop)
+
+    def _quietly_at_shutdown(self, loop: Callable[[], None]) -> None:
+        """Ctrl+C shuts ROS down before the threads stop: a publish may fail then, quietly."""
+        try:
+            loop()
+        except Exception:
+            if self.context.ok() and not self.stopping.is_set():
+                raise
+
+    def physics_loop(self) -> None:
         """Step in time with the wall clock (scaled), publishing each stream when it is due."""
         dt = self.engine.timestep
         anchor_wall = anchor_sim = 0.0
@@ -319,6 +331,9 @@ class SimWorld(Node):
 
     # --- the camera thread ---------------------------------------------------------------
     def run_camera(self) -> None:
+        self._quietly_at_shutdown(self.camera_loop)
+
+    def camera_loop(self) -> None:
         width, height = int(self._param("camera_width")), int(self._param("camera_height"))
         try:
             camera = SnapshotCamera(self.engine.model, "camera", width, height)

