@@ -2,27 +2,30 @@
 
 As ROS 2 Jazzy's joint_state_publisher: it reads the URDF from the
 ``robot_description`` topic (transient local, so it may start before or
-after robot_state_publisher), then publishes ``/joint_states`` ``rate``
-times a second (10 Hz) with one position per free joint: 0, or the middle
-of the limits when 0 is outside them. Mimic joints follow their leader. Values received on
-the topics of ``source_list`` (JointState messages, e.g. a driver or
-sliders in a browser) replace the defaults of the joints they name.
+after robot_state_publisher) or from a file named as its first argument,
+then publishes ``joint_states`` ``rate`` times a second (10) with one
+position per movable joint in document order: ``zeros.<joint>`` if given,
+else 0, or the middle of the limits when 0 is outside them. Mimic joints
+follow their leader (``use_mimic_tags``). JointState messages on the topics
+of ``source_list`` (a driver, or the dashboard's sliders) set the joints
+they name; ``delta`` > 0 sweeps every joint back and forth on its own.
 
-The maths of choosing start values lives in plain functions
-(``initial_position``, ``positions_with_mimics``).
+The choice of start values and the mimic arithmetic are plain functions.
 """
 
 from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
 
 import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile
+from rclpy.utilities import remove_ros_args
 from robot_state_publisher.urdf_tree import Joint, RobotModel, UrdfError, parse_urdf
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
@@ -30,97 +33,151 @@ from std_msgs.msg import String
 DESCRIPTION_QOS = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
 
-def initial_position(joint: Joint, zero: float | None = None) -> float:
-    """0 (or ``zero``) when the limits allow it, else the middle of the limits."""
-    value = 0.0 if zero is None else zero
-    if joint.lower is None or joint.upper is None or joint.lower > joint.upper:
-        return value
-    if joint.lower <= value <= joint.upper:
-        return value
-    return (joint.lower + joint.upper) / 2.0
+@dataclass
+class FreeJoint:
+    """A joint a user sets: its range (continuous: -pi..pi) and current position."""
+
+    lower: float
+    upper: float
+    position: float
+    continuous: bool = False
+    forward: bool = True
 
 
-def free_joints(model: RobotModel) -> list[Joint]:
-    """The joints a user sets: movable and not mimicking another joint."""
-    return [j for j in model.movable_joints() if j.mimic is None]
+def start_position(lower: float, upper: float, zero: float | None = None) -> float:
+    """``zero`` if given, else 0, or the middle of the range when 0 lies outside it."""
+    if zero is not None:
+        return zero
+    if lower > 0.0 or upper < 0.0:
+        return (lower + upper) / 2.0
+    return 0.0
 
 
-def positions_with_mimics(model: RobotModel, free: Mapping[str, float]) -> dict[str, float]:
-    """Every movable joint's position: the free ones, then each mimic from its leader."""
-    result = dict(free)
-    pending = [j for j in model.movable_joints() if j.mimic is not None]
-    for _ in range(len(pending) + 1):  # a mimic of a mimic resolves on a later pass
-        waiting = []
-        for joint in pending:
-            assert joint.mimic is not None
-            if joint.mimic.joint in result:
-                leader = result[joint.mimic.joint]
-                result[joint.name] = leader * joint.mimic.multiplier + joint.mimic.offset
+def free_joint(joint: Joint, zero: float | None = None) -> FreeJoint:
+    if joint.type == "continuous" or joint.lower is None or joint.upper is None:
+        return FreeJoint(-math.pi, math.pi, start_position(-math.pi, math.pi, zero), True)
+    return FreeJoint(joint.lower, joint.upper, start_position(joint.lower, joint.upper, zero))
+
+
+def mimic_chain(model: RobotModel, name: str) -> tuple[str, float, float]:
+    """(free leader, factor, offset) of a mimic joint, following mimics of mimics."""
+    factor, offset, seen = 1.0, 0.0, [name]
+    joint = model.joints[name]
+    while joint.mimic is not None:
+        offset += factor * joint.mimic.offset
+        factor *= joint.mimic.multiplier
+        if joint.mimic.joint in seen:
+            raise UrdfError(
+                f"Found an infinite recursive mimic chain: {seen + [joint.mimic.joint]}"
+            )
+        seen.append(joint.mimic.joint)
+        joint = model.joints[joint.mimic.joint]
+    return joint.name, factor, offset
+
+
+def sweep(joint: FreeJoint, delta: float) -> None:
+    """One step of ``delta``: back and forth between the limits, round and round if continuous."""
+    if joint.forward:
+        joint.position += delta
+        if joint.position > joint.upper:
+            if joint.continuous:
+                joint.position = joint.lower
             else:
-                waiting.append(joint)
-        pending = waiting
-    return {j.name: result[j.name] for j in model.movable_joints() if j.name in result}
+                joint.position, joint.forward = joint.upper, False
+    else:
+        joint.position -= delta
+        if joint.position < joint.lower:
+            joint.position, joint.forward = joint.lower, True
 
 
 class JointStatePublisher(Node):
-    def __init__(self) -> None:
-        super().__init__("joint_state_publisher")
-        self.declare_parameter("rate", 10.0)
-        self.declare_parameter("source_list", Parameter.Type.STRING_ARRAY)
-        self.declare_parameter("use_mimic_tags", True)
-        self.declare_parameter("publish_default_positions", True)
+    def __init__(self, description_file: str | None = None) -> None:
+        super().__init__(
+            "joint_state_publisher", automatically_declare_parameters_from_overrides=True
+        )
+        defaults: tuple[tuple[str, object], ...] = (
+            ("publish_default_positions", True),
+            ("rate", 10),
+            ("source_list", Parameter.Type.STRING_ARRAY),  # declared, empty
+            ("use_mimic_tags", True),
+            ("delta", 0.0),
+        )
+        for name, default in defaults:
+            if not self.has_parameter(name):  # given on the command line: declared already
+                self.declare_parameter(name, default)
+        zeros: dict[str, Any] = dict(self.get_parameters_by_prefix("zeros"))
+        self.zeros = {name: float(parameter.value) for name, parameter in zeros.items()}
         self.model: RobotModel | None = None
-        self.positions: dict[str, float] = {}
-        self.publisher = self.create_publisher(JointState, "joint_states", 10)
+        self.free: dict[str, FreeJoint] = {}
+        self.order: list[str] = []
+        if description_file is not None:
+            with open(description_file, encoding="utf-8") as description:
+                self.configure_robot(description.read())
+        else:
+            self.get_logger().info(
+                "Waiting for robot_description to be published on the robot_description topic..."
+            )
         self.description_subscription = self.create_subscription(
             String, "robot_description", self.on_robot_description, DESCRIPTION_QOS
         )
-        sources = self.get_parameter("source_list").value or []
         self.source_subscriptions = [
             self.create_subscription(JointState, str(topic), self.on_source_state, 10)
-            for topic in sources
+            for topic in (self.get_parameter("source_list").value or [])
         ]
+        self.publisher = self.create_publisher(JointState, "joint_states", 10)
         rate = float(self.get_parameter("rate").value)
         if not math.isfinite(rate) or rate <= 0.0:
             raise ValueError(f"rate must be a positive number of Hz, got {rate}")
         self.timer = self.create_timer(1.0 / rate, self.on_timer)
-        self.get_logger().info(
-            "Waiting for robot_description to be published on the robot_description topic..."
-        )
+
+    def configure_robot(self, description: str) -> None:
+        model = parse_urdf(description)
+        use_mimic = bool(self.get_parameter("use_mimic_tags").value)
+        for joint in model.movable_joints():
+            if use_mimic and joint.mimic is not None:
+                mimic_chain(model, joint.name)  # refuse a loop now, not at every tick
+        self.model = model
+        self.order = [j.name for j in model.movable_joints()]
+        self.free = {
+            j.name: free_joint(j, self.zeros.get(j.name))
+            for j in model.movable_joints()
+            if not (use_mimic and j.mimic is not None)
+        }
 
     def on_robot_description(self, msg: String) -> None:
         try:
-            model = parse_urdf(msg.data)
+            self.configure_robot(msg.data)
         except UrdfError as exc:
-            self.get_logger().error(f"Failed to parse the robot description: {exc}")
-            return
-        self.model = model
-        old = self.positions
-        self.positions = {j.name: old.get(j.name, initial_position(j)) for j in free_joints(model)}
-
-    def set_position(self, joint: str, position: float) -> bool:
-        """Set one free joint (clamped to its limits); False for a joint it does not have."""
-        if self.model is None or joint not in self.positions or not math.isfinite(position):
-            return False
-        info = self.model.joints[joint]
-        if info.lower is not None and info.upper is not None and info.lower <= info.upper:
-            position = min(max(position, info.lower), info.upper)
-        self.positions[joint] = position
-        return True
+            self.get_logger().warning(str(exc))
 
     def on_source_state(self, msg: JointState) -> None:
-        for name, position in zip(msg.name, msg.position, strict=False):
-            self.set_position(name, float(position))
+        for index, name in enumerate(msg.name):
+            if name in self.free and index < len(msg.position):
+                position = float(msg.position[index])
+                if math.isfinite(position):
+                    self.free[name].position = position
+
+    def positions(self) -> dict[str, float]:
+        """Every movable joint's position, in the description's order."""
+        result: dict[str, float] = {}
+        for name in self.order:
+            if name in self.free:
+                result[name] = self.free[name].position
+            elif self.model is not None:
+                leader, factor, offset = mimic_chain(self.model, name)
+                result[name] = self.free[leader].position * factor + offset
+        return result
 
     def on_timer(self) -> None:
-        if self.model is None:
-            return
+        delta = float(self.get_parameter("delta").value)
+        if delta > 0.0:
+            for joint in self.free.values():
+                sweep(joint, delta)
+        positions = self.positions()
+        if not positions:
+            return  # upstream publishes only non-empty messages
         msg = JointState()
         msg.header.stamp = self.get_clock().now().to_msg()
-        if self.get_parameter("use_mimic_tags").value:
-            positions = positions_with_mimics(self.model, self.positions)
-        else:
-            positions = dict(self.positions)
         msg.name = list(positions)
         if self.get_parameter("publish_default_positions").value:
             msg.position = [float(v) for v in positions.values()]
@@ -131,9 +188,10 @@ def main(args: list[str] | None = None) -> None:
     node: JointStatePublisher | None = None
     try:
         rclpy.init(args=args)
+        program_args = remove_ros_args(args if args is not None else sys.argv)
         try:
-            node = JointStatePublisher()
-        except ValueError as exc:
+            node = JointStatePublisher(program_args[1] if len(program_args) > 1 else None)
+        except (ValueError, OSError) as exc:
             print(f"joint_state_publisher: error: {exc}", file=sys.stderr)
             raise SystemExit(2) from None
         rclpy.spin(node)
