@@ -26,6 +26,11 @@ def _print(line: str) -> None:
     print(line, flush=True)
 
 
+def _note(line: str) -> None:
+    """What ros2 would not print on stdout (its stdout stays the same as ours)."""
+    print(line, file=sys.stderr, flush=True)
+
+
 def main(argv: list[str]) -> int:
     """Run one verb; the caller has already configured DDS for this process."""
     cancel = threading.Event()
@@ -43,7 +48,7 @@ def main(argv: list[str]) -> int:
     runtime = RosRuntime(f"_ros2_classroom_cli_{os.getpid()}")
     ctx = CallContext(node=runtime.node, write=_print, limits=CLI_LIMITS, cancel=cancel)
     try:
-        code = run_argv(ctx, argv, "ros2-classroom")
+        code = run_argv(ctx, argv, "ros2-classroom", note=_note)
         return EXIT_INTERRUPTED if cancel.is_set() else code
     finally:
         runtime.shutdown()

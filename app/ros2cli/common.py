@@ -22,7 +22,11 @@ class Ros2cliMessage(Ros2Error):
 
 
 class SilentFailure(Ros2Error):
-    """ros2cli ends with exit code 1 and prints nothing (`ros2 service type /unknown`)."""
+    """ros2cli ends with exit code 1 and prints nothing (`ros2 service type /unknown`).
+
+    A terminal keeps stdout as ros2's (the reason goes to stderr); the Console,
+    which has one output, shows the reason in parentheses.
+    """
 
 
 def is_hidden_name(name: str) -> bool:

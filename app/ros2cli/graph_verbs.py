@@ -89,7 +89,7 @@ def service_list(
 def service_type(ctx: CallContext, name: str, include_hidden: bool = False) -> int:
     types = dict(_services(ctx, include_hidden)).get(name)
     if not types:
-        raise SilentFailure(name)  # ros2cli prints nothing and exits with 1
+        raise SilentFailure(f"no service '{name}' on the graph")
     for type_text in types:
         ctx.write(type_text)
     return 0
@@ -156,7 +156,7 @@ def action_list(ctx: CallContext, show_types: bool = False, count: bool = False)
 def action_type(ctx: CallContext, name: str) -> int:
     action_type = action_type_of(ctx.node, name)
     if action_type is None:
-        raise SilentFailure(name)  # ros2cli prints nothing and exits with 1
+        raise SilentFailure(f"no action '{name}' on the graph")
     ctx.write(action_type)
     return 0
 

@@ -93,32 +93,57 @@ _PRIMITIVES = {
 }
 
 
-def show(type_text: str, *, expand: bool = True) -> str:
-    """The definition text, with nested message types expanded (indented) as ros2 does."""
+def show(
+    type_text: str, *, expand: bool = True, comments: bool = True, nested_comments: bool = False
+) -> str:
+    """The definition text, nested message types expanded (one tab deeper) as ros2 does.
+
+    As `ros2 interface show`: the top level keeps its comments and empty lines
+    unless ``comments`` is False (``--no-comments``); nested definitions show
+    theirs only with ``nested_comments`` (``--all-comments``). Without them a
+    line loses its trailing comment, and empty or comment lines are left out.
+    """
     path, package, _kind, _name = definition_path(type_text)
-    return "\n".join(_expand(path.read_text().rstrip("\n").splitlines(), package, expand, 0))
+    lines = path.read_text().rstrip("\n").splitlines()
+    return "\n".join(_expand(lines, package, expand, 0, comments, nested_comments))
 
 
-def _expand(lines: list[str], package: str, expand: bool, depth: int) -> list[str]:
+def _without_comment(line: str, keep: bool) -> str | None:
+    """The line as printed: None when it is left out (empty or a comment, comments hidden)."""
+    if keep:
+        return line
+    stripped = line.strip()
+    if not stripped or stripped.startswith("#"):
+        return None
+    if "#" in line:
+        return line[: line.index("#")].strip()
+    return line
+
+
+def _expand(
+    lines: list[str], package: str, expand: bool, depth: int, comments: bool, nested: bool
+) -> list[str]:
     out: list[str] = []
     indent = "\t" * depth
-    for line in lines:
-        if depth and (not line.strip() or line.lstrip().startswith("#")):
-            continue  # nested definitions are shown without their comments
-        out.append(indent + line)
-        match = _FIELD.match(line)
-        if not expand or not match or depth >= 4 or "=" in line.split("#", 1)[0]:
+    for raw in lines:
+        line = _without_comment(raw.rstrip(), comments)
+        if line is None:
+            continue
+        out.append(indent + line if line else "")
+        match = _FIELD.match(raw)
+        if not expand or not match or depth >= 8 or "=" in raw.split("#", 1)[0]:
             continue
         base = match.group(1)
         if base in _PRIMITIVES or base.startswith("string<") or base.startswith("---"):
             continue
-        nested = _nested_name(base, package)
+        nested_type = _nested_name(base, package)
         try:
-            nested_path = definition_path(nested)[0]
+            nested_path = definition_path(nested_type)[0]
         except Ros2Error:
             continue
-        nested_pkg = nested.split("/")[0]
-        out += _expand(nested_path.read_text().splitlines(), nested_pkg, expand, depth + 1)
+        nested_pkg = nested_type.split("/")[0]
+        nested_lines = nested_path.read_text().rstrip("\n").splitlines()
+        out += _expand(nested_lines, nested_pkg, expand, depth + 1, nested, nested)
     return out
 
 

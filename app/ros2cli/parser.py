@@ -108,11 +108,14 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
     p.add_argument("-s", "--only-srvs", action="store_true")
     p.add_argument("-a", "--only-actions", action="store_true")
     p = verb(v, "packages", "interface packages", _interface_packages)
+    verb_args.only_kinds(p)
     p = verb(v, "package", "one package's interfaces", _interface_package)
+    verb_args.only_kinds(p)
     p.add_argument("package_name")
     p = verb(v, "show", "a definition", _interface_show)
     p.add_argument("type")
     p.add_argument("--no-expand", action="store_true", help="do not expand nested types")
+    verb_args.comment_options(p)
 
     bag.add_verbs(group("bag", "record, inspect and replay topics"), verb)
     v = group("pkg", "packages")
@@ -159,23 +162,47 @@ def _interface_list(ctx: CallContext, args: argparse.Namespace) -> int:
     return 0
 
 
+def _kinds(args: argparse.Namespace) -> set[str]:
+    """-m/-s/-a: which kinds to list (none given: all)."""
+    chosen = {
+        k
+        for k, on in (
+            ("msg", args.only_msgs),
+            ("srv", args.only_srvs),
+            ("action", args.only_actions),
+        )
+        if on
+    }
+    return chosen or {"msg", "srv", "action"}
+
+
 def _interface_packages(ctx: CallContext, args: argparse.Namespace) -> int:
-    for package in interfaces.interface_packages():
-        ctx.write(package)
+    kinds = _kinds(args)
+    for package, names in interfaces.interface_packages().items():
+        if any(name.split("/", 1)[0] in kinds for name in names):
+            ctx.write(package)
     return 0
 
 
 def _interface_package(ctx: CallContext, args: argparse.Namespace) -> int:
     packages = interfaces.interface_packages()
     if args.package_name not in packages:
-        raise Ros2Error(f"unknown interface package '{args.package_name}'")
+        raise Ros2cliMessage(f"Unknown package '{args.package_name}'")
+    kinds = _kinds(args)
     for name in packages[args.package_name]:
-        ctx.write(f"{args.package_name}/{name}")
+        if name.split("/", 1)[0] in kinds:
+            ctx.write(f"{args.package_name}/{name}")
     return 0
 
 
 def _interface_show(ctx: CallContext, args: argparse.Namespace) -> int:
-    for line in interfaces.show(args.type, expand=not args.no_expand).splitlines():
+    text = interfaces.show(
+        args.type,
+        expand=not args.no_expand,
+        comments=not args.no_comments,
+        nested_comments=args.all_comments,
+    )
+    for line in text.split("\n"):
         ctx.write(line)
     return 0
 
@@ -192,8 +219,13 @@ def parse(argv: list[str], write: Write, prog: str = "ros2") -> argparse.Namespa
         raise UsageError(str(exc)) from None
 
 
-def run_argv(ctx: CallContext, argv: list[str], prog: str = "ros2") -> int:
-    """Run one verb; every failure becomes one 'error: ...' line and an exit code."""
+def run_argv(
+    ctx: CallContext, argv: list[str], prog: str = "ros2", note: Write | None = None
+) -> int:
+    """Run one verb; every failure becomes one 'error: ...' line and an exit code.
+
+    ``note`` (a terminal's stderr) takes what ros2 would not print on stdout.
+    """
     try:
         args = parse(argv, ctx.write, prog)
         if args is None:
@@ -210,7 +242,8 @@ def run_argv(ctx: CallContext, argv: list[str], prog: str = "ros2") -> int:
     except Cancelled:
         ctx.write("(stopped)")
         return EXIT_FAILED
-    except SilentFailure:
+    except SilentFailure as exc:  # ros2 prints nothing; say why where it does not disturb
+        (note or ctx.write)(f"({exc})" if note is None else str(exc))
         return EXIT_FAILED
     except Ros2cliMessage as exc:  # ros2cli's own words, as `ros2` prints them
         ctx.write(str(exc))

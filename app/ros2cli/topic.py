@@ -96,7 +96,7 @@ def topic_info(ctx: CallContext, topic: str, verbose: bool = False) -> int:
 def topic_type(ctx: CallContext, topic: str, include_hidden: bool = False) -> int:
     types = dict(_topics(ctx, include_hidden)).get(topic)
     if not types:
-        raise SilentFailure(topic)  # ros2cli prints nothing and exits with 1
+        raise SilentFailure(f"no topic '{topic}' on the graph")
     for type_text in types:
         ctx.write(type_text)
     return 0

@@ -624,3 +624,21 @@ def add_lifecycle(v: Any, verb: Verb) -> None:
     _param_node(p)
     p.add_argument("transition", help="The lifecycle transition")
     unsupported(p, *_STRATEGY_UNSUPPORTED)
+
+
+def only_kinds(p: argparse.ArgumentParser) -> None:
+    """`ros2 interface package(s)`: -m, -s, -a."""
+    p.add_argument("-m", "--only-msgs", action="store_true", help="Only message types")
+    p.add_argument("-s", "--only-srvs", action="store_true", help="Only service types")
+    p.add_argument("-a", "--only-actions", action="store_true", help="Only action types")
+
+
+def comment_options(p: argparse.ArgumentParser) -> None:
+    """`ros2 interface show`: --all-comments or --no-comments."""
+    group = p.add_mutually_exclusive_group()
+    group.add_argument(
+        "--all-comments",
+        action="store_true",
+        help="Show all comments, including for nested interface definitions",
+    )
+    group.add_argument("--no-comments", action="store_true", help="Show no comments or whitespace")

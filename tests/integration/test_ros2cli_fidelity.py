@@ -276,10 +276,11 @@ def test_graph_verbs_golden(supervisor, ros2):
     assert ros2("node info /nobody") == (1, ["Unable to find node '/nobody'"])
     assert ros2("node info talker") == (1, ["Unable to find node 'talker'"])  # as typed
     assert ros2("topic info /nope") == (1, ["Unknown topic '/nope'"])
-    assert ros2("topic type /nope") == (1, [])
-    assert ros2("service type /nope") == (1, [])
+    # ros2 prints nothing for these (exit 1); the Console says why in parentheses
+    assert ros2("topic type /nope") == (1, ["(no topic '/nope' on the graph)"])
+    assert ros2("service type /nope") == (1, ["(no service '/nope' on the graph)"])
     assert ros2("service info /nope") == (1, ["Unknown service '/nope'"])
-    assert ros2("action type /nope") == (1, [])
+    assert ros2("action type /nope") == (1, ["(no action '/nope' on the graph)"])
     code, lines = ros2("node info")
     assert code == 2 and lines[0].startswith("usage: ros2 node info"), lines
     assert lines[-1] == "ros2 node info: error: the following arguments are required: node_name"
@@ -384,3 +385,6 @@ def test_terminal_face_hides_its_own_node(ros_env, supervisor):
     assert (done.returncode, done.stdout.split("\n")) == (0, [*talker_info(), ""]), done.stdout
     done = run_cli("node", "info", "/nobody", env=ros_env)
     assert (done.returncode, done.stdout) == (1, "Unable to find node '/nobody'\n")
+    done = run_cli("topic", "type", "/nope", env=ros_env)  # stdout as ros2's: empty
+    assert (done.returncode, done.stdout) == (1, "")
+    assert "no topic '/nope' on the graph" in done.stderr
