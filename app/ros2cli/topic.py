@@ -188,10 +188,14 @@ def echo(
     return 0
 
 
-def _measure(ctx: CallContext, topic: str, type_text: str | None, window: int, report) -> int:
+def _measure(
+    ctx: CallContext, topic: str, type_text: str | None, window: int, report, first: str = ""
+) -> int:
     msg_type = resolve_topic_type(ctx, topic, type_text)
     # Best effort, as ros2 hz/bw subscribe: measuring must not slow a reliable publisher.
     monitor = TopicMonitor(ctx.node, topic, msg_type, window=window, keep=1, qos=MEASURE_QOS)
+    if first:
+        ctx.write(first)
     deadline = _deadline(ctx)
     reported = False
     try:
@@ -222,12 +226,30 @@ def hz(ctx: CallContext, topic: str, type_text: str | None = None, window: int =
     return _measure(ctx, topic, type_text, window, report)
 
 
+def bandwidth_text(per_sec: float, count: int, mean: float, low: float, high: float) -> str:
+    """`ros2 topic bw`'s two lines: one unit for all four sizes, chosen by the rate."""
+    if per_sec < 1000:
+        unit, scale, digits = "B", 1.0, 0
+    elif per_sec < 1_000_000:
+        unit, scale, digits = "KB", 1000.0, 2
+    else:
+        unit, scale, digits = "MB", 1_000_000.0, 2
+    rate, mean_t, low_t, high_t = (
+        f"{value / scale:.{digits}f} {unit}" for value in (per_sec, mean, low, high)
+    )
+    return (
+        f"{rate}/s from {count} messages\n\tMessage size mean: {mean_t} min: {low_t} max: {high_t}"
+    )
+
+
 def bw(ctx: CallContext, topic: str, type_text: str | None = None, window: int = 100) -> int:
     def report(monitor: TopicMonitor) -> str | None:
-        stats = monitor.bandwidth()
-        return stats.ros2_text() if stats else None
+        s = monitor.bandwidth()
+        if s is None:
+            return None
+        return bandwidth_text(s.bytes_per_sec, s.count, s.mean, s.min_size, s.max_size)
 
-    return _measure(ctx, topic, type_text, window, report)
+    return _measure(ctx, topic, type_text, window, report, f"Subscribed to [{topic}]")
 
 
 def with_stamps(cls: type, data: dict[str, Any], stamp: dict[str, int]) -> dict[str, Any]:

@@ -25,7 +25,7 @@ from app.ros2cli.common import is_hidden_name, visible, write_text
 from app.ros2cli.msg_yaml import message_to_yaml
 from app.ros2cli.param import describe_lines
 from app.ros2cli.parser import parse
-from app.ros2cli.topic import echo_text
+from app.ros2cli.topic import bandwidth_text, echo_text
 
 
 def test_sequences_print_in_block_style_not_indented_under_their_key():
@@ -153,3 +153,15 @@ def test_abbreviated_include_hidden_is_accepted_as_ros2_accepts_it():
     assert isinstance(args, argparse.Namespace) and args.include_hidden_topics
     args = parse(["service", "list", "--include-hidden"], lambda _line: None)
     assert isinstance(args, argparse.Namespace) and args.include_hidden_services
+
+
+def test_bandwidth_lines_use_one_unit_chosen_by_the_rate():
+    assert bandwidth_text(500.0, 10, 50.0, 40, 60) == (
+        "500 B/s from 10 messages\n\tMessage size mean: 50 B min: 40 B max: 60 B"
+    )
+    assert bandwidth_text(12_346.0, 100, 1236.0, 1000, 1500) == (
+        "12.35 KB/s from 100 messages\n\tMessage size mean: 1.24 KB min: 1.00 KB max: 1.50 KB"
+    )
+    assert bandwidth_text(2_500_000.0, 100, 25_000.0, 25_000, 25_000) == (
+        "2.50 MB/s from 100 messages\n\tMessage size mean: 0.03 MB min: 0.03 MB max: 0.03 MB"
+    )
