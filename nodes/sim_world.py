@@ -21,6 +21,7 @@ drivers publish, stamped with simulation time:
   ``/reset_simulation`` (time back to 0), ``/reset_world`` (time goes on), all
   std_srvs/Empty, and ``/step_simulation`` (std_srvs/Trigger, advances
   ``step_duration`` seconds while paused);
+- ``world -> arm_base_link`` on ``/tf_static``: where the world file bolted the arm;
 - ``/real_time_factor`` (std_msgs/Float64, once a second): simulated seconds
   per wall-clock second, measured.
 
@@ -44,6 +45,7 @@ from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, LaserScan
 from std_msgs.msg import Float64
@@ -138,6 +140,10 @@ class SimWorld(Node):
         self.image_pub = self.create_publisher(Image, "camera/image_raw", 5)
         self.info_pub = self.create_publisher(CameraInfo, "camera/camera_info", 5)
         self.rtf_pub = self.create_publisher(Float64, "real_time_factor", 10)
+        latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        self.static_tf_pub = self.create_publisher(TFMessage, "/tf_static", latched)
+        if self.engine.has_arm:  # the arm is bolted to its table: world -> arm_base_link
+            self.static_tf_pub.publish(TFMessage(transforms=[self.arm_mount()]))
 
         self.create_subscription(Twist, "cmd_vel", self.on_cmd_vel, 10)
         self.create_subscription(
@@ -177,6 +183,18 @@ class SimWorld(Node):
             f"real_time_factor {self.rtf_target:g}, camera rendering through "
             f"{GL_BACKEND or 'no OpenGL found'}"
         )
+
+    def arm_mount(self) -> TransformStamped:
+        """Where the world file put the arm's base (a fixed transform, as a URDF's fixed joint)."""
+        position, quat = self.engine.body_pose("arm_base_link")
+        mount = TransformStamped()
+        mount.header.stamp = stamp(self.engine.time)
+        mount.header.frame_id = "world"
+        mount.child_frame_id = "arm_base_link"
+        t, r = mount.transform.translation, mount.transform.rotation
+        t.x, t.y, t.z = (float(v) for v in position)
+        r.x, r.y, r.z, r.w = (float(v) for v in quat)
+        return mount
 
     def _param(self, name: str):
         return self.get_parameter(name).value

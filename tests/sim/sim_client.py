@@ -23,6 +23,7 @@ from rcl_interfaces.msg import Log, Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, LaserScan
 from std_msgs.msg import Float64
@@ -70,6 +71,8 @@ class SimClient(Node):
         for topic, kind in topics.items():
             self.create_subscription(kind, topic, self._keeper(topic), 10)
         self.create_subscription(Log, "/rosout", self.on_log, 100)
+        latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        self.create_subscription(TFMessage, "/tf_static", self._keeper("/tf_static"), latched)
         self.cmd = self.create_publisher(Twist, "/cmd_vel", 10)
         self.traj = self.create_publisher(JointTrajectory, "/arm_controller/joint_trajectory", 10)
         self.gripper = self.create_publisher(Float64, "/gripper/command", 10)
@@ -168,12 +171,18 @@ def start(c: SimClient) -> dict:
     wait(lambda: c.get("/real_time_factor"), what="/real_time_factor")
     joints = c.get("/joint_states")
     tf = c.get("/tf")
+    mount = wait(lambda: c.get("/tf_static"), what="/tf_static").transforms[0]
     return {
         "image": [image.width, image.height, image.encoding, len(image.data)],
         "info_k": list(info.k),
         "scan": [len(scan.ranges), scan.angle_min, scan.angle_increment, scan.header.frame_id],
         "joint_names": list(joints.name),
         "tf": [(t.header.frame_id, t.child_frame_id) for t in tf.transforms],
+        "tf_static": [
+            mount.header.frame_id,
+            mount.child_frame_id,
+            [mount.transform.translation.x, mount.transform.translation.y],
+        ],
         "rates": {
             "scan": c.rate("/scan", 3.0),
             "camera": c.rate("/camera/image_raw", 3.0),

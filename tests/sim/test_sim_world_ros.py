@@ -95,6 +95,7 @@ def test_sensors_publish_what_a_real_robot_publishes(report):
     for joint in ("left_wheel_joint", "right_wheel_joint", "base_yaw", "wrist_pitch"):
         assert joint in start["joint_names"]
     assert ["odom", "base_link"] in start["tf"]
+    assert start["tf_static"] == ["world", "arm_base_link", [1.4, 1.4]]  # room/world.xml
     assert 8.5 <= start["rates"]["scan"] <= 11.5, start["rates"]
     assert start["rates"]["camera"] >= 0.8 * 15, start["rates"]
     assert 0.8 <= start["rtf"] <= 1.2

@@ -199,6 +199,12 @@ class SimEngine:
     def body_position(self, name: str) -> np.ndarray:
         return self.data.body(name).xpos.copy()
 
+    def body_pose(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """World position and quaternion (x, y, z, w) of a body."""
+        body = self.data.body(name)
+        w, x, y, z = body.xquat
+        return body.xpos.copy(), np.array([x, y, z, w])
+
     def snapshot(self) -> np.ndarray:
         """A copy of the state a camera needs to draw the world (qpos)."""
         return self.data.qpos.copy()
