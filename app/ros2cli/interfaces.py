@@ -13,7 +13,9 @@ import re
 import sys
 from pathlib import Path
 
+from app.ros.convert import import_type
 from app.ros.errors import Ros2Error
+from app.ros2cli.msg_yaml import message_to_yaml
 
 _EXT = {"msg": ".msg", "srv": ".srv", "action": ".action"}
 
@@ -154,3 +156,15 @@ def _nested_name(base: str, package: str) -> str:
         return f"{package}/msg/{base}"
     pkg, name = base.split("/", 1)
     return f"{pkg}/msg/{name.split('/')[-1]}"
+
+
+def prototype(type_text: str, quotes: bool = True) -> str:
+    """`ros2 interface proto`: a default instance as YAML (a goal or request for actions
+    and services), in double quotes unless ``quotes`` is False."""
+    cls = import_type(type_text)
+    if hasattr(cls, "Goal"):
+        cls = cls.Goal
+    elif hasattr(cls, "Request"):
+        cls = cls.Request
+    text = message_to_yaml(cls())
+    return f'"{text}"' if quotes else text

@@ -116,6 +116,9 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
     p.add_argument("type")
     p.add_argument("--no-expand", action="store_true", help="do not expand nested types")
     verb_args.comment_options(p)
+    p = verb(v, "proto", "Output an interface prototype", _interface_proto)
+    p.add_argument("type", help="Type of the interface (e.g. 'std_msgs/msg/String')")
+    p.add_argument("--no-quotes", action="store_true", help="if true output has no outer quotes.")
 
     bag.add_verbs(group("bag", "record, inspect and replay topics"), verb)
     v = group("pkg", "packages")
@@ -128,6 +131,7 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
 
 _NO_DDS = (
     {("interface", v) for v in ("list", "packages", "package", "show")}
+    | {("interface", "proto")}
     | {("pkg", "executables")}
     | {("bag", v) for v in bag.NO_DDS_VERBS}
 )
@@ -192,6 +196,12 @@ def _interface_package(ctx: CallContext, args: argparse.Namespace) -> int:
     for name in packages[args.package_name]:
         if name.split("/", 1)[0] in kinds:
             ctx.write(f"{args.package_name}/{name}")
+    return 0
+
+
+def _interface_proto(ctx: CallContext, args: argparse.Namespace) -> int:
+    for line in interfaces.prototype(args.type, quotes=not args.no_quotes).split("\n"):
+        ctx.write(line)
     return 0
 
 

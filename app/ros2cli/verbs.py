@@ -138,9 +138,16 @@ def add_topic(v: Any, verb: Verb) -> None:
     )
     unsupported(p, *_STRATEGY_UNSUPPORTED)
 
-    p = verb(v, "type", "Print a topic's type", lambda c, a: topic.topic_type(c, a.topic_name))
+    p = verb(
+        v,
+        "type",
+        "Print a topic's type",
+        lambda c, a: topic.topic_type(c, a.topic_name, a.include_hidden_topics),
+    )
     strategy(p)
     p.add_argument("topic_name", help="Name of the ROS topic to get type (e.g. '/chatter')")
+    # ros2 takes this one before the verb (`ros2 topic --include-hidden-topics type ...`)
+    p.add_argument("--include-hidden-topics", action="store_true", help=hidden_help)
     unsupported(p, *_STRATEGY_UNSUPPORTED)
 
     p = verb(

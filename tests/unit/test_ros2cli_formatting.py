@@ -24,7 +24,7 @@ from app.ros.context import CallContext
 from app.ros2cli.common import is_hidden_name, visible, write_text
 from app.ros2cli.msg_yaml import message_to_yaml
 from app.ros2cli.param import describe_lines
-from app.ros2cli.parser import parse
+from app.ros2cli.parser import parse, run_argv
 from app.ros2cli.topic import bandwidth_text, echo_text
 
 
@@ -165,3 +165,16 @@ def test_bandwidth_lines_use_one_unit_chosen_by_the_rate():
     assert bandwidth_text(2_500_000.0, 100, 25_000.0, 25_000, 25_000) == (
         "2.50 MB/s from 100 messages\n\tMessage size mean: 0.03 MB min: 0.03 MB max: 0.03 MB"
     )
+
+
+def test_interface_proto_prints_a_quoted_default_instance():
+    lines: list[str] = []
+    ctx = CallContext(node=None, write=lines.append)  # type: ignore[arg-type]
+    assert run_argv(ctx, ["interface", "proto", "geometry_msgs/msg/Vector3"]) == 0
+    assert lines == ['"x: 0.0', "y: 0.0", "z: 0.0", '"']
+    lines.clear()
+    assert (
+        run_argv(ctx, ["interface", "proto", "tutorial_interfaces/action/Fibonacci", "--no-quotes"])
+        == 0
+    )
+    assert lines == ["order: 0", ""]  # the goal, as print() shows YAML's last newline
