@@ -301,7 +301,7 @@ ENTRIES: tuple[CatalogEntry, ...] = (
             "-p",
             "scale_angular:=1.5",
         ),
-        package="sim_world",
+        package="turtlesim",  # upstream's teleop drives any robot: remap its topic
     ),
     # --- URDF (issue 23): robot_state_publisher, joint_state_publisher, the arm's TF ---
     CatalogEntry(

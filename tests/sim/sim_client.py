@@ -23,6 +23,7 @@ from rcl_interfaces.msg import Log, Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
+from rclpy.parameter import Parameter as RclpyParameter
 from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, LaserScan
@@ -191,6 +192,24 @@ def start(c: SimClient) -> dict:
     }
 
 
+def sim_time(c: SimClient) -> dict:
+    """A node with use_sim_time: its clock follows /clock, and stands still while paused."""
+    c.set_parameters([RclpyParameter("use_sim_time", RclpyParameter.Type.BOOL, True)])
+    time.sleep(1.0)
+    offsets = []
+    for _ in range(5):
+        offsets.append(c.get_clock().now().nanoseconds * 1e-9 - c.sim_time())
+        time.sleep(0.1)
+    c.call(Empty, "/pause_physics")
+    time.sleep(0.3)
+    paused_at = c.get_clock().now().nanoseconds * 1e-9
+    time.sleep(1.0)
+    paused_later = c.get_clock().now().nanoseconds * 1e-9
+    c.call(Empty, "/unpause_physics")
+    c.set_parameters([RclpyParameter("use_sim_time", RclpyParameter.Type.BOOL, False)])
+    return {"offsets": offsets, "paused": [paused_at, paused_later]}
+
+
 def scan_in_room(c: SimClient) -> dict:
     c.call(Empty, "/reset_simulation")
     c.wait_sim(0.5)
@@ -316,6 +335,7 @@ def main() -> int:
     try:
         for name, scenario in (
             ("start", start),
+            ("sim_time", sim_time),
             ("scan_in_room", scan_in_room),
             ("pause_and_step", pause_and_step),
             ("drive", drive),

@@ -101,6 +101,12 @@ def test_sensors_publish_what_a_real_robot_publishes(report):
     assert 0.8 <= start["rtf"] <= 1.2
 
 
+def test_a_node_with_use_sim_time_follows_the_clock_and_stops_when_paused(report):
+    sim = part(report, "sim_time")
+    assert max(abs(offset) for offset in sim["offsets"]) < 0.1, sim["offsets"]
+    assert sim["paused"][1] == sim["paused"][0] > 0.0
+
+
 def test_the_scan_matches_the_walls_of_the_room_within_the_noise(report):
     scan = part(report, "scan_in_room")
     x, y = scan["truth"]
