@@ -84,6 +84,7 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
 
     def group(name: str, help_text: str):
         g = groups.add_parser(name, help=help_text, write=write)
+        verb_args.command_options(name, g)  # `ros2 topic --include-hidden-topics ...`
         verbs = g.add_subparsers(dest="verb", metavar="VERB", parser_class=_Parser)
         verbs.required = True
         return verbs

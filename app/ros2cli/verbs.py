@@ -146,8 +146,6 @@ def add_topic(v: Any, verb: Verb) -> None:
     )
     strategy(p)
     p.add_argument("topic_name", help="Name of the ROS topic to get type (e.g. '/chatter')")
-    # ros2 takes this one before the verb (`ros2 topic --include-hidden-topics type ...`)
-    p.add_argument("--include-hidden-topics", action="store_true", help=hidden_help)
     unsupported(p, *_STRATEGY_UNSUPPORTED)
 
     p = verb(
@@ -361,9 +359,6 @@ def add_service(v: Any, verb: Verb) -> None:
         lambda c, a: graph_verbs.service_type(c, a.service_name, a.include_hidden_services),
     )
     p.add_argument("service_name", help="Name of the ROS service to get type")
-    p.add_argument(
-        "--include-hidden-services", action="store_true", help="Consider hidden services as well"
-    )
 
     p = verb(
         v,
@@ -389,9 +384,6 @@ def add_service(v: Any, verb: Verb) -> None:
     strategy(p)
     p.add_argument(
         "service_name", help="Name of the ROS service to get info (e.g. '/add_two_ints')"
-    )
-    p.add_argument(
-        "--include-hidden-services", action="store_true", help="Consider hidden services as well"
     )
     unsupported(p, *_STRATEGY_UNSUPPORTED)
 
@@ -649,3 +641,14 @@ def comment_options(p: argparse.ArgumentParser) -> None:
         help="Show all comments, including for nested interface definitions",
     )
     group.add_argument("--no-comments", action="store_true", help="Show no comments or whitespace")
+
+
+def command_options(group: str, p: argparse.ArgumentParser) -> None:
+    """Options ros2 takes before the verb: `ros2 topic --include-hidden-topics type /x`."""
+    noun = {"topic": "topics", "service": "services"}.get(group)
+    if noun:
+        p.add_argument(
+            f"--include-hidden-{noun}",
+            action="store_true",
+            help=f"Consider hidden {noun} as well",
+        )

@@ -153,6 +153,11 @@ def test_abbreviated_include_hidden_is_accepted_as_ros2_accepts_it():
     assert isinstance(args, argparse.Namespace) and args.include_hidden_topics
     args = parse(["service", "list", "--include-hidden"], lambda _line: None)
     assert isinstance(args, argparse.Namespace) and args.include_hidden_services
+    # before the verb, as `ros2 topic --include-hidden-topics type ...` takes it
+    args = parse(["topic", "--include-hidden-topics", "type", "/_x"], lambda _line: None)
+    assert isinstance(args, argparse.Namespace) and args.include_hidden_topics
+    args = parse(["service", "--include-hidden-services", "info", "/_x"], lambda _line: None)
+    assert isinstance(args, argparse.Namespace) and args.include_hidden_services
 
 
 def test_bandwidth_lines_use_one_unit_chosen_by_the_rate():
