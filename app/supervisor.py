@@ -62,6 +62,8 @@ class LearnerProgram:
     cwd: Path
     # Called with the pid once the process is reaped (contained code: end its forks too).
     after_exit: Callable[[int], object] | None = field(default=None, compare=False)
+    # Variables set on top of the supervisor's environment (e.g. AMENT_PREFIX_PATH for a launch).
+    env: Mapping[str, str] | None = field(default=None, compare=False)
 
 
 Program = CatalogEntry | LearnerProgram
@@ -177,6 +179,9 @@ class Supervisor:
         self._ended: deque[NodeStatus] = deque(maxlen=500)  # who ended, newest last
         self._spawner = ThreadPoolExecutor(max_workers=1, thread_name_prefix="supervisor-spawn")
         self._closed = False
+        # How learner code may run (app.exercises.runner.RunPolicy), set by whoever serves the
+        # page; None refuses it. `ros2 launch` of a learner's launch file reads it.
+        self.learner_policy: object | None = None
 
     # -- queries -----------------------------------------------------------
 
@@ -302,8 +307,11 @@ class Supervisor:
     # -- internals ---------------------------------------------------------
 
     def _spawn(self, entry: Program, extra_ros_args: tuple[str, ...]) -> NodeStatus:
+        env = self._env
         if isinstance(entry, LearnerProgram):
             argv, cwd = list(entry.argv), entry.cwd
+            if entry.env:
+                env = {**self._env, **entry.env}
         else:
             argv = [sys.executable, "-m", f"nodes.{entry.module}", *entry.argv_tail()]
             if extra_ros_args:
@@ -312,7 +320,7 @@ class Supervisor:
         popen = subprocess.Popen(
             argv,
             cwd=cwd,
-            env=self._env,
+            env=env,
             stdin=subprocess.DEVNULL,
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
