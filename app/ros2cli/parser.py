@@ -54,13 +54,22 @@ class _Parser(argparse.ArgumentParser):
         raise _HelpShown()
 
     def error(self, message: str) -> NoReturn:
-        # As argparse (and so ros2) prints it: the usage, then "PROG: error: MESSAGE".
-        self._print_message(self.format_usage())
-        raise ArgumentUsageError(f"{self.prog}: error: {message}")
+        raise ArgumentUsageError(self.prog, message, self.format_usage())
 
 
 class ArgumentUsageError(UsageError):
-    """argparse's own complaint, written verbatim (exit code 2, as ros2's)."""
+    """argparse's own complaint (exit code 2, as ros2's)."""
+
+    def __init__(self, prog: str, message: str, usage: str) -> None:
+        super().__init__(f"{prog}: {message}")
+        self.usage = usage
+        # As argparse (and so ros2) prints it: the usage, then "PROG: error: MESSAGE".
+        self.as_ros2 = f"{prog}: error: {message}"
+
+
+# Groups whose argparse mistakes still read as one 'error: ...' line (not yet
+# compared with ros2cli's; their owners decide).
+_ONE_LINE_ERRORS = {"run", "launch", "pkg", "bag"}
 
 
 def split_command(text: str) -> list[str]:
@@ -245,7 +254,12 @@ def run_argv(
             settle_discovery(ctx)
         return args.handler(ctx, args)
     except ArgumentUsageError as exc:
-        ctx.write(str(exc))
+        if argv[:1] and argv[0] in _ONE_LINE_ERRORS:
+            ctx.write(f"error: {exc}")
+        else:
+            for line in exc.usage.rstrip("\n").split("\n"):
+                ctx.write(line)
+            ctx.write(exc.as_ros2)
         return EXIT_USAGE
     except UsageError as exc:
         ctx.write(f"error: {exc}")
