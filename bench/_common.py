@@ -139,13 +139,18 @@ def start_dashboard(log_name: str = "bench-dashboard.log") -> tuple[subprocess.P
 
 
 def stop(proc: subprocess.Popen, timeout: float = 10.0) -> None:
-    """SIGINT (Ctrl+C) first, as a learner would, then harder."""
+    """SIGINT (Ctrl+C) first, as a learner would, then SIGKILL to its whole group.
+
+    Children started by ``spawn`` lead their own process group: killing the
+    group also ends what they started. What a child left after ending on its
+    own is found by the run's mark (``bench._reaper``).
+    """
     if proc.poll() is None:
         proc.send_signal(2)
         try:
             proc.wait(timeout)
         except subprocess.TimeoutExpired:
-            proc.kill()
+            os.killpg(proc.pid, 9)  # not yet reaped: the group id is still this child's
             proc.wait()
 
 

@@ -34,6 +34,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import signal
 import subprocess
 import sys
 import threading
@@ -96,9 +97,31 @@ def baseline_main(topic: str, t0: float, t1: float, out: Path) -> None:
     out.write_text(
         json.dumps({"topic": topic, "count": len(inside), "hz": rate_from_stamps(inside)})
     )
-    executor.shutdown()
+    end_bounded(node, executor)
+
+
+TEARDOWN_SEC = 5  # a child that has written its figures gets this long to end
+
+
+def end_bounded(node: Any, executor: Any) -> None:
+    """Tear down in a bounded time: entities first, then the executor, then the context.
+
+    The reader of a 1 kHz topic once spun at 95 % of a core for 15+ minutes in
+    ``destroy_node`` (native code, under load), holding the GIL, so no Python
+    watchdog could run: the kernel's alarm ends the process instead. Entities
+    are destroyed while the executor still exists (rclpy 7.1.6's
+    ``Executor.shutdown`` does not wait for work in progress, so nothing is
+    gained by shutting it down first).
+    """
+    import rclpy
+
+    signal.signal(signal.SIGALRM, signal.SIG_DFL)  # default action: the process ends
+    signal.alarm(TEARDOWN_SEC)
+    executor.remove_node(node)
     node.destroy_node()
+    executor.shutdown(timeout_sec=1.0)
     rclpy.try_shutdown()
+    signal.alarm(0)
 
 
 def dashboard_main(t0: float, t1: float, out: Path) -> None:
@@ -215,6 +238,7 @@ def run(seconds: float) -> dict[str, Any]:
     publisher, pub_log = _child(["--publisher", str(pub_out)], "bench-load-publisher.log")
     results: dict[str, dict[str, Any]] = {}
     windows: dict[str, tuple[float, float]] = {}
+    children: list[subprocess.Popen] = []  # ended in `finally`, whatever happens
     try:
         wait_for_text(publisher, pub_log, "PUBLISHER READY", 30)
         # Baseline: one plain subscriber process per topic.
@@ -224,9 +248,15 @@ def run(seconds: float) -> dict[str, Any]:
             out = LOGS / f"bench-load-plain-{k}.json"
             args = ["--baseline", topic, f"{t0!r}", f"{t1!r}", str(out)]
             procs.append((_child(args, f"bench-load-plain-{k}.log")[0], out))
+            children.append(procs[-1][0])
         results["baseline"] = {}
         for proc, out in procs:
-            proc.wait(timeout=WARMUP_SEC + seconds + 30)
+            try:
+                proc.wait(timeout=WARMUP_SEC + seconds + 30)
+            except subprocess.TimeoutExpired:
+                raise SystemExit(f"a plain subscriber did not end: {proc.args!r}") from None
+            if not out.exists():
+                raise SystemExit(f"a plain subscriber wrote no figures (exit {proc.returncode})")
             data = json.loads(out.read_text())
             results["baseline"][data["topic"]] = data
         # Dashboard: one process, every topic.
@@ -235,11 +265,14 @@ def run(seconds: float) -> dict[str, Any]:
         proc, log = _child(
             ["--dashboard-side", f"{t0!r}", f"{t1!r}", str(out)], "bench-load-dashboard.log"
         )
+        children.append(proc)
         proc.wait(timeout=WARMUP_SEC + seconds + 30)
         if proc.returncode != 0:
             raise SystemExit(f"dashboard side failed:\n{log.read_text(errors='replace')}")
         results["dashboard"] = json.loads(out.read_text())
     finally:
+        for child in children:
+            stop(child, timeout=3.0)
         stop(publisher)
     pub_data = json.loads(pub_out.read_text())
     figures: dict[str, Any] = {"seconds": seconds}

@@ -15,6 +15,7 @@ import datetime
 import json
 import math
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -22,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from bench._common import ROOT, machine, require_private_netns
+from bench._reaper import MARK, end_leftovers
 
 RESULTS = ROOT / "bench" / "results" / "summary.md"
 LOAD = [0.0]  # the 1-minute load average when the run began: others may share the cores
@@ -338,6 +340,14 @@ ROWS += (
         lambda v: v >= 0.9,
     ),
     (
+        "MuJoCo world drawn in the browser: the dashboard's extra CPU",
+        "sim_world",
+        "dashboard_draw_cpu_percent",
+        "% of a core",
+        "measured",
+        lambda v: True,
+    ),
+    (
         "MuJoCo world as fast as it can (every sensor on) / bare mj_step loop",
         "sim_world",
         "max_rtf|bare_rtf",
@@ -385,22 +395,43 @@ def last_json(output: str) -> dict[str, Any] | None:
     return None
 
 
-def run_one(name: str, args: list[str]) -> tuple[dict[str, Any] | None, float]:
+BENCH_TIMEOUT_SEC = 300
+
+
+def run_one(name: str, args: list[str]) -> tuple[dict[str, Any] | None, float, str]:
+    """Run one benchmark in its own session; (figures, seconds, why it failed or '')."""
     print(f"\n== {name} {' '.join(args)}", flush=True)
     t0 = time.monotonic()
-    proc = subprocess.run(
+    proc = subprocess.Popen(
         [sys.executable, "-m", "bench", name, *args],
         cwd=ROOT,
-        capture_output=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
         text=True,
-        timeout=300,
+        start_new_session=True,  # a timeout ends its whole group, not just the first process
     )
+    failure = ""
+    try:
+        stdout, stderr = proc.communicate(timeout=BENCH_TIMEOUT_SEC)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        stdout, stderr = proc.communicate()
+        failure = f"timed out after {BENCH_TIMEOUT_SEC} s"
     elapsed = time.monotonic() - t0
-    lines = proc.stdout.strip().splitlines()
+    lines = stdout.strip().splitlines()
     print("\n".join(lines[-8:]), flush=True)
     if proc.returncode != 0:
-        print(f"(failed with code {proc.returncode})\n{proc.stderr[-2000:]}", flush=True)
-    return last_json(proc.stdout), elapsed
+        print(f"(failed with code {proc.returncode})\n{stderr[-2000:]}", flush=True)
+        last = (stderr.strip().splitlines() or [f"exit code {proc.returncode}"])[-1]
+        failure = failure or f"exit code {proc.returncode}: {last[:120]}"
+    left = end_leftovers(os.environ[MARK]) if MARK in os.environ else []
+    if left:
+        print("left running (killed now):\n" + "\n".join(left), flush=True)
+        failure = (failure + "; " if failure else "") + f"left {len(left)} processes running"
+    figures = last_json(stdout)
+    if figures is None and not failure:
+        failure = "printed no figures"
+    return figures, elapsed, failure
 
 
 def cell(figures: dict[str, Any], key: str) -> tuple[str, float | None]:
@@ -415,7 +446,12 @@ def cell(figures: dict[str, Any], key: str) -> tuple[str, float | None]:
     return " / ".join(parts), first
 
 
-def markdown(results: dict[str, dict[str, Any]], times: dict[str, float]) -> str:
+def markdown(
+    results: dict[str, dict[str, Any]],
+    times: dict[str, float],
+    failures: dict[str, str] | None = None,
+) -> str:
+    failures = failures or {}
     m = machine()
     lines = [
         "# Benchmark summary",
@@ -434,14 +470,18 @@ def markdown(results: dict[str, dict[str, Any]], times: dict[str, float]) -> str
     for label, bench, key, unit, aim, test in ROWS:
         if bench not in results:
             if bench in times:  # it ran and printed no figures: a failure row, never a gap
+                why = failures.get(bench, "printed no figures").replace("|", "/")
                 lines.append(
-                    f"| {label} | not measured: {bench} failed | {unit} | {aim} | **no** |"
+                    f"| {label} | FAILED: not measured ({bench}: {why}) | {unit} | {aim} | **no** |"
                 )
             continue
         text, value = cell(results[bench], key)
         met = "" if test is None else "**no** (not measured)" if value is None else ""
         met = met or ("" if test is None or value is None else "yes" if test(value) else "**no**")
         lines.append(f"| {label} | {text} | {unit} | {aim} | {met} |")
+    broken = [f"{b}: {why}" for b, why in failures.items() if b in results]
+    if broken:  # figures printed, yet the benchmark failed (e.g. it left processes running)
+        lines += ["", "FAILED despite figures: " + "; ".join(broken)]
     lines += ["", "Wall time per benchmark: "]
     lines[-1] += ", ".join(f"{name} {sec:.0f} s" for name, sec in times.items())
     return "\n".join(lines) + "\n"
@@ -457,15 +497,18 @@ def main(argv: list[str] | None = None) -> int:
     here = Path(__file__).parent
     results: dict[str, dict[str, Any]] = {}
     times: dict[str, float] = {}
+    failures: dict[str, str] = {}
     for name, bench_args in RUNS:
         if args.only and name not in args.only:
             continue
         if not (here / f"{name}.py").exists():
             continue
-        figures, times[name] = run_one(name, bench_args)
+        figures, times[name], failure = run_one(name, bench_args)
         if figures is not None:
             results[name] = figures
-    text = markdown(results, times)
+        if failure:
+            failures[name] = failure
+    text = markdown(results, times, failures)
     print("\n" + text)
     if not args.no_write:
         RESULTS.parent.mkdir(parents=True, exist_ok=True)
@@ -473,6 +516,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"written to {RESULTS.relative_to(ROOT)}")
     headline = {key: results.get(b, {}).get(k) for key, (b, k) in HEADLINE.items()}
     print(json.dumps(headline, sort_keys=True))
+    if failures:
+        print("FAILED benchmarks: " + "; ".join(f"{b} ({w})" for b, w in failures.items()))
+        return 1
     return 0
 
 

@@ -15,6 +15,7 @@ import pytest
 
 from app import PROJECT_ROOT
 from app.dds import configure_dds_env
+from bench import _reaper
 
 ARTIFACTS = PROJECT_ROOT / "test-artifacts"
 _domain_ids = itertools.count(1 + os.getpid() % 50)
@@ -223,3 +224,17 @@ def page(browser, dashboard, request):
     ARTIFACTS.mkdir(exist_ok=True)
     page.screenshot(path=str(ARTIFACTS / f"{request.node.name}.png"))
     context.close()
+
+
+# Nothing a test started outlives the session: every process this session
+# starts inherits this mark, and the session fails naming any still running at
+# its end (after killing them), however they were started (bench/_reaper.py).
+_RUN_MARK = _reaper.mark_this_run("test")
+
+
+def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    left = _reaper.end_leftovers(_RUN_MARK)
+    if left:
+        print("\nFAILED: processes started by the tests were still running (killed now):")
+        print("\n".join(f"  {line}" for line in left))
+        session.exitstatus = 1

@@ -28,7 +28,9 @@ from app.ros.errors import Cancelled
 from app.ros.graph import snapshot
 from app.supervisor import Supervisor
 
-CHECK_WAIT_SEC = 6.0  # a check that has not passed by then fails with its last reason
+# A check that has not passed by then fails with its last reason; a rate check
+# needs about 4 s of messages after discovery, with room for a loaded machine.
+CHECK_WAIT_SEC = 10.0
 NODE_WAIT_SEC = 10.0  # a fresh process needs a few seconds to import rclpy and join
 POLL_SEC = 0.2
 PROBE_LIMITS = Limits(service_timeout=3.0, action_timeout=30.0)

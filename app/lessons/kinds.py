@@ -44,7 +44,7 @@ CHECK_KINDS: dict[str, Kind] = {
     "node_running": make_kind("node"),
     "node_absent": make_kind("node"),
     "topic_messages": make_kind("topic type at_least", "field contains"),
-    "topic_rate": make_kind("topic type min_hz max_hz"),
+    "topic_rate": make_kind("topic type min_hz max_hz", "samples"),
     "topic_subscribers": make_kind("topic at_least"),
     "log_contains": make_kind("catalog_node text", "at_least"),
     "bag_contains": make_kind("bag topic at_least"),

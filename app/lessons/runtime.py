@@ -52,6 +52,18 @@ ROSOUT_QOS = QoSProfile(
 ROSOUT_KEEP = 500
 
 
+RATE_SECONDS = 4.0  # a rate is judged on about this long of the rate under test
+RATE_MIN_SAMPLES, RATE_MAX_SAMPLES = 8, 60
+
+
+def rate_samples_needed(check: Spec) -> int:
+    """Messages a topic_rate check judges on: its ``samples``, else ~4 s at the mid rate."""
+    if "samples" in check.fields:
+        return int(check["samples"])
+    mid = (float(check["min_hz"]) + float(check["max_hz"])) / 2
+    return max(RATE_MIN_SAMPLES, min(RATE_MAX_SAMPLES, round(mid * RATE_SECONDS)))
+
+
 @dataclass(frozen=True)
 class CheckResult:
     state: str  # pass | fail | waiting
@@ -74,6 +86,7 @@ class LessonRuntime:
         self.graph = GraphSnapshot()
         self._lock = threading.Lock()
         self._taps: dict[tuple[str, str], TopicMonitor] = {}
+        self._tap_born: dict[tuple[str, str], float] = {}  # when each tap began to listen
         self._services = ServicePoller(node, RECALL_PERIOD_SEC)
         self._goals: dict[str, GoalRun] = {}
         self._senders: dict[tuple[str, str], Any] = {}  # kept: a fresh one misses subscribers
@@ -86,6 +99,7 @@ class LessonRuntime:
         with self._lock:
             key = (topic, type_name + (" (history)" if history else ""))
             if key not in self._taps:
+                self._tap_born[key] = time.monotonic()
                 self._taps[key] = TopicMonitor(
                     self.node,
                     topic,
@@ -239,17 +253,27 @@ class LessonRuntime:
         return CheckResult(WAITING, f"{count} of {c['at_least']} messages on {c['topic']}")
 
     def _check_topic_rate(self, c: Spec) -> CheckResult:
+        """Judged on enough messages (``samples``, else about 4 s of the rate under test),
+        by the publisher's clock where the middleware gives it, over a window no
+        longer than those messages need at the slowest accepted rate (older ones,
+        e.g. from before a rate change, do not count)."""
         tap = self.tap(c["topic"], c["type"])
-        rate = tap.rate_hz()
-        if rate is None:
+        needed = rate_samples_needed(c)
+        window = (needed + 1) / c["min_hz"] if c["min_hz"] > 0 else None
+        stats = tap.published_rate(window)
+        got = 0 if stats is None else (stats.published or stats.received)
+        listened = time.monotonic() - self._tap_born.get((c["topic"], c["type"]), time.monotonic())
+        if stats is None or (got < needed and (window is None or listened < window)):
             if not self._publishers(c["topic"]):
                 return CheckResult(FAIL, f"no publisher on {c['topic']}")
-            return CheckResult(WAITING, f"measuring the rate of {c['topic']}")
-        if c["min_hz"] <= rate <= c["max_hz"]:
-            return CheckResult(PASS, f"{c['topic']} at {rate:.1f} Hz")
-        return CheckResult(
-            FAIL, f"{c['topic']} at {rate:.1f} Hz, expected {c['min_hz']}-{c['max_hz']} Hz"
-        )
+            return CheckResult(
+                WAITING, f"measuring the rate of {c['topic']}: {got} of {needed} messages"
+            )
+        how = "by the publisher's clock" if not stats.fallback else "by arrival times"
+        text = f"{c['topic']} at {stats.rate:.2f} Hz over {got} messages ({how})"
+        if c["min_hz"] <= stats.rate <= c["max_hz"] and got >= needed:
+            return CheckResult(PASS, text)
+        return CheckResult(FAIL, f"{text}, expected {c['min_hz']}-{c['max_hz']} Hz")
 
     def _check_topic_subscribers(self, c: Spec) -> CheckResult:
         # Count the learner's subscribers, not the dashboard's own taps.
