@@ -195,3 +195,31 @@ def test_the_camera_renders_the_room_headless():
         camera.close()
     assert image.shape == (240, 320, 3)
     assert image.std() > 10  # walls, floor and objects, not a blank frame
+
+
+def test_odometry_integrates_encoder_angles_exactly_on_a_straight_line_and_an_arc():
+    odom = Odometry(radius=0.05, separation=0.2)
+    odom.reset(0.0, 0.0)
+    odom.update(10.0, 10.0, dt=1.0)  # both wheels 10 rad: 0.5 m straight ahead
+    assert (odom.x, odom.y, odom.yaw) == pytest.approx((0.5, 0.0, 0.0))
+    assert odom.linear == pytest.approx(0.5)
+    odom.reset(0.0, 0.0)
+    turn = math.pi / 2  # right wheel further: a quarter circle to the left of radius 0.5 m
+    left, right = (0.5 - 0.1) * turn / 0.05, (0.5 + 0.1) * turn / 0.05
+    for k in range(1, 101):
+        odom.update(left * k / 100, right * k / 100, dt=0.01)
+    assert (odom.x, odom.y, odom.yaw) == pytest.approx((0.5, 0.5, turn), abs=1e-6)
+    assert quantize(0.0015, 4096) == 0.0 and quantize(0.0016, 4096) == pytest.approx(
+        2 * math.pi / 4096
+    )
+
+
+def test_the_gripper_opening_is_clamped_to_what_the_fingers_can_do(room):
+    room.reset()
+    assert room.set_gripper(0.5) == 0.09
+    assert room.set_gripper(-1.0) == 0.0
+    assert room.set_gripper(0.04) == 0.04
+    room.step(round(0.5 / room.timestep))
+    names, positions, _ = room.joint_state()
+    fingers = [positions[names.index(n)] for n in ("left_finger_joint", "right_finger_joint")]
+    assert fingers == pytest.approx([0.02, 0.02], abs=0.002)

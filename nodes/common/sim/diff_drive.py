@@ -92,10 +92,12 @@ class Odometry:
         self._last = (left, right)
         distance = (d_left + d_right) / 2.0
         turn = (d_right - d_left) / self.separation
-        # Move along the chord of the arc: heading halfway through the turn.
+        # Move along the chord of the arc: heading halfway through the turn, and the
+        # chord is shorter than the arc by sin(turn/2) / (turn/2).
         heading = self.yaw + turn / 2.0
-        self.x += distance * math.cos(heading)
-        self.y += distance * math.sin(heading)
+        chord = distance * (math.sin(turn / 2.0) / (turn / 2.0) if abs(turn) > 1e-9 else 1.0)
+        self.x += chord * math.cos(heading)
+        self.y += chord * math.sin(heading)
         self.yaw = math.atan2(math.sin(self.yaw + turn), math.cos(self.yaw + turn))
         if dt > 0:
             self.linear = distance / dt
