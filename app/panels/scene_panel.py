@@ -25,6 +25,7 @@ from app.scene.markers import MarkerLayer
 from app.scene.plots import JointPlot
 from app.scene.pointclouds import PointCloudLayer
 from app.scene.stamped import StampedLayer
+from app.scene.tf_view import TfView
 from app.ui import MarkdownView, assign, code_block
 from app.ui.loop import UiLoop
 
@@ -32,6 +33,9 @@ INTRO = (
     "The **3D view** draws live topics, as rviz does. Drag to orbit, scroll to zoom. "
     "Axes are red = x, green = y, blue = z."
 )
+
+
+AUTO_FIXED = "(root of the tree)"
 
 
 class _Offer(NamedTuple):
@@ -151,6 +155,22 @@ class ScenePanel:
             self._matrix = MarkdownView(gui)
             self._param_status = MarkdownView(gui)
         self._stamped_info = MarkdownView(gui)
+        with gui.add_folder("TF and robot model"):
+            MarkdownView(
+                gui,
+                "Every frame on `/tf` and `/tf_static` with its axes and name, and the robot "
+                "described on `/robot_description` drawn from its URDF, as rviz shows them.",
+            )
+            self.tf_view = TfView(node, server)
+            self._fixed_options: tuple[str, ...] = (AUTO_FIXED,)
+            self._fixed = gui.add_dropdown(
+                "Fixed Frame",
+                self._fixed_options,
+                initial_value=AUTO_FIXED,
+                hint="The frame everything is drawn relative to (rviz's Global Options)",
+            )
+            self._frame_names = gui.add_checkbox("Frame names", True)
+            self._tf_status = MarkdownView(gui)
 
         self.params = CameraParamSync(node)
         self._wire()
@@ -164,6 +184,10 @@ class ScenePanel:
         self._joint_row.on_pick(ui, self._select_joints)
         self._frame_cloud.on_click(ui.callback(self._look_at_cloud))
         self._budget.on_update(ui.callback(self._apply_budget))
+        self._fixed.on_update(ui.callback(self._on_fixed_frame))
+        self._frame_names.on_update(
+            ui.callback(lambda: setattr(self.tf_view, "show_names", self._frame_names.value))
+        )
         self._image_on_frustum.on_update(
             ui.callback(lambda: self.images.show_on_frustum(self._image_on_frustum.value))
         )
@@ -174,6 +198,10 @@ class ScenePanel:
         self.frames.on_change(
             lambda pose, source: ui.post(lambda: self._on_pose_changed(pose, source))
         )
+
+    def _on_fixed_frame(self) -> None:
+        value = str(self._fixed.value)
+        self.tf_view.fixed_frame = "" if value == AUTO_FIXED else value
 
     def _look_at_cloud(self) -> None:
         self.clouds.frame_in_view(self.frames.to_world)
@@ -236,7 +264,15 @@ class ScenePanel:
         self.stamped.refresh(graph)
         self._stamped_info.show(self.stamped.describe())
         self._param_status.show(self.params.status)
+        frames = (AUTO_FIXED, *self.tf_view.frame_names())
+        if frames != self._fixed_options:
+            if self._fixed.value not in frames:
+                frames = (*frames, str(self._fixed.value))  # a picked frame that went away
+            self._fixed_options = frames
+            self._fixed.options = frames
+        self._tf_status.show(self.tf_view.status())
 
     def close(self) -> None:
-        for layer in (self.clouds, self.images, self.markers, self.arm, self.stamped, self.params):
+        layers = (self.clouds, self.images, self.markers, self.arm, self.stamped, self.params)
+        for layer in (*layers, self.tf_view):
             layer.close()

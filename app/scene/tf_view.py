@@ -1,0 +1,259 @@
+"""TF frames and the robot of /robot_description in the 3D view, as rviz's TF and RobotModel.
+
+Every frame on ``/tf`` and ``/tf_static`` is drawn with its axes and name at
+its pose in the Fixed Frame (chosen by the learner; until then the root of
+the biggest tree). The robot described on ``/robot_description`` is drawn
+link by link from its URDF, each link at its TF frame, so it moves as
+robot_state_publisher publishes. A dynamic frame whose publisher falls
+silent is shown stale. Bad input (a description that does not parse, a
+NaN or zero-length quaternion, a loop of frames) is one line in the status
+and in the log; nothing is drawn from it and nothing stops.
+
+Threads: the subscriptions' callbacks (executor) only store transforms or
+drop the description into a one-slot box; a drawing thread of this layer
+parses descriptions and moves scene nodes, at most ``MAX_HZ`` times a second.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+
+import numpy as np
+import viser
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from robot_state_publisher.urdf_tree import UrdfError
+from std_msgs.msg import String
+from tf2_msgs.msg import TFMessage
+
+from app.scene import transforms as tf
+from app.scene.qos import SCENE_CALLBACK_GROUP
+from app.scene.robot_model import RobotDrawing, build_drawing
+from app.scene.tf_tree import TfStore, TreeView
+
+log = logging.getLogger(__name__)
+
+TF_PATH = "/tf_view"
+MAX_HZ = 30.0
+AXES_LENGTH = 0.08
+TF_QOS = QoSProfile(depth=100)
+STATIC_QOS = QoSProfile(depth=100, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+DESCRIPTION_QOS = QoSProfile(
+    depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
+)
+
+
+def scene_name(frame: str) -> str:
+    """A TF frame name as one scene-path segment (a '/' inside would nest nodes)."""
+    return frame.replace("/", "__") or "_"
+
+
+class TfView:
+    def __init__(self, node: Node, server: viser.ViserServer) -> None:
+        self._server = server
+        self.store = TfStore()
+        self.fixed_frame = ""  # "" until the learner picks one: follow the biggest tree
+        self.show_names = True
+        self._lock = threading.Lock()
+        self._description: str | None = None
+        self._robot: RobotDrawing | None = None
+        self.robot_status = "No robot on /robot_description yet."
+        self.robot_error = ""
+        self._frames: dict[str, tuple[viser.FrameHandle, viser.LabelHandle]] = {}
+        self._links: dict[str, viser.FrameHandle] = {}
+        self._link_nodes: list[viser.SceneNodeHandle] = []
+        self._logged: set[str] = set()
+        self.view: TreeView | None = None
+        self._root = server.scene.add_frame(TF_PATH, show_axes=False)
+        self._wake = threading.Event()
+        self._stop = threading.Event()
+        self._subscriptions = [
+            node.create_subscription(
+                TFMessage, "/tf", self._on_tf, TF_QOS, callback_group=SCENE_CALLBACK_GROUP
+            ),
+            node.create_subscription(
+                TFMessage,
+                "/tf_static",
+                self._on_tf_static,
+                STATIC_QOS,
+                callback_group=SCENE_CALLBACK_GROUP,
+            ),
+            node.create_subscription(
+                String,
+                "/robot_description",
+                self._on_description,
+                DESCRIPTION_QOS,
+                callback_group=SCENE_CALLBACK_GROUP,
+            ),
+        ]
+        self._node = node
+        self._thread = threading.Thread(target=self._run, name="scene-tf", daemon=True)
+        self._thread.start()
+
+    # --- executor thread: store and hand over, nothing else ---
+    def _on_tf(self, msg: TFMessage) -> None:
+        self._store(msg, static=False)
+
+    def _on_tf_static(self, msg: TFMessage) -> None:
+        self._store(msg, static=True)
+
+    def _store(self, msg: TFMessage, *, static: bool) -> None:
+        for t in msg.transforms:
+            v, r = t.transform.translation, t.transform.rotation
+            self.store.add(
+                t.header.frame_id, t.child_frame_id, (v.x, v.y, v.z), (r.x, r.y, r.z, r.w),
+                static=static,
+            )  # fmt: skip
+        self._wake.set()
+
+    def _on_description(self, msg: String) -> None:
+        with self._lock:
+            self._description = msg.data
+        self._wake.set()
+
+    # --- drawing thread ---
+    def _run(self) -> None:
+        last_version = -1
+        last_draw = 0.0
+        while not self._stop.is_set():
+            self._wake.wait(0.25)  # also wakes to notice frames going stale
+            self._wake.clear()
+            wait = last_draw + 1.0 / MAX_HZ - time.monotonic()
+            if wait > 0 and self._stop.wait(wait):
+                break
+            with self._lock:
+                description, self._description = self._description, None
+            try:
+                if description is not None:
+                    self._load_robot(description)
+                version = self.store.version
+                last_draw = time.monotonic()
+                self._draw(force=version != last_version)
+                last_version = version
+            except Exception:  # a bad frame must not end the view
+                log.exception("drawing TF failed")
+
+    def _load_robot(self, description: str) -> None:
+        try:
+            drawing = build_drawing(description)
+        except UrdfError as exc:
+            self.robot_error = f"robot_description: {exc}"
+            self._log_once(self.robot_error)
+            return
+        self.robot_error = ""
+        for handle in self._link_nodes:
+            handle.remove()
+        self._link_nodes.clear()
+        self._links.clear()
+        scene = self._server.scene
+        with self._server.atomic():
+            for link in drawing.links:
+                frame = scene.add_frame(
+                    f"{TF_PATH}/robot/{scene_name(link)}", show_axes=False, visible=False
+                )
+                self._links[link] = frame
+                self._link_nodes.append(frame)
+            for i, visual in enumerate(drawing.visuals):
+                self._link_nodes.append(
+                    scene.add_mesh_trimesh(
+                        f"{TF_PATH}/robot/{scene_name(visual.link)}/visual{i}", visual.mesh
+                    )
+                )
+        self._robot = drawing
+        shown = len({v.link for v in drawing.visuals})
+        note = f" ({'; '.join(drawing.warnings)})" if drawing.warnings else ""
+        self.robot_status = (
+            f"Robot **{drawing.name}**: {len(drawing.links)} links, {shown} with shapes{note}."
+        )
+        log.info("robot_description: robot %s with %d links", drawing.name, len(drawing.links))
+
+    def _log_once(self, line: str) -> None:
+        if line not in self._logged:
+            self._logged.add(line)
+            log.warning("%s", line)
+
+    def _choose_fixed(self) -> str:
+        if self.fixed_frame:
+            return self.fixed_frame
+        roots = self.store.roots()
+        return roots[0] if roots else ""
+
+    def _draw(self, *, force: bool) -> None:
+        fixed = self._choose_fixed()
+        view = self.store.view(fixed)
+        changed_stale = self.view is None or view.stale != self.view.stale
+        self.view = view
+        for line in list(self.store.errors):
+            self._log_once(line)
+        if not force and not changed_stale:
+            return
+        scene = self._server.scene
+        with self._server.atomic():
+            for frame in sorted(set(view.poses) | set(view.problems)):
+                handles = self._frames.get(frame)
+                if handles is None:
+                    axes = scene.add_frame(
+                        f"{TF_PATH}/frames/{scene_name(frame)}",
+                        axes_length=AXES_LENGTH,
+                        axes_radius=AXES_LENGTH / 20,
+                    )
+                    label = scene.add_label(
+                        f"{TF_PATH}/frames/{scene_name(frame)}/name", frame, font_screen_scale=0.8
+                    )
+                    handles = (axes, label)
+                    self._frames[frame] = handles
+                axes, label = handles
+                pose = view.poses.get(frame)
+                axes.visible = pose is not None
+                if pose is not None:
+                    axes.position = tf.as_xyz(pose[:3, 3])
+                    axes.wxyz = tf.matrix_to_quat(pose[:3, :3])
+                text = f"{frame} (stale)" if frame in view.stale else frame
+                if label.text != text:
+                    label.text = text
+                label.visible = self.show_names
+            for link, handle in self._links.items():
+                pose = view.poses.get(link)
+                handle.visible = pose is not None
+                if pose is not None:
+                    handle.position = tf.as_xyz(pose[:3, 3])
+                    handle.wxyz = tf.matrix_to_quat(pose[:3, :3])
+
+    # --- UI thread ---
+    def frame_names(self) -> list[str]:
+        return self.store.frames()
+
+    def status(self) -> str:
+        """One short Markdown paragraph: frames, fixed frame, stale ones, the last problem."""
+        view = self.view
+        lines = []
+        if view is None or not (view.poses or view.problems):
+            lines.append("No TF frames yet (nothing on /tf or /tf_static).")
+        else:
+            lines.append(
+                f"{len(view.poses)} frames drawn in Fixed Frame **{view.fixed}**"
+                + (f"; {len(view.problems)} not connected to it" if view.problems else "")
+                + "."
+            )
+            if view.stale:
+                lines.append("Stale (publisher silent): " + ", ".join(sorted(view.stale)) + ".")
+            loops = sorted({p for p in view.problems.values() if "loop" in p})
+            if loops:
+                lines.append("⚠️ " + loops[0])
+        if self.store.errors:
+            lines.append("⚠️ " + self.store.errors[-1])
+        lines.append(("⚠️ " + self.robot_error) if self.robot_error else self.robot_status)
+        return "\n\n".join(lines)
+
+    def poses(self) -> dict[str, np.ndarray]:
+        view = self.view
+        return dict(view.poses) if view is not None else {}
+
+    def close(self) -> None:
+        self._stop.set()
+        self._wake.set()
+        self._thread.join(timeout=2.0)
+        for subscription in self._subscriptions:
+            self._node.destroy_subscription(subscription)
