@@ -15,6 +15,7 @@ import sys
 from typing import Any
 
 import yaml
+from rosidl_parser import definition as idl
 
 from app.ros.convert import is_message
 
@@ -37,45 +38,124 @@ def _cut(text: str, limit: int | None) -> str:
     return text[:limit] + "..." if limit is not None and len(text) > limit else text
 
 
-def plain_value(value: Any, limit: int | None = None) -> Any:
+def _type_name(value_type: Any) -> str:
+    if isinstance(value_type, idl.BasicType):
+        return str(value_type.typename)
+    if isinstance(value_type, idl.AbstractWString):
+        return "wstring"
+    if isinstance(value_type, idl.AbstractString):
+        return "string"
+    if isinstance(value_type, idl.NamespacedType):
+        return "/".join(value_type.namespaced_name())
+    if isinstance(value_type, idl.NamedType):
+        return str(value_type.name)
+    return "unknown"
+
+
+def array_summary(value: Any, field_type: Any) -> str:
+    """What `--no-arr` prints instead of an array or sequence field."""
+    name = _type_name(field_type.value_type)
+    if isinstance(field_type, idl.Array):
+        return f"<array type: {name}[{field_type.size}]>"
+    if isinstance(field_type, idl.BoundedSequence):
+        return f"<sequence type: {name}[{field_type.maximum_size}], length: {len(value)}>"
+    if isinstance(field_type, idl.UnboundedSequence):
+        return f"<sequence type: {name}, length: {len(value)}>"
+    return "unknown"
+
+
+def plain_value(
+    value: Any,
+    limit: int | None = None,
+    *,
+    field_type: Any = None,
+    no_arr: bool = False,
+    no_str: bool = False,
+) -> Any:
     """One field value as ros2cli turns it into YAML data (bytes become text, arrays lists)."""
     if isinstance(value, bytes | bytearray):
         return _cut("".join(chr(b) for b in value), limit)
     if isinstance(value, str):
-        return _cut(value, limit)
-    if hasattr(value, "tolist") and not isinstance(value, bool | int | float):
-        value = value.tolist()  # numpy arrays and numpy scalars
-    if isinstance(value, array.array):
-        value = value.tolist()
-    if isinstance(value, list | tuple):
-        items = [plain_value(v, limit) for v in value[: limit if limit is not None else None]]
+        return f"<string length: <{len(value)}>>" if no_str else _cut(value, limit)
+    if isinstance(value, list | tuple | array.array) or (
+        hasattr(value, "tolist") and hasattr(value, "shape") and value.shape != ()
+    ):
+        if no_arr and field_type is not None:
+            return array_summary(value, field_type)
+        items = [
+            plain_value(v, limit, no_arr=no_arr, no_str=no_str)
+            for v in list(value)[: limit if limit is not None else None]
+        ]
         if limit is not None and len(value) > limit:
             items.append("...")
         return items
+    if hasattr(value, "item") and not isinstance(value, bool | int | float):
+        return value.item()  # a numpy scalar
     if is_message(value):
-        return message_to_plain(value, limit)
+        return message_to_plain(value, limit, no_arr=no_arr, no_str=no_str)
     return value
 
 
-def message_to_plain(msg: Any, limit: int | None = None) -> dict[str, Any]:
+def message_to_plain(
+    msg: Any, limit: int | None = None, *, no_arr: bool = False, no_str: bool = False
+) -> dict[str, Any]:
     """A message as an ordered dict of plain values, in the order its definition gives."""
     return {
-        name: plain_value(getattr(msg, name), limit) for name in msg.get_fields_and_field_types()
+        name: plain_value(getattr(msg, name), limit, field_type=slot, no_arr=no_arr, no_str=no_str)
+        for name, slot in zip(msg.get_fields_and_field_types(), msg.SLOT_TYPES, strict=False)
     }
 
 
-def message_to_yaml(msg: Any, truncate_length: int | None = None) -> str:
-    """Block-style YAML text of a message, ending in a newline (``{}`` for an empty one)."""
+def message_to_yaml(
+    msg: Any,
+    truncate_length: int | None = None,
+    *,
+    no_arr: bool = False,
+    no_str: bool = False,
+    flow_style: bool = False,
+) -> str:
+    """YAML text of a message, ending in a newline (``{}`` for an empty one)."""
     return yaml.dump(
-        message_to_plain(msg, truncate_length),
+        message_to_plain(msg, truncate_length, no_arr=no_arr, no_str=no_str),
         Dumper=_BlockDumper,
         allow_unicode=True,
         width=sys.maxsize,
-        default_flow_style=False,
+        default_flow_style=flow_style,
         sort_keys=False,
     )
 
 
-def printed(text: str) -> list[str]:
-    """The lines Python's ``print(text)`` shows (a trailing newline gives an empty line)."""
-    return text.split("\n")
+def message_to_csv(
+    msg: Any, truncate_length: int | None = None, *, no_arr: bool = False, no_str: bool = False
+) -> str:
+    """`ros2 topic echo --csv`: every leaf value, depth first, joined by commas."""
+
+    def text(value: Any, field_type: Any = None) -> str:
+        if isinstance(value, list | tuple | array.array) or (
+            hasattr(value, "tolist") and hasattr(value, "shape") and value.shape != ()
+        ):
+            if no_arr and field_type is not None:
+                return array_summary(value, field_type)
+            parts = []
+            for i, item in enumerate(list(value)):
+                if truncate_length is not None and i >= truncate_length:
+                    parts.append("...")
+                    break
+                parts.append(text(item))
+            return ",".join(parts)
+        if is_message(value):
+            return message_to_csv(value, truncate_length, no_arr=no_arr, no_str=no_str)
+        if isinstance(value, str) and no_str:
+            return f"<string length: <{len(value)}>>"
+        if truncate_length is not None and isinstance(value, str):
+            value = _cut(value, truncate_length)
+        elif truncate_length is not None and isinstance(value, bytes):
+            if len(value) > truncate_length:
+                value = value[:truncate_length] + b"..."
+        return str(value)
+
+    result = ""
+    for name, slot in zip(msg.get_fields_and_field_types(), msg.SLOT_TYPES, strict=False):
+        # A comma only once something was written: an empty first field adds none.
+        result += ("," if result else "") + text(getattr(msg, name), slot)
+    return result

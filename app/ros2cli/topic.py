@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass
 from typing import Any
 
 import yaml
@@ -28,7 +29,7 @@ from app.ros2cli.common import (
     write_names,
     write_text,
 )
-from app.ros2cli.msg_yaml import ECHO_TRUNCATE_LENGTH, message_to_yaml
+from app.ros2cli.msg_yaml import ECHO_TRUNCATE_LENGTH, message_to_csv, message_to_yaml
 
 # ------------------------------------------------------------------ verbs
 
@@ -134,11 +135,28 @@ def _selected(msg: Any, field: list[str] | None, field_text: str) -> Any:
     return msg
 
 
-def echo_text(value: Any, truncate_length: int | None = ECHO_TRUNCATE_LENGTH) -> str:
+@dataclass(frozen=True)
+class EchoStyle:
+    """How `ros2 topic echo` prints: its --truncate-length, --no-arr, --no-str, ... options."""
+
+    truncate_length: int | None = ECHO_TRUNCATE_LENGTH
+    no_arr: bool = False
+    no_str: bool = False
+    flow_style: bool = False
+    csv: bool = False
+
+
+def echo_text(value: Any, style: EchoStyle = EchoStyle()) -> str:
     """One echoed message as ros2cli prints it, up to and with its closing '---'."""
-    if is_message(value):
-        return message_to_yaml(value, truncate_length) + "---"
-    return f"{value}\n---"  # a selected field that is not a message: printed as Python does
+    if not is_message(value):
+        return f"{value}\n---"  # a selected field that is not a message: printed as Python does
+    options = {"no_arr": style.no_arr, "no_str": style.no_str}
+    if style.csv:
+        return message_to_csv(value, style.truncate_length, **options)
+    return (
+        message_to_yaml(value, style.truncate_length, flow_style=style.flow_style, **options)
+        + "---"
+    )
 
 
 def echo(
@@ -149,7 +167,7 @@ def echo(
     once: bool = False,
     field: str | None = None,
     count: int | None = None,
-    truncate_length: int | None = ECHO_TRUNCATE_LENGTH,
+    style: EchoStyle = EchoStyle(),
     timeout: float | None = None,
 ) -> int:
     parts = None
@@ -178,7 +196,7 @@ def echo(
                 if limit is not None and shown >= limit:
                     break
                 shown += 1
-                write_text(ctx, echo_text(_selected(msg, parts, field or ""), truncate_length))
+                write_text(ctx, echo_text(_selected(msg, parts, field or ""), style))
             shown = max(shown, seen)  # messages dropped from the buffer count as shown
     finally:
         monitor.close()

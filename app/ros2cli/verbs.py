@@ -177,7 +177,13 @@ def add_topic(v: Any, verb: Verb) -> None:
             a.message_type,
             once=a.once,
             field=a.field,
-            truncate_length=None if a.full_length else a.truncate_length,
+            style=topic.EchoStyle(
+                truncate_length=None if a.full_length else a.truncate_length,
+                no_arr=a.no_arr,
+                no_str=a.no_str,
+                flow_style=a.flow_style,
+                csv=a.csv,
+            ),
             timeout=a.timeout,
         ),
     )
@@ -202,6 +208,18 @@ def add_topic(v: Any, verb: Verb) -> None:
         default=128,
         help="The length to truncate arrays, bytes, and string to (default: 128)",
     )
+    p.add_argument("--no-arr", action="store_true", help="Don't print array fields of messages")
+    p.add_argument("--no-str", action="store_true", help="Don't print string fields of messages")
+    p.add_argument(
+        "--flow-style",
+        action="store_true",
+        help="Print collections in the flow style (not available with csv format)",
+    )
+    p.add_argument(
+        "--csv",
+        action="store_true",
+        help="Output all recursive fields separated by commas (e.g. for plotting)",
+    )
     p.add_argument(
         "--once", action="store_true", help="Print the first message received and then exit."
     )
@@ -215,10 +233,6 @@ def add_topic(v: Any, verb: Verb) -> None:
     unsupported(
         p,
         *_QOS,
-        "--csv",
-        "--no-arr",
-        "--no-str",
-        "--flow-style",
         "--no-lost-messages",
         "--raw",
         "--filter",

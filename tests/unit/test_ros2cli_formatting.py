@@ -25,7 +25,7 @@ from app.ros2cli.common import is_hidden_name, visible, write_text
 from app.ros2cli.msg_yaml import message_to_yaml
 from app.ros2cli.param import describe_lines
 from app.ros2cli.parser import parse, run_argv
-from app.ros2cli.topic import bandwidth_text, echo_text
+from app.ros2cli.topic import EchoStyle, bandwidth_text, echo_text
 
 
 def test_sequences_print_in_block_style_not_indented_under_their_key():
@@ -183,3 +183,26 @@ def test_interface_proto_prints_a_quoted_default_instance():
         == 0
     )
     assert lines == ["order: 0", ""]  # the goal, as print() shows YAML's last newline
+
+
+def test_echo_options_no_arr_no_str_flow_style_and_csv():
+    from geometry_msgs.msg import Polygon
+    from sensor_msgs.msg import Imu
+
+    msg = UInt8MultiArray(data=[1, 2, 3])
+    assert echo_text(msg, EchoStyle(no_arr=True)).endswith(
+        "data: '<sequence type: uint8, length: 3>'\n---"
+    )
+    imu = Imu()
+    text = echo_text(imu, EchoStyle(no_arr=True, no_str=True))
+    assert "  frame_id: '<string length: <0>>'" in text, text
+    assert "orientation_covariance: '<array type: double[9]>'" in text, text
+    assert echo_text(Polygon(), EchoStyle(no_arr=True)) == (
+        "points: '<sequence type: geometry_msgs/msg/Point32, length: 0>'\n---"
+    )
+    assert echo_text(String(data="hi"), EchoStyle(flow_style=True)) == "{data: hi}\n---"
+    twist = Twist()
+    twist.linear.x = 2.0
+    assert echo_text(twist, EchoStyle(csv=True)) == "2.0,0.0,0.0,0.0,0.0,0.0"
+    # layout: its empty dim adds nothing (not even a comma), data_offset 0; then the data
+    assert echo_text(msg, EchoStyle(csv=True, truncate_length=2)) == "0,1,2,..."
