@@ -147,6 +147,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     settings = ExerciseSettings(
         _run_policy(args, progress.path.parent, workspace), args.reveal_solution_after
     )
+    supervisor.learner_policy = settings.policy  # `ros2 launch` of a learner's launch file
     dashboard = Dashboard(
         server, runtime, supervisor, progress, editor_hub, workspace, settings, page_links
     )
@@ -175,7 +176,10 @@ def cmd_serve(args: argparse.Namespace) -> int:
 
 def _progress_beacon(args: argparse.Namespace, dashboard: Any) -> Any:
     """In a classroom: report this learner's progress to the teacher (app/teacher/beacon.py)."""
-    if args.classroom_domain_id is None:
+    from app.hub.progress_link import HubTarget
+
+    hub = HubTarget.from_env()  # inside a JupyterHub server: HTTP to the teacher service
+    if args.classroom_domain_id is None and hub is None:
         return None
     from app.lessons.schema import load_course
     from app.teacher.beacon import LearnerSources, ProgressBeacon
@@ -192,10 +196,11 @@ def _progress_beacon(args: argparse.Namespace, dashboard: Any) -> Any:
         dashboard.ui,
         sources,
         dashboard.notice,
-        site=args.site,
-        learner=args.learner,
+        site="hub" if hub else args.site,
+        learner=hub.learner if hub else args.learner,
         domain_id=int(os.environ.get("ROS_DOMAIN_ID", "0")),
-        classroom_domain=args.classroom_domain_id,
+        classroom_domain=None if hub else args.classroom_domain_id,
+        hub=hub,
     )
     beacon.start()
     return beacon
@@ -318,12 +323,26 @@ def cmd_launch(args: argparse.Namespace) -> int:
     """Run a launch group in the foreground (app/launch.py), or print its launch file."""
     from app.launch import launch_file_text, launch_in_foreground
 
+    if args.words or args.group.endswith(".py") or os.path.isfile(args.group):
+        return _ros2_launch([args.group, *args.words], args)  # `ros2 launch PKG FILE [args]`
     if args.print_launch_file:
         print(launch_file_text(args.group), end="")
         return 0
     catalog.lookup_group(args.group)
     configure_this_process(domain_id=args.domain_id, network=args.network)
     return launch_in_foreground(args.group, os.environ)
+
+
+def _ros2_launch(words: list[str], args: argparse.Namespace) -> int:
+    """Replace this process with ros2launch (app/launch_prefix.py), as `ros2 launch` runs."""
+    from app.launch_prefix import ROS2LAUNCH_MAIN, with_catalog_prefix
+
+    if args.print_launch_file:
+        raise CliError("--print takes a launch group name (see `ros2-classroom list`)")
+    configure_this_process(domain_id=args.domain_id, network=args.network)
+    argv = [sys.executable, str(ROS2LAUNCH_MAIN), *(["-s"] if args.show_args else []), *words]
+    os.execve(sys.executable, argv, with_catalog_prefix(os.environ))
+    return 0  # not reached
 
 
 def cmd_exercise(args: argparse.Namespace) -> int:
@@ -487,7 +506,15 @@ def build_parser() -> argparse.ArgumentParser:
     lst.set_defaults(func=cmd_list)
 
     launch = sub.add_parser("launch", help="start a launch group, like `ros2 launch`")
-    launch.add_argument("group", help="launch group name (see `ros2-classroom list`)")
+    launch.add_argument(
+        "group", help="launch group name (see `ros2-classroom list`), or PACKAGE, or a FILE"
+    )
+    launch.add_argument(
+        "words", nargs="*", help="PACKAGE FILE [name:=value ...] or FILE [name:=value ...]"
+    )
+    launch.add_argument(
+        "-s", "--show-args", action="store_true", help="show a launch file's arguments"
+    )
     launch.add_argument(
         "--print", dest="print_launch_file", action="store_true", help="print its launch file"
     )

@@ -28,11 +28,13 @@ import sys
 import tempfile
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Protocol
 
 import ros2launch
 
 from app.catalog import ENTRIES, GROUPS, CatalogEntry
 from app.launch import PACKAGE, launch_file_text
+from app.supervisor import LearnerProgram
 
 PREFIX_ENV = "AMENT_PREFIX_PATH"
 # Upstream executable names the catalog files under another name.
@@ -198,3 +200,58 @@ def find_launch_file(package: str, file_name: str, env: Mapping[str, str] | None
 def is_ours(path: Path) -> bool:
     """A launch file of the catalog prefix (trusted), not a learner's."""
     return path.resolve().is_relative_to(catalog_prefix().resolve())
+
+
+class LaunchRefused(RuntimeError):
+    """A learner's launch file may not run here (the same rule as their other code)."""
+
+
+class Policy(Protocol):
+    """How learner code may run (app.exercises.runner.RunPolicy has these)."""
+
+    @property
+    def allowed(self) -> bool: ...
+
+    @property
+    def contained(self) -> bool: ...
+
+    @property
+    def hidden(self) -> tuple[Path, ...]: ...
+
+    def refusal(self) -> str: ...
+
+
+def launch_program(
+    name: str,
+    node_name: str,
+    words: list[str],
+    cwd: Path,
+    policy: Policy | None,
+    *,
+    trusted: bool,
+) -> LearnerProgram:
+    """``ros2 launch WORDS`` as one supervised program (its nodes are in its process group).
+
+    A launch file is Python code: one of ours (``trusted``) runs as is, a learner's
+    runs exactly as their exercise code does (refused, or contained).
+    """
+    env = launch_env()
+    if policy is None and not trusted:
+        raise LaunchRefused(
+            f"{words[0]} is a learner's launch file, and no rule for learner code was given here"
+        )
+    if trusted or (policy is not None and policy.allowed and not policy.contained):
+        argv = [sys.executable, str(ROS2LAUNCH_MAIN), *words]
+        return LearnerProgram(name, node_name, tuple(argv), cwd, env=env)
+    assert policy is not None
+    if not policy.allowed:
+        raise LaunchRefused(policy.refusal())
+    from app.exercises import sandbox
+
+    missing = sandbox.sandbox_available()
+    if missing:
+        raise LaunchRefused(f"learner code must run contained here, and cannot: {missing}")
+    argv = sandbox.contained_argv(ROS2LAUNCH_MAIN, cwd, policy.hidden) + words
+    return LearnerProgram(
+        name, node_name, tuple(argv), cwd, after_exit=sandbox.kill_leftovers, env=env
+    )

@@ -51,41 +51,19 @@ def is_launch_file(script: Path) -> bool:
     return re.search(r"^def generate_launch_description\(", text, re.MULTILINE) is not None
 
 
-def launch_program(
-    name: str, node_name: str, words: list[str], cwd: Path, policy: RunPolicy, *, trusted: bool
-) -> LearnerProgram:
-    """``ros2 launch WORDS`` as one supervised program (its nodes are in its process group).
-
-    A launch file is Python code: one of ours (``trusted``) runs as is, a learner's
-    runs exactly as their exercise code does (refused, or contained).
-    """
-    from app.launch_prefix import ROS2LAUNCH_MAIN, launch_env
-
-    env = launch_env()
-    if trusted or (policy.allowed and not policy.contained):
-        argv = [sys.executable, str(ROS2LAUNCH_MAIN), *words]
-        return LearnerProgram(name, node_name, tuple(argv), cwd, env=env)
-    if not policy.allowed:
-        raise RunRefused(policy.refusal())
-    from app.exercises import sandbox
-
-    missing = sandbox.sandbox_available()
-    if missing:
-        raise RunRefused(f"learner code must run contained here, and cannot: {missing}")
-    argv = sandbox.contained_argv(ROS2LAUNCH_MAIN, cwd, policy.hidden) + words
-    return LearnerProgram(
-        name, node_name, tuple(argv), cwd, after_exit=sandbox.kill_leftovers, env=env
-    )
-
-
 def program_for(exercise: Exercise, script: Path, policy: RunPolicy) -> LearnerProgram:
     if not policy.allowed:
         raise RunRefused(policy.refusal())
     scratch = script.parent
     if is_launch_file(script):
-        words = [str(script)]
-        return launch_program(exercise.program_name, exercise.node, words, scratch, policy,
-                              trusted=False)  # fmt: skip
+        from app.launch_prefix import LaunchRefused, launch_program
+
+        try:
+            return launch_program(
+                exercise.program_name, exercise.node, [str(script)], scratch, policy, trusted=False
+            )
+        except LaunchRefused as exc:
+            raise RunRefused(str(exc)) from None
     if not policy.contained:
         argv = [sys.executable, str(script)]
         return LearnerProgram(exercise.program_name, exercise.node, tuple(argv), scratch)
