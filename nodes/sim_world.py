@@ -62,6 +62,12 @@ from nodes.common.sim.engine import Pose2D, SimEngine
 from nodes.common.sim.trajectory import TrajectoryError
 
 MAX_LAG = 1.0  # s of simulation behind schedule before the world gives up catching up
+# Integer parameters a start-up cannot use: refused with the reason (exit status 2).
+INTEGER_RANGES = {
+    "encoder_ticks": (1, 1 << 20),
+    "camera_width": (16, 1920),
+    "camera_height": (16, 1080),
+}
 CHUNK = 50  # physics steps between two looks at the clock when running flat out
 
 
@@ -103,6 +109,9 @@ class SimWorld(Node):
         p("step_duration", 0.1, _range(0.001, 10.0, "s that /step_simulation advances"))
         p("seed", 0)
         g = self._param
+        for name, (low, high) in INTEGER_RANGES.items():
+            if not low <= int(g(name)) <= high:
+                raise ValueError(f"parameter {name} = {g(name)} is outside {low}..{high}")
         self.engine = SimEngine(
             str(g("world")),
             start=self._start_pose(),

@@ -181,7 +181,9 @@ def test_a_joint_trajectory_is_reached_and_a_bad_one_refused_with_the_reason(rep
     assert "3 positions for 4 joint names" in joined
 
 
-def test_a_world_file_that_does_not_parse_stops_the_node_with_the_reason(env, tmp_path):
+def test_a_world_that_does_not_load_or_a_bad_parameter_stops_the_node_with_the_reason(
+    env, tmp_path
+):
     broken = tmp_path / "broken.xml"
     broken.write_text("<mujoco><worldbody><geom type='box'</worldbody></mujoco>")
     done = subprocess.run(
@@ -207,3 +209,14 @@ def test_a_world_file_that_does_not_parse_stops_the_node_with_the_reason(env, tm
     )
     assert missing.returncode == 2
     assert "does not exist (worlds under nodes/worlds: room)" in missing.stderr
+    ticks = subprocess.run(
+        [sys.executable, "-m", "nodes.sim_world", "--ros-args", "-p", "encoder_ticks:=0"],
+        cwd=PROJECT_ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    assert ticks.returncode == 2
+    assert "sim_world: error: parameter encoder_ticks = 0 is outside 1..1048576" in ticks.stderr
