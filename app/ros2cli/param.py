@@ -5,8 +5,10 @@ from __future__ import annotations
 import re
 
 import yaml
-from rcl_interfaces.msg import ParameterDescriptor, ParameterType
+from rcl_interfaces.msg import Parameter, ParameterDescriptor, ParameterType, ParameterValue
+from rcl_interfaces.srv import SetParameters
 
+from app.ros.calls import call_service
 from app.ros.context import CallContext
 from app.ros.errors import Ros2Error
 from app.ros.graph import all_nodes
@@ -110,6 +112,18 @@ def param_set(
     return 0  # ros2cli exits with 0 either way
 
 
+def param_delete(ctx: CallContext, fqn: str, name: str, include_hidden: bool = False) -> int:
+    """Set the parameter to 'not set' (what deleting is), and say how it went as ros2cli."""
+    target = param_node(ctx, fqn, include_hidden)
+    unset = ParameterValue(type=ParameterType.PARAMETER_NOT_SET)
+    request = SetParameters.Request(parameters=[Parameter(name=name, value=unset)])
+    service = f"{target.rstrip('/')}/set_parameters"
+    result = call_service(ctx, service, SetParameters, request).results[0]
+    words = "Deleted parameter successfully" if result.successful else "Deleting parameter failed"
+    ctx.write(words + (f": {result.reason}" if result.reason else ""))
+    return 0
+
+
 def describe_lines(descriptor: ParameterDescriptor) -> list[str]:
     """One parameter's descriptor as `ros2 param describe` prints it."""
     lines = [
@@ -161,14 +175,20 @@ def _flatten(values: dict, prefix: str = "") -> dict:
     return flat
 
 
-def param_load(ctx: CallContext, fqn: str, file_text: str, include_hidden: bool = False) -> int:
+def param_load(
+    ctx: CallContext,
+    fqn: str,
+    file_text: str,
+    include_hidden: bool = False,
+    use_wildcard: bool = True,
+) -> int:
     """Set every parameter a dump file holds for this node (or for every node: ``/**``)."""
     target = param_node(ctx, fqn, include_hidden)
     data = yaml.safe_load(params_file(file_text).read_text(encoding="utf-8"))
     sections = [
         section["ros__parameters"]
         for key, section in data.items()
-        if key in ("/**", target, target.lstrip("/"))
+        if key in (target, target.lstrip("/")) or (use_wildcard and key == "/**")
     ]
     if not sections:
         raise Ros2Error(f"{file_text!r} has no parameters for {target} (nor for /**)")

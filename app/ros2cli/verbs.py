@@ -584,12 +584,30 @@ def add_param(v: Any, verb: Verb) -> None:
         v,
         "load",
         "Load parameter file for a node",
-        lambda c, a: param.param_load(c, a.node_name, a.parameter_file, a.include_hidden_nodes),
+        lambda c, a: param.param_load(
+            c, a.node_name, a.parameter_file, a.include_hidden_nodes, not a.no_use_wildcard
+        ),
     )
     _param_node(p)
     p.add_argument("parameter_file", help="Parameter file")
     _timeout(p)
-    unsupported(p, "--no-use-wildcard", *_STRATEGY_UNSUPPORTED)
+    p.add_argument(
+        "--no-use-wildcard",
+        action="store_true",
+        help="Do not load parameters in the '/**' namespace into the node",
+    )
+    unsupported(p, *_STRATEGY_UNSUPPORTED)
+
+    p = verb(
+        v,
+        "delete",
+        "Delete parameter",
+        lambda c, a: param.param_delete(c, a.node_name, a.parameter_name, a.include_hidden_nodes),
+    )
+    _param_node(p)
+    p.add_argument("parameter_name", help="Name of the parameter")
+    _timeout(p)
+    unsupported(p, *_STRATEGY_UNSUPPORTED)
 
 
 def add_lifecycle(v: Any, verb: Verb) -> None:

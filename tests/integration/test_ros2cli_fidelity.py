@@ -351,6 +351,11 @@ def test_param_lifecycle_and_hidden_names_golden(supervisor, ros2):
     assert ros2("param get /turtlesim background_b") == (0, ["Integer value is: 255"])
     assert ros2("param get /nobody greeting") == (1, ["Node not found"])
     assert ros2("param describe /nobody greeting") == (1, ["Node not found"])
+    # the node refuses (rclpy's reason); ros2cli still exits with 0
+    assert ros2("param delete /parameters_node shout") == (
+        0,
+        ["Deleting parameter failed: Static parameter cannot be undeclared"],
+    )
     code, lines = ros2("param dump /parameters_node")
     assert lines[:3] == ["/parameters_node:", "  ros__parameters:", "    greeting: Hello"]
     assert lines[-1] == "", lines  # print() of yaml.dump's text
