@@ -27,7 +27,7 @@ from rclpy.parameter import Parameter as RclpyParameter
 from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, LaserScan
-from std_msgs.msg import Float64
+from std_msgs.msg import Float64, String
 from std_srvs.srv import Empty, Trigger
 from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
@@ -192,6 +192,20 @@ def start(c: SimClient) -> dict:
     }
 
 
+def teleop(c: SimClient) -> dict:
+    """The sim_drive group's teleop: the browser's "up" key drives the robot forward."""
+    keys = c.create_publisher(String, "/sim_teleop_key/_key", 10)
+    wait(lambda: keys.get_subscription_count() > 0, what="the teleop's key topic")
+    start_xy = c.truth()
+    for _ in range(20):  # a held key repeats
+        keys.publish(String(data="up"))
+        time.sleep(0.05)
+    c.wait_sim(1.0)  # the last command times out
+    moved = (c.truth()[0] - start_xy[0], c.truth()[1] - start_xy[1])
+    c.destroy_publisher(keys)
+    return {"moved": moved}
+
+
 def sim_time(c: SimClient) -> dict:
     """A node with use_sim_time: its clock follows /clock, and stands still while paused."""
     c.set_parameters([RclpyParameter("use_sim_time", RclpyParameter.Type.BOOL, True)])
@@ -335,6 +349,7 @@ def main() -> int:
     try:
         for name, scenario in (
             ("start", start),
+            ("teleop", teleop),
             ("sim_time", sim_time),
             ("scan_in_room", scan_in_room),
             ("pause_and_step", pause_and_step),

@@ -1,9 +1,9 @@
 """sim_world over real DDS, judged from a separate plain-rclpy process (sim_client.py).
 
-The node starts as a catalog program under the supervisor; the client imports
-only rclpy and message packages, runs from a folder outside the project, and
-reports what it measured. Each test judges one part against what a Gazebo user
-would expect of the robot's drivers.
+The launch group sim_drive (sim_world and the arrow-key teleop) starts under
+the supervisor; the client imports only rclpy and message packages, runs from a
+folder outside the project, and reports what it measured. Each test judges one
+part against what a Gazebo user would expect of the robot's drivers.
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 from app import PROJECT_ROOT
+from app.catalog import lookup_group
 from app.dds import configure_dds_env
 from tests.conftest import ARTIFACTS, _domain_ids, fail_on_leftover_nodes, in_private_netns
 
@@ -44,7 +45,8 @@ def report(env, tmp_path_factory) -> dict:
 
     supervisor = Supervisor(env)
     try:
-        supervisor.start("sim_world")
+        for member in lookup_group("sim_drive").members:  # sim_world and the teleop
+            supervisor.start(member)
         clean = {k: v for k, v in env.items() if k not in ("PYTHONPATH", "PYTHONSTARTUP")}
         done = subprocess.run(
             [sys.executable, "-I", str(CLIENT)],
@@ -99,6 +101,11 @@ def test_sensors_publish_what_a_real_robot_publishes(report):
     assert 8.5 <= start["rates"]["scan"] <= 11.5, start["rates"]
     assert start["rates"]["camera"] >= 0.8 * 15, start["rates"]
     assert 0.8 <= start["rtf"] <= 1.2
+
+
+def test_the_sim_drive_group_teleop_drives_the_robot_forward(report):
+    dx, dy = part(report, "teleop")["moved"]
+    assert 0.1 < dx < 0.6 and abs(dy) < 0.05, (dx, dy)  # 0.3 m/s while the key is held
 
 
 def test_a_node_with_use_sim_time_follows_the_clock_and_stops_when_paused(report):
