@@ -15,11 +15,13 @@ INTERFACE_FILES := $(foreach p,$(INTERFACES),$(wildcard $(p)/msg/* $(p)/srv/* $(
 	$(p)/CMakeLists.txt $(p)/package.xml $(p)/pyproject.toml)
 EDITOR := app/exercises/editor
 EDITOR_STAMP := $(EDITOR)/node_modules/.classroom-setup
+HUB_PROXY := app/hub/proxy
+HUB_PROXY_STAMP := $(HUB_PROXY)/node_modules/.classroom-setup
 ARGS ?=
 
 .PHONY: setup run test browser sandbox lint bench screenshots clean render
 
-setup: $(STAMP) $(EDITOR_STAMP) render
+setup: $(STAMP) $(EDITOR_STAMP) $(HUB_PROXY_STAMP) render
 
 # The exercise code editor (Ace), from the npm registry at the version the lock file pins.
 $(EDITOR_STAMP): $(EDITOR)/package.json $(EDITOR)/package-lock.json
@@ -30,6 +32,12 @@ $(EDITOR_STAMP): $(EDITOR)/package.json $(EDITOR)/package-lock.json
 	@echo "== installing the exercise editor (ace-builds from npm)"
 	npm ci --prefix $(EDITOR) --no-audit --no-fund --loglevel=error
 	@touch $(EDITOR_STAMP)
+
+# JupyterHub's configurable-http-proxy (deploy/, tests/hub), from npm like the editor.
+$(HUB_PROXY_STAMP): $(HUB_PROXY)/package.json $(HUB_PROXY)/package-lock.json $(EDITOR_STAMP)
+	@echo "== installing JupyterHub's configurable-http-proxy (npm)"
+	npm ci --prefix $(HUB_PROXY) --no-audit --no-fund --loglevel=error
+	@touch $(HUB_PROXY_STAMP)
 
 $(STAMP): pyproject.toml ros_python/pyproject.toml $(INTERFACE_FILES)
 	@test -n "$(PYTHON)" || { echo "error: ROS 2 Jazzy wheels need CPython 3.10, 3.11 or 3.12; none found" >&2; exit 1; }
@@ -98,4 +106,4 @@ screenshots: setup browser
 	$(VPY) tests/run.py --script docs/screenshots.py
 
 clean:
-	rm -rf $(VENV) $(EDITOR)/node_modules $(addsuffix /build,$(INTERFACES)) .mypy_cache .import_linter_cache
+	rm -rf $(VENV) $(EDITOR)/node_modules $(HUB_PROXY)/node_modules $(addsuffix /build,$(INTERFACES)) .mypy_cache .import_linter_cache

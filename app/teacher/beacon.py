@@ -26,6 +26,7 @@ from app.exercises import runner
 from app.exercises.model import Exercise, ExerciseBook
 from app.exercises.panel import ExerciseSettings
 from app.exercises.workspace import Workspace
+from app.hub.progress_link import HubLink, HubTarget, NoticeSink, ReportRefused, SettingsSink
 from app.lessons.runtime import LessonRuntime
 from app.lessons.schema import Course
 from app.ros.side_participant import SideParticipant
@@ -65,7 +66,8 @@ class ProgressBeacon:
         site: str,
         learner: str,
         domain_id: int,
-        classroom_domain: int,
+        classroom_domain: int | None = None,
+        hub: HubTarget | None = None,
     ) -> None:
         self._ui = ui
         self._sources = sources
@@ -76,17 +78,18 @@ class ProgressBeacon:
         self._stop = threading.Event()
         self._crash_key: tuple | None = None  # UI thread: the crash text read once per process
         self._crash_text = ""
-        self._side = SideParticipant(wire.node_name_for(site, learner), classroom_domain)
-        node = self._side.node
-        self._publisher = node.create_publisher(
-            wire.LearnerProgress, wire.PROGRESS_TOPIC, wire.PROGRESS_PUB_QOS
-        )
-        node.create_subscription(
-            wire.TeacherNotice, wire.NOTICES_TOPIC, self._on_notice, wire.NOTICES_QOS
-        )
-        node.create_subscription(
-            wire.ClassroomSettings, wire.SETTINGS_TOPIC, self._on_settings, wire.SETTINGS_QOS
-        )
+        self._link: DdsLink | HubLink
+        if hub is not None:  # on a JupyterHub: HTTP to the teacher service
+            self._link = HubLink(hub, self._on_notice, self._on_settings)
+        elif classroom_domain is not None:  # a LAN class: the classroom domain
+            self._link = DdsLink(
+                wire.node_name_for(site, learner),
+                classroom_domain,
+                self._on_notice,
+                self._on_settings,
+            )
+        else:
+            raise ValueError("a progress beacon needs a classroom domain or a hub")
         self._thread = threading.Thread(target=self._run, name="progress-beacon", daemon=True)
 
     def start(self) -> None:
@@ -96,7 +99,7 @@ class ProgressBeacon:
         self._stop.set()
         self._records.put(None)  # wake the beacon thread now
         self._thread.join(timeout=2.0)
-        self._side.shutdown()
+        self._link.close()
 
     # -- the beacon thread --------------------------------------------------------
 
@@ -122,11 +125,15 @@ class ProgressBeacon:
                 activity = now
                 if record.position() != last.position():
                     progress = now
-            if changed or now - sent_at >= HEARTBEAT_SEC:
+            if changed or now - sent_at >= self._link.heartbeat_sec:
                 stamped = _with_stamps(record, activity, progress)
                 try:
-                    self._publisher.publish(wire.to_message(stamped))
+                    self._link.send(stamped)
                     sent_at = now
+                except ReportRefused as refused:  # sent again next round (the newest record)
+                    log.warning("the teacher service refused this progress report: %s", refused)
+                except OSError as error:  # the hub is restarting or unreachable: next round
+                    log.warning("could not reach the teacher service: %s", error)
                 except Exception:  # shutting down, or a bug: the dashboard keeps going
                     log.exception("publishing progress failed")
             last = record
@@ -221,19 +228,57 @@ class ProgressBeacon:
             return f"{failed} failed check{'s' if failed != 1 else ''}, not passed yet"
         return ""
 
-    # -- the side participant's executor thread -------------------------------------
+    # -- the link's thread (DDS executor, or the beacon thread for HTTP) --------------
+
+    def _on_notice(self, to_key: str, text: str, stamp: float) -> None:
+        if to_key not in ("", self._key):
+            return
+        when = time.strftime("%H:%M", time.localtime(stamp))
+        to = "to you" if to_key else "to the class"
+        shown = f"📣 **Message from your teacher** ({to}, {when}): {plain_markdown(text)}"
+        self._ui.post(lambda: self._notice_view.show(shown))
+
+    def _on_settings(self, reveal_solution_after: int) -> None:
+        limit = reveal_solution_after or None
+        self._ui.post(lambda: _set_reveal_after(self._sources.settings, limit))
+
+
+class DdsLink:
+    """Progress out and the teacher's voice in, on the classroom domain (a LAN class)."""
+
+    heartbeat_sec = HEARTBEAT_SEC  # lets the teacher page tell a quiet learner from a gone one
+
+    def __init__(
+        self,
+        node_name: str,
+        classroom_domain: int,
+        on_notice: NoticeSink,
+        on_settings: SettingsSink,
+    ) -> None:
+        self._on_notice_sink, self._on_settings_sink = on_notice, on_settings
+        self._side = SideParticipant(node_name, classroom_domain)
+        node = self._side.node
+        self._publisher = node.create_publisher(
+            wire.LearnerProgress, wire.PROGRESS_TOPIC, wire.PROGRESS_PUB_QOS
+        )
+        node.create_subscription(
+            wire.TeacherNotice, wire.NOTICES_TOPIC, self._on_notice, wire.NOTICES_QOS
+        )
+        node.create_subscription(
+            wire.ClassroomSettings, wire.SETTINGS_TOPIC, self._on_settings, wire.SETTINGS_QOS
+        )
+
+    def send(self, record: LearnerRecord) -> None:
+        self._publisher.publish(wire.to_message(record))
+
+    def close(self) -> None:
+        self._side.shutdown()
 
     def _on_notice(self, msg: wire.TeacherNotice) -> None:
-        if msg.to not in ("", self._key):
-            return
-        when = time.strftime("%H:%M", time.localtime(wire.seconds(msg.stamp)))
-        to = "to you" if msg.to else "to the class"
-        text = f"📣 **Message from your teacher** ({to}, {when}): {plain_markdown(msg.text)}"
-        self._ui.post(lambda: self._notice_view.show(text))
+        self._on_notice_sink(msg.to, msg.text, wire.seconds(msg.stamp))
 
     def _on_settings(self, msg: wire.ClassroomSettings) -> None:
-        limit = msg.reveal_solution_after or None
-        self._ui.post(lambda: _set_reveal_after(self._sources.settings, limit))
+        self._on_settings_sink(msg.reveal_solution_after)
 
 
 def _with_stamps(record: LearnerRecord, activity: float, progress: float) -> LearnerRecord:

@@ -1,0 +1,365 @@
+"""The teacher's page as a JupyterHub service: the whole class, behind the hub's OAuth.
+
+JupyterHub starts it (``python -m app.hub.teacher_service``, registered in
+deploy/jupyterhub_config.py) and proxies ``/services/classroom-teacher/`` to
+it. Two kinds of callers:
+
+- Learners' dashboards POST their progress to ``api/progress`` with their
+  own hub API token (``JUPYTERHUB_API_TOKEN`` of their single-user server).
+  The hub tells us whose token it is; a report about anyone else is refused
+  (403, saying whose token it was), so nobody can write another learner's
+  row. The answer carries the teacher's messages and the reveal setting, so
+  nothing needs multicast between pods.
+- Teachers open the page in a browser and log in with the hub's OAuth. Only
+  users the hub grants ``access:services!service=classroom-teacher`` get in:
+  admins, and the teachers' group through the role in the config.
+
+All state lives on tornado's one thread: no locks. Rows, stuck marks and the
+CSV are those of ``classroom``'s teacher page (app.teacher.record).
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import logging
+import os
+import time
+from dataclasses import replace
+from typing import Any
+from urllib.parse import urlsplit
+
+from jupyterhub.services.auth import (
+    HubAuth,
+    HubOAuthCallbackHandler,
+    HubOAuthenticated,
+)
+from jupyterhub.utils import url_path_join
+from tornado import ioloop, web
+
+from app.hub.reports import ReportError, from_json
+from app.teacher.record import (
+    COLUMNS,
+    MAX_NOTICE,
+    LearnerRecord,
+    StuckRule,
+    checks_text,
+    table,
+    to_csv,
+)
+
+log = logging.getLogger(__name__)
+
+SERVICE_NAME = "classroom-teacher"
+SITE = "hub"  # the "site" of every row: the hub vouches for the learner's name
+MAX_NOTICES = 50
+
+
+class ClassState:
+    """Everyone's latest record, the teacher's messages and the class settings."""
+
+    def __init__(self) -> None:
+        self.records: dict[str, LearnerRecord] = {}
+        self.notices: list[dict[str, Any]] = []  # {"id", "to", "text", "stamp"}
+        self.reveal_after = 0  # 0: each exercise's own number
+        self.rule = StuckRule()
+        self.reports = 0
+        self.refused = 0
+
+    def notices_for(self, learner_key: str, since: int) -> list[dict[str, Any]]:
+        return [n for n in self.notices if n["id"] > since and n["to"] in ("", learner_key)]
+
+    def add_notice(self, to: str, text: str) -> dict[str, Any]:
+        notice = {
+            "id": (self.notices[-1]["id"] + 1) if self.notices else 1,
+            "to": to,
+            "text": text,
+            "stamp": time.time(),
+        }
+        self.notices = [*self.notices, notice][-MAX_NOTICES:]
+        return notice
+
+
+class _Base(web.RequestHandler):
+    def initialize(self, state: ClassState) -> None:
+        self.state = state
+
+    def write_error(self, status_code: int, **kwargs: Any) -> None:
+        reason = self._reason
+        error = kwargs.get("exc_info", (None, None, None))[1]
+        if isinstance(error, web.HTTPError) and error.log_message:
+            reason = error.log_message
+        self.set_header("Content-Type", "application/json")
+        self.finish(json.dumps({"status": status_code, "error": reason}))
+
+
+class ProgressReportHandler(_Base):
+    """``POST api/progress``: one learner's record, sent with that learner's hub token."""
+
+    def check_xsrf_cookie(self) -> None:  # a token in a header, never a browser cookie
+        return
+
+    async def post(self) -> None:
+        hub_auth: HubAuth = self.settings["hub_auth"]
+        token = hub_auth.get_token(self, in_cookie=False)
+        if not token:
+            self._refuse(401, "send your hub API token: Authorization: token <token>")
+        user = await hub_auth.user_for_token(token, sync=False)
+        if not user or user.get("kind", "user") != "user":
+            self._refuse(403, "the hub knows no user with this token")
+        try:
+            record = from_json(self.request.body, received_at=time.time())
+        except ReportError as error:
+            self._refuse(400, str(error))
+        name = user["name"]
+        if record.learner != name:
+            self._refuse(
+                403,
+                f"this token is {name}'s: it cannot report progress for {record.learner!r}",
+            )
+        record = replace(record, site=SITE)
+        self.state.records[record.key] = record
+        self.state.reports += 1
+        since = _int_arg(self.get_argument("since", "0"))
+        self.finish(
+            {
+                "accepted": record.key,
+                "notices": self.state.notices_for(record.key, since),
+                "reveal_after": self.state.reveal_after,
+            }
+        )
+
+    def _refuse(self, status: int, reason: str) -> None:
+        self.state.refused += 1
+        raise web.HTTPError(status, reason)
+
+
+def _int_arg(text: str) -> int:
+    try:
+        return max(0, int(text))
+    except ValueError:
+        raise web.HTTPError(400, "since must be a whole number") from None
+
+
+class _TeacherBase(HubOAuthenticated, _Base):
+    """Pages for teachers: the hub's OAuth, and only users granted this service."""
+
+
+class PageHandler(_TeacherBase):
+    @web.authenticated
+    def get(self) -> None:
+        user = self.current_user
+        self.set_header("Content-Type", "text/html; charset=utf-8")
+        self.set_header("Cache-Control", "no-store")
+        self.finish(
+            PAGE.replace("{{xsrf}}", html.escape(self.xsrf_token.decode()))
+            .replace("{{teacher}}", html.escape(user["name"]))
+            .replace("{{columns}}", "".join(f"<th>{html.escape(c)}</th>" for c in COLUMNS))
+            .replace("{{max_notice}}", str(MAX_NOTICE))
+        )
+
+
+class TableHandler(_TeacherBase):
+    @web.authenticated
+    def get(self) -> None:
+        records = list(self.state.records.values())
+        rows = table(records, self.state.rule)
+        self.set_header("Cache-Control", "no-store")
+        self.finish(
+            {
+                "columns": COLUMNS,
+                "rows": rows,
+                "keys": sorted(r.key for r in records),
+                "reports": self.state.reports,
+                "refused": self.state.refused,
+                "reveal_after": self.state.reveal_after,
+            }
+        )
+
+
+class CsvHandler(_TeacherBase):
+    @web.authenticated
+    def get(self) -> None:
+        self.set_header("Content-Type", "text/csv; charset=utf-8")
+        self.set_header("Content-Disposition", 'attachment; filename="classroom-progress.csv"')
+        self.finish(to_csv(self.state.records.values(), self.state.rule))
+
+
+class LearnerHandler(_TeacherBase):
+    """One learner's detail (their code and last error), as data the page shows as text."""
+
+    @web.authenticated
+    def get(self) -> None:
+        key = self.get_argument("key", "")
+        record = self.state.records.get(key)
+        if record is None:
+            raise web.HTTPError(404, f"no learner {key!r} has reported yet")
+        self.finish(
+            {
+                "key": record.key,
+                "where": f"Unit {record.unit} · {record.lesson_title} · step "
+                f"{record.step}/{record.steps}: {record.step_title}",
+                "checks": checks_text(record),
+                "reasons": [
+                    f"{state}: {reason}"
+                    for state, reason in zip(
+                        record.check_states, record.check_reasons, strict=False
+                    )
+                ],
+                "exercise": record.exercise,
+                "passed": record.exercise_passed_here,
+                "code": record.code_excerpt,
+                "last_error": record.last_error,
+            }
+        )
+
+
+class NoticeHandler(_TeacherBase):
+    @web.authenticated
+    def post(self) -> None:
+        body = _json_body(self.request.body)
+        to, text = body.get("to", ""), str(body.get("text", "")).strip()
+        if not isinstance(to, str) or (to and to not in self.state.records):
+            raise web.HTTPError(400, f"no learner {to!r} in this class")
+        if not text or len(text) > MAX_NOTICE:
+            raise web.HTTPError(400, f"a message needs 1-{MAX_NOTICE} characters")
+        self.finish({"sent": self.state.add_notice(to, text)})
+
+
+class SettingsHandler(_TeacherBase):
+    @web.authenticated
+    def post(self) -> None:
+        body = _json_body(self.request.body)
+        value = body.get("reveal_after")
+        if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= 100:
+            raise web.HTTPError(400, "reveal_after must be a whole number from 0 to 100")
+        self.state.reveal_after = value
+        self.finish({"reveal_after": value})
+
+
+def _json_body(body: bytes) -> dict[str, Any]:
+    try:
+        data = json.loads(body or b"{}")
+    except (UnicodeDecodeError, json.JSONDecodeError):
+        raise web.HTTPError(400, "the body must be a JSON object") from None
+    if not isinstance(data, dict):
+        raise web.HTTPError(400, "the body must be a JSON object")
+    return data
+
+
+def make_app(prefix: str, state: ClassState | None = None) -> web.Application:
+    state = state or ClassState()
+    args = {"state": state}
+    routes: list[Any] = [
+        (prefix, PageHandler, args),
+        (url_path_join(prefix, "progress.json"), TableHandler, args),
+        (url_path_join(prefix, "progress.csv"), CsvHandler, args),
+        (url_path_join(prefix, "learner.json"), LearnerHandler, args),
+        (url_path_join(prefix, "notice"), NoticeHandler, args),
+        (url_path_join(prefix, "settings"), SettingsHandler, args),
+        (url_path_join(prefix, "api/progress"), ProgressReportHandler, args),
+        (url_path_join(prefix, "oauth_callback"), HubOAuthCallbackHandler),
+    ]
+    return web.Application(
+        routes,
+        cookie_secret=os.urandom(32),
+        login_url=url_path_join(prefix, "oauth_start"),  # replaced by HubOAuth's redirect
+        hub_auth=HubAuth(),
+        xsrf_cookies=True,
+    )
+
+
+def main() -> None:
+    logging.basicConfig(level=logging.INFO)
+    prefix = os.environ.get("JUPYTERHUB_SERVICE_PREFIX", f"/services/{SERVICE_NAME}/")
+    where = urlsplit(os.environ.get("JUPYTERHUB_SERVICE_URL", "http://127.0.0.1:10101"))
+    app = make_app(prefix)
+    app.listen(where.port or 80, where.hostname or "127.0.0.1", xheaders=True)
+    log.info("classroom teacher service on %s under %s", where.geturl(), prefix)
+    try:
+        ioloop.IOLoop.current().start()
+    except KeyboardInterrupt:  # the hub stops its services with SIGINT
+        log.info("classroom teacher service stopped")
+
+
+PAGE = """<!doctype html>
+<html><head><meta charset="utf-8"><title>ROS 2 Classroom: teacher</title>
+<style>
+body{font-family:system-ui,sans-serif;margin:1.2em}table{border-collapse:collapse}
+td,th{border:1px solid #ccc;padding:.25em .5em;text-align:left;font-size:.9em}
+pre{background:#f4f4f4;padding:.5em;max-height:24em;overflow:auto}
+.stuck{color:#a40}section{margin:1em 0}
+</style></head><body>
+<h2>ROS 2 Classroom: teacher's view</h2>
+<p>Signed in through the hub as <b>{{teacher}}</b> ·
+<a href="progress.csv">Download the class's progress (CSV)</a> · <span id="summary"></span></p>
+<table id="class"><thead><tr>{{columns}}</tr></thead><tbody></tbody></table>
+<section><label>Learner <select id="learner"><option value="">(choose a learner)</option>
+</select></label><div id="detail"></div></section>
+<section><h3>Message to learners</h3>
+<label>To <select id="to"><option value="">everyone</option></select></label>
+<input id="text" size="60" maxlength="{{max_notice}}"> <button id="send">Send</button>
+<span id="sent"></span></section>
+<section><h3>Class settings</h3>
+<label>Solution after N failed checks (0: each exercise's own)
+<input id="reveal" type="number" min="0" max="100" value="0"></label>
+<button id="apply">Apply to every learner</button> <span id="applied"></span></section>
+<script>
+// The hub's cookie counts for fetch() only with the XSRF token (JupyterHub >= 4.1).
+const xsrf = "{{xsrf}}";
+function cell(text){const td=document.createElement("td");td.textContent=text;return td;}
+function options(select, keys){
+  const have=[...select.options].map(o=>o.value).filter(v=>v);
+  for(const k of keys){if(!have.includes(k)){const o=document.createElement("option");
+    o.value=k;o.textContent=k;select.appendChild(o);}}
+}
+async function post(path, body){
+  const r=await fetch(path,{method:"POST",headers:{"Content-Type":"application/json",
+    "X-XSRFToken":xsrf},body:JSON.stringify(body)});
+  const data=await r.json();return r.ok?data:Promise.reject(data.error||r.statusText);
+}
+async function refresh(){
+  try{
+    const r=await fetch("progress.json",{cache:"no-store",headers:{"X-XSRFToken":xsrf}});
+    if(!r.ok)return;
+    const data=await r.json();const body=document.querySelector("#class tbody");
+    body.replaceChildren(...data.rows.map(row=>{const tr=document.createElement("tr");
+      tr.dataset.learner=row[0];row.forEach(v=>tr.appendChild(cell(v)));
+      if(row[row.length-1])tr.className="stuck";return tr;}));
+    document.getElementById("summary").textContent=
+      `${data.rows.length} learners · updated ${new Date().toLocaleTimeString()}`;
+    options(document.getElementById("learner"),data.keys);
+    options(document.getElementById("to"),data.keys);
+    await detail();
+  }catch(e){}
+}
+async function detail(){
+  const key=document.getElementById("learner").value,box=document.getElementById("detail");
+  if(!key){box.replaceChildren();return;}
+  const r=await fetch("learner.json?key="+encodeURIComponent(key),
+    {cache:"no-store",headers:{"X-XSRFToken":xsrf}});
+  if(!r.ok)return;const d=await r.json();
+  const parts=[["h3",d.key],["p",d.where],["p","Checks "+d.checks],
+    ...d.reasons.map(x=>["p",x]),["p",d.exercise?`Exercise ${d.exercise}: `+
+    (d.passed?"passed":"not passed yet"):"No exercise in this unit."]];
+  if(d.last_error)parts.push(["pre",d.last_error]);
+  if(d.exercise)parts.push(["pre",d.code]);
+  box.replaceChildren(...parts.map(([tag,text])=>{const e=document.createElement(tag);
+    e.textContent=text;if(tag==="pre")e.className=text===d.code?"code":"error";return e;}));
+}
+document.getElementById("learner").onchange=detail;
+document.getElementById("send").onclick=()=>post("notice",{to:document.getElementById("to").value,
+  text:document.getElementById("text").value}).then(d=>{document.getElementById("text").value="";
+  document.getElementById("sent").textContent="Sent.";},e=>{
+  document.getElementById("sent").textContent="⚠ "+e;});
+document.getElementById("apply").onclick=()=>post("settings",{reveal_after:
+  Number(document.getElementById("reveal").value)}).then(d=>{
+  document.getElementById("applied").textContent="Applied: "+d.reveal_after;},e=>{
+  document.getElementById("applied").textContent="⚠ "+e;});
+refresh();setInterval(refresh,500);
+</script></body></html>
+"""
+
+
+if __name__ == "__main__":
+    main()
