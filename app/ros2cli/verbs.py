@@ -257,6 +257,7 @@ def add_topic(v: Any, verb: Verb) -> None:
             "--window",
             type=int,
             default=window,
+            metavar="WINDOW",
             help=f"window size, in # of messages, for calculating rate (default: {window})",
         )
         unsupported(
