@@ -14,6 +14,7 @@ from typing import Any
 from app.exercises.model import Exercise
 from app.exercises.probes import PROBE_DRAWS
 from app.exercises.probes.base import is_range, range_text
+from app.lessons.kinds import CHECKS
 from app.lessons.schema import Spec
 
 HOW_INPUTS_ARE_DRAWN = (
@@ -63,7 +64,9 @@ def explain(exercise: Exercise) -> list[str]:
     lines = [f"{exercise.slug}: {exercise.title} (your node {exercise.node})"]
     if exercise.setup:
         lines.append(f"started first: {', '.join(exercise.setup)}")
-    lines += [f"check  {spec_line(c)}" for c in exercise.checks]
+    for check in exercise.checks:
+        words = CHECKS[check.kind].words if check.kind in CHECKS else ""
+        lines.append(f"check  {spec_line(check)}" + (f" ({words})" if words else ""))
     for probe in exercise.probes:
         lines.append(f"probe  {spec_line(probe)}")
         if probe.kind in PROBE_DRAWS:

@@ -144,6 +144,7 @@ def param_set(ctx: ProbeContext, p: Spec) -> Result:
         hz = float(expected_value(check.pop("expect_hz"), {"value": value}))
         spread = float(check.pop("rate_tolerance", 0.1))
         check["min_hz"], check["max_hz"] = round(hz * (1 - spread), 3), round(hz * (1 + spread), 3)
+        check.setdefault("samples", max(8, round(hz * RATE_JUDGED_SEC)))
     passed, detail = ctx.wait_check(Spec(then["kind"], check), p.get("within", 10.0))
     verdict = "then " + detail
     return Result(name, passed, f"accepted; {verdict}")
@@ -258,6 +259,7 @@ _VALID_TRANSITIONS = {
     "active": {"deactivate": "inactive"},
 }
 _TRANSITIONS = ("configure", "activate", "deactivate", "cleanup")
+RATE_JUDGED_SEC = 4.0  # a rate that follows a drawn value is judged on this long of messages
 INVALID_SHARE = 0.3  # of a walk's requests, about this many are invalid from the state
 
 

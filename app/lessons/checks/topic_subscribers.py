@@ -1,0 +1,25 @@
+"""Check ``topic_subscribers``: enough nodes (not the dashboard) subscribe to the topic."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from app.lessons.registry import FAIL, PASS, CheckResult, register_check
+
+if TYPE_CHECKING:
+    from app.lessons.runtime import LessonRuntime
+    from app.lessons.schema import Spec
+
+
+@register_check(
+    "topic_subscribers",
+    required="topic at_least",
+    words="enough nodes (not the dashboard) subscribe to the topic",
+)
+def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
+    # Count the learner's subscribers, not the dashboard's own taps.
+    infos = rt.node.get_subscriptions_info_by_topic(c["topic"])
+    count = sum(1 for info in infos if info.node_name != rt.node.get_name())
+    if count >= c["at_least"]:
+        return CheckResult(PASS, f"{count} subscribers on {c['topic']}")
+    return CheckResult(FAIL, f"{count} of {c['at_least']} subscribers on {c['topic']}")
