@@ -41,6 +41,8 @@ RUNS: tuple[tuple[str, list[str]], ...] = (
     ("bag_record", ["--seconds", "10"]),
     ("turtlesim_rate", ["--seconds", "8"]),
     ("sim_world", ["--seconds", "8"]),
+    ("urdf_draw", ["--seconds", "5"]),
+    ("hub_spawn", ["--counts", "1,5", "--seconds", "6"]),  # 20 learners: run it alone
 )
 
 # (figure, benchmark, key ("a|b" shows both), unit, aim text, aim test)
@@ -357,6 +359,52 @@ ROWS += (
     ),
 )
 
+ROWS += (
+    (
+        "3D view drawing a 30-link URDF moving at 50 Hz: frame rate / a plain viser scene's",
+        "urdf_draw",
+        "urdf_draw_ratio",
+        "x",
+        "≥ 0.9",
+        lambda v: v >= 0.9,
+    ),
+    (
+        "30-link URDF at 50 Hz: robot poses shown per second, 3D view / plain viser scene",
+        "urdf_draw",
+        "dashboard_moves_per_s|baseline_moves_per_s",
+        "moves/s",
+        "",
+        None,
+    ),
+)
+
+ROWS += (
+    (
+        "JupyterHub: spawn → dashboard ready p50 / p95 (largest class measured)",
+        "hub_spawn",
+        "hub_spawn_p50_s|hub_spawn_p95_s",
+        "s",
+        "",
+        None,
+    ),
+    (
+        "JupyterHub learner's memory over a `classroom` learner's (shared costs spread)",
+        "hub_spawn",
+        "hub_memory_overhead_percent",
+        "%",
+        "≤ 15",
+        lambda v: v <= 15,
+    ),
+    (
+        "JupyterHub learner's idle CPU over a `classroom` learner's",
+        "hub_spawn",
+        "hub_cpu_overhead_core_percent",
+        "% of a core",
+        "≤ 1",
+        lambda v: v <= 1,
+    ),
+)
+
 HEADLINE = {
     "start_ratio": ("start_to_visible", "start_ratio"),
     "start_extra_ms": ("start_to_visible", "start_extra_ms"),
@@ -378,6 +426,9 @@ HEADLINE = {
     "turtlesim_browser_fps": ("turtlesim_rate", "browser_frames_per_s"),
     "sim_rtf": ("sim_world", "sim_rtf"),
     "sim_camera_rate_ratio": ("sim_world", "sim_camera_rate_ratio"),
+    "urdf_draw_ratio": ("urdf_draw", "urdf_draw_ratio"),
+    "hub_spawn_p50_s": ("hub_spawn", "hub_spawn_p50_s"),
+    "hub_memory_overhead_percent": ("hub_spawn", "hub_memory_overhead_percent"),
 }
 
 

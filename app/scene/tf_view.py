@@ -36,7 +36,7 @@ from app.scene.tf_tree import TfStore, TreeView
 log = logging.getLogger(__name__)
 
 TF_PATH = "/tf_view"
-MAX_HZ = 30.0
+MAX_HZ = 30.0  # as the other layers; poses that did not change are not resent
 AXES_LENGTH = 0.08
 TF_QOS = QoSProfile(depth=100)
 STATIC_QOS = QoSProfile(depth=100, durability=DurabilityPolicy.TRANSIENT_LOCAL)
@@ -62,9 +62,9 @@ class TfView:
         self.robot_status = "No robot on /robot_description yet."
         self.robot_error = ""
         self._frames: dict[str, tuple[viser.FrameHandle, viser.LabelHandle]] = {}
-        self._links: dict[str, viser.FrameHandle] = {}
-        self._link_nodes: list[viser.SceneNodeHandle] = []
+        self._visuals: list[viser.SceneNodeHandle] = []
         self._logged: set[str] = set()
+        self._sent: dict[str, tuple[object, ...]] = {}  # scene path -> pose last sent
         self.view: TreeView | None = None
         self._root = server.scene.add_frame(TF_PATH, show_axes=False)
         self._wake = threading.Event()
@@ -143,22 +143,17 @@ class TfView:
             self._log_once(self.robot_error)
             return
         self.robot_error = ""
-        for handle in self._link_nodes:
+        for handle in self._visuals:
             handle.remove()
-        self._link_nodes.clear()
-        self._links.clear()
+        self._visuals.clear()
         scene = self._server.scene
         with self._server.atomic():
             for link in drawing.links:
-                frame = scene.add_frame(
-                    f"{TF_PATH}/robot/{scene_name(link)}", show_axes=False, visible=False
-                )
-                self._links[link] = frame
-                self._link_nodes.append(frame)
+                self._frame(link)  # meshes hang under the link's TF frame: one pose moves both
             for i, visual in enumerate(drawing.visuals):
-                self._link_nodes.append(
+                self._visuals.append(
                     scene.add_mesh_trimesh(
-                        f"{TF_PATH}/robot/{scene_name(visual.link)}/visual{i}", visual.mesh
+                        f"{TF_PATH}/frames/{scene_name(visual.link)}/visual{i}", visual.mesh
                     )
                 )
         self._robot = drawing
@@ -189,37 +184,40 @@ class TfView:
             self._log_once(line)
         if not force and not changed_stale:
             return
-        scene = self._server.scene
         with self._server.atomic():
-            for frame in sorted(set(view.poses) | set(view.problems)):
-                handles = self._frames.get(frame)
-                if handles is None:
-                    axes = scene.add_frame(
-                        f"{TF_PATH}/frames/{scene_name(frame)}",
-                        axes_length=AXES_LENGTH,
-                        axes_radius=AXES_LENGTH / 20,
-                    )
-                    label = scene.add_label(
-                        f"{TF_PATH}/frames/{scene_name(frame)}/name", frame, font_screen_scale=0.8
-                    )
-                    handles = (axes, label)
-                    self._frames[frame] = handles
-                axes, label = handles
-                pose = view.poses.get(frame)
-                axes.visible = pose is not None
-                if pose is not None:
-                    axes.position = tf.as_xyz(pose[:3, 3])
-                    axes.wxyz = tf.matrix_to_quat(pose[:3, :3])
+            for frame in sorted(set(view.poses) | set(view.problems) | set(self._frames)):
+                axes, label = self._frame(frame)
+                self._place(axes, view.poses.get(frame))
                 text = f"{frame} (stale)" if frame in view.stale else frame
                 if label.text != text:
                     label.text = text
-                label.visible = self.show_names
-            for link, handle in self._links.items():
-                pose = view.poses.get(link)
-                handle.visible = pose is not None
-                if pose is not None:
-                    handle.position = tf.as_xyz(pose[:3, 3])
-                    handle.wxyz = tf.matrix_to_quat(pose[:3, :3])
+                if label.visible != self.show_names:
+                    label.visible = self.show_names
+
+    def _frame(self, frame: str) -> tuple[viser.FrameHandle, viser.LabelHandle]:
+        """The axes and name of a TF frame, made hidden on first use (drawing thread)."""
+        handles = self._frames.get(frame)
+        if handles is None:
+            path = f"{TF_PATH}/frames/{scene_name(frame)}"
+            axes = self._server.scene.add_frame(
+                path, axes_length=AXES_LENGTH, axes_radius=AXES_LENGTH / 20, visible=False
+            )
+            label = self._server.scene.add_label(f"{path}/name", frame, font_screen_scale=0.8)
+            self._sent[path] = ("hidden",)
+            handles = (axes, label)
+            self._frames[frame] = handles
+        return handles
+
+    def _place(self, handle: viser.FrameHandle, pose: np.ndarray | None) -> None:
+        """Show ``handle`` at ``pose`` (hide it for None), sending only what changed."""
+        key = ("hidden",) if pose is None else tuple(np.round(pose[:3, :].ravel(), 6).tolist())
+        if self._sent.get(handle.name) == key:
+            return
+        self._sent[handle.name] = key
+        handle.visible = pose is not None
+        if pose is not None:
+            handle.position = tf.as_xyz(pose[:3, 3])
+            handle.wxyz = tf.matrix_to_quat(pose[:3, :3])
 
     # --- UI thread ---
     def frame_names(self) -> list[str]:

@@ -28,7 +28,12 @@ from tests.conftest import ARTIFACTS
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
 FLEXIBLE = share_directory() / "urdf" / "06-flexible.urdf"
-POLE = "/tf_view/robot/gripper_pole"
+POLE = "/tf_view/frames/gripper_pole"
+# The pole's shape: a mesh under its TF frame.
+HAS_VISUAL_JS = (
+    "(n) => !!window.__viserMutable && Object.keys(window.__viserMutable.nodeRefFromName)"
+    ".some((k) => k.startsWith(n + '/visual'))"
+)
 HAS_NODE_JS = "(n) => !!window.__viserMutable && (n in window.__viserMutable.nodeRefFromName)"
 MOVED_JS = (
     "([name, old, far]) => { const o = window.__viserMutable.nodeRefFromName[name];"
@@ -54,7 +59,7 @@ def test_robot_appears_moves_and_bad_description_is_one_line(page, probe, ros_en
     repeater = Repeater(states, joints, 0.05)
     try:
         open_tab(page, "3D view")
-        page.wait_for_function(HAS_NODE_JS, arg=POLE, polling=100, timeout=40_000)
+        page.wait_for_function(HAS_VISUAL_JS, arg=POLE, polling=100, timeout=40_000)
         expect(page.get_by_text("14 links").first).to_be_visible(timeout=20_000)
         page.wait_for_function(
             HAS_NODE_JS, arg="/tf_view/frames/head/name", polling=100, timeout=20_000
@@ -86,7 +91,7 @@ def test_robot_appears_moves_and_bad_description_is_one_line(page, probe, ros_en
         expect(
             page.get_by_text("parent link [nowhere] of joint [j] not found").first
         ).to_be_visible(timeout=20_000)
-        assert page.evaluate(HAS_NODE_JS, POLE)
+        assert page.evaluate(HAS_VISUAL_JS, POLE)
     finally:
         repeater.stop()
         os.killpg(rsp.pid, signal.SIGINT)

@@ -1,0 +1,248 @@
+"""Benchmark: the 3D view drawing a 30-link URDF moving at 50 Hz, beside a plain viser scene.
+
+- **dashboard**: the real ``ros2-classroom serve`` with one headless Chromium
+  page on its 3D view; our robot_state_publisher (a process) has a 30-link
+  chain as its ``robot_description``; this process publishes
+  ``/joint_states`` at 50 Hz, so ``/tf`` moves every joint 50 times a second
+  and the view draws the robot from its URDF at its TF frames.
+- **baseline**: the least a viser page can do for the same robot: a bare
+  viser server in this process with the same 30 boxes, whose poses this
+  process computes itself and sets 50 times a second. No ROS in between.
+
+In each page the browser counts its own rendered frames (requestAnimationFrame)
+and the frames in which the chain's last link moved. The headline
+``urdf_draw_ratio`` is the dashboard page's frame rate over the baseline's
+(aim >= 0.9); ``urdf_motion_ratio`` compares the robot poses shown per second.
+The pages are measured one after the other, each alone in the browser.
+Run: ``.venv/bin/python tests/run.py --bench urdf_draw [--seconds S]``. The
+last line printed is one JSON object.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import threading
+import time
+from typing import Any
+
+import numpy as np
+
+from bench._common import (
+    LOGS,
+    configure_dds,
+    free_port,
+    launch_browser,
+    open_dashboard,
+    require_private_netns,
+    rounded,
+    spawn,
+    start_dashboard,
+    stop,
+    wait_for_text,
+)
+
+LINKS = 30
+RATE_HZ = 50.0
+AIM = 0.9
+SEGMENT = 0.06  # metres between joints
+
+# Counts rendered frames, and frames in which scene node ``name`` moved, for ``ms``.
+MEASURE_JS = """async ([name, ms]) => {
+  const nodes = window.__viserMutable.nodeRefFromName;
+  let frames = 0, moved = 0, last = null;
+  const t0 = performance.now();
+  await new Promise((done) => {
+    const tick = () => {
+      frames += 1;
+      const o = nodes[name];
+      if (o) {
+        o.updateWorldMatrix(true, false);
+        const key = Array.from(o.matrixWorld.elements).map((v) => v.toFixed(5)).join(',');
+        if (last !== null && key !== last) moved += 1;
+        last = key;
+      }
+      if (performance.now() - t0 < ms) requestAnimationFrame(tick); else done();
+    };
+    requestAnimationFrame(tick);
+  });
+  const seconds = (performance.now() - t0) / 1000;
+  return {fps: frames / seconds, moved: moved / seconds};
+}"""
+HAS_NODE_JS = "(n) => !!window.__viserMutable && !!window.__viserMutable.nodeRefFromName[n]"
+
+
+def chain_urdf(links: int) -> str:
+    """A snake of ``links`` boxes joined by revolute joints that alternate about z and y."""
+    parts = ['<?xml version="1.0"?>', '<robot name="snake">']
+    for i in range(links):
+        parts.append(
+            f'<link name="link{i}"><visual><origin xyz="{SEGMENT / 2} 0 0"/>'
+            f'<geometry><box size="{SEGMENT * 0.9} 0.03 0.03"/></geometry></visual></link>'
+        )
+    for i in range(1, links):
+        axis = "0 0 1" if i % 2 else "0 1 0"
+        parts.append(
+            f'<joint name="joint{i}" type="revolute"><parent link="link{i - 1}"/>'
+            f'<child link="link{i}"/><origin xyz="{SEGMENT} 0 0"/><axis xyz="{axis}"/>'
+            '<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>'
+        )
+    parts.append("</robot>")
+    return "\n".join(parts)
+
+
+def positions(t: float, links: int) -> list[float]:
+    return [0.25 * math.sin(2.0 * t + 0.3 * i) for i in range(1, links)]
+
+
+def chain_poses(q: list[float]) -> list[np.ndarray]:
+    """The baseline's own forward kinematics: the pose of every link in link0."""
+    poses = [np.eye(4)]
+    for i, angle in enumerate(q, start=1):
+        c, s = math.cos(angle), math.sin(angle)
+        motion = np.eye(4)
+        if i % 2:
+            motion[:2, :2] = [[c, -s], [s, c]]
+        else:
+            motion[[0, 0, 2, 2], [0, 2, 0, 2]] = [c, s, -s, c]
+        offset = np.eye(4)
+        offset[0, 3] = SEGMENT
+        poses.append(poses[-1] @ offset @ motion)
+    return poses
+
+
+def measure(page: Any, name: str, seconds: float) -> dict[str, float]:
+    page.wait_for_function(HAS_NODE_JS, arg=name, polling=200, timeout=60_000)
+    page.wait_for_timeout(1500)  # settle: the first meshes, the first poses
+    return page.evaluate(MEASURE_JS, [name, seconds * 1000.0])
+
+
+def run(seconds: float) -> dict[str, Any]:
+    import rclpy
+    import viser
+    from playwright.sync_api import sync_playwright
+    from rclpy.executors import SingleThreadedExecutor
+    from sensor_msgs.msg import JointState
+
+    from app.scene import transforms as tf
+
+    require_private_netns("urdf_draw")
+    configure_dds(44)
+    LOGS.mkdir(exist_ok=True)
+    urdf = chain_urdf(LINKS)
+    params = LOGS / "bench-urdf-params.yaml"
+    params.write_text(
+        "robot_state_publisher:\n  ros__parameters:\n    publish_frequency: 100.0\n"
+        f"    robot_description: {json.dumps(urdf)}\n"
+    )
+    dashboard, url = start_dashboard("bench-urdf-dashboard.log")
+    rsp, rsp_log = spawn(
+        [sys.executable, "-m", "robot_state_publisher", "--ros-args",
+         "--params-file", str(params)],
+        "bench-urdf-rsp.log",
+    )  # fmt: skip
+    rclpy.init()
+    node = rclpy.create_node("bench_urdf_draw")
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    spinner = threading.Thread(target=executor.spin, daemon=True)
+    spinner.start()
+    publisher = node.create_publisher(JointState, "/joint_states", 10)
+    names = [f"joint{i}" for i in range(1, LINKS)]
+    t_start = time.monotonic()
+
+    def publish() -> None:
+        msg = JointState()
+        msg.header.stamp = node.get_clock().now().to_msg()
+        msg.name = names
+        msg.position = positions(time.monotonic() - t_start, LINKS)
+        publisher.publish(msg)
+
+    server = None
+    figures: dict[str, Any] = {"links": LINKS, "rate_hz": RATE_HZ, "seconds": seconds}
+    try:
+        wait_for_text(rsp, rsp_log, "Robot initialized", 30.0)
+        timer = node.create_timer(1.0 / RATE_HZ, publish)
+        with sync_playwright() as pw:
+            browser = launch_browser(pw)
+            page = open_dashboard(browser, url)
+            page.get_by_role("tab", name="3D view").click()
+            dash = measure(page, f"/tf_view/frames/link{LINKS - 1}", seconds)
+            page.context.close()
+            node.destroy_timer(timer)
+
+            # The baseline: the same boxes in a bare viser scene, moved by this process.
+            port = free_port()
+            server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
+            server.scene.configure_environment_map(None)
+            frames = []
+            for i in range(LINKS):
+                frames.append(server.scene.add_frame(f"/robot/link{i}", show_axes=False))
+                server.scene.add_box(
+                    f"/robot/link{i}/box",
+                    dimensions=(SEGMENT * 0.9, 0.03, 0.03),
+                    color=(200, 200, 200),
+                    position=(SEGMENT / 2, 0.0, 0.0),
+                )
+            stop_moving = threading.Event()
+
+            def move() -> None:
+                while not stop_moving.wait(1.0 / RATE_HZ):
+                    poses = chain_poses(positions(time.monotonic() - t_start, LINKS))
+                    with server.atomic():
+                        for handle, pose in zip(frames, poses, strict=True):
+                            handle.position = tf.as_xyz(pose[:3, 3])
+                            handle.wxyz = tf.matrix_to_quat(pose[:3, :3])
+
+            mover = threading.Thread(target=move, daemon=True)
+            mover.start()
+            context = browser.new_context(viewport={"width": 1400, "height": 900})
+            base_page = context.new_page()
+            base_page.goto(f"http://127.0.0.1:{port}")
+            base = measure(base_page, f"/robot/link{LINKS - 1}", seconds)
+            stop_moving.set()
+            mover.join(2.0)
+            browser.close()
+    finally:
+        executor.shutdown()
+        spinner.join(2.0)
+        node.destroy_node()
+        rclpy.try_shutdown()
+        if server is not None:
+            server.stop()
+        stop(rsp)
+        stop(dashboard)
+    figures.update(
+        {
+            "dashboard_fps": dash["fps"],
+            "baseline_fps": base["fps"],
+            "urdf_draw_ratio": dash["fps"] / base["fps"] if base["fps"] else math.nan,
+            "dashboard_moves_per_s": dash["moved"],
+            "baseline_moves_per_s": base["moved"],
+            "urdf_motion_ratio": dash["moved"] / base["moved"] if base["moved"] else math.nan,
+        }
+    )
+    return figures
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m bench urdf_draw")
+    parser.add_argument("--seconds", type=float, default=8.0)
+    args = parser.parse_args(argv)
+    f = run(args.seconds)
+    f["aim_met"] = bool(f["urdf_draw_ratio"] >= AIM)
+    print(
+        f"{LINKS}-link URDF moving at {RATE_HZ:.0f} Hz: the 3D view renders "
+        f"{f['dashboard_fps']:.1f} frames/s (robot moved in {f['dashboard_moves_per_s']:.1f}/s), "
+        f"a plain viser scene {f['baseline_fps']:.1f} frames/s (moved in "
+        f"{f['baseline_moves_per_s']:.1f}/s): ratio {f['urdf_draw_ratio']:.2f} (aim >= {AIM}), "
+        f"motion ratio {f['urdf_motion_ratio']:.2f}"
+    )
+    print(json.dumps(rounded(f, 3), sort_keys=True))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
