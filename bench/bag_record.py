@@ -39,6 +39,7 @@ from typing import Any
 from bench._common import (
     LOGS,
     configure_dds,
+    end_bounded,
     percentile,
     ratio,
     require_private_netns,
@@ -110,9 +111,7 @@ def baseline_main(bag: Path, t0: float, t1: float) -> None:
     while time.monotonic() < t1 + MARGIN_SEC:
         executor.spin_once(timeout_sec=0.05)
     writer.close()
-    executor.shutdown()
-    node.destroy_node()
-    rclpy.try_shutdown()
+    end_bounded(node, executor)
 
 
 def ours_main(bag: Path, t0: float, t1: float) -> None:
@@ -154,9 +153,7 @@ def listener_main(out: Path, seconds: float) -> None:
     while time.monotonic() < end:
         executor.spin_once(timeout_sec=0.05)
     out.write_text(json.dumps(got))
-    executor.shutdown()
-    node.destroy_node()
-    rclpy.try_shutdown()
+    end_bounded(node, executor)
 
 
 def player_main(bag: Path, out: Path) -> None:

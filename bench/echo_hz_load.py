@@ -34,7 +34,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import signal
 import subprocess
 import sys
 import threading
@@ -45,6 +44,7 @@ from typing import Any
 from bench._common import (
     LOGS,
     configure_dds,
+    end_bounded,
     rate_from_stamps,
     ratio,
     require_private_netns,
@@ -98,30 +98,6 @@ def baseline_main(topic: str, t0: float, t1: float, out: Path) -> None:
         json.dumps({"topic": topic, "count": len(inside), "hz": rate_from_stamps(inside)})
     )
     end_bounded(node, executor)
-
-
-TEARDOWN_SEC = 5  # a child that has written its figures gets this long to end
-
-
-def end_bounded(node: Any, executor: Any) -> None:
-    """Tear down in a bounded time: entities first, then the executor, then the context.
-
-    The reader of a 1 kHz topic once spun at 95 % of a core for 15+ minutes in
-    ``destroy_node`` (native code, under load), holding the GIL, so no Python
-    watchdog could run: the kernel's alarm ends the process instead. Entities
-    are destroyed while the executor still exists (rclpy 7.1.6's
-    ``Executor.shutdown`` does not wait for work in progress, so nothing is
-    gained by shutting it down first).
-    """
-    import rclpy
-
-    signal.signal(signal.SIGALRM, signal.SIG_DFL)  # default action: the process ends
-    signal.alarm(TEARDOWN_SEC)
-    executor.remove_node(node)
-    node.destroy_node()
-    executor.shutdown(timeout_sec=1.0)
-    rclpy.try_shutdown()
-    signal.alarm(0)
 
 
 def dashboard_main(t0: float, t1: float, out: Path) -> None:
