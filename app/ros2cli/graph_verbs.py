@@ -13,7 +13,7 @@ from rclpy.action import (
     get_action_server_names_and_types_by_node,
 )
 
-from app.ros.calls import GoalRun, action_type_of, call_service, send_goal
+from app.ros.calls import GoalRun, action_type_of, call_service, send_goal, wait_for_server
 from app.ros.context import CallContext
 from app.ros.convert import from_yaml, import_type, message_repr
 from app.ros.graph import all_nodes, wait_for_graph
@@ -196,6 +196,14 @@ def action_send_goal(
     goal = from_yaml(action_cls.Goal, values)
     run = GoalRun(name, type_text, goal)
     ctx.write("Waiting for an action server to become available...")
+    # ros2 prints the goal once a server is there: wait for one on the graph first.
+    timeout = ctx.limits.service_timeout
+    wait_for_server(
+        ctx,
+        lambda: any(n == name for n, _t in get_action_names_and_types(ctx.node)),
+        timeout,
+        f"action server '{name}'",
+    )
     write_message_block(ctx, "Sending goal", goal, 5)
 
     # Feedback runs on the executor thread and may come before we have read the

@@ -235,6 +235,17 @@ def test_graph_verbs_golden(supervisor, ros2):
             "Goal finished with status: SUCCEEDED",
         ],
     ), lines
+    # no server: the goal is not printed (ros2 would wait endlessly; we stop after the limit)
+    assert ros2(
+        "action send_goal /nobody tutorial_interfaces/action/Fibonacci '{order: 1}'",
+        Limits(service_timeout=1.0, max_seconds=2.0),
+    ) == (
+        1,
+        [
+            "Waiting for an action server to become available...",
+            "error: action server '/nobody' is not available (waited 1 s)",
+        ],
+    )
     assert ros2("action info /fibonacci -t") == (
         0,
         [
