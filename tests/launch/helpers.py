@@ -74,9 +74,12 @@ def run(args: list[str], env: Mapping[str, str], timeout: float = 30.0) -> tuple
 class Launch:
     """A running ``ros2 launch`` in its own session, as in a terminal of its own."""
 
-    def __init__(self, args: list[str], env: Mapping[str, str]) -> None:
+    def __init__(
+        self, args: list[str], env: Mapping[str, str], command: list[str] | None = None
+    ) -> None:
+        """``ros2 launch ARGS``, or another ``command`` that runs a launch."""
         self.proc = subprocess.Popen(
-            [sys.executable, "-m", "ros2launch", *args],
+            command or [sys.executable, "-m", "ros2launch", *args],
             env=dict(env),
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
