@@ -303,6 +303,120 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         ),
         package="turtlesim",  # upstream's teleop drives any robot: remap its topic
     ),
+    # --- tf2 (issue 23): tf2_ros/tf2_tools programs and the turtle_tf2_py tutorial nodes ---
+    CatalogEntry(
+        "tf2_echo",
+        "tf2_echo",
+        "/tf2_echo",
+        "Prints the transform between two frames once a second (tf2_echo SOURCE TARGET).",
+        package="tf2_ros",
+    ),
+    CatalogEntry(
+        "static_transform_publisher",
+        "static_transform_publisher",
+        "/static_transform_publisher",  # upstream adds 16 random characters to the name
+        "Publishes one static transform on /tf_static from its command line.",
+        package="tf2_ros",
+    ),
+    CatalogEntry(
+        "view_frames",
+        "view_frames",
+        "/view_frames",
+        "Listens to /tf for 5 s, then writes the frame tree as frames_<date>.gv and a picture.",
+        package="tf2_tools",
+    ),
+    CatalogEntry(
+        "static_turtle_tf2_broadcaster",
+        "static_turtle_tf2_broadcaster",
+        "/static_turtle_tf2_broadcaster",
+        "world -> CHILD once on /tf_static (args: child x y z roll pitch yaw).",
+        package="turtle_tf2_py",
+    ),
+    CatalogEntry(
+        "turtle_tf2_broadcaster",
+        "turtle_tf2_broadcaster",
+        "/turtle_tf2_frame_publisher",
+        "Broadcasts world -> <turtlename> on /tf from /<turtlename>/pose.",
+        package="turtle_tf2_py",
+    ),
+    CatalogEntry(
+        "turtle_tf2_listener",
+        "turtle_tf2_listener",
+        "/turtle_tf2_frame_listener",
+        "Spawns turtle2 and drives it towards target_frame (turtle1) with tf2 lookups.",
+        package="turtle_tf2_py",
+    ),
+    CatalogEntry(
+        "fixed_frame_tf2_broadcaster",
+        "fixed_frame_tf2_broadcaster",
+        "/fixed_frame_tf2_broadcaster",
+        "Broadcasts carrot1, 2 m to turtle1's left, at 10 Hz.",
+        package="turtle_tf2_py",
+    ),
+    CatalogEntry(
+        "dynamic_frame_tf2_broadcaster",
+        "dynamic_frame_tf2_broadcaster",
+        "/dynamic_frame_tf2_broadcaster",
+        "Broadcasts carrot1 circling turtle1 at 10 m, at 10 Hz.",
+        package="turtle_tf2_py",
+    ),
+    # turtle_tf2_demo.launch.py: turtlesim as /sim, a broadcaster per turtle, the listener.
+    CatalogEntry(
+        "tf2_demo_sim",
+        "turtlesim_node",
+        "/sim",
+        "turtlesim of the tf2 demo launch, named sim.",
+        ros_args=("-r", "__node:=sim"),
+        package="turtle_tf2_py",
+    ),
+    CatalogEntry(
+        "tf2_demo_broadcaster1",
+        "turtle_tf2_broadcaster",
+        "/broadcaster1",
+        "The tf2 demo's broadcaster for turtle1.",
+        ros_args=("-r", "__node:=broadcaster1", "-p", "turtlename:=turtle1"),
+        package="turtle_tf2_py",
+    ),
+    CatalogEntry(
+        "tf2_demo_broadcaster2",
+        "turtle_tf2_broadcaster",
+        "/broadcaster2",
+        "The tf2 demo's broadcaster for turtle2.",
+        ros_args=("-r", "__node:=broadcaster2", "-p", "turtlename:=turtle2"),
+        package="turtle_tf2_py",
+    ),
+    CatalogEntry(
+        "tf2_demo_listener",
+        "turtle_tf2_listener",
+        "/listener",
+        "The tf2 demo's listener: turtle2 follows turtle1.",
+        ros_args=("-r", "__node:=listener", "-p", "target_frame:=turtle1"),
+        package="turtle_tf2_py",
+    ),
+    CatalogEntry(
+        "tf2_demo_listener_carrot",
+        "turtle_tf2_listener",
+        "/listener",
+        "The tf2 demo's listener with target_frame carrot1: turtle2 follows the carrot.",
+        ros_args=("-r", "__node:=listener", "-p", "target_frame:=carrot1"),
+        package="turtle_tf2_py",
+    ),
+    CatalogEntry(
+        "tf2_demo_fixed_broadcaster",
+        "fixed_frame_tf2_broadcaster",
+        "/fixed_broadcaster",
+        "The fixed-frame demo's carrot1 broadcaster.",
+        ros_args=("-r", "__node:=fixed_broadcaster"),
+        package="turtle_tf2_py",
+    ),
+    CatalogEntry(
+        "tf2_demo_dynamic_broadcaster",
+        "dynamic_frame_tf2_broadcaster",
+        "/dynamic_broadcaster",
+        "The dynamic-frame demo's carrot1 broadcaster.",
+        ros_args=("-r", "__node:=dynamic_broadcaster"),
+        package="turtle_tf2_py",
+    ),
     # --- URDF (issue 23): robot_state_publisher, joint_state_publisher, the arm's TF ---
     CatalogEntry(
         "robot_state_publisher",
@@ -319,10 +433,26 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         package="joint_state_publisher",
     ),
     CatalogEntry(
+        "joint_state_publisher_gui",
+        "joint_state_publisher",
+        "/joint_state_publisher",
+        "joint_state_publisher driven by the sliders in the 3D view (/joint_state_sliders).",
+        ros_args=("-p", "source_list:=['/joint_state_sliders']"),
+        package="joint_state_publisher_gui",
+    ),
+    CatalogEntry(
         "arm_state_publisher",
-        "arm_state_publisher",
+        "model_state_publisher",
         "/robot_state_publisher",
         "robot_state_publisher with robotic_arm's URDF: the arm's joints become /tf.",
+    ),
+    CatalogEntry(
+        "urdf_tutorial_rsp",
+        "model_state_publisher",
+        "/robot_state_publisher",
+        "robot_state_publisher with the URDF tutorial's movable robot (06-flexible.urdf).",
+        args=("ros_python/src/urdf_tutorial/urdf/06-flexible.urdf",),
+        package="urdf_tutorial",
     ),
 )
 
@@ -391,11 +521,44 @@ GROUPS: tuple[LaunchGroup, ...] = (
         "the MuJoCo room and the arrow-key teleop on /cmd_vel: drive the robot",
         ("sim_world", "sim_teleop_key"),
     ),
+    # --- tf2 (issue 23): the turtle_tf2_py demo launch files ---
+    LaunchGroup(
+        "turtle_tf2_demo",
+        "turtlesim, a tf2 broadcaster per turtle, and a listener: turtle2 follows turtle1",
+        ("tf2_demo_sim", "tf2_demo_broadcaster1", "tf2_demo_broadcaster2", "tf2_demo_listener"),
+    ),
+    LaunchGroup(
+        "turtle_tf2_fixed_frame_demo",
+        "the tf2 demo with a fixed carrot1 frame beside turtle1: turtle2 follows the carrot",
+        (
+            "tf2_demo_sim",
+            "tf2_demo_broadcaster1",
+            "tf2_demo_broadcaster2",
+            "tf2_demo_listener_carrot",
+            "tf2_demo_fixed_broadcaster",
+        ),
+    ),
+    LaunchGroup(
+        "turtle_tf2_dynamic_frame_demo",
+        "the tf2 demo with carrot1 circling turtle1: turtle2 chases the moving carrot",
+        (
+            "tf2_demo_sim",
+            "tf2_demo_broadcaster1",
+            "tf2_demo_broadcaster2",
+            "tf2_demo_listener_carrot",
+            "tf2_demo_dynamic_broadcaster",
+        ),
+    ),
     # --- URDF (issue 23) ---
     LaunchGroup(
         "arm_tf",
         "robotic_arm + robot_state_publisher with its URDF: the arm on /tf",
         ("robotic_arm", "arm_state_publisher"),
+    ),
+    LaunchGroup(
+        "urdf_tutorial_display",
+        "the URDF tutorial's display.launch.py: its robot, robot_state_publisher, joint sliders",
+        ("urdf_tutorial_rsp", "joint_state_publisher_gui"),
     ),
 )
 

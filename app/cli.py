@@ -141,6 +141,11 @@ def cmd_serve(args: argparse.Namespace) -> int:
         server.stop()
         raise CliError(f"port {args.port} on {args.host} became busy; pick another with --port")
     runtime = RosRuntime()
+    # The learner's colcon workspace and the ament underlay, before the supervisor copies
+    # the environment (issue 22: app/ros2cli/pkg.py).
+    from app.ros2cli.pkg import setup_workspace
+
+    setup_workspace(progress.path, remote=not _is_loopback(args.host))
     supervisor = Supervisor(os.environ)
     scratch_root = args.scratch_dir or (args.progress_dir or DEFAULT_DIR).parent / "scratch"
     workspace = Workspace(progress, scratch_root)

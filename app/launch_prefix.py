@@ -35,6 +35,7 @@ import ros2launch
 from app.catalog import ENTRIES, GROUPS, CatalogEntry
 from app.launch import PACKAGE, launch_file_text
 from app.supervisor import LearnerProgram
+from app.tf2_launch_files import LAUNCH_FILES as TF2_LAUNCH_FILES
 
 PREFIX_ENV = "AMENT_PREFIX_PATH"
 # Upstream executable names the catalog files under another name.
@@ -94,6 +95,7 @@ def _files() -> dict[str, str]:
     for group in GROUPS:
         files[f"share/{PACKAGE}/launch/{group.name}.launch.py"] = launch_file_text(group)
     files["share/turtlesim/launch/multisim.launch.py"] = MULTISIM
+    files.update(TF2_LAUNCH_FILES)  # issue 23: turtle_tf2_py's demo launch files
     packages = {path.split("/")[1] for path in files}
     for package in packages:
         files[f"share/ament_index/resource_index/packages/{package}"] = ""

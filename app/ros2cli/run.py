@@ -38,6 +38,7 @@ import yaml
 from app.catalog import ENTRIES, CatalogEntry, UnknownNodeError, lookup
 from app.ros.context import CallContext
 from app.ros.errors import Ros2Error
+from app.ros2cli import tool_args
 
 # (package, executable) of the tutorials -> catalog name.
 _UPSTREAM: dict[tuple[str, str], str] = {
@@ -71,8 +72,25 @@ _UPSTREAM: dict[tuple[str, str], str] = {
     ("lifecycle", "lifecycle_talker"): "lifecycle_talker",
     ("lifecycle_py", "lifecycle_talker"): "lifecycle_talker",
     ("sim_world", "sim_world"): "sim_world",  # issue 26: the MuJoCo world
+    # issue 23: tf2's programs and the tf2 tutorials' nodes (turtle_tf2_py; learning_tf2_py
+    # is the package the tutorials have the learner write)
+    ("tf2_ros", "tf2_echo"): "tf2_echo",
+    ("tf2_ros", "static_transform_publisher"): "static_transform_publisher",
+    ("tf2_tools", "view_frames"): "view_frames",
+    **{
+        (pkg, exe): exe
+        for pkg in ("turtle_tf2_py", "learning_tf2_py")
+        for exe in (
+            "static_turtle_tf2_broadcaster",
+            "turtle_tf2_broadcaster",
+            "turtle_tf2_listener",
+            "fixed_frame_tf2_broadcaster",
+            "dynamic_frame_tf2_broadcaster",
+        )
+    },
     ("robot_state_publisher", "robot_state_publisher"): "robot_state_publisher",  # issue 23
     ("joint_state_publisher", "joint_state_publisher"): "joint_state_publisher",
+    ("joint_state_publisher_gui", "joint_state_publisher_gui"): "joint_state_publisher_gui",
 }
 # ...and every catalog entry under its own package (`ros2 run tutorial_nodes talker`).
 EXECUTABLES: dict[tuple[str, str], str] = {
@@ -222,6 +240,8 @@ def node_name_after(entry: CatalogEntry, ros_args: list[str]) -> str:
 
 def program_args(entry: CatalogEntry, words: list[str]) -> tuple[str, ...]:
     """Words before ``--ros-args``: numbers for a client that takes them (``client 2 3``)."""
+    if entry.module in tool_args.FREE_FORM:  # the tf2 tools: frame names and flags
+        return tool_args.check_words(entry.module, words)
     if not words:
         return entry.args
     if entry.module == "robot_state_publisher" and len(words) == 1 and words[0].endswith(".urdf"):
@@ -332,4 +352,9 @@ def _handle(ctx: CallContext, args: argparse.Namespace) -> int:
         return stop(ctx, args.stop)
     if not args.package or not args.executable:
         raise Ros2Error("usage: ros2 run PACKAGE EXECUTABLE [args] [--ros-args ...]")
+    from app.ros2cli.pkg import run_own  # a sourced workspace's packages first (issue 22)
+
+    own = run_own(ctx, args.package, args.executable, list(args.arguments))
+    if own is not None:
+        return own
     return run(ctx, args.package, args.executable, list(args.arguments))
