@@ -45,7 +45,8 @@ def main(argv: list[str]) -> int:
     # Ctrl+C (or SIGTERM) asks the running verb to stop at its next wait, so it
     # always cleans up (subscriptions, publishers) instead of dying mid-call.
     previous = {sig: signal.signal(sig, lambda *_: cancel.set()) for sig in STOP_SIGNALS}
-    runtime = RosRuntime(f"_ros2_classroom_cli_{os.getpid()}")
+    # Hidden, and without parameter services, as ros2cli's own node is.
+    runtime = RosRuntime(f"_ros2_classroom_cli_{os.getpid()}", quiet=True)
     ctx = CallContext(node=runtime.node, write=_print, limits=CLI_LIMITS, cancel=cancel)
     try:
         code = run_argv(ctx, argv, "ros2-classroom", note=_note)
