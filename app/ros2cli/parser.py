@@ -16,7 +16,7 @@ from typing import Any, NoReturn
 
 from app.ros.context import CallContext, Write
 from app.ros.errors import Cancelled, Ros2Error
-from app.ros2cli import bag, interfaces, launch_verb, run
+from app.ros2cli import bag, interfaces, launch_verb, pkg, run
 from app.ros2cli import verbs as verb_args
 from app.ros2cli.common import Ros2cliMessage, SilentFailure, settle_discovery
 
@@ -131,9 +131,8 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
     p.add_argument("--no-quotes", action="store_true", help="if true output has no outer quotes.")
 
     bag.add_verbs(group("bag", "record, inspect and replay topics"), verb)
-    v = group("pkg", "packages")
-    p = verb(v, "executables", "what `ros2 run` can start", _pkg_executables)
-    p.add_argument("package_name", nargs="?")
+    pkg.add_verbs(group("pkg", "Various package related sub-commands"), verb)  # issue 22
+    pkg.add_commands(groups, write)  # `colcon ...` and `source install/setup.bash`
     run.add_command(groups, write)  # `ros2 run PKG EXE`: a command, not a group of verbs
     launch_verb.add_command(groups, write)  # `ros2 launch PKG FILE`: the same
     return parser
@@ -142,7 +141,7 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
 _NO_DDS = (
     {("interface", v) for v in ("list", "packages", "package", "show")}
     | {("interface", "proto")}
-    | {("pkg", "executables")}
+    | pkg.NO_DDS
     | {("bag", v) for v in bag.NO_DDS_VERBS}
 )
 
@@ -152,7 +151,7 @@ def needs_ros(argv: list[str]) -> bool:
     words = [w for w in argv if not w.startswith("-")]
     if words[:1] and words[0] in _HELP_WITHOUT_DDS and ("-h" in argv or "--help" in argv):
         return False  # help only: no need to discover the graph first
-    return tuple(words[:2]) not in _NO_DDS
+    return tuple(words[:2]) not in _NO_DDS and not pkg.no_dds(words)
 
 
 _HELP_WITHOUT_DDS = {"node", "topic", "service", "action", "param", "lifecycle", "interface"}

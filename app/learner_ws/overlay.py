@@ -1,0 +1,155 @@
+"""`source install/setup.bash`, understood: a workspace's install space over the underlay.
+
+In a terminal, sourcing a colcon workspace puts each of its package prefixes
+(``install/<pkg>``) in front of ``AMENT_PREFIX_PATH``, their Python folders in
+front of ``PYTHONPATH`` and their libraries in front of ``LD_LIBRARY_PATH``;
+what was there before (the ROS install, here the ROS wheels and the catalog's
+prefixes) is the *underlay*. Here the dashboard keeps that list for its
+Console, takes a snapshot of the install space when it is sourced (a package
+built later needs another ``source``, as in a terminal), and gives every
+program started from the Console the same variables.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import threading
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+
+PREFIX_ENV = "AMENT_PREFIX_PATH"
+INDEX = Path("share/ament_index/resource_index/packages")
+
+_lock = threading.Lock()
+_overlay: list[Path] = []  # package prefixes of sourced workspaces, newest first
+_sourced: list[Path] = []  # the install folders sourced, newest first
+_underlay: list[Path] | None = None
+
+
+def install_prefixes(install: Path) -> list[Path]:
+    """The prefixes a colcon install space adds: install/ (merged) or install/<pkg>/."""
+    layout = install / ".colcon_install_layout"
+    try:
+        merged = layout.read_text(encoding="utf-8").strip() == "merged"
+    except OSError:
+        merged = False
+    if merged:
+        return [install]
+    return sorted(
+        child for child in install.iterdir()
+        if child.is_dir() and (child / INDEX / child.name).is_file()
+    )  # fmt: skip
+
+
+def _paths(text: str | None) -> list[Path]:
+    return [Path(p) for p in (text or "").split(os.pathsep) if p]
+
+
+def set_underlay(prefixes: Iterable[Path]) -> None:
+    """What the Console sees before any `source`: the ROS wheels and the catalog's prefixes."""
+    global _underlay
+    with _lock:
+        _underlay = list(dict.fromkeys(prefixes))
+
+
+def underlay() -> list[Path]:
+    with _lock:
+        if _underlay is not None:
+            return list(_underlay)
+    return _paths(os.environ.get(PREFIX_ENV)) or [Path(sys.prefix)]
+
+
+def overlay() -> list[Path]:
+    with _lock:
+        return list(_overlay)
+
+
+def sourced() -> list[Path]:
+    with _lock:
+        return list(_sourced)
+
+
+def source(install: Path) -> list[Path]:
+    """Put ``install``'s prefixes in front (again, if it was sourced before); returns them."""
+    prefixes = install_prefixes(install)
+    with _lock:
+        _overlay[:] = prefixes + [p for p in _overlay if p not in prefixes]
+        _sourced[:] = [install] + [p for p in _sourced if p != install]
+    # This process's own index lookups (`ros2 interface show`) see it too.
+    os.environ[PREFIX_ENV] = os.pathsep.join(str(p) for p in search_path())
+    return prefixes
+
+
+def forget() -> None:
+    """A fresh Console: nothing sourced."""
+    with _lock:
+        _overlay.clear()
+        _sourced.clear()
+    os.environ[PREFIX_ENV] = os.pathsep.join(str(p) for p in search_path())
+
+
+def search_path() -> list[Path]:
+    """AMENT_PREFIX_PATH as the Console sees it: overlays first, then the underlay."""
+    return list(dict.fromkeys([*overlay(), *underlay()]))
+
+
+def packages() -> dict[str, Path]:
+    """Every package of the index, with the first prefix that has it (overlays win)."""
+    found: dict[str, Path] = {}
+    for prefix in search_path():
+        try:
+            names = sorted(entry.name for entry in os.scandir(prefix / INDEX) if entry.is_file())
+        except OSError:
+            continue
+        for name in names:
+            found.setdefault(name, prefix)
+    return found
+
+
+def package_prefix(name: str) -> Path | None:
+    for prefix in search_path():
+        if (prefix / INDEX / name).is_file():
+            return prefix
+    return None
+
+
+def executables(name: str, prefix: Path) -> list[Path]:
+    """Executable files under ``<prefix>/lib/<name>/`` (hidden folders skipped), sorted."""
+    found: list[Path] = []
+    for folder, subfolders, files in os.walk(prefix / "lib" / name):
+        subfolders[:] = sorted(d for d in subfolders if not d.startswith("."))
+        for file_name in sorted(files):
+            path = Path(folder) / file_name
+            if os.access(path, os.X_OK) and path.is_file():
+                found.append(path)
+    return found
+
+
+def _python_dirs(prefix: Path) -> list[Path]:
+    version = f"python{sys.version_info.major}.{sys.version_info.minor}"
+    return [
+        p for p in (prefix / "lib" / version / "site-packages",
+                    prefix / "local" / "lib" / version / "dist-packages")
+        if p.is_dir()
+    ]  # fmt: skip
+
+
+def child_env(base: Mapping[str, str] | None = None) -> dict[str, str]:
+    """The variables a sourced shell would hand a program it starts (only those four)."""
+    base = os.environ if base is None else base
+    prefixes = overlay()
+    python = [str(d) for p in prefixes for d in _python_dirs(p)]
+    libs = [str(p / "lib") for p in prefixes if (p / "lib").is_dir()]
+    bins = [str(p / "bin") for p in prefixes if (p / "bin").is_dir()]
+
+    def joined(front: list[str], name: str) -> str:
+        rest = [p for p in base.get(name, "").split(os.pathsep) if p and p not in front]
+        return os.pathsep.join(list(dict.fromkeys(front)) + rest)
+
+    return {
+        PREFIX_ENV: os.pathsep.join(str(p) for p in search_path()),
+        "PYTHONPATH": joined(python, "PYTHONPATH"),
+        "LD_LIBRARY_PATH": joined(libs, "LD_LIBRARY_PATH"),
+        "PATH": joined(bins, "PATH"),
+    }

@@ -1,0 +1,398 @@
+"""The learner's own packages in the Console: ros2 pkg, colcon, source, and their `ros2 run`.
+
+* ``ros2 pkg create`` is ros2pkg's (ros_python/src/ros2pkg). In the Console
+  it acts as if typed in ``~/ros2_ws/src`` (where the tutorials type it);
+  ``--destination-directory`` stays inside the workspace. In a terminal it
+  writes into the working folder, as upstream.
+* ``colcon build|test ...`` runs real colcon in the workspace root as a
+  supervisor program (app.learner_ws.build), its output streamed here,
+  bounded in time and disk.
+* ``source install/setup.bash`` puts that install space over the underlay
+  for this Console (app.learner_ws.overlay): `ros2 run`, `ros2 pkg ...`,
+  `ros2 interface ...` and the programs started from here see it.
+* ``ros2 run PKG EXE`` of a package found in a sourced workspace runs
+  ``<prefix>/lib/<pkg>/<exe>`` through the supervisor, like upstream's
+  ros2run; catalog packages keep going through ``run``.
+* ``ros2 pkg list/executables/prefix`` read the ament index of the search
+  path: sourced workspaces first, then the wheels and the catalog's prefixes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from ros2pkg.verb import add_create_arguments, main_create
+
+from app.learner_ws import build, folder, overlay
+from app.learner_ws.folder import LearnerWorkspace
+from app.ros.context import CallContext
+from app.ros.errors import Cancelled, Ros2Error
+from app.ros2cli import run
+from app.ros2cli.common import Ros2cliMessage
+from app.supervisor import LearnerProgram
+
+NO_DDS = {("pkg", v) for v in ("create", "list", "executables", "prefix")}
+FIRST_WORDS_WITHOUT_DDS = ("colcon", "source")
+SETUP_FILES = ("setup.bash", "setup.sh", "setup.zsh", "local_setup.bash", "local_setup.sh")
+POLL_SEC = 0.1
+DISK_CHECK_SEC = 1.0
+
+
+def no_dds(words: list[str]) -> bool:
+    """colcon and source read and write files only."""
+    return bool(words) and words[0] in FIRST_WORDS_WITHOUT_DDS
+
+
+def workspace() -> LearnerWorkspace | None:
+    return folder.current()
+
+
+# -- the dashboard's wiring ------------------------------------------------------------
+
+
+def setup_workspace(progress_file: Path, *, remote: bool) -> LearnerWorkspace:
+    """Called once by `ros2-classroom serve` before the supervisor copies the environment.
+
+    The learner's workspace beside their progress, and the underlay every
+    program and index lookup sees: the catalog's ament prefixes, then what
+    AMENT_PREFIX_PATH held (or the wheels' prefix).
+    """
+    from app.launch_prefix import catalog_prefix
+    from app.ros2cli.tutorial_prefix import tutorial_prefix
+
+    ws = LearnerWorkspace(folder.default_root(progress_file), remote=remote)
+    folder.configure(ws)
+    before = [Path(p) for p in os.environ.get(overlay.PREFIX_ENV, "").split(os.pathsep) if p]
+    underlay = [*before, Path(sys.prefix), tutorial_prefix(), catalog_prefix()]
+    overlay.set_underlay(underlay)
+    os.environ[overlay.PREFIX_ENV] = os.pathsep.join(str(p) for p in overlay.search_path())
+    return ws
+
+
+# -- ros2 pkg --------------------------------------------------------------------------
+
+
+def add_verbs(verbs: Any, verb: Any) -> None:
+    """The `pkg` group's verbs (parser.build_parser gives the group and its helper)."""
+    p = verb(verbs, "create", "Create a new ROS 2 package", _create)
+    add_create_arguments(p)
+    verb(verbs, "list", "Output a list of available packages", _list)
+    p = verb(verbs, "executables", "Output a list of package specific executables", _executables)
+    p.add_argument("package_name", nargs="?")
+    p.add_argument("--full-path", action="store_true", help="Show full path of each executable")
+    p = verb(verbs, "prefix", "Output the prefix path of a package", _prefix)
+    p.add_argument("package_name")
+    p.add_argument("--share", action="store_true", help="Show share directory for the package")
+
+
+def add_commands(groups: Any, write: Any) -> None:
+    """`colcon VERB ...` and `source FILE`: commands the tutorials type beside ros2."""
+    p = groups.add_parser("colcon", help="build the workspace: colcon build [options]", write=write)
+    p.add_argument("words", nargs=argparse.REMAINDER, help="verb and options")
+    p.set_defaults(handler=_colcon)
+    p = groups.add_parser("source", help="use a workspace: source install/setup.bash", write=write)
+    p.add_argument("file")
+    p.set_defaults(handler=_source)
+
+
+def _create(ctx: CallContext, args: argparse.Namespace) -> int:
+    ws = workspace()
+    base: Path | None = None
+    if ws is not None:
+        destination = args.destination_directory
+        typed = (
+            destination
+            if os.path.isabs(destination) or destination.startswith("~")
+            else (os.path.join("src", destination))
+        )
+        real = ws.confine(typed)
+        real.mkdir(parents=True, exist_ok=True)
+        # Shown as typed; resolved where the tutorial types it (~/ros2_ws/src).
+        if destination.startswith("~"):
+            args.destination_directory = str(real)
+        base = ws.src
+    problem = main_create(args, ctx.write, base)
+    if problem:
+        raise Ros2cliMessage(problem)
+    return 0
+
+
+def _own_packages() -> dict[str, Path]:
+    """Packages of sourced workspaces (the overlay), with their prefix."""
+    mine = set(overlay.overlay())
+    if workspace() is None:  # a terminal: whatever its shell sourced that colcon built
+        mine = {p for p in overlay.search_path() if (p / "share" / "colcon-core").is_dir()}
+    return {name: prefix for name, prefix in overlay.packages().items() if prefix in mine}
+
+
+def _list(ctx: CallContext, args: argparse.Namespace) -> int:
+    names = set(overlay.packages()) | {pkg for pkg, _exe in run.EXECUTABLES}
+    for name in sorted(names):
+        ctx.write(name)
+    return 0
+
+
+def _executables(ctx: CallContext, args: argparse.Namespace) -> int:
+    own = _own_packages()
+    package = args.package_name
+    if package is not None and package in own:
+        pairs = [(package, p) for p in overlay.executables(package, own[package])]
+        for pkg, path in pairs:
+            ctx.write(str(path) if args.full_path else f"{pkg} {path.name}")
+        return 0
+    if package is not None and package not in {pkg for pkg, _exe in run.EXECUTABLES}:
+        raise Ros2cliMessage(f"Package '{package}' not found" + _not_found_hint(package))
+    lines: list[tuple[str, str]] = []
+    for pkg, exe in run.executables(package):
+        if pkg not in own:
+            prefix = overlay.package_prefix(pkg)
+            lines.append((pkg, str(prefix / "lib" / pkg / exe) if prefix else exe))
+    if package is None:
+        for pkg, own_prefix in own.items():
+            lines += [(pkg, str(path)) for path in overlay.executables(pkg, own_prefix)]
+    for pkg, shown in sorted(lines):
+        ctx.write(shown if args.full_path else f"{pkg} {os.path.basename(shown)}")
+    return 0
+
+
+def _prefix(ctx: CallContext, args: argparse.Namespace) -> int:
+    prefix = overlay.package_prefix(args.package_name)
+    if prefix is None:
+        raise Ros2cliMessage("Package not found")
+    ctx.write(str(prefix / "share" / args.package_name) if args.share else str(prefix))
+    return 0
+
+
+# -- source ----------------------------------------------------------------------------
+
+
+def _source(ctx: CallContext, args: argparse.Namespace) -> int:
+    ws = workspace()
+    if ws is None:
+        raise Ros2Error("`source` is for the dashboard's Console; in a terminal, type it in bash")
+    path = ws.confine(args.file)
+    if path.name not in SETUP_FILES or path.parent.name != "install":
+        raise Ros2Error(
+            f"{args.file}: the Console sources a workspace's install/setup.bash "
+            "(or setup.sh, local_setup.bash) only"
+        )
+    if not path.is_file():
+        ctx.write(f"bash: {args.file}: No such file or directory")
+        ctx.write(
+            "(nothing is built yet: `colcon build` in the workspace writes install/setup.bash)"
+        )
+        return 1
+    prefixes = overlay.source(path.parent)
+    names = sorted(name for p in prefixes for name in _names_in(p))
+    ctx.write(
+        f"(sourced {ws.shown(path)}: from now on this Console's `ros2 run`, `ros2 launch`, "
+        "`ros2 pkg` and `ros2 interface` find this workspace's packages"
+        + (f" ({', '.join(names)})" if names else " (it holds no package yet)")
+        + " in front of the underlay, the ROS packages installed here. In a terminal, "
+        "sourcing sets AMENT_PREFIX_PATH, PYTHONPATH and LD_LIBRARY_PATH the same way; "
+        "a package built later needs `source` again.)"
+    )
+    return 0
+
+
+def _names_in(prefix: Path) -> list[str]:
+    index = prefix / overlay.INDEX
+    return [p.name for p in index.iterdir()] if index.is_dir() else []
+
+
+# -- colcon ----------------------------------------------------------------------------
+
+
+def _colcon(ctx: CallContext, args: argparse.Namespace) -> int:
+    ws = workspace()
+    if ws is None:
+        raise Ros2Error("in a terminal, run colcon itself (it is installed in the venv)")
+    programs = run.programs_of(ctx)
+    words = list(args.words)
+    program = build.colcon_program(ws, words)
+    if _active(programs, program.name):
+        raise Ros2Error(f"`colcon {words[0]}` is already running in this workspace")
+    programs.start_program(program)
+    return follow_build(ctx, programs, program.name, ws)
+
+
+def follow_build(ctx: CallContext, programs: Any, key: str, ws: LearnerWorkspace) -> int:
+    """Stream a build's output until it ends; stop it at the time or disk limit, or on Stop."""
+    started = time.monotonic()
+    shown = 0
+    next_disk_check = started + DISK_CHECK_SEC
+    reason: str | None = None
+    try:
+        while True:
+            shown = _write_new(ctx, programs, key, shown)
+            status = programs.status(key)
+            if not status.active:
+                shown = _write_new(ctx, programs, key, shown)
+                _explain_dash_spelling(ctx, programs.output(key))
+                if status.exit_code != 0:
+                    ctx.write(
+                        f"(colcon ended with exit code {status.exit_code}: the lines under "
+                        "'--- stderr:' name the file and line; the full logs are in "
+                        f"{ws.shown(ws.root / 'log')})"
+                    )
+                return 0 if status.exit_code == 0 else 1
+            now = time.monotonic()
+            if now - started > ws.limits.seconds:
+                reason = (
+                    f"the build ran longer than {ws.limits.seconds:g} s, the limit here, and was "
+                    "stopped (does a setup.py or CMakeLists.txt loop forever?)"
+                )
+                break
+            if now >= next_disk_check:
+                next_disk_check = now + DISK_CHECK_SEC
+                used = build.disk_usage(ws.root)
+                if used > ws.limits.disk_bytes:
+                    reason = (
+                        f"build/, install/ and log/ grew past {ws.limits.disk_bytes // 2**20} MiB, "
+                        "the disk budget here, and the build was stopped; your src/ is untouched "
+                        "(delete build/ and install/ to start again)"
+                    )
+                    break
+            ctx.sleep(POLL_SEC)
+    except Cancelled:
+        programs.stop(key).result(timeout=15.0)
+        _write_new(ctx, programs, key, shown)
+        raise
+    programs.stop(key).result(timeout=15.0)
+    _write_new(ctx, programs, key, shown)
+    ctx.write(f"error: {reason}")
+    return 1
+
+
+def _explain_dash_spelling(ctx: CallContext, lines: list[str]) -> None:
+    """setup.cfg with script-dir/install-scripts (older templates, ros2cli #730)."""
+    if any("dash-separated 'script-dir'" in line or "dash-separated 'install-scripts'" in line
+           for line in lines):  # fmt: skip
+        ctx.write(
+            "(hint: setup.cfg says script-dir/install-scripts; setuptools still reads the dash "
+            "spelling but warns it will stop, and then your executables would not land in "
+            "lib/<package>, where `ros2 run` looks: use script_dir and install_scripts)"
+        )
+
+
+def _write_new(ctx: CallContext, programs: Any, key: str, shown: int) -> int:
+    """Write lines not shown yet; ``shown`` counts lines ever produced (the buffer is bounded)."""
+    status = programs.status(key)
+    lines = programs.output(key)
+    total = status.dropped_lines + len(lines)
+    new = lines[max(0, len(lines) - (total - shown)) :] if total > shown else []
+    for line in new:
+        ctx.write(line)
+    return total
+
+
+def _active(programs: Any, key: str) -> bool:
+    return key in programs.statuses() and programs.statuses()[key].active
+
+
+# -- ros2 run of the learner's own packages ----------------------------------------------
+
+
+def run_own(ctx: CallContext, package: str, executable: str, words: list[str]) -> int | None:
+    """`ros2 run` of a package in a sourced workspace; None when it is not one of those."""
+    own = _own_packages()
+    if package not in own:
+        if package not in {pkg for pkg, _exe in run.EXECUTABLES}:
+            hint = _not_found_hint(package)
+            if hint:
+                raise Ros2cliMessage(f"Package '{package}' not found{hint}")
+        return None
+    ws = workspace()
+    if ws is not None and ws.remote:
+        raise Ros2Error("your own packages run only on your own machine's dashboard here")
+    paths = [p for p in overlay.executables(package, own[package]) if p.name == executable]
+    if not paths:
+        present = [p.name for p in overlay.executables(package, own[package])]
+        raise Ros2cliMessage(
+            "No executable found\n"
+            f"(package '{package}' has "
+            + (f"the executables {', '.join(present)}" if present else "no executables")
+            + ": an ament_python executable is a line of console_scripts in setup.py's "
+            "entry_points, 'name = package.module:main', installed into lib/<package> when "
+            "setup.cfg says script_dir/install_scripts (underscores); fix it, then "
+            "`colcon build` and `source install/setup.bash` again)"
+        )
+    programs = run.programs_of(ctx)
+    before, ros_args = run.split_ros_args(words)
+    key = f"own:/{package}/{executable}"
+    if _active(programs, key):
+        raise Ros2Error(
+            f"{package} {executable} is already running; stop it with "
+            f"`ros2 run --stop /{package}/{executable}`"
+        )
+    argv = [str(paths[0]), *before] + (["--ros-args", *ros_args] if ros_args else [])
+    cwd = ws.root if ws is not None else Path.cwd()
+    program = LearnerProgram(
+        name=key, node_name=f"/{package}/{executable}", argv=tuple(argv), cwd=cwd,
+        env=overlay.child_env(),
+    )  # fmt: skip
+    nodes_before = _node_names(ctx)
+    programs.start_program(program)
+    return _show_own_start(ctx, programs, key, nodes_before)
+
+
+def _node_names(ctx: CallContext) -> set[str]:
+    return {f"{ns.rstrip('/')}/{n}" for n, ns in ctx.node.get_node_names_and_namespaces()}
+
+
+def _show_own_start(ctx: CallContext, programs: Any, key: str, before: set[str]) -> int:
+    """Its output while it starts; all of it when it ends meanwhile (a script that prints)."""
+    shown = 0
+    waited = 0.0
+    limit = run.STARTUP_WAIT_SEC
+    new_nodes: set[str] = set()
+    while True:
+        shown = _write_new(ctx, programs, key, shown)
+        status = programs.status(key)
+        if not status.active:
+            shown = _write_new(ctx, programs, key, shown)
+            return 0 if status.exit_code == 0 else 1
+        new_nodes = _node_names(ctx) - before
+        if (new_nodes and shown) or waited >= limit:
+            break
+        ctx.sleep(POLL_SEC)
+        waited += POLL_SEC
+    stop = key.split(":", 1)[1]
+    on_graph = f" as {', '.join(sorted(new_nodes))}" if new_nodes else ""
+    ctx.write(
+        f"(it keeps running{on_graph}, pid {status.pid}: stop it with `ros2 run --stop {stop}`)"
+    )
+    return 0
+
+
+def _not_found_hint(package: str) -> str:
+    """Why a package of the learner's workspace is not found: not built, or not sourced."""
+    ws = workspace()
+    if ws is None:
+        return ""
+    install = ws.root / "install"
+    built = (install / package).is_dir() or (install / overlay.INDEX / package).is_file()
+    in_src = any((p.parent.name == package) for p in ws.src.glob("*/package.xml")) or any(
+        p.parent.name == package for p in ws.src.glob("*/*/package.xml")
+    )
+    if built and install not in overlay.sourced():
+        return (
+            f"\n(hint: {package} is built in your workspace, but this Console has not sourced "
+            "it: type `source install/setup.bash`, then try again)"
+        )
+    if built:
+        return (
+            f"\n(hint: {package} was built after your last `source`: source "
+            "install/setup.bash again, as a new terminal would)"
+        )
+    if in_src:
+        return (
+            f"\n(hint: {package} is in src/ but not built: `colcon build --packages-select "
+            f"{package}`, then `source install/setup.bash`)"
+        )
+    return ""

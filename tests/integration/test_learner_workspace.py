@@ -1,0 +1,358 @@
+"""The learner's own workspace (issue 22): the tutorials' commands verbatim in the Console.
+
+One workspace is created and built once for the module (real colcon: an
+ament_python package, an ament_cmake interface package with Num.msg and
+AddThreeInts.srv, the usual mistakes as packages of their own, and 5,000
+files of the learner's); the tests then source it, run its nodes, and look
+at it from outside with no module of ours imported.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+
+from app.learner_ws import folder, overlay
+from app.learner_ws.folder import BuildLimits, LearnerWorkspace
+from app.ros.context import CallContext, Limits
+from app.ros2cli import run_text
+from app.ros2cli.pkg import setup_workspace
+from app.supervisor import Supervisor
+
+LIMITS = Limits(max_messages=3, max_seconds=6.0)
+TUTORIAL_CREATE = (
+    "ros2 pkg create --build-type ament_python --license Apache-2.0 --node-name my_node my_package"
+)
+NUM_NODE = """\
+import rclpy
+from rclpy.node import Node
+
+from my_interfaces.msg import Num
+from my_interfaces.srv import AddThreeInts
+
+
+class NumPublisher(Node):
+    def __init__(self):
+        super().__init__('num_publisher')
+        self.publisher_ = self.create_publisher(Num, 'topic', 10)
+        msg = Num()
+        msg.num = 7
+        request = AddThreeInts.Request(a=1, b=2, c=3)
+        total = request.a + request.b + request.c
+        self.get_logger().info(f'Publishing: "{msg.num}", request sums to {total}')
+        self.publisher_.publish(msg)
+
+
+def main(args=None):
+    rclpy.init(args=args)
+    node = NumPublisher()
+    node.destroy_node()
+    rclpy.try_shutdown()
+"""
+
+
+class Console:
+    """The Console's path: text -> run_text with the supervisor, output kept."""
+
+    def __init__(self, programs: Supervisor, node=None) -> None:
+        self.programs = programs
+        self.node = node
+
+    def __call__(self, text: str) -> tuple[int, str]:
+        lines: list[str] = []
+        ctx = CallContext(self.node, lines.append, LIMITS, programs=self.programs)
+        code = run_text(ctx, text)
+        return code, "\n".join(lines)
+
+
+def _edit(path: Path, old: str, new: str) -> None:
+    text = path.read_text()
+    assert old in text, (path, old)
+    path.write_text(text.replace(old, new, 1))
+
+
+def _interface_package(console: Console, src: Path) -> None:
+    """'Creating custom msg and srv files', as the tutorial edits the files."""
+    code, out = console(
+        "ros2 pkg create --build-type ament_cmake --license Apache-2.0 my_interfaces"
+    )
+    assert code == 0, out
+    pkg = src / "my_interfaces"
+    (pkg / "msg").mkdir()
+    (pkg / "srv").mkdir()
+    (pkg / "msg" / "Num.msg").write_text("int64 num\n")
+    (pkg / "srv" / "AddThreeInts.srv").write_text("int64 a\nint64 b\nint64 c\n---\nint64 sum\n")
+    _edit(
+        pkg / "CMakeLists.txt",
+        "find_package(ament_cmake REQUIRED)\n",
+        "find_package(ament_cmake REQUIRED)\nfind_package(rosidl_default_generators REQUIRED)\n\n"
+        "rosidl_generate_interfaces(${PROJECT_NAME}\n"
+        '  "msg/Num.msg"\n  "srv/AddThreeInts.srv"\n)\n',
+    )
+    _edit(
+        pkg / "package.xml",
+        "  <test_depend>ament_lint_auto</test_depend>",
+        "  <buildtool_depend>rosidl_default_generators</buildtool_depend>\n"
+        "  <exec_depend>rosidl_default_runtime</exec_depend>\n"
+        "  <member_of_group>rosidl_interface_packages</member_of_group>\n\n"
+        "  <test_depend>ament_lint_auto</test_depend>",
+    )
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    """One workspace, created and built through the Console, shared by the module."""
+    saved = os.environ.get(overlay.PREFIX_ENV)
+    progress = tmp_path_factory.mktemp("learner") / "progress" / "ada.json"
+    ws = setup_workspace(progress, remote=False)
+    sup = Supervisor(os.environ)
+    console = Console(sup)
+    src = ws.src
+    log: dict[str, str] = {}
+    try:
+        log["create"] = console(TUTORIAL_CREATE)[1]
+        pkg = src / "my_package"
+        (pkg / "my_package" / "num_node.py").write_text(NUM_NODE)
+        _edit(
+            pkg / "setup.py",
+            "'my_node = my_package.my_node:main'",
+            "'my_node = my_package.my_node:main',\n"
+            "            'num_node = my_package.num_node:main'",
+        )
+        _edit(
+            pkg / "package.xml",
+            "  <test_depend>",
+            "  <depend>my_interfaces</depend>\n\n  <test_depend>",
+        )
+        _interface_package(console, src)
+        # A typo in console_scripts: the entry names my_nod, the learner runs my_node.
+        assert (
+            console("ros2 pkg create --build-type ament_python --node-name my_node typo_pkg")[0]
+            == 0
+        )
+        _edit(src / "typo_pkg" / "setup.py", "'my_node = ", "'my_nod = ")
+        # The old template's dash spelling in setup.cfg (ros2cli #730).
+        assert (
+            console("ros2 pkg create --build-type ament_python --node-name my_node dash_pkg")[0]
+            == 0
+        )
+        _edit(src / "dash_pkg" / "setup.cfg", "script_dir", "script-dir")
+        _edit(src / "dash_pkg" / "setup.cfg", "install_scripts", "install-scripts")
+        # 5,000 files of the learner's beside the packages.
+        notes = src / "notes"
+        notes.mkdir()
+        for i in range(5000):
+            (notes / f"n{i:04d}.txt").write_text(f"note {i}\n")
+        started = time.monotonic()
+        log["build_code"], log["build"] = (str(x) for x in console("colcon build"))
+        log["build_seconds"] = f"{time.monotonic() - started:.1f}"
+        yield ws, console, log
+    finally:
+        sup.shutdown()
+        overlay.forget()
+        overlay.set_underlay([])
+        folder.configure(None)
+        if saved is None:
+            os.environ.pop(overlay.PREFIX_ENV, None)
+        else:
+            os.environ[overlay.PREFIX_ENV] = saved
+
+
+def test_create_prints_and_writes_what_ros2pkg_does(built):
+    ws, _console, log = built
+    out = log["create"]
+    for line in (
+        "going to create a new package",
+        "package name: my_package",
+        f"destination directory: {ws.src.resolve()}",
+        "package format: 3",
+        "licenses: ['Apache-2.0']",
+        "build type: ament_python",
+        "node_name: my_node",
+        "creating folder ./my_package",
+        "creating ./my_package/package.xml",
+        "creating ./my_package/setup.cfg",
+        "creating ./my_package/resource/my_package",
+        "creating ./my_package/test/test_flake8.py",
+        "creating ./my_package/my_package/my_node.py",
+    ):
+        assert line in out.splitlines(), (line, out)
+    pkg = ws.src / "my_package"
+    assert '<package format="3">' in (pkg / "package.xml").read_text()
+    assert "script_dir=$base/lib/my_package" in (pkg / "setup.cfg").read_text()
+    assert "Apache License" in (pkg / "LICENSE").read_text()
+    cmake = (ws.src / "my_interfaces" / "CMakeLists.txt").read_text()
+    assert "project(my_interfaces)" in cmake and "ament_package()" in cmake
+
+
+def test_colcon_build_builds_everything(built):
+    ws, _console, log = built
+    assert log["build_code"] == "0", log["build"]
+    for package in ("my_package", "my_interfaces", "typo_pkg", "dash_pkg"):
+        assert f"Finished <<< {package}" in log["build"], log["build"]
+    for name in ("build", "install", "log"):
+        assert (ws.root / name).is_dir()
+    assert (ws.root / "install" / "setup.bash").is_file()
+    assert (ws.root / "install/my_package/lib/my_package/my_node").is_file()
+    # The learner's 5,000 files are crawled past and left as they were.
+    notes = sorted((ws.src / "notes").iterdir())
+    assert len(notes) == 5000 and notes[1234].read_text() == "note 1234\n"
+
+
+def test_tutorial_run_needs_source_then_prints_hi(built, probe):
+    ws, console, _log = built
+    console.node = probe.node
+    overlay.forget()
+    code, out = console("ros2 run my_package my_node")
+    assert code == 1
+    assert out.splitlines()[0] == "Package 'my_package' not found", out
+    assert "source install/setup.bash" in out
+    code, out = console("source install/setup.bash")
+    assert code == 0 and "underlay" in out, out
+    code, out = console("ros2 run my_package my_node")
+    assert code == 0, out
+    assert "Hi from my_package." in out.splitlines()
+
+
+def test_pkg_verbs_include_the_sourced_workspace(built):
+    ws, console, _log = built
+    console("source ~/ros2_ws/install/setup.bash")
+    assert "my_package" in console("ros2 pkg list")[1].splitlines()
+    assert "turtlesim" in console("ros2 pkg list")[1].splitlines()
+    out = console("ros2 pkg executables my_package")[1].splitlines()
+    assert out == ["my_package my_node", "my_package num_node"], out
+    assert console("ros2 pkg prefix my_package")[1] == str(ws.root / "install" / "my_package")
+    assert console("ros2 pkg prefix no_such_pkg") == (1, "Package not found")
+
+
+def test_interface_package_is_shown_and_used_by_a_node(built, probe):
+    _ws, console, _log = built
+    console.node = probe.node
+    console("source install/setup.bash")
+    code, out = console("ros2 interface show my_interfaces/msg/Num")
+    assert (code, out) == (0, "int64 num"), out
+    assert "my_interfaces/srv/AddThreeInts" in console("ros2 interface list")[1]
+    code, out = console("ros2 run my_package num_node")
+    assert code == 0, out
+    assert 'Publishing: "7", request sums to 6' in out, out
+
+
+def test_typo_in_console_scripts_gives_no_executable_found(built, probe):
+    _ws, console, _log = built
+    console.node = probe.node
+    console("source install/setup.bash")
+    code, out = console("ros2 run typo_pkg my_node")
+    assert code == 1
+    assert out.splitlines()[0] == "No executable found", out
+    assert "my_nod" in out and "console_scripts" in out
+
+
+def test_dash_spelling_in_setup_cfg_warns_and_is_explained(built, probe):
+    _ws, console, log = built
+    console.node = probe.node
+    # setuptools still reads the dash spelling but warns that it will stop; we explain it.
+    assert "dash-separated 'script-dir'" in log["build"], log["build"]
+    assert "use script_dir and install_scripts" in log["build"]
+    console("source install/setup.bash")
+    code, out = console("ros2 run dash_pkg my_node")
+    assert (code, out.splitlines()[-1]) == (0, "Hi from dash_pkg."), out
+
+
+def test_bad_input_is_one_clear_line(built):
+    ws, console, _log = built
+    code, out = console("ros2 pkg create My-Package")
+    assert code == 1 and 'Package name "My-Package" does not follow' in out, out
+    assert not (ws.src / "My-Package").exists()
+    code, out = console("ros2 pkg create --destination-directory ../../.. escaped")
+    assert code == 1 and "outside your workspace" in out, out
+    code, out = console("ros2 pkg create --destination-directory /tmp escaped")
+    assert code == 1 and "outside your workspace" in out, out
+    (ws.root / "elsewhere").symlink_to("/tmp")
+    code, out = console("ros2 pkg create --destination-directory ../elsewhere escaped")
+    assert code == 1 and "outside your workspace" in out, out
+    code, out = console("source /etc/profile")
+    assert code == 1 and "outside your workspace" in out, out
+    code, out = console("colcon build --build-base /tmp/x")
+    assert code == 1 and "not available here" in out, out
+    code, out = console("ros2 pkg create my_package")
+    assert code == 1 and "The directory already exists: ./my_package" in out, out
+
+
+def test_install_space_runs_without_any_module_of_ours(built):
+    """An ordinary colcon workspace: bash sources it; the ament index alone finds the node."""
+    ws, _console, _log = built
+    check = textwrap.dedent(
+        """
+        import os, runpy, subprocess, sys
+        from ament_index_python import get_package_prefix
+        prefix = get_package_prefix('my_package')
+        exe = os.path.join(prefix, 'lib', 'my_package', 'my_node')
+        print(subprocess.run([exe], capture_output=True, text=True, check=True).stdout.strip())
+        runpy.run_module('my_package.my_node', run_name='__main__')
+        from my_interfaces.msg import Num
+        print(Num(num=5).num)
+        ours = sorted(m for m in sys.modules if m.split('.')[0] in ('app', 'nodes', 'ros2pkg'))
+        print('ours:', ours)
+        """
+    )
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", overlay.PREFIX_ENV)}
+    env["AMENT_PREFIX_PATH"] = sys.prefix
+    script = f'source install/setup.bash && {sys.executable} -c "$CHECK"'
+    env["CHECK"] = check
+    done = subprocess.run(
+        ["bash", "-c", script], cwd=ws.root, env=env, capture_output=True, text=True, timeout=60
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split("\n")[:4] == [
+        "Hi from my_package.",
+        "Hi from my_package.",
+        "5",
+        "ours: []",
+    ], done.stdout
+
+
+def test_build_limits_time_and_disk(tmp_path):
+    """A setup.py that loops forever, and one that fills the disk: stopped, said so."""
+    sup = Supervisor(os.environ)
+    try:
+        for limits, body, expect in (
+            (BuildLimits(seconds=4.0), "while True:\n    pass\n", "ran longer than 4 s"),
+            (
+                BuildLimits(disk_bytes=8 * 2**20),
+                "import os, time\nos.makedirs('../../build/junk', exist_ok=True)\n"
+                "for i in range(400):\n"
+                "    open(f'../../build/junk/{i}', 'wb').write(os.urandom(2**20))\n"
+                "    time.sleep(0.02)\n",
+                "grew past 8 MiB",
+            ),
+        ):
+            root = tmp_path / f"ws{len(expect)}"
+            ws = LearnerWorkspace(root, limits=limits)
+            folder.configure(ws)
+            pkg = ws.src / "greedy"
+            pkg.mkdir(parents=True)
+            (pkg / "package.xml").write_text(
+                '<?xml version="1.0"?>\n<package format="3"><name>greedy</name><version>0.0.0'
+                '</version><description>d</description><maintainer email="a@b.c">a</maintainer>'
+                "<license>MIT</license><export><build_type>ament_python</build_type></export>"
+                "</package>\n"
+            )
+            (pkg / "setup.py").write_text(
+                body + "from setuptools import setup\nsetup(name='greedy')\n"
+            )
+            (root / "src" / "keep.txt").write_text("mine\n")
+            started = time.monotonic()
+            code, out = Console(sup)("colcon build")
+            assert code == 1 and expect in out, out
+            assert time.monotonic() - started < limits.seconds + 40
+            assert not any(s.active for s in sup.statuses().values())
+            assert (root / "src" / "keep.txt").read_text() == "mine\n"
+    finally:
+        folder.configure(None)
+        sup.shutdown()
