@@ -15,7 +15,7 @@ from app.ros.lifecycle import (
     lifecycle_target,
 )
 from app.ros2cli.common import Ros2cliMessage, write_names
-from app.ros2cli.param import param_node
+from app.ros2cli.graph_verbs import find_node
 
 
 def _managed(ctx: CallContext, include_hidden: bool) -> list[str]:
@@ -25,7 +25,8 @@ def _managed(ctx: CallContext, include_hidden: bool) -> list[str]:
 
 
 def _target(ctx: CallContext, fqn: str, include_hidden: bool) -> str:
-    return lifecycle_target(ctx, param_node(ctx, fqn, include_hidden))
+    target = fqn if fqn.startswith("/") else "/" + fqn
+    return lifecycle_target(ctx, find_node(ctx, target, include_hidden, "Node not found"))
 
 
 def verb_nodes(ctx: CallContext, count: bool = False, all_: bool = False) -> int:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import time
 
 import yaml
 from rcl_interfaces.msg import Parameter, ParameterDescriptor, ParameterType, ParameterValue
@@ -44,7 +45,17 @@ TYPE_WORDS_CLI = {
 def param_node(ctx: CallContext, fqn: str, include_hidden: bool = False) -> str:
     """The node's absolute name if it is on the graph, else ros2cli's 'Node not found'."""
     target = fqn if fqn.startswith("/") else "/" + fqn
-    return find_node(ctx, target, include_hidden, "Node not found")
+    find_node(ctx, target, include_hidden, "Node not found")
+    # As ros2cli's parameter client: the node's parameter services, within 5 s.
+    wanted = f"{target.rstrip('/')}/list_parameters"
+    deadline = time.monotonic() + ctx.limits.service_timeout
+    while not any(n == wanted for n, _t in ctx.node.get_service_names_and_types()):
+        if time.monotonic() > deadline:
+            raise Ros2cliMessage(
+                f"Wait for service timed out waiting for parameter services for node {target}"
+            )
+        ctx.sleep(0.1)
+    return target
 
 
 def param_list(

@@ -14,6 +14,7 @@ from __future__ import annotations
 import re
 
 import pytest
+from rclpy.node import Node
 
 from app.ros.context import CallContext, Limits
 from app.ros2cli import run_text
@@ -301,7 +302,7 @@ def test_graph_verbs_golden(supervisor, ros2):
     assert lines[-1] == "ros2: error: unrecognized arguments: --qos-profile sensor_data"
 
 
-def test_param_lifecycle_and_hidden_names_golden(supervisor, ros2):
+def test_param_lifecycle_and_hidden_names_golden(supervisor, probe, ros2):
     for name in ("turtlesim_node", "lifecycle_talker", "parameters_node"):
         supervisor.start(name)
     ros2.until("lifecycle nodes", "/lifecycle_talker")
@@ -361,6 +362,15 @@ def test_param_lifecycle_and_hidden_names_golden(supervisor, ros2):
     assert ros2("param get /parameters_node greeting --hide-type") == (0, ["Hello"])
     assert ros2("param get /turtlesim background_b") == (0, ["Integer value is: 255"])
     assert ros2("param get /nobody greeting") == (1, ["Node not found"])
+    silent = Node("no_params_here", context=probe.context, start_parameter_services=False)
+    try:
+        ros2.until("node list", "/no_params_here")
+        assert ros2("param get /no_params_here x", Limits(service_timeout=1.0)) == (
+            1,
+            ["Wait for service timed out waiting for parameter services for node /no_params_here"],
+        )
+    finally:
+        silent.destroy_node()
     assert ros2("param describe /nobody greeting") == (1, ["Node not found"])
     # the node refuses (rclpy's reason); ros2cli still exits with 0
     assert ros2("param delete /parameters_node shout") == (
