@@ -1,4 +1,5 @@
-"""What only the command-line face needs: letting a brand-new node see the graph."""
+"""Shared by the verbs: ros2cli's failure kinds, hidden names, print()-like output, and
+letting a brand-new node see the graph."""
 
 from __future__ import annotations
 
