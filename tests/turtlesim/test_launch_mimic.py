@@ -141,3 +141,24 @@ def test_every_launch_group_is_a_tutorial_nodes_launch_file(console, supervisor)
     for child in children:  # reaped: no orphan left
         with pytest.raises(ProcessLookupError):
             os.kill(child, 0)
+
+
+def test_a_lesson_log_check_reads_a_node_inside_a_console_launch(console, supervisor):  # noqa: F811
+    """The lesson's `ros2 launch tutorial_nodes chatter_demo.launch.py`, typed in the Console:
+    one program for three nodes, yet the step's check on listener2's log still sees it."""
+    from types import SimpleNamespace
+
+    from app.lessons.checks.log_contains import evaluate
+    from app.lessons.registry import FAIL, PASS
+    from app.lessons.schema import Spec
+
+    rt = SimpleNamespace(supervisor=supervisor)
+    check = Spec("log_contains", {"catalog_node": "listener2", "text": "I heard", "at_least": 3})
+    assert evaluate(rt, check).state == FAIL  # nothing runs yet
+    ok(console, "ros2 launch tutorial_nodes chatter_demo.launch.py")
+    wait_until(lambda: evaluate(rt, check).state == PASS, timeout=20, what="listener2 hearing")
+    lines = supervisor.output("launch:tutorial_nodes/chatter_demo.launch.py")
+    assert any(
+        line.startswith("[listener-3] ") and "[listener2]: I heard" in line for line in lines
+    )
+    ok(console, "ros2 launch --stop tutorial_nodes chatter_demo.launch.py")
