@@ -14,6 +14,7 @@ from typing import NamedTuple
 import viser
 from rclpy.node import Node
 
+from app.panels.joint_sliders import JointSliders
 from app.ros.graph import GraphSnapshot
 from app.scene import topic_picker as picker
 from app.scene import transforms as tf
@@ -171,6 +172,7 @@ class ScenePanel:
             )
             self._frame_names = gui.add_checkbox("Frame names", True)
             self._tf_status = MarkdownView(gui)
+        self.joint_sliders = JointSliders(gui, ui, node)
 
         self.params = CameraParamSync(node)
         self._wire()
@@ -271,8 +273,9 @@ class ScenePanel:
             self._fixed_options = frames
             self._fixed.options = frames
         self._tf_status.show(self.tf_view.status())
+        self.joint_sliders.show(self.tf_view.robot_joints)
 
     def close(self) -> None:
         layers = (self.clouds, self.images, self.markers, self.arm, self.stamped, self.params)
-        for layer in (*layers, self.tf_view):
+        for layer in (*layers, self.tf_view, self.joint_sliders):
             layer.close()

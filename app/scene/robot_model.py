@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import io
 import logging
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,11 +38,21 @@ class LinkVisual:
 
 
 @dataclass(frozen=True)
+class SliderJoint:
+    """A joint a slider may set, as joint_state_publisher_gui offers it (continuous: +-pi)."""
+
+    name: str
+    lower: float
+    upper: float
+
+
+@dataclass(frozen=True)
 class RobotDrawing:
     name: str
     links: tuple[str, ...]
     visuals: tuple[LinkVisual, ...]
     warnings: tuple[str, ...]
+    joints: tuple[SliderJoint, ...] = ()
 
 
 def resolve_mesh(fname: str) -> str:
@@ -112,7 +123,18 @@ def build_drawing(text: str) -> RobotDrawing:
             placed = mesh.copy()
             placed.apply_transform(offset)
             visuals.append(LinkVisual(link, placed))
-    return RobotDrawing(model.name, model.links, tuple(visuals), tuple(warnings))
+    joints = tuple(
+        SliderJoint(j.name, *_slider_range(j.lower, j.upper))
+        for j in model.movable_joints()
+        if j.mimic is None
+    )
+    return RobotDrawing(model.name, model.links, tuple(visuals), tuple(warnings), joints)
+
+
+def _slider_range(lower: float | None, upper: float | None) -> tuple[float, float]:
+    if lower is None or upper is None or not lower < upper:
+        return (-math.pi, math.pi)
+    return (lower, upper)
 
 
 class _CollectingHandler(logging.Handler):

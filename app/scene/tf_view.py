@@ -30,7 +30,7 @@ from tf2_msgs.msg import TFMessage
 
 from app.scene import transforms as tf
 from app.scene.qos import SCENE_CALLBACK_GROUP
-from app.scene.robot_model import RobotDrawing, build_drawing
+from app.scene.robot_model import RobotDrawing, SliderJoint, build_drawing
 from app.scene.tf_tree import TfStore, TreeView
 
 log = logging.getLogger(__name__)
@@ -59,6 +59,7 @@ class TfView:
         self._lock = threading.Lock()
         self._description: str | None = None
         self._robot: RobotDrawing | None = None
+        self.robot_joints: tuple[SliderJoint, ...] = ()  # for the joint sliders (UI thread reads)
         self.robot_status = "No robot on /robot_description yet."
         self.robot_error = ""
         self._frames: dict[str, tuple[viser.FrameHandle, viser.LabelHandle]] = {}
@@ -157,6 +158,7 @@ class TfView:
                     )
                 )
         self._robot = drawing
+        self.robot_joints = drawing.joints
         shown = len({v.link for v in drawing.visuals})
         note = f" ({'; '.join(drawing.warnings)})" if drawing.warnings else ""
         self.robot_status = (

@@ -21,7 +21,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 from urdf_tutorial import share_directory
 
-from tests.browser.helpers import choose_when_listed, open_tab
+from tests.browser.helpers import choose_when_listed, open_tab, start_group
 from tests.browser.scene_helpers import Repeater, world_position
 from tests.conftest import ARTIFACTS
 
@@ -100,3 +100,26 @@ def test_robot_appears_moves_and_bad_description_is_one_line(page, probe, ros_en
         except subprocess.TimeoutExpired:
             os.killpg(rsp.pid, signal.SIGKILL)
             rsp.wait(timeout=5)
+
+
+def test_joint_sliders_drive_joint_state_publisher(page) -> None:
+    """display.launch.py as a group: moving a slider in the browser moves the robot."""
+    start_group(page, "urdf_tutorial_display")
+    open_tab(page, "3D view")
+    page.wait_for_function(HAS_VISUAL_JS, arg=POLE, polling=100, timeout=40_000)
+    row = page.get_by_text("gripper_extension", exact=True).locator(
+        "xpath=ancestor::div[contains(@class,'Flex-root')][1]"
+    )
+    slider = row.get_by_role("slider").first
+    slider.wait_for(timeout=20_000)
+    page.wait_for_function(
+        "(n) => { const o = window.__viserMutable.nodeRefFromName[n]; return !!o && o.visible; }",
+        arg=POLE,
+        polling=100,
+        timeout=30_000,
+    )
+    start = world_position(page, POLE)
+    assert start is not None
+    slider.focus()
+    page.keyboard.press("Home")  # all the way in: -0.35 m along the pole's axis
+    page.wait_for_function(MOVED_JS, arg=[POLE, start, 0.3], polling=100, timeout=20_000)
