@@ -427,3 +427,35 @@ def test_the_test_process_imports_nothing_of_the_classroom():
     out = __import__("subprocess").run([sys.executable, "-c", code], capture_output=True,
                                        text=True, check=True).stdout  # fmt: skip
     assert out.strip() == "[]"
+
+
+def test_respawn_environment_and_scoped_environment(tmp_path, prefix):
+    path = write(
+        tmp_path,
+        """
+        def generate_launch_description():
+            show = [PY, "-c", "import os; print('color', os.environ.get('COLOR', 'unset'))"]
+            return LaunchDescription([
+                GroupAction([
+                    SetEnvironmentVariable("COLOR", "red"),
+                    ExecuteProcess(cmd=show, name="inside", output="screen"),
+                ]),
+                ExecuteProcess(cmd=show, name="outside", output="screen"),
+                ExecuteProcess(cmd=show, name="extra", additional_env={"COLOR": "blue"},
+                               output="screen"),
+                Node(package="demo_pkg", executable="echo", arguments=["4"], respawn=True,
+                     respawn_delay=0.1, respawn_max_retries=2, output="log"),
+            ])
+        """,
+    )
+    code, out = run([str(path)], env_for(tmp_path, prefix))
+    assert code == 0, out
+    assert "[inside-1] color red" in out and "[outside-2] color unset" in out, out
+    assert "[extra-3] color blue" in out, out
+    starts = [line for line in out if line.startswith("[INFO] [echo-4]: process started")]
+    deaths = [line for line in out if line.startswith("[ERROR] [echo-4]: process has died")]
+    assert len(starts) == 3 and len(deaths) == 3, out  # the first run and two respawns
+    # output="log": stdout only in launch.log, stderr also on the screen (upstream's default).
+    assert "[echo-4] to stderr" in out and not any("[echo-4] argv" in line for line in out)
+    log = (next((tmp_path / "log").iterdir()) / "launch.log").read_text()
+    assert "[echo-4] argv 4 --ros-args" in log
