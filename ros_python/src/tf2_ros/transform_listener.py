@@ -66,7 +66,8 @@ class TransformListener:
                     pass
                 self.executor.remove_node(self.node)
 
-            self.dedicated_listener_thread = Thread(target=run_func, daemon=True)
+            # Not a daemon: the thread ends when ROS shuts down (the executor stops then).
+            self.dedicated_listener_thread = Thread(target=run_func)
             self.dedicated_listener_thread.start()
 
     def __del__(self) -> None:
