@@ -245,7 +245,7 @@ def program_args(entry: CatalogEntry, words: list[str]) -> tuple[str, ...]:
     if not words:
         return entry.args
     if entry.module == "robot_state_publisher" and len(words) == 1 and words[0].endswith(".urdf"):
-        return (str(Path(words[0]).expanduser().resolve()),)  # upstream's URDF-file fallback
+        return (str(Path(words[0]).expanduser()),)  # upstream's URDF-file fallback (cwd: project)
     if len(words) != len(entry.args) or not all(re.fullmatch(r"-?\d+", w) for w in words):
         takes = f"{len(entry.args)} whole numbers" if entry.args else "no arguments"
         raise Ros2Error(f"{entry.name} takes {takes} before --ros-args here, got {words}")
