@@ -1,0 +1,230 @@
+"""Benchmark: a class on JupyterHub beside the same class from ``classroom``, in one run.
+
+For N learners (1, 5, 20 by default) a real JupyterHub (tests/hub/local_hub.py:
+deploy/jupyterhub_config.py, configurable-http-proxy, ClassroomLocalSpawner)
+is asked to start all N servers at once, as a class arriving together.
+Per learner, spawn -> dashboard ready is the time from the spawn request to
+the moment a websocket client, through the hub's proxy and the learner's
+single-user server, is sent the dashboard's GUI (the page is fetched first,
+which makes jupyter-server-proxy start the dashboard). p50 and p95 over the
+learners.
+
+Then, idle with one client each (tests/wire_client.py, through the proxy),
+every process is sampled over the same seconds: each learner's single-user
+server and dashboard, and the hub's shared processes (hub, proxy, teacher
+service). The baseline is ``classroom --learners N`` in the same run
+(bench/classroom_footprint.py: N dashboards and the teacher page in one
+process). Per learner = the whole class's total / N on each side, so the
+hub's shared processes count, spread over the class; the overhead is the hub
+side's per-learner PSS (and CPU) over the baseline's.
+
+A class size the machine cannot hold (memory) is a failure row with the reason.
+Run: ``.venv/bin/python tests/run.py --bench hub_spawn [--counts 1,5,20]``.
+The last line printed is one JSON object.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import statistics
+import threading
+import time
+from typing import Any
+
+from bench._common import LOGS, configure_dds, percentile, require_private_netns, rounded, sample
+
+SETTLE_SEC = 4.0
+MB_PER_LEARNER_BOTH_SIDES = 700  # hub learner (~300) + classroom learner (~130), with headroom
+
+
+def _ready_one(hub: Any, user: str, started: float, out: dict[str, Any]) -> None:
+    from tests.hub.local_hub import ADMIN_TOKEN
+    from tests.wire_client import WireClient
+
+    try:
+        hub.spawn(user)
+        deadline = started + 240.0
+        while not hub.server_ready(user):
+            if time.monotonic() > deadline:
+                raise TimeoutError("the hub never reported the server ready")
+            time.sleep(0.1)
+        status, body = hub.api("GET", f"/user/{user}/ros2-classroom/", timeout=180.0)
+        if status != 200 or "viser" not in str(body).lower():
+            raise RuntimeError(f"the Classroom page answered {status}")
+        ws = f"http://127.0.0.1:{hub.port}/user/{user}/ros2-classroom/"
+        client = WireClient(ws, headers={"Authorization": f"token {ADMIN_TOKEN}"})
+        while "ros2" not in client.markdown():
+            if time.monotonic() > deadline:
+                raise TimeoutError("the dashboard never sent its GUI")
+            time.sleep(0.05)
+        out["seconds"] = time.monotonic() - started
+        out["client"] = client
+    except Exception as error:  # reported in the row, never swallowed
+        out["error"] = f"{type(error).__name__}: {error}"
+
+
+def hub_class(learners: int, seconds: float) -> dict[str, Any]:
+    import psutil
+
+    from tests.hub.local_hub import LocalHub
+
+    state = LOGS / f"bench-hub-{learners}"
+    shutil.rmtree(state, ignore_errors=True)
+    users = [f"learner{i + 1}" for i in range(learners)]
+    hub = LocalHub(state, dict(os.environ), learners=users, teachers=[], first_domain_id=1)
+    results: dict[str, dict[str, Any]] = {u: {} for u in users}
+    try:
+        hub.wait_ready()
+        started = time.monotonic()
+        threads = [
+            threading.Thread(target=_ready_one, args=(hub, u, started, results[u])) for u in users
+        ]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+        errors = {u: r["error"] for u, r in results.items() if "error" in r}
+        if errors:
+            raise RuntimeError(f"{len(errors)} of {learners} never got ready: {errors}")
+        time.sleep(SETTLE_SEC)
+        servers, dashboards = hub.single_user_servers(), hub.dashboards()
+        shared = {"hub": hub.proc.pid}
+        for proc in psutil.Process(hub.proc.pid).children():
+            cmd = " ".join(proc.cmdline())
+            if "configurable-http-proxy" in cmd:
+                shared["proxy"] = proc.pid
+            elif "app.hub.teacher_service" in cmd:
+                shared["teacher_service"] = proc.pid
+        pids = {
+            **shared,
+            **{f"server:{u}": servers[u].pid for u in users},
+            **{f"dashboard:{u}": dashboards[u].pid for u in users},
+        }
+        figures = sample(pids, seconds)
+    finally:
+        for result in results.values():
+            if "client" in result:
+                result["client"].close()
+        left = hub.stop()
+        if left:
+            print(f"warning: killed {len(left)} processes that outlived the hub", flush=True)
+    spawn = [results[u]["seconds"] for u in users]
+
+    def mean(prefix: str, key: str) -> float:
+        return statistics.fmean(figures[f"{prefix}:{u}"][key] for u in users)
+
+    return {
+        "learners": learners,
+        "spawn_p50_s": percentile(spawn, 50),
+        "spawn_p95_s": percentile(spawn, 95),
+        "server_cpu_percent": mean("server", "cpu_percent"),
+        "server_pss_mb": mean("server", "pss_mb"),
+        "dashboard_cpu_percent": mean("dashboard", "cpu_percent"),
+        "dashboard_pss_mb": mean("dashboard", "pss_mb"),
+        "shared_cpu_percent": sum(figures[n]["cpu_percent"] for n in shared),
+        "shared_pss_mb": sum(figures[n]["pss_mb"] for n in shared),
+        "per_learner_cpu_percent": sum(f["cpu_percent"] for f in figures.values()) / learners,
+        "per_learner_pss_mb": sum(f["pss_mb"] for f in figures.values()) / learners,
+    }
+
+
+def classroom_class(learners: int, seconds: float) -> dict[str, Any]:
+    from bench.classroom_footprint import classroom
+
+    row = classroom(learners, seconds)
+    return {
+        "per_learner_cpu_percent": row["total_cpu_percent"] / learners,
+        "per_learner_pss_mb": row["total_pss_mb"] / learners,
+        "dashboard_cpu_percent": row["dashboard_cpu_percent"],
+        "dashboard_pss_mb": row["dashboard_pss_mb"],
+    }
+
+
+def _room_for(learners: int) -> str:
+    import psutil
+
+    available = psutil.virtual_memory().available / 2**20
+    needed = learners * MB_PER_LEARNER_BOTH_SIDES
+    if available < needed:
+        return f"needs about {needed} MB free, the machine has {available:.0f} MB"
+    return ""
+
+
+def _deep_round(row: dict[str, Any]) -> dict[str, Any]:
+    return {k: _deep_round(v) if isinstance(v, dict) else v for k, v in rounded(row, 2).items()}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m bench hub_spawn")
+    parser.add_argument("--counts", default="1,5,20", help="class sizes, comma-separated")
+    parser.add_argument("--seconds", type=float, default=10.0, help="sampling window")
+    args = parser.parse_args(argv)
+    counts = [int(n) for n in args.counts.split(",") if n.strip()]
+    require_private_netns("hub_spawn")
+    configure_dds(45)
+    LOGS.mkdir(parents=True, exist_ok=True)
+
+    print(
+        "| learners | spawn→ready p50 / p95 s | hub learner PSS MB (server + dashboard + shared/N) "
+        "| classroom learner PSS MB | memory overhead | hub learner CPU % | classroom CPU % "
+        "| CPU overhead (% of a core) |",
+        flush=True,
+    )
+    print("|---|---|---|---|---|---|---|---|", flush=True)
+    rows: list[dict[str, Any]] = []
+    for n in counts:
+        row: dict[str, Any] = {"learners": n}
+        reason = _room_for(n)
+        if reason:
+            row["error"] = reason
+        else:
+            try:
+                hub = hub_class(n, args.seconds)
+                base = classroom_class(n, args.seconds)
+                row.update(hub=hub, classroom=base)
+                row["memory_overhead_percent"] = 100.0 * (
+                    hub["per_learner_pss_mb"] / base["per_learner_pss_mb"] - 1.0
+                )
+                row["cpu_overhead_core_percent"] = (
+                    hub["per_learner_cpu_percent"] - base["per_learner_cpu_percent"]
+                )
+            except Exception as error:  # a failure row, with the reason
+                row["error"] = f"{type(error).__name__}: {error}"[:500]
+        rows.append(row)
+        if "error" in row:
+            print(f"| {n} | failed: {row['error']} |||||||", flush=True)
+            continue
+        hub, base = row["hub"], row["classroom"]
+        print(
+            f"| {n} | {hub['spawn_p50_s']:.1f} / {hub['spawn_p95_s']:.1f} "
+            f"| {hub['per_learner_pss_mb']:.0f} ({hub['server_pss_mb']:.0f} + "
+            f"{hub['dashboard_pss_mb']:.0f} + {hub['shared_pss_mb'] / n:.0f}) "
+            f"| {base['per_learner_pss_mb']:.0f} | {row['memory_overhead_percent']:+.0f} % "
+            f"| {hub['per_learner_cpu_percent']:.1f} | {base['per_learner_cpu_percent']:.1f} "
+            f"| {row['cpu_overhead_core_percent']:+.1f} |",
+            flush=True,
+        )
+    good = [r for r in rows if "error" not in r]
+    result: dict[str, Any] = {"seconds": args.seconds, "rows": [_deep_round(r) for r in rows]}
+    if good:
+        largest = max(good, key=lambda r: r["learners"])
+        result.update(
+            hub_spawn_p50_s=largest["hub"]["spawn_p50_s"],
+            hub_spawn_p95_s=largest["hub"]["spawn_p95_s"],
+            hub_memory_overhead_percent=largest["memory_overhead_percent"],
+            hub_cpu_overhead_core_percent=largest["cpu_overhead_core_percent"],
+            hub_learners_measured=largest["learners"],
+        )
+    else:
+        result["error"] = "no class size could be measured: " + "; ".join(
+            f"{r['learners']}: {r['error']}" for r in rows
+        )
+    print(json.dumps(rounded(result, 2), sort_keys=True, default=str))
+    return 0 if good else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
