@@ -300,6 +300,16 @@ def _run_entry(args: argparse.Namespace) -> catalog.CatalogEntry:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    from app.ros.errors import Ros2Error
+    from app.ros2cli.pkg import terminal_argv
+
+    try:  # a package of a sourced colcon workspace, as ros2run finds it (issue 22)
+        own = terminal_argv(args.node, list(args.ros_args))
+    except Ros2Error as exc:
+        raise CliError(str(exc)) from None
+    if own is not None:
+        configure_this_process(domain_id=args.domain_id, network=args.network)
+        os.execv(own[0], own)
     entry = _run_entry(args)
     configure_this_process(domain_id=args.domain_id, network=args.network)
     argv = [sys.executable, "-m", f"nodes.{entry.module}", *entry.argv_tail()]
@@ -544,7 +554,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else argv
+    parser = build_parser()
+    if argv[:1] and argv[0] in ROS2_GROUPS:
+        # Options before the verb (`topic -h`, `topic --include-hidden-topics type X`) are the
+        # verb's, as in `ros2`: hand them on instead of rejecting them here.
+        args, before = parser.parse_known_args(argv)
+        args.words = [*before, *args.words]
+    else:
+        args = parser.parse_args(argv)
     try:
         return args.func(args)
     except (CliError, catalog.UnknownNodeError, ValueError) as exc:

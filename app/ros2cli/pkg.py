@@ -396,3 +396,22 @@ def _not_found_hint(package: str) -> str:
             f"{package}`, then `source install/setup.bash`)"
         )
     return ""
+
+
+def terminal_argv(package: str, words: list[str]) -> list[str] | None:
+    """`ros2-classroom run PKG EXE ...` in a shell that sourced a colcon workspace.
+
+    The executable as upstream's ros2run finds it (``<prefix>/lib/<pkg>/<exe>``
+    of the first prefix in AMENT_PREFIX_PATH holding the package), when that
+    prefix was built by colcon; None for everything else (catalog names).
+    """
+    if not words or workspace() is not None:
+        return None
+    prefix = overlay.package_prefix(package)
+    if prefix is None or not (prefix / "share" / "colcon-core").is_dir():
+        return None
+    executable, rest = words[0], words[1:]
+    paths = [p for p in overlay.executables(package, prefix) if p.name == executable]
+    if not paths:
+        raise Ros2cliMessage("No executable found")
+    return [str(paths[0]), *rest]

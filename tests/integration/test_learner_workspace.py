@@ -356,3 +356,28 @@ def test_build_limits_time_and_disk(tmp_path):
     finally:
         folder.configure(None)
         sup.shutdown()
+
+
+def test_tutorial_sequence_in_a_terminal(tmp_path):
+    """The same commands in bash: ros2-classroom pkg create, real colcon, source, run."""
+    src = tmp_path / "ros2_ws" / "src"
+    src.mkdir(parents=True)
+    env = {k: v for k, v in os.environ.items() if k not in (overlay.PREFIX_ENV, "PYTHONPATH")}
+    env["PATH"] = f"{Path(sys.executable).parent}{os.pathsep}{env.get('PATH', '')}"
+    classroom = f"{sys.executable} -m app"
+    script = (
+        f"cd {src} && {classroom} {TUTORIAL_CREATE.removeprefix('ros2 ')} && cd .. && "
+        "colcon build --packages-select my_package && source install/setup.bash && "
+        f"{classroom} pkg executables my_package && {classroom} run my_package my_node && "
+        f"{{ {classroom} run my_package no_such_node; echo exit=$?; }}"
+    )
+    done = subprocess.run(
+        ["bash", "-c", script], env=env, capture_output=True, text=True, timeout=120
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+    lines = done.stdout.splitlines()
+    assert "creating folder ./my_package" in lines, lines
+    assert any(line.startswith("Finished <<< my_package") for line in lines), lines
+    assert lines[-3:] == ["my_package my_node", "Hi from my_package.", "exit=2"], lines
+    assert "No executable found" in done.stderr, done.stderr
+    assert (tmp_path / "ros2_ws" / "install" / "my_package").is_dir()
