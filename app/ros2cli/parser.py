@@ -149,7 +149,9 @@ _NO_DDS = (
 def needs_ros(argv: list[str]) -> bool:
     """False for verbs that only read files (interface ...): the CLI skips DDS for them."""
     words = [w for w in argv if not w.startswith("-")]
-    if words[:1] and words[0] in _HELP_WITHOUT_DDS and ("-h" in argv or "--help" in argv):
+    if len(words) < 2:
+        return False  # a group without its verb: help or a usage error, no graph needed
+    if words[0] in _HELP_WITHOUT_DDS and ("-h" in argv or "--help" in argv):
         return False  # help only: no need to discover the graph first
     return tuple(words[:2]) not in _NO_DDS and not pkg.no_dds(words)
 

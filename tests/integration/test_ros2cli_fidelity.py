@@ -411,6 +411,10 @@ def test_terminal_face_hides_its_own_node(ros_env, supervisor):
     assert (done.returncode, done.stdout.split("\n")) == (0, [*talker_info(), ""]), done.stdout
     done = run_cli("node", "info", "/nobody", env=ros_env)
     assert (done.returncode, done.stdout) == (1, "Unable to find node '/nobody'\n")
+    done = run_cli("topic", "-h", env=ros_env)  # options before the verb reach the verbs
+    assert done.returncode == 0 and done.stdout.startswith(
+        "usage: ros2-classroom topic [-h] [--include-hidden-topics] VERB ..."
+    ), done.stdout + done.stderr
     done = run_cli("topic", "type", "/nope", env=ros_env)  # stdout as ros2's: empty
     assert (done.returncode, done.stdout) == (1, "")
     assert "no topic '/nope' on the graph" in done.stderr
