@@ -454,6 +454,21 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         args=("ros_python/src/urdf_tutorial/urdf/06-flexible.urdf",),
         package="urdf_tutorial",
     ),
+    CatalogEntry(
+        "r2d2_state_publisher",
+        "r2d2_state_publisher",
+        "/state_publisher",
+        "The URDF tutorial's R2-D2 on a circle: its joints on /joint_states, odom -> axis on /tf.",
+        package="urdf_tutorial_r2d2",
+    ),
+    CatalogEntry(
+        "r2d2_rsp",
+        "model_state_publisher",
+        "/robot_state_publisher",
+        "robot_state_publisher with the tutorial's r2d2.urdf.xml.",
+        args=("ros_python/src/urdf_tutorial_r2d2/urdf/r2d2.urdf.xml",),
+        package="urdf_tutorial_r2d2",
+    ),
 )
 
 GROUPS: tuple[LaunchGroup, ...] = (
@@ -559,6 +574,11 @@ GROUPS: tuple[LaunchGroup, ...] = (
         "urdf_tutorial_display",
         "the URDF tutorial's display.launch.py: its robot, robot_state_publisher, joint sliders",
         ("urdf_tutorial_rsp", "joint_state_publisher_gui"),
+    ),
+    LaunchGroup(
+        "urdf_tutorial_r2d2_demo",
+        "demo.launch.py of urdf_tutorial_r2d2: robot_state_publisher + state_publisher",
+        ("r2d2_rsp", "r2d2_state_publisher"),
     ),
 )
 

@@ -91,6 +91,7 @@ _UPSTREAM: dict[tuple[str, str], str] = {
     ("robot_state_publisher", "robot_state_publisher"): "robot_state_publisher",  # issue 23
     ("joint_state_publisher", "joint_state_publisher"): "joint_state_publisher",
     ("joint_state_publisher_gui", "joint_state_publisher_gui"): "joint_state_publisher_gui",
+    ("urdf_tutorial_r2d2", "state_publisher"): "r2d2_state_publisher",
 }
 # ...and every catalog entry under its own package (`ros2 run tutorial_nodes talker`).
 EXECUTABLES: dict[tuple[str, str], str] = {

@@ -1,0 +1,10 @@
+"""state_publisher of urdf_tutorial_r2d2: ``ros2 run urdf_tutorial_r2d2 state_publisher``.
+
+The tutorial's node (``ros_python/src/urdf_tutorial_r2d2/state_publisher.py``)
+as a catalog node: R2-D2's joints on /joint_states and odom -> axis on /tf.
+"""
+
+from urdf_tutorial_r2d2.state_publisher import main
+
+if __name__ == "__main__":
+    main()
