@@ -12,6 +12,9 @@ from rclpy.action import (
     get_action_names_and_types,
     get_action_server_names_and_types_by_node,
 )
+from rclpy.exceptions import InvalidTopicNameException
+from rclpy.expand_topic_name import expand_topic_name
+from rclpy.validate_full_topic_name import validate_full_topic_name
 
 from app.ros.calls import GoalRun, action_type_of, call_service, send_goal, wait_for_server
 from app.ros.context import CallContext
@@ -163,6 +166,11 @@ def action_type(ctx: CallContext, name: str) -> int:
 
 def action_info(ctx: CallContext, name: str, show_types: bool = False, count: bool = False) -> int:
     """Clients and servers of an action (an unknown action simply has none, as in ros2cli)."""
+    try:  # a relative name counts from our node, and a malformed one is refused, as ros2cli
+        expanded = expand_topic_name(name, ctx.node.get_name(), ctx.node.get_namespace())
+        validate_full_topic_name(expanded)
+    except (ValueError, InvalidTopicNameException) as exc:
+        raise Ros2cliMessage(str(exc)) from None
     clients: list[tuple[str, list[str]]] = []
     servers: list[tuple[str, list[str]]] = []
     for fqn in all_nodes(ctx.node, include_hidden=True):
@@ -172,8 +180,8 @@ def action_info(ctx: CallContext, name: str, show_types: bool = False, count: bo
             cli = get_action_client_names_and_types_by_node(ctx.node, node_name, namespace)
         except Exception:  # the node left the graph between the two calls
             continue
-        servers += [(fqn, list(t)) for a, t in srv if a == name]
-        clients += [(fqn, list(t)) for a, t in cli if a == name]
+        servers += [(fqn, list(t)) for a, t in srv if a == expanded]
+        clients += [(fqn, list(t)) for a, t in cli if a == expanded]
     ctx.write(f"Action: {name}")
     for title, found in (("Action clients", clients), ("Action servers", servers)):
         ctx.write(f"{title}: {len(found)}")

@@ -256,6 +256,17 @@ def test_graph_verbs_golden(supervisor, ros2):
             "    /fibonacci_action_server [tutorial_interfaces/action/Fibonacci]",
         ],
     )
+    assert ros2("action info fibonacci") == (  # relative: expanded from our node, as ros2cli
+        0,
+        [
+            "Action: fibonacci",
+            "Action clients: 0",
+            "Action servers: 1",
+            "    /fibonacci_action_server",
+        ],
+    )
+    code, lines = ros2("action info 'bad name!'")
+    assert code == 1 and lines[0].startswith("topic name 'bad name!' is invalid"), lines
     assert ros2("action info /fibonacci -c") == (
         0,
         ["Action: /fibonacci", "Action clients: 0", "Action servers: 1"],
