@@ -1,0 +1,92 @@
+"""Progress reports over HTTP (app/hub/reports.py) and the spawner's domain pool, without a hub."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import pytest
+
+from app.hub.reports import MAX_BODY, ReportError, from_json, to_json
+from app.hub.spawner import DomainPool
+from app.teacher.record import MAX_CODE, LearnerRecord
+
+RECORD = LearnerRecord(
+    site="hub",
+    learner="alice",
+    domain_id=61,
+    lesson_id="03_topics",
+    unit=3,
+    lesson_title="Topics",
+    step=2,
+    steps=5,
+    step_title="Start a listener",
+    steps_passed=7,
+    check_states=("pass", "fail"),
+    check_reasons=("talker runs", "no listener yet"),
+    exercises_passed=1,
+    exercise_attempts=4,
+    exercise="multiply_service",
+    exercise_attempts_here=3,
+    exercise_failed_here=2,
+    exercise_passed_here=False,
+    code_excerpt="import rclpy\n",
+    last_error="2 failed checks",
+    nodes_running=("listener", "talker"),
+    last_activity=1_790_000_000.5,
+    last_progress=1_789_999_000.0,
+)
+
+
+def test_a_record_survives_the_trip():
+    back = from_json(to_json(RECORD), received_at=123.0)
+    assert back == RECORD and back.received_at == 123.0
+
+
+@pytest.mark.parametrize(
+    ("body", "reason"),
+    [
+        (b"[1,", "must be JSON"),
+        (b'"alice"', "JSON object"),
+        (b'{"learner": "alice", "admin": true}', "unknown field(s) in the progress report: admin"),
+        (b'{"learner": "alice", "received_at": 1}', "unknown field"),
+        (b'{"learner": ""}', "must name its learner"),
+        (b'{"steps": 3}', "must name its learner"),
+        (b'{"learner": 7}', "learner must be a string"),
+        (b'{"learner": "a", "step": true}', "step must be a whole number"),
+        (b'{"learner": "a", "step": -1}', "step must be a whole number"),
+        (b'{"learner": "a", "step": 1.5}', "step must be a whole number"),
+        (b'{"learner": "a", "last_activity": "now"}', "last_activity must be a time"),
+        (b'{"learner": "a", "exercise_passed_here": 1}', "must be true or false"),
+        (b'{"learner": "a", "nodes_running": "talker"}', "nodes_running must be a list"),
+        (b'{"learner": "a", "check_states": [1]}', "check_states must be a list of strings"),
+        (b"\xff\xfe", "must be JSON"),
+    ],
+)
+def test_a_bad_report_gets_its_reason(body, reason):
+    with pytest.raises(ReportError, match=reason.replace("(", r"\(").replace(")", r"\)")):
+        from_json(body, received_at=0.0)
+
+
+def test_texts_and_lists_are_clipped_to_the_records_bounds():
+    long = replace(RECORD, code_excerpt="x" * 9000, nodes_running=tuple(f"n{i}" for i in range(50)))
+    back = from_json(to_json(long), received_at=0.0)
+    assert len(back.code_excerpt) == MAX_CODE and back.code_excerpt.endswith("…")
+    assert len(back.nodes_running) == 32
+
+
+def test_an_oversized_report_is_refused_before_parsing():
+    body = json.dumps({"learner": "a", "code_excerpt": "x" * MAX_BODY}).encode()
+    with pytest.raises(ReportError, match="at most"):
+        from_json(body, received_at=0.0)
+
+
+def test_the_domain_pool_gives_each_running_server_its_own_id_and_says_when_none_is_left():
+    pool = DomainPool()
+    assert [pool.take(u, 5, 7) for u in ("a", "b", "c")] == [5, 6, 7]
+    assert pool.take("b", 5, 7) == 6  # the same server asking again keeps its id
+    with pytest.raises(RuntimeError, match="every ROS domain id 5..7 is held"):
+        pool.take("d", 5, 7)
+    pool.give_back("b")
+    assert pool.take("d", 5, 7) == 6
+    assert pool.held() == {"a": 5, "c": 7, "d": 6}
