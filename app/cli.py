@@ -314,6 +314,12 @@ def cmd_run(args: argparse.Namespace) -> int:
     configure_this_process(domain_id=args.domain_id, network=args.network)
     argv = [sys.executable, "-m", f"nodes.{entry.module}", *entry.argv_tail()]
     extra = list(args.ros_args)
+    from app.ros2cli.tool_args import FREE_FORM  # tf2 tools take words (issue 23)
+
+    if entry.module in FREE_FORM and extra and extra[0] != "--ros-args":
+        words = extra[: extra.index("--ros-args")] if "--ros-args" in extra else extra
+        argv += words
+        extra = extra[len(words) :]
     if extra:
         if extra[0] != "--ros-args":
             raise CliError("extra arguments must follow --ros-args, as with `ros2 run`")
