@@ -459,3 +459,25 @@ def test_respawn_environment_and_scoped_environment(tmp_path, prefix):
     assert "[echo-4] to stderr" in out and not any("[echo-4] argv" in line for line in out)
     log = (next((tmp_path / "log").iterdir()) / "launch.log").read_text()
     assert "[echo-4] argv 4 --ros-args" in log
+
+
+def test_an_error_in_the_launch_file_names_its_line(tmp_path, prefix):
+    path = write(
+        tmp_path,
+        """
+        def generate_launch_description():
+            return LaunchDescription([
+                Nod(package="demo_pkg", executable="echo"),
+            ])
+        """,
+    )
+    code, out = run([str(path)], env_for(tmp_path, prefix))
+    assert code == 1
+    assert (
+        "[ERROR] [launch]: Caught exception in launch (see debug for traceback): Caught "
+        "exception when trying to load file of format [py]: name 'Nod' is not defined"
+    ) in out, out
+    lines = path.read_text().splitlines()
+    line = next(i for i, text in enumerate(lines, start=1) if text.strip().startswith("Nod("))
+    assert f'  File "{path}", line {line}, in generate_launch_description' in out, out
+    assert out[-1] == "NameError: name 'Nod' is not defined"

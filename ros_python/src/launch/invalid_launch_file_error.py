@@ -6,10 +6,14 @@ class InvalidLaunchFileError(Exception):
         self._extension = extension
         self._likely_errors = likely_errors or []
         if self._likely_errors:
-            detail = "\n".join(f"{type(e).__name__}: {e}" for e in self._likely_errors)
+            detail = "\n".join(str(e) for e in self._likely_errors)
             message = f"Caught exception when trying to load file of format [{extension}]: {detail}"
         else:
             message = (
                 f"The launch file may have a syntax error, or its format is unknown: [{extension}]"
             )
         super().__init__(message)
+
+    @property
+    def likely_errors(self) -> list[Exception]:
+        return self._likely_errors

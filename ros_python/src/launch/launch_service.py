@@ -12,8 +12,11 @@ ends them.
 from __future__ import annotations
 
 import asyncio
+import os
 import signal
+import sys
 import threading
+import traceback
 from collections.abc import Iterable
 from typing import Any
 
@@ -23,6 +26,7 @@ from .event_handler import BaseEventHandler
 from .events.execution_complete import ExecutionComplete
 from .events.include_launch_description import IncludeLaunchDescription
 from .events.shutdown import Shutdown
+from .invalid_launch_file_error import InvalidLaunchFileError
 from .launch_context import LaunchContext
 from .launch_description import LaunchDescription
 from .launch_description_entity import LaunchDescriptionEntity
@@ -220,9 +224,9 @@ class LaunchService:
     def __fail(self, exc: BaseException) -> None:
         self.__logger.error(f"Caught exception in launch (see debug for traceback): {exc}")
         if self.__debug:
-            import traceback
-
             self.__logger.error("".join(traceback.format_exception(exc)))
+        elif isinstance(exc, InvalidLaunchFileError):
+            _print_launch_file_traceback(exc)
         self.__return_code = 1
         if not self.__shutting_down:
             self.__context.emit_event_sync(Shutdown(reason="exception in launch"))
@@ -237,6 +241,33 @@ class LaunchService:
             assert self.__loop is not None
             self.__shutdown_began = self.__loop.time()
             self.__context._set_is_shutdown(True)
+
+
+def _print_launch_file_traceback(exc: InvalidLaunchFileError) -> None:
+    """The frames of the launch file itself, so an error points at its line.
+
+    (Upstream shows tracebacks only with ``--debug``; a learner needs the line.)
+    """
+    for error in exc.likely_errors:
+        if isinstance(error, SyntaxError):
+            continue  # its message already names the file and line
+        tb = error.__traceback__
+        while tb is not None and not tb.tb_frame.f_code.co_filename.endswith(".py"):
+            tb = tb.tb_next
+        frames = []
+        while tb is not None:
+            if "launch" in os.path.basename(tb.tb_frame.f_code.co_filename) or (
+                tb.tb_frame.f_code.co_name == "generate_launch_description"
+            ):
+                frames.append(tb)
+            tb = tb.tb_next
+        if frames:
+            print(
+                "".join(traceback.format_exception(type(error), error, frames[0])),
+                end="",
+                file=sys.stderr,
+                flush=True,
+            )
 
 
 class _Builtin(BaseEventHandler):

@@ -62,7 +62,7 @@ def get_launch_description_from_any_launch_file(path: str) -> LaunchDescription:
     if path.endswith(".py"):
         try:
             return get_launch_description_from_python_launch_file(path)
-        except (InvalidPythonLaunchFileError, SyntaxError, ImportError) as exc:
+        except Exception as exc:  # any error of the learner's file, named as upstream names it
             raise InvalidLaunchFileError("py", likely_errors=[exc]) from exc
     extension = os.path.splitext(path)[1].lstrip(".")
     raise InvalidLaunchFileError(extension)
