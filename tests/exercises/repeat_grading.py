@@ -22,8 +22,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
-from app.exercises import runner  # noqa: E402
-from app.exercises.model import load_exercises  # noqa: E402
+from app.exercises import runner
+from app.exercises.model import load_exercises
 
 BURN = "import time\nwhile True:\n    sum(i * i for i in range(10000)); time.sleep(0.001)\n"
 
