@@ -42,7 +42,9 @@ RUNS: tuple[tuple[str, list[str]], ...] = (
     ("turtlesim_rate", ["--seconds", "8"]),
     ("sim_world", ["--seconds", "8"]),
     ("urdf_draw", ["--seconds", "5"]),
+    ("tf2_lookup", ["--seconds", "5", "--lookups", "3000"]),
     ("hub_spawn", ["--counts", "1,5", "--seconds", "6"]),  # 20 learners: run it alone
+    ("colcon_build", ["--python-rounds", "2", "--interface-rounds", "1", "--run-rounds", "3"]),
 )
 
 # (figure, benchmark, key ("a|b" shows both), unit, aim text, aim test)
@@ -380,6 +382,33 @@ ROWS += (
 
 ROWS += (
     (
+        "tf2 lookup_transform p50 / p99, 20 frames, full 10 s cache at 100 Hz",
+        "tf2_lookup",
+        "tf2_lookup_p50_us|tf2_lookup_p99_us",
+        "µs",
+        "p50 ≤ 50",
+        lambda v: v <= 50,
+    ),
+    (
+        "The same lookups in plain numpy, p50 / p99",
+        "tf2_lookup",
+        "numpy_lookup_p50_us|numpy_lookup_p99_us",
+        "µs",
+        "",
+        None,
+    ),
+    (
+        "Ingesting 2,000 transforms/s over DDS: tf2 listener / plain numpy subscriber",
+        "tf2_lookup",
+        "tf2_ingest_cpu_percent|numpy_ingest_cpu_percent",
+        "% of a core",
+        "tf2 ≤ 10",
+        lambda v: v <= 10,
+    ),
+)
+
+ROWS += (
+    (
         "JupyterHub: spawn → dashboard ready p50 / p95 (largest class measured)",
         "hub_spawn",
         "hub_spawn_p50_s|hub_spawn_p95_s",
@@ -427,9 +456,48 @@ HEADLINE = {
     "sim_rtf": ("sim_world", "sim_rtf"),
     "sim_camera_rate_ratio": ("sim_world", "sim_camera_rate_ratio"),
     "urdf_draw_ratio": ("urdf_draw", "urdf_draw_ratio"),
+    "tf2_lookup_p50_us": ("tf2_lookup", "tf2_lookup_p50_us"),
+    "tf2_ingest_cpu_percent": ("tf2_lookup", "tf2_ingest_cpu_percent"),
     "hub_spawn_p50_s": ("hub_spawn", "hub_spawn_p50_s"),
     "hub_memory_overhead_percent": ("hub_spawn", "hub_memory_overhead_percent"),
+    "colcon_build_ratio": ("colcon_build", "colcon_build_ratio"),
+    "own_node_run_ratio": ("colcon_build", "own_node_run_ratio"),
 }
+
+ROWS += (
+    (
+        "colcon build in the Console / the same colcon run directly (worse of python, interface)",
+        "colcon_build",
+        "colcon_build_ratio",
+        "x",
+        "≤ 1.1",
+        lambda v: v <= 1.1,
+    ),
+    (
+        "colcon build, fresh ament_python package: Console / direct",
+        "colcon_build",
+        "python_console_s|python_direct_s",
+        "s",
+        "",
+        None,
+    ),
+    (
+        "colcon build, two-message interface package: Console / direct",
+        "colcon_build",
+        "interface_console_s|interface_direct_s",
+        "s",
+        "",
+        None,
+    ),
+    (
+        "ros2 run of the learner's built node → on graph, ratio to a catalog node's",
+        "colcon_build",
+        "own_node_run_ratio",
+        "x",
+        "≤ 1.2",
+        lambda v: v <= 1.2,
+    ),
+)
 
 
 def last_json(output: str) -> dict[str, Any] | None:

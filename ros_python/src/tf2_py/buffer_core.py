@@ -131,7 +131,8 @@ class BufferCore:
                 f'authority "{authority}" because frame_id not set',
             )
             ok = False
-        if any(math.isnan(v) for v in (*t, *q)):
+        total = t[0] + t[1] + t[2] + q[0] + q[1] + q[2] + q[3]
+        if total != total and any(math.isnan(v) for v in (*t, *q)):  # cheap test first
             _log(
                 "error",
                 f'TF_NAN_INPUT: Ignoring transform for child_frame_id "{child}" from authority '

@@ -90,7 +90,8 @@ class Buffer(BufferCore, BufferInterface):
         self, target_frame: str, source_frame: str, time: Time, timeout: Duration = NO_TIMEOUT
     ) -> TransformStamped:
         """The transform from ``source_frame`` into ``target_frame`` (time 0: the latest)."""
-        self.can_transform(target_frame, source_frame, time, timeout)
+        if timeout.nanoseconds:  # without a timeout the check would only repeat the walk
+            self.can_transform(target_frame, source_frame, time, timeout)
         return self.lookup_transform_core(target_frame, source_frame, time)
 
     async def lookup_transform_async(
@@ -109,9 +110,10 @@ class Buffer(BufferCore, BufferInterface):
         timeout: Duration = NO_TIMEOUT,
     ) -> TransformStamped:
         """Time travel: ``source_frame`` at ``source_time`` into ``target_frame`` at target_time."""
-        self.can_transform_full(
-            target_frame, target_time, source_frame, source_time, fixed_frame, timeout
-        )
+        if timeout.nanoseconds:
+            self.can_transform_full(
+                target_frame, target_time, source_frame, source_time, fixed_frame, timeout
+            )
         return self.lookup_transform_full_core(
             target_frame, target_time, source_frame, source_time, fixed_frame
         )
