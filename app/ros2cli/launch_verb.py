@@ -25,11 +25,14 @@ from typing import Any
 
 from app.ros.context import CallContext
 from app.ros.errors import Ros2Error
-from app.ros2cli.run import STARTUP_WAIT_SEC, Programs, programs_of
+from app.ros2cli.run import Programs, programs_of
 
 _ARGUMENT = re.compile(r"^[A-Za-z_][\w.-]*:=[^\n\x00]*$")
 _STARTED = re.compile(r"^\[INFO\] \[(?P<label>[^\]]+)\]: process started with pid \[\d+\]$")
 _INTERRUPTED = "[WARNING] [launch]: user interrupted with ctrl-c (SIGINT)"
+# How long the verb shows a starting launch: until every process has printed a line
+# (several rclpy nodes starting at once on a loaded machine take a while).
+STARTUP_WAIT_SEC = 10.0
 STOP_WAIT_SEC = 20.0  # above the supervisor's SIGINT -> SIGTERM -> SIGKILL escalation
 
 
@@ -94,7 +97,7 @@ def _show_start(
     """What ros2 launch prints while its processes start; all of it if it ends meanwhile."""
     shown = 0
     waited = 0.0
-    limit = min(STARTUP_WAIT_SEC, ctx.limits.max_seconds or STARTUP_WAIT_SEC)
+    limit = STARTUP_WAIT_SEC  # not a stream: the Console limit for streams does not apply
     while True:
         lines = programs.output(key)
         for line in lines[shown:]:

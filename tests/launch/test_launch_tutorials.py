@@ -31,7 +31,7 @@ from tests.launch.helpers import (
 
 pytestmark = pytest.mark.ros
 
-DISCOVERY_SEC = 20.0
+DISCOVERY_SEC = 30.0  # generous: a loaded 2-core machine starts rclpy nodes slowly
 
 
 def node_exec(module: str) -> str:
@@ -306,7 +306,7 @@ def test_two_turtlesims_and_mimic_then_ctrl_c_ends_all(tutorial, graph):
     path = tmp_path / "turtlesim_mimic_launch.py"
     path.write_text(MIMIC_LAUNCH)
     launch = start([str(path)])
-    launch.read_until(lambda lines: len(started_pids(lines)) == 3, 15)
+    launch.read_until(lambda lines: len(started_pids(lines)) == 3, DISCOVERY_SEC)
     wait_for(lambda: {"/turtlesim1/sim", "/turtlesim2/sim", "/mimic"} <= names(graph), "nodes")
     wait_for(lambda: graph.count_publishers("/turtlesim2/turtle1/cmd_vel") == 1, "mimic's pub")
     wait_for(lambda: graph.count_subscribers("/turtlesim1/turtle1/pose") == 1, "mimic's sub")
@@ -314,7 +314,7 @@ def test_two_turtlesims_and_mimic_then_ctrl_c_ends_all(tutorial, graph):
     assert set(pids) == {"turtlesim_node-1", "turtlesim_node-2", "mimic-3"}
     assert sorted(group_members(launch.pgid)) == sorted([launch.pgid, *pids.values()])
     lines = launch.read_until(
-        lambda lines: sum("Spawning turtle [turtle1]" in line for line in lines) == 2, 10
+        lambda lines: sum("Spawning turtle [turtle1]" in line for line in lines) == 2, DISCOVERY_SEC
     )
     assert any(
         re.fullmatch(r"\[turtlesim_node-1\] \[INFO\] \[[\d.]+\] \[turtlesim1\.sim\]: Starting "
@@ -337,7 +337,9 @@ def test_substitutions_include_with_arguments_and_a_parameter(tutorial, graph):
 
     start, _ = tutorial
     launch = start(["launch_tutorial", "example_main.launch.py"])
-    launch.read_until(lambda lines: any("background_r of " in line for line in lines), 15)
+    launch.read_until(
+        lambda lines: any("background_r of " in line for line in lines), DISCOVERY_SEC
+    )
     assert "[INFO] [launch.user]: background_r of turtlesim2 is 200" in launch.lines
     wait_for(lambda: "/turtlesim2/sim" in names(graph), "/turtlesim2/sim")
     client = graph.create_client(GetParameters, "/turtlesim2/sim/get_parameters")
@@ -357,7 +359,9 @@ def test_event_handlers(tutorial, graph):
     launch = start(
         ["launch_tutorial", "example_event_handlers.launch.py", "turtlesim_ns:=turtlesim3"]
     )
-    lines = launch.read_until(lambda lines: any("Spawn finished" in line for line in lines), 30)
+    lines = launch.read_until(
+        lambda lines: any("Spawn finished" in line for line in lines), DISCOVERY_SEC
+    )
     user = [line.split("]: ", 1)[1] for line in lines if line.startswith("[INFO] [launch.user]")]
     assert user == [
         "Turtlesim started, spawning turtle",

@@ -24,7 +24,7 @@ def test_terminal_launch_of_multisim_and_ctrl_c(tmp_path, ros_env):
     launch = Launch([], env, command=command)
     try:
         lines = launch.read_until(
-            lambda lines: sum("Spawning turtle [turtle1]" in line for line in lines) == 2, 20
+            lambda lines: sum("Spawning turtle [turtle1]" in line for line in lines) == 2, 30
         )
         assert lines[1] == "[INFO] [launch]: Default logging verbosity is set to INFO", lines
         pids = started_pids(lines)
