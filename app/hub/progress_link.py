@@ -57,6 +57,7 @@ class HubLink:
         self._target = target
         self._on_notice, self._on_settings = on_notice, on_settings
         self._since = 0
+        self._epoch: str | None = None
         self._reveal: int | None = None
 
     def send(self, record: LearnerRecord) -> None:
@@ -74,6 +75,13 @@ class HubLink:
                 reply = json.loads(answer.read())
         except urllib.error.HTTPError as error:
             raise ReportRefused(f"{error.code}: {error.read()[:300]!r}") from None
+        epoch = str(reply.get("epoch", ""))
+        if epoch != self._epoch:  # a restarted service numbers its notices from 1 again
+            if self._epoch is not None and self._since:
+                self._since = 0
+                self._epoch = epoch
+                return  # the next report (a heartbeat away) fetches them all
+            self._epoch = epoch
         for notice in reply.get("notices", []):
             self._since = max(self._since, int(notice["id"]))
             self._on_notice(str(notice["to"]), str(notice["text"]), float(notice["stamp"]))

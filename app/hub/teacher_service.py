@@ -65,6 +65,8 @@ class ClassState:
         self.rule = StuckRule()
         self.reports = 0
         self.refused = 0
+        # Notice ids restart with the service: a dashboard that sees a new epoch asks anew.
+        self.epoch = os.urandom(8).hex()
 
     def notices_for(self, learner_key: str, since: int) -> list[dict[str, Any]]:
         return [n for n in self.notices if n["id"] > since and n["to"] in ("", learner_key)]
@@ -124,6 +126,7 @@ class ProgressReportHandler(_Base):
         self.finish(
             {
                 "accepted": record.key,
+                "epoch": self.state.epoch,
                 "notices": self.state.notices_for(record.key, since),
                 "reveal_after": self.state.reveal_after,
             }

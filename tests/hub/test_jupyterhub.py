@@ -23,7 +23,7 @@ from playwright.sync_api import Browser, BrowserContext, Page, expect
 from app.dds import configure_dds_env
 from app.hub.reports import to_json
 from app.teacher.record import LearnerRecord
-from tests.browser.helpers import expect_text, open_tab, start_node
+from tests.browser.helpers import choose, click, expect_text, open_tab, start_node
 from tests.conftest import ARTIFACTS, fail_on_leftover_nodes, in_private_netns, wait_until
 from tests.hub.local_hub import PASSWORD, LocalHub
 
@@ -68,7 +68,10 @@ def pages(hub: LocalHub, browser: Browser) -> Iterator[dict[str, Page]]:
             context = browser.new_context(viewport={"width": 1400, "height": 900})
             contexts.append(context)
             page = context.new_page()
-            page.goto(f"{hub.base}/hub/login")
+            # A learner lands in their Classroom (spawned on login); the teacher goes
+            # straight to the teacher service and starts no server of their own.
+            after = f"?next={SERVICE}" if user == TEACHER else ""
+            page.goto(f"{hub.base}/hub/login{after}")
             page.get_by_label("Username").fill(user)
             page.get_by_label("Password").fill(PASSWORD)
             # Logging in spawns the server; the spawn page then goes to default_url.
@@ -101,9 +104,9 @@ def test_each_learner_gets_their_own_classroom(hub, pages):
     expect(pages["alice"].get_by_text("/listener", exact=True)).to_have_count(0)
     expect(pages["bob"].get_by_text("/talker", exact=True)).to_have_count(0)
 
-    # Every server (the teacher's too: logging in starts one) has a domain of its own.
+    # Every learner's server has a ROS domain of its own.
     domains = {u: p.environ()["ROS_DOMAIN_ID"] for u, p in hub.dashboards().items()}
-    assert set(LEARNERS) <= set(domains) and len(set(domains.values())) == len(domains), domains
+    assert sorted(domains) == sorted(LEARNERS) and len(set(domains.values())) == 3, domains
     for user in LEARNERS:  # progress lives in each learner's own home
         assert (hub.homes / user / "ros2-classroom" / "progress").is_dir()
 
@@ -114,16 +117,19 @@ def _row(page: Page, user: str):
 
 def test_the_teacher_sees_every_row_move_within_two_seconds(hub, pages):
     teacher = pages[TEACHER]
-    teacher.goto(f"{hub.base}{SERVICE}")  # the hub's OAuth, then the page
+    teacher.goto(f"{hub.base}{SERVICE}")  # the hub's OAuth (done at login), then the page
     expect(teacher.get_by_text(f"Signed in through the hub as {TEACHER}")).to_be_visible()
     for user in LEARNERS:
         expect(_row(teacher, user)).to_be_visible(timeout=60_000)
     for user in LEARNERS:
-        expect_text(pages[user], "ros2 node list", timeout=90_000)
-        start_node(pages[user], "listener2")
+        page = pages[user]
+        open_tab(page, "Nodes")
+        choose(page, "Catalog node", "listener2")
+        click(page, "Start")
         clicked = time.monotonic()
         expect(_row(teacher, user)).to_contain_text("listener2", timeout=2_000)
-        print(f"{user}: row moved {time.monotonic() - clicked:.2f} s after the start")
+        print(f"{user}: the teacher's row moved {time.monotonic() - clicked:.2f} s after Start")
+        expect_text(page, "Started listener2")
     # The CSV export and a learner's code, as on `classroom`'s teacher page.
     csv = _teacher_get(hub, teacher, "progress.csv")
     assert csv.status == 200 and all(f"hub,{u}," in csv.text() for u in LEARNERS)
@@ -167,8 +173,8 @@ def _shown(row: list) -> tuple:
 
 def test_bad_input_is_refused_with_a_clear_status(hub, pages):
     tokens = _tokens(hub)
-    assert set(LEARNERS) <= set(tokens), tokens
-    wait_until(lambda: set(LEARNERS) <= set(_teacher_table(hub, pages)), 30, what="three rows")
+    assert sorted(tokens) == sorted(LEARNERS), tokens
+    wait_until(lambda: sorted(_teacher_table(hub, pages)) == sorted(LEARNERS), 30, what="3 rows")
     bob_before = _shown(_teacher_table(hub, pages)["bob"])
 
     # A forged user: Alice's token, a report about Bob.
@@ -208,6 +214,8 @@ def test_bad_input_is_refused_with_a_clear_status(hub, pages):
         "/user/alice/ros2-classroom/../../bob/ros2-classroom/",
         "/user/alice/ros2-classroom/%2e%2e/%2e%2e/bob/api/status",
         "/user/alice/proxy/..%2F..%2Fbob/api/status",
+        "/services/classroom-teacher/../../user/bob/api/status",
+        "/services/classroom-teacher/..%2F..%2Fuser/bob/api/status",
     ):
         connection = http.client.HTTPConnection("127.0.0.1", hub.port, timeout=15)
         connection.request("GET", path, headers={"Authorization": f"token {tokens['alice']}"})
