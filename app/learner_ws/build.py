@@ -54,12 +54,15 @@ _OPTIONS: dict[str, dict[str, object]] = {
     "info": {},
 }  # fmt: skip
 _SAFE_VALUE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
-# colcon reads these launcher lines itself; they set the per-file size cap first.
+# The per-file size cap first, then colcon's own entry point in the same process
+# (one interpreter start, as the `colcon` script has).
 _LAUNCHER = (
-    "import os, resource, sys\n"
+    "import resource, sys\n"
     "cap = int(sys.argv[1])\n"
     "resource.setrlimit(resource.RLIMIT_FSIZE, (cap, cap))\n"
-    "os.execv(sys.executable, [sys.executable, '-m', 'colcon', *sys.argv[2:]])\n"
+    "sys.argv = ['colcon', *sys.argv[2:]]\n"
+    "from colcon_core.command import main\n"
+    "sys.exit(main())\n"
 )
 
 
@@ -124,7 +127,7 @@ def build_env(workspace: LearnerWorkspace) -> dict[str, str]:
 
 
 def colcon_argv(workspace: LearnerWorkspace, words: list[str]) -> list[str]:
-    """The process: our launcher (file-size cap), then ``python -m colcon WORDS``."""
+    """The process: our launcher (file-size cap), then colcon's main with WORDS."""
     cap = str(workspace.limits.file_bytes)
     return [sys.executable, "-c", _LAUNCHER, cap, *check_words(words)]
 
