@@ -319,6 +319,13 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         package="tf2_ros",
     ),
     CatalogEntry(
+        "tf2_monitor",
+        "tf2_monitor",
+        "/tf2_monitor_main",
+        "Every 10 s: the delay of /tf data per frame and per broadcaster (optional: two frames).",
+        package="tf2_ros",
+    ),
+    CatalogEntry(
         "view_frames",
         "view_frames",
         "/view_frames",

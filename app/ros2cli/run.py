@@ -75,6 +75,7 @@ _UPSTREAM: dict[tuple[str, str], str] = {
     # issue 23: tf2's programs and the tf2 tutorials' nodes (turtle_tf2_py; learning_tf2_py
     # is the package the tutorials have the learner write)
     ("tf2_ros", "tf2_echo"): "tf2_echo",
+    ("tf2_ros", "tf2_monitor"): "tf2_monitor",
     ("tf2_ros", "static_transform_publisher"): "static_transform_publisher",
     ("tf2_tools", "view_frames"): "view_frames",
     **{

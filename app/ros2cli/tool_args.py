@@ -18,6 +18,7 @@ from app.ros.errors import Ros2Error
 # catalog module -> the most words it takes
 FREE_FORM: dict[str, int] = {
     "tf2_echo": 3,
+    "tf2_monitor": 2,
     "static_transform_publisher": 24,
     "view_frames": 4,
     "static_turtle_tf2_broadcaster": 7,

@@ -128,6 +128,7 @@ def test_demo_launch_echo_and_view_frames_in_the_console(console, probe, supervi
 
 
 def test_static_publishers_and_tf_static_in_the_console(console, probe, supervisor):  # noqa: F811
+    ok(console, "ros2 run tf2_ros tf2_monitor")  # reports every 10 s, read at the end
     out = ok(
         console,
         "ros2 run tf2_ros static_transform_publisher --x 0 --y 0 --z 1 --yaw 0 --pitch 0 "
@@ -193,6 +194,24 @@ def test_static_publishers_and_tf_static_in_the_console(console, probe, supervis
     ok(console, "ros2 run --stop /static_turtle_tf2_broadcaster")
     code, out = console("ros2 run tf2_ros tf2_echo world ../etc")
     assert code == 1 and "not a frame name" in out[-1], out
+
+    wait_until(
+        lambda: "RESULTS: for all Frames" in supervisor.output("tf2_monitor"),
+        timeout=20,
+        what="tf2_monitor's first report",
+    )
+    report = supervisor.output("tf2_monitor")
+    assert report[0] == "Gathering data on all frames for 10 seconds...", report
+    assert any(
+        re.fullmatch(
+            r"Frame: mystaticturtle, published by <no authority available>, "
+            r"Average Delay: \S+, Max Delay: \S+",
+            line,
+        )
+        for line in report
+    ), report
+    assert any(line.startswith("Node: <no authority available> ") for line in report), report
+    ok(console, "ros2 run --stop /tf2_monitor_main")
 
 
 def test_terminal_runs_the_tf2_tools(ros_env, probe, tmp_path):
