@@ -52,6 +52,11 @@ class DomainPool:
             "(each pod has its own loopback)"
         )
 
+    def hold(self, owner: str, domain: int) -> None:
+        """An id a running server already has (from the hub's saved state)."""
+        with self._lock:
+            self._held[owner] = domain
+
     def give_back(self, owner: str) -> None:
         with self._lock:
             self._held.pop(owner, None)
@@ -65,6 +70,7 @@ class ClassroomSystemUserSpawner(LocalProcessSpawner):
     """JupyterHub's local spawner (each learner as their own system user), plus a ROS domain id."""
 
     pool: ClassVar[DomainPool] = DomainPool()
+    domain_id: int | None = None
 
     first_domain_id = Int(1, config=True, help="Lowest ROS domain id given to a learner.")
     last_domain_id = Int(MAX_DOMAIN_ID, config=True, help="Highest ROS domain id given out.")
@@ -74,9 +80,27 @@ class ClassroomSystemUserSpawner(LocalProcessSpawner):
 
     def get_env(self) -> dict[str, Any]:
         env = super().get_env()
-        domain = self.pool.take(self._owner(), self.first_domain_id, self.last_domain_id)
-        env["ROS_DOMAIN_ID"] = str(domain)
+        self.domain_id = self.pool.take(self._owner(), self.first_domain_id, self.last_domain_id)
+        env["ROS_DOMAIN_ID"] = str(self.domain_id)
         return env
+
+    # A hub restarted with cleanup_servers=False finds its servers running: their ids
+    # must stay held, or the next learner would get a running learner's domain.
+    def get_state(self) -> dict[str, Any]:
+        state = super().get_state()
+        if self.domain_id is not None:
+            state["ros_domain_id"] = self.domain_id
+        return state
+
+    def load_state(self, state: dict[str, Any]) -> None:
+        super().load_state(state)
+        if "ros_domain_id" in state:
+            self.domain_id = int(state["ros_domain_id"])
+            self.pool.hold(self._owner(), self.domain_id)
+
+    def clear_state(self) -> None:
+        super().clear_state()
+        self.domain_id = None
 
     async def stop(self, now: bool = False) -> None:
         try:

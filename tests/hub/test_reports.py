@@ -90,3 +90,24 @@ def test_the_domain_pool_gives_each_running_server_its_own_id_and_says_when_none
     pool.give_back("b")
     assert pool.take("d", 5, 7) == 6
     assert pool.held() == {"a": 5, "c": 7, "d": 6}
+
+
+def test_a_restarted_hub_keeps_a_running_servers_domain_held():
+    from types import SimpleNamespace
+
+    from app.hub.spawner import ClassroomSystemUserSpawner
+
+    class Fresh(ClassroomSystemUserSpawner):
+        pool = DomainPool()  # not the class-wide pool of a real hub
+
+    before = Fresh(user=SimpleNamespace(name="ada"))
+    before.domain_id = Fresh.pool.take("ada", 1, 3)
+    state = before.get_state()
+    assert state["ros_domain_id"] == 1
+
+    Fresh.pool = DomainPool()  # the hub restarted: the pool starts empty
+    after = Fresh(user=SimpleNamespace(name="ada"))
+    after.load_state(state)
+    assert after.domain_id == 1 and Fresh.pool.take("bob", 1, 3) == 2  # ada's 1 stays hers
+    after.clear_state()
+    assert after.domain_id is None and "ros_domain_id" not in after.get_state()
