@@ -101,6 +101,11 @@ def test_demo_launch_echo_and_view_frames_in_the_console(console, probe, supervi
     assert z == 0.0 and math.hypot(x, y) < first, block
     assert ok(console, "ros2 run --stop /tf2_echo") == ["/tf2_echo: stopped (exit code 0)"]
 
+    # Adding a frame: carrot1, fixed 2 m to turtle1's left, joins the tree
+    ok(console, "ros2 run turtle_tf2_py fixed_frame_tf2_broadcaster")
+    wait_until(
+        lambda: "/fixed_frame_tf2_broadcaster" in node_names(probe), timeout=DISCOVERY_TIMEOUT
+    )
     out = ok(console, "ros2 run tf2_tools view_frames")
     wait_until(
         lambda: not supervisor.status("view_frames").active,
@@ -119,11 +124,13 @@ def test_demo_launch_echo_and_view_frames_in_the_console(console, probe, supervi
     assert gv.startswith("digraph G {\n"), gv
     for child in ("turtle1", "turtle2"):
         assert f'"world" -> "{child}"[label=" Broadcaster: default_authority\\n' in gv, gv
+    assert '"turtle1" -> "carrot1"[label=' in gv, gv
     picture = (folder / f"{exported[1]}.{exported[2]}").read_bytes()
     assert picture.startswith(b"<svg") or picture.startswith(b"%PDF"), picture[:40]
     if exported[2] == "svg":
         assert b">turtle2</text>" in picture and b">world</text>" in picture
     assert supervisor.status("view_frames").exit_code == 0
+    ok(console, "ros2 run --stop /fixed_frame_tf2_broadcaster")
     ok(console, "ros2 launch --stop turtle_tf2_py turtle_tf2_demo.launch.py")
 
 
