@@ -5,14 +5,18 @@ description, that drive joint_state_publisher. Here the sliders are built
 from the robot the 3D view has parsed; moving one publishes every slider's
 value as a sensor_msgs/JointState on ``/joint_state_sliders``, the topic in
 the ``source_list`` of the catalog's ``joint_state_publisher_gui``. The
-publisher is made once, with the panel; slider callbacks run on the UI
-thread (posted intents) and only publish.
+publisher is made on the UI thread when the first robot with joints arrives
+(an idle dashboard adds no JointState topic); slider callbacks run on the UI
+thread too (posted intents) and only publish.
 """
 
 from __future__ import annotations
 
+import math
+
 import viser
 from rclpy.node import Node
+from rclpy.publisher import Publisher
 from sensor_msgs.msg import JointState
 
 from app.scene.robot_model import SliderJoint
@@ -31,7 +35,7 @@ class JointSliders:
         self._gui = gui
         self._ui = ui
         self._node = node
-        self._publisher = node.create_publisher(JointState, TOPIC, 10)
+        self._publisher: Publisher | None = None
         self._joints: tuple[SliderJoint, ...] = ()
         self._sliders: dict[str, viser.GuiSliderHandle] = {}
         self._folder = gui.add_folder("Joint sliders (joint_state_publisher_gui)")
@@ -43,6 +47,8 @@ class JointSliders:
         if joints == self._joints:
             return
         self._joints = joints
+        if joints and self._publisher is None:
+            self._publisher = self._node.create_publisher(JointState, TOPIC, 10)
         for slider in self._sliders.values():
             slider.remove()
         self._sliders.clear()
@@ -63,11 +69,22 @@ class JointSliders:
         self._note.show(HINT if joints else "This robot has no movable joints.")
 
     def publish(self) -> None:
+        """Every slider's value; a value that is not a finite number (forged) is left out."""
+        names, positions = [], []
+        for name, slider in self._sliders.items():
+            try:
+                value = float(slider.value)
+            except (TypeError, ValueError):
+                continue
+            if math.isfinite(value):
+                names.append(name)
+                positions.append(value)
         msg = JointState()
         msg.header.stamp = self._node.get_clock().now().to_msg()
-        msg.name = list(self._sliders)
-        msg.position = [float(s.value) for s in self._sliders.values()]
-        self._publisher.publish(msg)
+        msg.name, msg.position = names, positions
+        if self._publisher is not None:
+            self._publisher.publish(msg)
 
     def close(self) -> None:
-        self._node.destroy_publisher(self._publisher)
+        if self._publisher is not None:
+            self._node.destroy_publisher(self._publisher)

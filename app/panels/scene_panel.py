@@ -14,6 +14,7 @@ from typing import NamedTuple
 import viser
 from rclpy.node import Node
 
+from app.panels.joint_sliders import TOPIC as SLIDER_TOPIC
 from app.panels.joint_sliders import JointSliders
 from app.ros.graph import GraphSnapshot
 from app.scene import topic_picker as picker
@@ -45,6 +46,7 @@ class _Offer(NamedTuple):
     types: tuple[str, ...]
     hint: str
     preferred: tuple[str, ...]
+    avoid: tuple[str, ...] = ()  # never followed by itself (the dashboard's own topics)
 
 
 CLOUDS = _Offer(picker.CLOUD_TYPES, "sensor_msgs/msg/PointCloud2 topics", ("/cam/map_points",))
@@ -56,7 +58,12 @@ IMAGES = _Offer(
 MARKERS = _Offer(
     picker.MARKER_TYPES, "visualization_msgs Marker or MarkerArray topics", ("/cam/camera_pose",)
 )
-JOINTS = _Offer(picker.JOINT_TYPES, "sensor_msgs/msg/JointState topics", ("/joint_states",))
+JOINTS = _Offer(
+    picker.JOINT_TYPES,
+    "sensor_msgs/msg/JointState topics",
+    ("/joint_states",),
+    avoid=(SLIDER_TOPIC,),
+)
 
 
 class _TopicRow:
@@ -91,9 +98,12 @@ class _TopicRow:
             self._options = opts
             self.dropdown.options = opts
         if not self.chosen_by_learner and self.dropdown.value == picker.NONE and len(opts) > 1:
-            choice = next((t for t in self.offer.preferred if t in opts), opts[1])
-            assign(self.dropdown, choice)  # our own choice: posts no intent
-            self._select(choice)
+            choice = next((t for t in self.offer.preferred if t in opts), None)
+            if choice is None:
+                choice = next((t for t in opts[1:] if t not in self.offer.avoid), None)
+            if choice is not None:
+                assign(self.dropdown, choice)  # our own choice: posts no intent
+                self._select(choice)
 
 
 class ScenePanel:
@@ -188,7 +198,9 @@ class ScenePanel:
         self._budget.on_update(ui.callback(self._apply_budget))
         self._fixed.on_update(ui.callback(self._on_fixed_frame))
         self._frame_names.on_update(
-            ui.callback(lambda: setattr(self.tf_view, "show_names", self._frame_names.value))
+            ui.callback(
+                lambda: setattr(self.tf_view, "show_names", self._frame_names.value is True)
+            )
         )
         self._image_on_frustum.on_update(
             ui.callback(lambda: self.images.show_on_frustum(self._image_on_frustum.value))

@@ -237,6 +237,8 @@ class TfView:
                 + (f"; {len(view.problems)} not connected to it" if view.problems else "")
                 + "."
             )
+            if view.fixed and view.fixed not in view.poses:
+                lines.append(f"⚠️ Fixed Frame [{view.fixed}] does not exist")
             if view.stale:
                 lines.append("Stale (publisher silent): " + ", ".join(sorted(view.stale)) + ".")
             loops = sorted({p for p in view.problems.values() if "loop" in p})

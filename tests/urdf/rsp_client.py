@@ -168,8 +168,14 @@ def main() -> None:
     report: dict = {}
     workdir = tempfile.mkdtemp(prefix="rsp_outside_")
     urdf_path = os.path.join(workdir, "outside.urdf")
-    with open(urdf_path, "w") as f:
-        f.write(URDF)
+    with open(urdf_path, "w") as f:  # with an inertia on the root link, which KDL warns about
+        f.write(
+            URDF.replace(
+                '<link name="base_link"/>',
+                '<link name="base_link"><inertial><mass value="2"/><inertia ixx="1" ixy="0" '
+                'ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>',
+            )
+        )
     params = os.path.join(workdir, "params.yaml")
     with open(params, "w") as f:
         f.write("robot_state_publisher:\n  ros__parameters:\n    publish_frequency: 20.0\n")
@@ -315,10 +321,16 @@ def main() -> None:
         report["main_log"] = out.lines[-40:]
         report["main_exit"] = stop(main_proc)
         # The old command-line form: a URDF file name as the first argument.
-        file_proc = start([urdf_path, "--ros-args", "-r", "__node:=rsp_from_file"], workdir)
+        file_proc = start(
+            [urdf_path, "--ros-args", "-r", "__node:=rsp_from_file", "-p", "frame_prefix:=r2/"],
+            workdir,
+        )
         procs.append(file_proc)
         file_out = Output(file_proc)
         report["file_initialized"] = file_out.wait_for("Robot initialized", 20)
+        spin_until(node, lambda: "r2/camera" in statics, 15)
+        prefixed = statics.get("r2/camera")
+        report["prefixed_parent"] = prefixed.header.frame_id if prefixed else None
         report["file_log"] = file_out.lines[:10]
         report["file_exit"] = stop(file_proc)
         # No description at all: FATAL and a failing exit, as upstream.

@@ -87,6 +87,11 @@ def test_urdf_file_argument_and_missing_description(report) -> None:
     assert report["file_initialized"]
     assert any("Assuming argument is name of URDF file" in line for line in report["file_log"])
     assert report["file_exit"] == 0
+    assert any(
+        "[WARN]" in line and "[kdl_parser]: The root link base_link has an inertia" in line
+        for line in report["file_log"]
+    )
+    assert report["prefixed_parent"] == "r2/slider"  # frame_prefix on both ends
     assert report["empty_exit"] == 1
     assert any(
         "[FATAL]" in line and "robot_description parameter must not be empty" in line
