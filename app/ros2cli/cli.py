@@ -15,7 +15,8 @@ from typing import cast
 
 from rclpy.node import Node
 
-from app.ros.context import CLI_LIMITS, CallContext
+from app.ros.context import CLI_LIMITS
+from app.ros2cli.common import TerminalContext
 from app.ros2cli.parser import needs_ros, run_argv
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -38,7 +39,9 @@ def main(argv: list[str]) -> int:
         # Verbs that need no ROS (interface ...) never touch the node: none is made.
         no_node = cast(Node, None)
         return run_argv(
-            CallContext(node=no_node, write=_print, limits=CLI_LIMITS), argv, "ros2-classroom"
+            TerminalContext(node=no_node, write=_print, limits=CLI_LIMITS, note=_note),
+            argv,
+            "ros2-classroom",
         )
     from app.ros.runtime import RosRuntime
 
@@ -47,9 +50,11 @@ def main(argv: list[str]) -> int:
     previous = {sig: signal.signal(sig, lambda *_: cancel.set()) for sig in STOP_SIGNALS}
     # Hidden, and without parameter services, as ros2cli's own node is.
     runtime = RosRuntime(f"_ros2_classroom_cli_{os.getpid()}", quiet=True)
-    ctx = CallContext(node=runtime.node, write=_print, limits=CLI_LIMITS, cancel=cancel)
+    ctx = TerminalContext(
+        node=runtime.node, write=_print, limits=CLI_LIMITS, cancel=cancel, note=_note
+    )
     try:
-        code = run_argv(ctx, argv, "ros2-classroom", note=_note)
+        code = run_argv(ctx, argv, "ros2-classroom")
         return EXIT_INTERRUPTED if cancel.is_set() else code
     finally:
         runtime.shutdown()

@@ -4,10 +4,11 @@ letting a brand-new node see the graph."""
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 
 from rclpy.topic_or_service_is_hidden import topic_or_service_is_hidden
 
-from app.ros.context import CallContext
+from app.ros.context import CallContext, Write
 from app.ros.errors import Ros2Error
 
 MIN_DISCOVERY_SEC = 1.5
@@ -28,6 +29,27 @@ class SilentFailure(Ros2Error):
     A terminal keeps stdout as ros2's (the reason goes to stderr); the Console,
     which has one output, shows the reason in parentheses.
     """
+
+
+@dataclass
+class TerminalContext(CallContext):
+    """A terminal's context: ``note`` takes what ros2 prints on stderr, not stdout."""
+
+    note: Write | None = None
+
+
+def write_note(ctx: CallContext, line: str) -> None:
+    """A line ros2 prints on stderr (a warning, a refusal): a terminal's stderr, else the output."""
+    note = ctx.note if isinstance(ctx, TerminalContext) else None
+    (note or ctx.write)(line)
+
+
+def write_outcome(ctx: CallContext, ok: bool, line: str) -> None:
+    """ros2cli prints a success on stdout and a refusal on stderr."""
+    if ok:
+        ctx.write(line)
+    else:
+        write_note(ctx, line)
 
 
 def is_hidden_name(name: str) -> bool:

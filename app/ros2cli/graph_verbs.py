@@ -21,7 +21,14 @@ from app.ros.context import CallContext
 from app.ros.convert import from_yaml, import_type, message_repr
 from app.ros.graph import all_nodes, wait_for_graph
 from app.ros.names import split_node_name
-from app.ros2cli.common import Ros2cliMessage, SilentFailure, visible, write_names, write_text
+from app.ros2cli.common import (
+    Ros2cliMessage,
+    SilentFailure,
+    visible,
+    write_names,
+    write_note,
+    write_text,
+)
 from app.ros2cli.msg_yaml import message_to_yaml
 
 # ------------------------------------------------------------------- node
@@ -30,9 +37,10 @@ from app.ros2cli.msg_yaml import message_to_yaml
 def node_list(ctx: CallContext, all_: bool = False, count: bool = False) -> int:
     names = all_nodes(ctx.node, include_hidden=all_)
     if not count and len(set(names)) < len(names):
-        ctx.write(
+        write_note(
+            ctx,
             "WARNING: Be aware that there are nodes in the graph that share an exact "
-            "name, which can have unintended side effects."
+            "name, which can have unintended side effects.",
         )
     return write_names(ctx, names, count)
 

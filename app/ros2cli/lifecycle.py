@@ -14,7 +14,7 @@ from app.ros.lifecycle import (
     lifecycle_nodes,
     lifecycle_target,
 )
-from app.ros2cli.common import Ros2cliMessage, write_names
+from app.ros2cli.common import Ros2cliMessage, write_names, write_outcome
 from app.ros2cli.graph_verbs import find_node
 
 
@@ -73,5 +73,5 @@ def verb_set(ctx: CallContext, fqn: str, transition: str, include_hidden: bool =
             + "".join(f"\n- {t.label} [{t.id}]" for t in available)
         )
     ok, _chosen = change_state(ctx, target, transition)
-    ctx.write("Transitioning successful" if ok else "Transitioning failed")
+    write_outcome(ctx, ok, "Transitioning successful" if ok else "Transitioning failed")
     return 0

@@ -23,7 +23,7 @@ from app.ros.params import (
     python_value,
     set_value,
 )
-from app.ros2cli.common import Ros2cliMessage, write_text
+from app.ros2cli.common import Ros2cliMessage, write_outcome, write_text
 from app.ros2cli.graph_verbs import find_node
 from app.ros2cli.run import params_file
 
@@ -119,7 +119,7 @@ def param_set(
     target = param_node(ctx, fqn, include_hidden)
     ok, reason = set_value(ctx, target, name, parse_value(text))
     words = "Set parameter successful" if ok else "Setting parameter failed"
-    ctx.write(words + (f": {reason}" if reason else ""))
+    write_outcome(ctx, ok, words + (f": {reason}" if reason else ""))
     return 0  # ros2cli exits with 0 either way
 
 
@@ -131,7 +131,7 @@ def param_delete(ctx: CallContext, fqn: str, name: str, include_hidden: bool = F
     service = f"{target.rstrip('/')}/set_parameters"
     result = call_service(ctx, service, SetParameters, request).results[0]
     words = "Deleted parameter successfully" if result.successful else "Deleting parameter failed"
-    ctx.write(words + (f": {result.reason}" if result.reason else ""))
+    write_outcome(ctx, result.successful, words + (f": {result.reason}" if result.reason else ""))
     return 0
 
 
@@ -207,5 +207,7 @@ def param_load(
         for name, value in _flatten(section or {}).items():
             ok, reason = set_value(ctx, target, name, value)
             outcome = "successful" if ok else "failed"
-            ctx.write(f"Set parameter {name} {outcome}" + (f": {reason}" if reason else ""))
+            write_outcome(
+                ctx, ok, f"Set parameter {name} {outcome}" + (f": {reason}" if reason else "")
+            )
     return 0  # ros2cli exits with 0 even when a parameter was refused

@@ -18,7 +18,7 @@ from app.ros.context import CallContext, Write
 from app.ros.errors import Cancelled, Ros2Error
 from app.ros2cli import bag, interfaces, launch_verb, pkg, run
 from app.ros2cli import verbs as verb_args
-from app.ros2cli.common import Ros2cliMessage, SilentFailure, settle_discovery
+from app.ros2cli.common import Ros2cliMessage, SilentFailure, TerminalContext, settle_discovery
 
 log = logging.getLogger(__name__)
 
@@ -250,8 +250,11 @@ def run_argv(
 ) -> int:
     """Run one verb; every failure becomes one 'error: ...' line and an exit code.
 
-    ``note`` (a terminal's stderr) takes what ros2 would not print on stdout.
+    ``note`` (a terminal's stderr) takes what ros2 prints on stderr: argparse's
+    complaints, ros2cli's failure messages, and the reason of a silent failure.
     """
+    if note is None and isinstance(ctx, TerminalContext):
+        note = ctx.note
     try:
         args = parse(argv, ctx.write, prog)
         if args is None:
@@ -263,9 +266,8 @@ def run_argv(
         if argv[:1] and argv[0] in _ONE_LINE_ERRORS:
             ctx.write(f"error: {exc}")
         else:
-            for line in exc.usage.rstrip("\n").split("\n"):
-                ctx.write(line)
-            ctx.write(exc.as_ros2)
+            for line in [*exc.usage.rstrip("\n").split("\n"), exc.as_ros2]:
+                (note or ctx.write)(line)
         return EXIT_USAGE
     except UsageError as exc:
         ctx.write(f"error: {exc}")
@@ -276,8 +278,8 @@ def run_argv(
     except SilentFailure as exc:  # ros2 prints nothing; say why where it does not disturb
         (note or ctx.write)(f"({exc})" if note is None else str(exc))
         return EXIT_FAILED
-    except Ros2cliMessage as exc:  # ros2cli's own words, as `ros2` prints them
-        ctx.write(str(exc))
+    except Ros2cliMessage as exc:  # ros2cli's own words, as `ros2` prints them (stderr)
+        (note or ctx.write)(str(exc))
         return EXIT_FAILED
     except Ros2Error as exc:
         ctx.write(f"error: {exc}")

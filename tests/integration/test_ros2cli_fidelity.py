@@ -420,8 +420,14 @@ def test_terminal_face_hides_its_own_node(ros_env, supervisor):
     assert own and all(name.endswith("/get_type_description") for name in own), done.stdout
     done = run_cli("node", "info", "/talker", env=ros_env)
     assert (done.returncode, done.stdout.split("\n")) == (0, [*talker_info(), ""]), done.stdout
-    done = run_cli("node", "info", "/nobody", env=ros_env)
-    assert (done.returncode, done.stdout) == (1, "Unable to find node '/nobody'\n")
+    done = run_cli("node", "info", "/nobody", env=ros_env)  # ros2cli's message: on stderr
+    assert (done.returncode, done.stdout) == (1, ""), done.stdout
+    assert done.stderr.splitlines()[-1] == "Unable to find node '/nobody'", done.stderr
+    done = run_cli("node", "info", env=ros_env)  # argparse: usage and error on stderr, exit 2
+    assert (done.returncode, done.stdout) == (2, ""), done.stdout
+    assert done.stderr.splitlines()[-1] == (
+        "ros2-classroom node info: error: the following arguments are required: node_name"
+    ), done.stderr
     done = run_cli("topic", "-h", env=ros_env)  # options before the verb reach the verbs
     assert done.returncode == 0 and done.stdout.startswith(
         "usage: ros2-classroom topic [-h] [--include-hidden-topics] VERB ..."
