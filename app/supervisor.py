@@ -158,6 +158,7 @@ class Supervisor:
     """Starts, stops and watches catalog nodes. Thread-safe."""
 
     MAX_LINE_CHARS = 2000
+    DRAIN_SEC = 10.0  # after the main process exits, wait this long for its output to end
 
     def __init__(
         self,
@@ -336,6 +337,12 @@ class Supervisor:
         return proc.status()
 
     def _read_and_reap(self, proc: _Process) -> None:
+        """Read the output; reap on another thread, so a process that escaped the group
+        and holds the pipe open cannot keep an ended program "running" forever."""
+        drained = threading.Event()
+        threading.Thread(
+            target=self._reap, args=(proc, drained), name=f"reap-{proc.entry.name}", daemon=True
+        ).start()
         assert proc.popen.stdout is not None
         for raw in proc.popen.stdout:
             line = raw.decode("utf-8", errors="replace").rstrip("\n")
@@ -345,6 +352,16 @@ class Supervisor:
                 if len(proc.output) == proc.output.maxlen:
                     proc.dropped_lines += 1
                 proc.output.append(line)
+        drained.set()
+
+    def _reap(self, proc: _Process, drained: threading.Event) -> None:
+        try:  # until the main process has exited; WNOWAIT keeps its pid (and group id) ours
+            os.waitid(os.P_PID, proc.popen.pid, os.WEXITED | os.WNOWAIT)
+        except ChildProcessError:
+            pass
+        # Whatever shares its output (a launch file's nodes) may take a moment to end
+        # cleanly; a process that escaped the group may hold the pipe for ever.
+        drained.wait(self.DRAIN_SEC)
         self._end_group(proc.popen.pid)
         code = proc.popen.wait()
         entry = proc.entry

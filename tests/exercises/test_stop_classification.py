@@ -93,3 +93,27 @@ def test_ended_state_reads_the_last_traceback_line():
     )
     assert ended_state(0, False, []) == NodeState.EXITED
     assert ended_state(1, True, []) == NodeState.STOPPED
+
+
+ESCAPES_WITH_THE_PIPE = """
+    import subprocess, sys
+    child = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"],
+                             start_new_session=True)  # out of the group, holding stdout
+    print(f"escaped {child.pid}", flush=True)
+    """
+
+
+def test_a_program_whose_escaped_child_holds_the_pipe_still_ends(tmp_path, supervisor):
+    """Its end must not wait for the escaped process to close the output pipe."""
+    supervisor.DRAIN_SEC = 1.0
+    supervisor.start_program(_program(tmp_path, "learner_escape", ESCAPES_WITH_THE_PIPE))
+    name = "learner_escape"
+    escaped = None
+    try:
+        _wait(supervisor, name, lambda s: any("escaped" in x for x in s.output(name)), "start")
+        escaped = int(next(x for x in supervisor.output(name) if "escaped" in x).split()[1])
+        _wait(supervisor, name, lambda s: not s.status(name).active, "the end", timeout=10)
+        assert supervisor.status(name).state == NodeState.EXITED
+    finally:
+        if escaped is not None:
+            os.kill(escaped, signal.SIGKILL)
