@@ -63,6 +63,13 @@ def find_node(ctx: CallContext, name: str, include_hidden: bool, message: str) -
 def node_info(ctx: CallContext, fqn: str, include_hidden: bool = False) -> int:
     """Six sections; an empty one still prints its (empty) list, as one empty line."""
     target = find_node(ctx, fqn, include_hidden, f"Unable to find node '{fqn}'")
+    same = all_nodes(ctx.node, include_hidden=include_hidden).count(target)
+    if same > 1:
+        write_note(
+            ctx,
+            f'There are {same} nodes in the graph with the exact name "{target}". '
+            "You are seeing information about only one of them.",
+        )
     name, namespace = split_node_name(target)
     node = ctx.node
     sections = [

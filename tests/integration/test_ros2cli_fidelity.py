@@ -382,6 +382,24 @@ def test_param_lifecycle_and_hidden_names_golden(supervisor, probe, ros2):
         )
     finally:
         silent.destroy_node()
+
+    # two nodes with one name: ros2cli's warnings (stderr in a terminal)
+    twins = [Node("twin", context=probe.context) for _ in range(2)]
+    try:
+        out = ros2.until("node list", lambda o: o.split("\n").count("/twin") == 2)
+        assert out.split("\n")[0] == (
+            "WARNING: Be aware that there are nodes in the graph that share an exact name, "
+            "which can have unintended side effects."
+        ), out
+        code, lines = ros2("node info /twin")
+        assert lines[:2] == [
+            'There are 2 nodes in the graph with the exact name "/twin". '
+            "You are seeing information about only one of them.",
+            "/twin",
+        ], lines
+    finally:
+        for twin in twins:
+            twin.destroy_node()
     assert ros2("param describe /nobody greeting") == (1, ["Node not found"])
     # the node refuses (rclpy's reason); ros2cli still exits with 0
     assert ros2("param delete /parameters_node shout") == (
