@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import yaml
+from rclpy.qos import DurabilityPolicy, ReliabilityPolicy
 
 from app.ros.context import CallContext
 from app.ros.convert import (
@@ -116,6 +117,23 @@ def _deadline(ctx: CallContext) -> float:
     return time.monotonic() + limit if limit else math.inf
 
 
+def qos_fallback_lines(publishers: list[Any]) -> list[str]:
+    """What `ros2 topic echo` says when only some publishers are reliable or transient local."""
+    lines = []
+    for attr, good, name, fallback in (
+        ("reliability", ReliabilityPolicy.RELIABLE, "RELIABLE", "BEST_EFFORT"),
+        ("durability", DurabilityPolicy.TRANSIENT_LOCAL, "TRANSIENT_LOCAL", "VOLATILE"),
+    ):
+        offering = sum(getattr(p.qos_profile, attr) == good for p in publishers)
+        if 0 < offering < len(publishers):
+            policy = "QoSReliabilityPolicy" if attr == "reliability" else "QoSDurabilityPolicy"
+            lines.append(
+                f"Some, but not all, publishers are offering {policy}.{name}. Falling back to "
+                f"{policy}.{fallback} as it will connect to all publishers"
+            )
+    return lines
+
+
 def _echo_type(ctx: CallContext, topic: str, type_text: str | None) -> type:
     if type_text:
         return import_type(type_text, "msg")
@@ -176,6 +194,8 @@ def echo(
         if not parts:
             raise Ros2cliMessage(f"Invalid field value '{field}'")
     msg_type = _echo_type(ctx, topic, type_text)
+    for line in qos_fallback_lines(ctx.node.get_publishers_info_by_topic(topic)):
+        ctx.write(line)
     limit = 1 if once else count or ctx.limits.max_messages
     monitor = TopicMonitor(ctx.node, topic, msg_type, keep=200, window=16)
     shown = 0

@@ -25,7 +25,7 @@ from app.ros2cli.common import is_hidden_name, visible, write_text
 from app.ros2cli.msg_yaml import message_to_yaml
 from app.ros2cli.param import describe_lines
 from app.ros2cli.parser import parse, run_argv
-from app.ros2cli.topic import EchoStyle, bandwidth_text, echo_text
+from app.ros2cli.topic import EchoStyle, bandwidth_text, echo_text, qos_fallback_lines
 
 
 def test_sequences_print_in_block_style_not_indented_under_their_key():
@@ -206,3 +206,24 @@ def test_echo_options_no_arr_no_str_flow_style_and_csv():
     assert echo_text(twist, EchoStyle(csv=True)) == "2.0,0.0,0.0,0.0,0.0,0.0"
     # layout: its empty dim adds nothing (not even a comma), data_offset 0; then the data
     assert echo_text(msg, EchoStyle(csv=True, truncate_length=2)) == "0,1,2,..."
+
+
+def test_echo_says_when_it_falls_back_to_best_effort_or_volatile():
+    from types import SimpleNamespace
+
+    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+
+    def publisher(reliability, durability):
+        return SimpleNamespace(
+            qos_profile=QoSProfile(depth=10, reliability=reliability, durability=durability)
+        )
+
+    reliable_latched = publisher(ReliabilityPolicy.RELIABLE, DurabilityPolicy.TRANSIENT_LOCAL)
+    best_effort = publisher(ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATILE)
+    assert qos_fallback_lines([reliable_latched, reliable_latched]) == []
+    assert qos_fallback_lines([reliable_latched, best_effort]) == [
+        "Some, but not all, publishers are offering QoSReliabilityPolicy.RELIABLE. Falling back "
+        "to QoSReliabilityPolicy.BEST_EFFORT as it will connect to all publishers",
+        "Some, but not all, publishers are offering QoSDurabilityPolicy.TRANSIENT_LOCAL. Falling "
+        "back to QoSDurabilityPolicy.VOLATILE as it will connect to all publishers",
+    ]
