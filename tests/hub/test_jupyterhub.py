@@ -22,6 +22,7 @@ from playwright.sync_api import Browser, BrowserContext, Page, expect
 
 from app.dds import configure_dds_env
 from app.hub.reports import to_json
+from app.lessons.schema import load_course
 from app.teacher.record import LearnerRecord
 from tests.browser.helpers import choose, click, expect_text, open_tab, start_node
 from tests.conftest import ARTIFACTS, fail_on_leftover_nodes, in_private_netns, wait_until
@@ -130,6 +131,21 @@ def test_the_teacher_sees_every_row_move_within_two_seconds(hub, pages):
         expect(_row(teacher, user)).to_contain_text("listener2", timeout=2_000)
         print(f"{user}: the teacher's row moved {time.monotonic() - clicked:.2f} s after Start")
         expect_text(page, "Started listener2")
+    # Carol passes a lesson step in her Classroom; her row shows the next step.
+    lesson = load_course().lessons[0]
+    step = lesson.steps[0]
+    carol = pages["carol"]
+    open_tab(carol, "Lessons")
+    choose(carol, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
+    for check in step.checks:
+        if check.kind == "quiz":
+            choose(carol, check["question"], check["answer"])
+    expect(carol.get_by_text("✓ step done")).to_be_visible(timeout=45_000)
+    click(carol, "Next")
+    expect(_row(teacher, "carol")).to_contain_text(
+        f"{lesson.unit} · 2/{len(lesson.steps)}", timeout=2_000
+    )
+
     # The CSV export and a learner's code, as on `classroom`'s teacher page.
     csv = _teacher_get(hub, teacher, "progress.csv")
     assert csv.status == 200 and all(f"hub,{u}," in csv.text() for u in LEARNERS)
