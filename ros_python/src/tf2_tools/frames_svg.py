@@ -11,7 +11,7 @@ from __future__ import annotations
 from html import escape
 from typing import Any
 
-NODE_W, ROW_H, LABEL_LINES = 190, 170, 5
+NODE_W, ROW_H, LABEL_LINES = 250, 170, 5
 
 
 def _label(data: dict[str, Any]) -> list[str]:
@@ -64,7 +64,8 @@ def render(frames: dict[str, dict[str, Any]], recorded_time: float) -> str:
         )
     pos = layout(frames)
     width = max(x for x, _ in pos.values()) + NODE_W / 2 + 20
-    height = max(y for _, y in pos.values()) + 120
+    width = max(width, 420)
+    height = max(y for _, y in pos.values()) + 70
     out = [
         f'<svg xmlns="http://www.w3.org/2000/svg" width="{width:.0f}" height="{height:.0f}" '
         'font-family="sans-serif" font-size="11">',
@@ -78,9 +79,9 @@ def render(frames: dict[str, dict[str, Any]], recorded_time: float) -> str:
             'stroke="black" marker-end="url(#arrow)"/>'
         )
         for k, line in enumerate(_label(data)):
-            out.append(
-                f'<text x="{(x1 + x2) / 2 + 6:.1f}" y="{(y1 + y2) / 2 - 30 + 13 * k:.1f}" '
-                f'font-size="9">{escape(line)}</text>'
+            out.append(  # in the child's own column: sibling labels never overlap
+                f'<text x="{x2 - NODE_W / 2 + 12:.1f}" y="{(y1 + y2) / 2 - 30 + 13 * k:.1f}" '
+                f'font-size="9" fill="#333">{escape(line)}</text>'
             )
     for name, (x, y) in pos.items():
         out.append(
