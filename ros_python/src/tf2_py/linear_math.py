@@ -70,9 +70,12 @@ def slerp(a: Quat, b: Quat, t: float) -> Quat:
         inv = 1.0 / math.sin(theta)
         s0 = math.sin((1.0 - t) * theta) * inv
         s1 = math.sin(t * theta) * inv
-    return quat_normalize(
-        (s0 * a[0] + s1 * b[0], s0 * a[1] + s1 * b[1], s0 * a[2] + s1 * b[2], s0 * a[3] + s1 * b[3])
-    )
+    x = s0 * a[0] + s1 * b[0]
+    y = s0 * a[1] + s1 * b[1]
+    z = s0 * a[2] + s1 * b[2]
+    w = s0 * a[3] + s1 * b[3]
+    n = 1.0 / math.sqrt(x * x + y * y + z * z + w * w)
+    return (x * n, y * n, z * n, w * n)
 
 
 def lerp(a: Vec, b: Vec, t: float) -> Vec:
@@ -80,9 +83,23 @@ def lerp(a: Vec, b: Vec, t: float) -> Vec:
 
 
 def compose(q_a: Quat, t_a: Vec, q_b: Quat, t_b: Vec) -> tuple[Quat, Vec]:
-    """The transform ``A * B``: first ``B``, then ``A``."""
-    r = quat_rotate(q_a, t_b)
-    return quat_multiply(q_a, q_b), (r[0] + t_a[0], r[1] + t_a[1], r[2] + t_a[2])
+    """The transform ``A * B``: first ``B``, then ``A`` (inlined: lookups call it per link)."""
+    ax, ay, az, aw = q_a
+    bx, by, bz, bw = q_b
+    vx, vy, vz = t_b
+    tx = 2.0 * (ay * vz - az * vy)
+    ty = 2.0 * (az * vx - ax * vz)
+    tz = 2.0 * (ax * vy - ay * vx)
+    return (
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    ), (
+        vx + aw * tx + (ay * tz - az * ty) + t_a[0],
+        vy + aw * ty + (az * tx - ax * tz) + t_a[1],
+        vz + aw * tz + (ax * ty - ay * tx) + t_a[2],
+    )
 
 
 def invert(q: Quat, t: Vec) -> tuple[Quat, Vec]:
