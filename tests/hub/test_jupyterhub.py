@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import http.client
 import os
+import re
 import time
 from collections.abc import Iterator
 from dataclasses import replace
@@ -25,6 +26,7 @@ from app.hub.reports import to_json
 from app.lessons.schema import load_course
 from app.teacher.record import LearnerRecord
 from tests.browser.helpers import choose, click, expect_text, open_tab, start_node
+from tests.browser.test_exercise import EXERCISE, _open_editor, _type_code
 from tests.conftest import ARTIFACTS, fail_on_leftover_nodes, in_private_netns, wait_until
 from tests.hub.local_hub import PASSWORD, LocalHub
 
@@ -145,6 +147,16 @@ def test_the_teacher_sees_every_row_move_within_two_seconds(hub, pages):
     expect(_row(teacher, "carol")).to_contain_text(
         f"{lesson.unit} · 2/{len(lesson.steps)}", timeout=2_000
     )
+
+    # Bob passes an exercise (his code runs in his own server); his row counts it.
+    bob = pages["bob"]
+    frame_locator, _frame = _open_editor(bob)
+    _type_code(bob, frame_locator, EXERCISE.reference)
+    click(bob, "Run my node")
+    expect_text(bob, re.compile(r"running \(pid \d+\) · on the graph"), timeout=30_000)
+    click(bob, "Check my node")
+    expect_text(bob, "All checks pass. Exercise done!", timeout=30_000)
+    expect(_row(teacher, "bob")).to_contain_text("1 passed", timeout=2_000)
 
     # The CSV export and a learner's code, as on `classroom`'s teacher page.
     csv = _teacher_get(hub, teacher, "progress.csv")
