@@ -333,7 +333,17 @@ def main() -> None:
         report["prefixed_parent"] = prefixed.header.frame_id if prefixed else None
         report["file_log"] = file_out.lines[:10]
         report["file_exit"] = stop(file_proc)
-        # No description at all: FATAL and a failing exit, as upstream.
+        # The terminal form: -p robot_description:="$(xacro model.urdf.xacro)".
+        if len(sys.argv) > 1:
+            xacro = os.path.join(os.path.dirname(sys.executable), "xacro")
+            described = subprocess.run([xacro, sys.argv[1]], capture_output=True, text=True)
+            xacro_proc = start(
+                ["--ros-args", "-p", f"robot_description:={described.stdout}"], workdir
+            )
+            procs.append(xacro_proc)
+            report["xacro_initialized"] = Output(xacro_proc).wait_for("Robot initialized", 20)
+            report["xacro_exit"] = stop(xacro_proc)
+            # No description at all: FATAL and a failing exit, as upstream.
         empty_proc = start([], workdir)
         procs.append(empty_proc)
         try:

@@ -23,6 +23,7 @@ from tests.conftest import _domain_ids, in_private_netns
 pytestmark = pytest.mark.ros
 
 CLIENT = Path(__file__).with_name("rsp_client.py")
+MACROED = Path(__file__).parents[2] / "ros_python/src/urdf_tutorial/urdf/08-macroed.urdf.xacro"
 
 
 @pytest.fixture(scope="module")
@@ -33,7 +34,7 @@ def report(tmp_path_factory) -> dict:
     configure_dds_env(env, domain_id=next(_domain_ids) % 100 + 1, network=False)
     clean = {k: v for k, v in env.items() if k not in ("PYTHONPATH", "PYTHONSTARTUP")}
     done = subprocess.run(
-        [sys.executable, "-I", str(CLIENT)],
+        [sys.executable, "-I", str(CLIENT), str(MACROED)],
         cwd=tmp_path_factory.mktemp("outside"),
         env={**clean, "PYTHONUNBUFFERED": "1"},
         capture_output=True,
@@ -81,6 +82,10 @@ def test_bad_input_is_refused_and_the_node_lives(report) -> None:
     assert report["good_set"] and report["new_static"]
     assert report["main_alive"]
     assert report["main_exit"] == 0
+
+
+def test_xacro_output_as_a_command_line_parameter(report) -> None:
+    assert report["xacro_initialized"] and report["xacro_exit"] == 0
 
 
 def test_urdf_file_argument_and_missing_description(report) -> None:

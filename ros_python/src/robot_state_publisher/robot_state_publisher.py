@@ -260,7 +260,11 @@ class RobotStatePublisher(Node):
 def main(args: list[str] | None = None) -> None:
     node: RobotStatePublisher | None = None
     try:
-        rclpy.init(args=args)
+        try:
+            rclpy.init(args=args)
+        except Exception as exc:  # rcl refuses the arguments (e.g. a -p value YAML cannot read)
+            print(f"robot_state_publisher: error: {exc}", file=sys.stderr)
+            raise SystemExit(1) from None
         program_args = remove_ros_args(args if args is not None else sys.argv)
         try:
             node = RobotStatePublisher(program_args)
