@@ -15,6 +15,7 @@ from rclpy.action import (
 from rclpy.exceptions import InvalidTopicNameException
 from rclpy.expand_topic_name import expand_topic_name
 from rclpy.validate_full_topic_name import validate_full_topic_name
+from rclpy.validate_topic_name import validate_topic_name
 
 from app.ros.calls import GoalRun, action_type_of, call_service, send_goal, wait_for_server
 from app.ros.context import CallContext
@@ -144,6 +145,7 @@ def service_call(
         raise Ros2cliMessage("rate must be greater than zero")
     srv_type = import_type(type_text, "srv")
     request = from_yaml(srv_type.Request, values)
+    validate_topic_name(name, is_service=True)  # before any line, as ros2's client does
     # A fresh `ros2 service call` has never seen the server yet: it always waits first.
     ctx.write("waiting for service to become available...")
     deadline = time.monotonic() + ctx.limits.max_seconds if ctx.limits.max_seconds else math.inf

@@ -14,6 +14,8 @@ import shlex
 from collections.abc import Callable
 from typing import Any, NoReturn
 
+from rclpy.exceptions import NameValidationException
+
 from app.ros.context import CallContext, Write
 from app.ros.errors import Cancelled, Ros2Error
 from app.ros2cli import bag, interfaces, launch_verb, pkg, run
@@ -284,7 +286,7 @@ def run_argv(
     except Ros2Error as exc:
         ctx.write(f"error: {exc}")
         return EXIT_FAILED
-    except (ValueError, TypeError, RuntimeError, LookupError) as exc:
+    except (ValueError, TypeError, RuntimeError, LookupError, NameValidationException) as exc:
         # rclpy's own complaints (an invalid topic name, a node that just left):
         # still one line for the learner, never a traceback.
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__

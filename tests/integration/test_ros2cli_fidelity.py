@@ -190,6 +190,9 @@ def test_graph_verbs_golden(supervisor, ros2):
             "",
         ],
     )
+    code, lines = ros2("service call '{a: 1}' tutorial_interfaces/srv/AddTwoInts")
+    assert code == 1 and len(lines) == 1, lines  # one line, no traceback
+    assert lines[0].startswith("error: Invalid service name: "), lines
     assert ros2("service info /add_two_ints") == (
         0,
         ["Type: tutorial_interfaces/srv/AddTwoInts", "Clients count: 0", "Services count: 1"],
