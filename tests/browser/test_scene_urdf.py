@@ -92,6 +92,12 @@ def test_robot_appears_moves_and_bad_description_is_one_line(page, probe, ros_en
             page.get_by_text("parent link [nowhere] of joint [j] not found").first
         ).to_be_visible(timeout=20_000)
         assert page.evaluate(HAS_VISUAL_JS, POLE)
+
+        # The joint states stop: the moving frames go stale, visibly; the fixed ones do not.
+        repeater.stop()
+        expect(page.get_by_text("Stale (publisher silent)").first).to_be_visible(timeout=20_000)
+        status = page.get_by_text("Stale (publisher silent)").first.inner_text()
+        assert "gripper_pole" in status and "left_leg," not in status
     finally:
         repeater.stop()
         os.killpg(rsp.pid, signal.SIGINT)
