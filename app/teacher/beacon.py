@@ -130,7 +130,8 @@ class ProgressBeacon:
                 try:
                     self._link.send(stamped)
                     sent_at = now
-                except ReportRefused as refused:  # sent again next round (the newest record)
+                except ReportRefused as refused:  # it would refuse again: wait a heartbeat
+                    sent_at = now
                     log.warning("the teacher service refused this progress report: %s", refused)
                 except OSError as error:  # the hub is restarting or unreachable: next round
                     log.warning("could not reach the teacher service: %s", error)
