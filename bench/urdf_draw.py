@@ -12,7 +12,10 @@
 In each page the browser counts its own rendered frames (requestAnimationFrame)
 and the frames in which the chain's last link moved. The headline
 ``urdf_draw_ratio`` is the dashboard page's frame rate over the baseline's
-(aim >= 0.9); ``urdf_motion_ratio`` compares the robot poses shown per second.
+(aim >= 0.9) with the robot model alone (the TF frames' names and axes
+switched off in the panel, as the baseline draws neither);
+``urdf_draw_with_frames_ratio`` is the same with them on, as the view opens;
+``urdf_motion_ratio`` compares the robot poses shown per second.
 The pages are measured one after the other, each alone in the browser; the
 dashboard page is also measured with the robot drawn but standing still (the
 same 50 Hz of ``/joint_states``, always one pose: ``dashboard_still_fps``),
@@ -184,6 +187,9 @@ def run(seconds: float) -> dict[str, Any]:
             )
             still = measure(page, tip, seconds)  # the same page with the robot standing still
             moving.set()
+            framed = measure(page, tip, seconds)  # as it opens: frame axes and names shown
+            for box in ("Frame names", "Frame axes"):  # the robot model alone, as asked
+                page.get_by_label(box, exact=True).uncheck()
             dash = measure(page, tip, seconds)
             page.context.close()
             node.destroy_timer(timer)
@@ -232,6 +238,8 @@ def run(seconds: float) -> dict[str, Any]:
     figures.update(
         {
             "dashboard_still_fps": still["fps"],
+            "dashboard_with_frames_fps": framed["fps"],
+            "urdf_draw_with_frames_ratio": framed["fps"] / base["fps"] if base["fps"] else math.nan,
             "dashboard_fps": dash["fps"],
             "baseline_fps": base["fps"],
             "urdf_draw_ratio": dash["fps"] / base["fps"] if base["fps"] else math.nan,
@@ -255,7 +263,9 @@ def main(argv: list[str] | None = None) -> int:
         f"a plain viser scene {f['baseline_fps']:.1f} frames/s (moved in "
         f"{f['baseline_moves_per_s']:.1f}/s): ratio {f['urdf_draw_ratio']:.2f} (aim >= {AIM}), "
         f"motion ratio {f['urdf_motion_ratio']:.2f}; the 3D view with the robot standing still "
-        f"{f['dashboard_still_fps']:.1f} frames/s"
+        f"{f['dashboard_still_fps']:.1f} frames/s, with TF frame axes and names "
+        f"{f['dashboard_with_frames_fps']:.1f} frames/s "
+        f"(ratio {f['urdf_draw_with_frames_ratio']:.2f})"
     )
     print(json.dumps(rounded(f, 3), sort_keys=True))
     return 0

@@ -181,6 +181,7 @@ class ScenePanel:
                 hint="The frame everything is drawn relative to (rviz's Global Options)",
             )
             self._frame_names = gui.add_checkbox("Frame names", True)
+            self._frame_axes = gui.add_checkbox("Frame axes", True)
             self._tf_status = MarkdownView(gui)
         self.joint_sliders = JointSliders(gui, ui, node)
 
@@ -197,11 +198,8 @@ class ScenePanel:
         self._frame_cloud.on_click(ui.callback(self._look_at_cloud))
         self._budget.on_update(ui.callback(self._apply_budget))
         self._fixed.on_update(ui.callback(self._on_fixed_frame))
-        self._frame_names.on_update(
-            ui.callback(
-                lambda: setattr(self.tf_view, "show_names", self._frame_names.value is True)
-            )
-        )
+        self._frame_names.on_update(ui.callback(self._on_frame_display))
+        self._frame_axes.on_update(ui.callback(self._on_frame_display))
         self._image_on_frustum.on_update(
             ui.callback(lambda: self.images.show_on_frustum(self._image_on_frustum.value))
         )
@@ -211,6 +209,11 @@ class ScenePanel:
         # The gizmo moves on a viser thread: the new pose is applied here.
         self.frames.on_change(
             lambda pose, source: ui.post(lambda: self._on_pose_changed(pose, source))
+        )
+
+    def _on_frame_display(self) -> None:
+        self.tf_view.set_display(
+            names=self._frame_names.value is True, axes=self._frame_axes.value is True
         )
 
     def _on_fixed_frame(self) -> None:

@@ -55,7 +55,9 @@ class TfView:
         self._server = server
         self.store = TfStore()
         self.fixed_frame = ""  # "" until the learner picks one: follow the biggest tree
-        self.show_names = True
+        self.show_names = True  # rviz's TF display: Show Names
+        self.show_axes = True  # ...and Show Axes
+        self._restyle = False
         self._lock = threading.Lock()
         self._description: str | None = None
         self._robot: RobotDrawing | None = None
@@ -131,7 +133,8 @@ class TfView:
                     self._load_robot(description)
                 version = self.store.version
                 last_draw = time.monotonic()
-                self._draw(force=version != last_version)
+                restyle, self._restyle = self._restyle, False
+                self._draw(force=version != last_version or restyle)
                 last_version = version
             except Exception:  # a bad frame must not end the view
                 log.exception("drawing TF failed")
@@ -195,6 +198,8 @@ class TfView:
                     label.text = text
                 if label.visible != self.show_names:
                     label.visible = self.show_names
+                if axes.show_axes != self.show_axes:
+                    axes.show_axes = self.show_axes
 
     def _frame(self, frame: str) -> tuple[viser.FrameHandle, viser.LabelHandle]:
         """The axes and name of a TF frame, made hidden on first use (drawing thread)."""
@@ -222,6 +227,12 @@ class TfView:
             handle.wxyz = tf.matrix_to_quat(pose[:3, :3])
 
     # --- UI thread ---
+    def set_display(self, *, names: bool, axes: bool) -> None:
+        """Show or hide the frames' names and axes (the robot's shapes stay)."""
+        self.show_names, self.show_axes = names, axes
+        self._restyle = True
+        self._wake.set()
+
     def frame_names(self) -> list[str]:
         return self.store.frames()
 
