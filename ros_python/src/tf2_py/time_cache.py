@@ -13,7 +13,7 @@ from __future__ import annotations
 from bisect import bisect_left, bisect_right
 from dataclasses import dataclass
 
-from tf2_py.linear_math import Quat, Vec, lerp, slerp
+from tf2_py.linear_math import Quat, Vec, slerp
 
 # Error codes, as tf2::TF2Error numbers them (the first seven are tf2_msgs/TF2Error's).
 NO_ERROR = 0
@@ -95,8 +95,13 @@ class TimeCache:
         newer = self._data[i + 1]
         if older[0] != newer[0]:  # the parent changed between the two: no blending
             return older
-        ratio = (time_ns - t0) / (stamps[i + 1] - t0)
-        return (older[0], slerp(older[1], newer[1], ratio), lerp(older[2], newer[2], ratio))
+        r = (time_ns - t0) / (stamps[i + 1] - t0)
+        (ax, ay, az), (bx, by, bz) = older[2], newer[2]
+        return (
+            older[0],
+            slerp(older[1], newer[1], r),
+            (ax + (bx - ax) * r, ay + (by - ay) * r, az + (bz - az) * r),
+        )
 
     def get_parent(self, time_ns: int) -> int | CacheError:
         found = self.get_data(time_ns)
