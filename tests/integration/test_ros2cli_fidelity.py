@@ -89,6 +89,14 @@ def talker_info() -> list[str]:
 def test_graph_verbs_golden(supervisor, ros2):
     for name in ("talker", "listener", "add_two_ints_server", "fibonacci_action_server"):
         supervisor.start(name)
+    # endpoints and node names are discovered separately: wait for both
+    ros2.until(
+        "node list",
+        lambda o: all(
+            f"/{n}" in o.split("\n")
+            for n in ("talker", "listener", "add_two_ints_server", "fibonacci_action_server")
+        ),
+    )
     ros2.until("node info /fibonacci_action_server", "/fibonacci: tutorial_interfaces")
     ros2.until("topic info /chatter", "Subscription count: 1")
 
