@@ -288,7 +288,13 @@ def cmd_classroom(args: argparse.Namespace) -> int:
 def _run_entry(args: argparse.Namespace) -> catalog.CatalogEntry:
     """``run NAME`` (a catalog name) or, as the tutorials type it, ``run PACKAGE EXECUTABLE``."""
     extra = args.ros_args
-    if args.node not in catalog.names() and extra and not extra[0].startswith("-"):
+    from app.ros2cli.run import EXECUTABLES  # a catalog name may also be a package's (issue 23)
+
+    if (
+        extra
+        and not extra[0].startswith("-")
+        and (args.node not in catalog.names() or (args.node, extra[0]) in EXECUTABLES)
+    ):
         from app.ros.errors import Ros2Error
         from app.ros2cli.run import resolve
 
@@ -320,6 +326,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         words = extra[: extra.index("--ros-args")] if "--ros-args" in extra else extra
         argv += words
         extra = extra[len(words) :]
+    if entry.module == "robot_state_publisher" and extra and extra[0].endswith(".urdf"):
+        argv.append(extra.pop(0))  # upstream's URDF-file argument
     if extra:
         if extra[0] != "--ros-args":
             raise CliError("extra arguments must follow --ros-args, as with `ros2 run`")

@@ -45,3 +45,51 @@ def test_urdf_file_argument_and_inline_description(console) -> None:
         "ros2 run robot_state_publisher robot_state_publisher --ros-args -r __node:=rsp_empty"
     )
     assert any("robot_description parameter must not be empty" in line for line in out), out
+
+
+@pytest.mark.parametrize("form", ["file", "xacro"])
+def test_terminal_forms_of_the_tutorials(ros_env, form) -> None:
+    """`ros2-classroom run robot_state_publisher robot_state_publisher ...` in a terminal."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+    from pathlib import Path
+
+    from app import PROJECT_ROOT
+
+    if form == "file":
+        words = [FLEXIBLE]
+    else:
+        xacro = Path(sys.executable).with_name("xacro")
+        model = "ros_python/src/urdf_tutorial/urdf/08-macroed.urdf.xacro"
+        described = subprocess.run(
+            [str(xacro), model], cwd=PROJECT_ROOT, capture_output=True, text=True, check=True
+        )  # what "$(xacro model.urdf.xacro)" gives the shell
+        words = ["--ros-args", "-p", f"robot_description:={described.stdout}"]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "app", "run", "robot_state_publisher", "robot_state_publisher"]
+        + words,
+        cwd=PROJECT_ROOT, env=ros_env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+        text=True, start_new_session=True,
+    )  # fmt: skip
+    lines: list[str] = []
+    try:
+        deadline = time.monotonic() + 30
+        assert proc.stdout is not None
+        while time.monotonic() < deadline:
+            line = proc.stdout.readline()
+            if not line:
+                break
+            lines.append(line)
+            if "Robot initialized" in line:
+                break
+        assert any("Robot initialized" in line for line in lines), lines
+    finally:
+        os.killpg(proc.pid, signal.SIGINT)
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait(timeout=5)
