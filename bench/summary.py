@@ -44,7 +44,7 @@ RUNS: tuple[tuple[str, list[str]], ...] = (
     ("urdf_draw", ["--seconds", "5"]),
     ("tf2_lookup", ["--seconds", "5", "--lookups", "3000"]),
     ("hub_spawn", ["--counts", "1,5", "--seconds", "6"]),  # 20 learners: run it alone
-    ("colcon_build", ["--python-rounds", "2", "--interface-rounds", "1", "--run-rounds", "3"]),
+    ("colcon_build", ["--python-rounds", "4", "--interface-rounds", "2", "--run-rounds", "4"]),
 )
 
 # (figure, benchmark, key ("a|b" shows both), unit, aim text, aim test)
@@ -472,6 +472,14 @@ ROWS += (
         "x",
         "≤ 1.1",
         lambda v: v <= 1.1,
+    ),
+    (
+        "colcon build: CPU seconds of the build processes, Console / direct",
+        "colcon_build",
+        "build_cpu_ratio",
+        "x",
+        "",
+        None,
     ),
     (
         "colcon build, fresh ament_python package: Console / direct",

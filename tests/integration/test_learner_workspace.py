@@ -274,8 +274,11 @@ def test_bad_input_is_one_clear_line(built):
     code, out = console("ros2 pkg create --destination-directory /tmp escaped")
     assert code == 1 and "outside your workspace" in out, out
     (ws.root / "elsewhere").symlink_to("/tmp")
-    code, out = console("ros2 pkg create --destination-directory ../elsewhere escaped")
-    assert code == 1 and "outside your workspace" in out, out
+    try:
+        code, out = console("ros2 pkg create --destination-directory ../elsewhere escaped")
+        assert code == 1 and "outside your workspace" in out, out
+    finally:  # colcon would crawl through it in later tests
+        (ws.root / "elsewhere").unlink()
     code, out = console("source /etc/profile")
     assert code == 1 and "outside your workspace" in out, out
     code, out = console("colcon build --build-base /tmp/x")
@@ -320,6 +323,7 @@ def test_install_space_runs_without_any_module_of_ours(built):
 def test_build_limits_time_and_disk(tmp_path):
     """A setup.py that loops forever, and one that fills the disk: stopped, said so."""
     sup = Supervisor(os.environ)
+    previous = folder.current()
     try:
         for limits, body, expect in (
             (BuildLimits(seconds=4.0), "while True:\n    pass\n", "ran longer than 4 s"),
@@ -354,7 +358,7 @@ def test_build_limits_time_and_disk(tmp_path):
             assert not any(s.active for s in sup.statuses().values())
             assert (root / "src" / "keep.txt").read_text() == "mine\n"
     finally:
-        folder.configure(None)
+        folder.configure(previous)
         sup.shutdown()
 
 
@@ -381,3 +385,32 @@ def test_tutorial_sequence_in_a_terminal(tmp_path):
     assert lines[-3:] == ["my_package my_node", "Hi from my_package.", "exit=2"], lines
     assert "No executable found" in done.stderr, done.stderr
     assert (tmp_path / "ros2_ws" / "install" / "my_package").is_dir()
+
+
+def test_colcon_test_runs_the_generated_linter_tests(built):
+    _ws, console, _log = built
+    code, out = console("colcon test --packages-select my_package")
+    assert code == 0 and "Finished <<< my_package" in out, out
+    code, out = console("colcon test-result --all")
+    assert "3 tests, 0 errors, 0 failures, 1 skipped" in out, out
+
+
+def test_ament_copyright_finds_files_without_a_notice(tmp_path):
+    """Our ament_copyright from outside: a process that imports nothing of app or nodes."""
+    (tmp_path / "good.py").write_text("# Copyright 2026 Ada\nx = 1\n")
+    (tmp_path / "empty.py").write_text("")
+    (tmp_path / "bad.py").write_text("x = 1\n")
+    script = "import sys; from ament_copyright.main import main; sys.exit(main([sys.argv[1]]))"
+    done = subprocess.run(
+        [sys.executable, "-c", script, str(tmp_path)], capture_output=True, text=True, timeout=30
+    )
+    assert done.returncode == 1
+    assert done.stdout.splitlines() == [
+        f"{tmp_path / 'bad.py'}: could not find copyright notice",
+        "1 errors, checked 3 files",
+    ]
+    (tmp_path / "bad.py").unlink()
+    done = subprocess.run(
+        [sys.executable, "-c", script, str(tmp_path)], capture_output=True, text=True, timeout=30
+    )
+    assert (done.returncode, done.stdout.strip()) == (0, "No problems found")
