@@ -17,6 +17,7 @@ from rclpy.node import Node
 from app.ros.context import CONSOLE_LIMITS, CallContext
 from app.ros.graph import GraphSnapshot
 from app.ros2cli.parser import run_text
+from app.ros2cli.workspace_files import WorkspaceFiles
 from app.ui import MarkdownView, code_block
 from app.ui.loop import UiLoop
 
@@ -63,6 +64,7 @@ class ConsolePanel:
         self._run = gui.add_button("Run", icon=viser.Icon.PLAYER_PLAY)
         self._stop = gui.add_button("Stop", icon=viser.Icon.PLAYER_STOP, disabled=True)
         self._view = MarkdownView(gui, "")
+        self._files = WorkspaceFiles(gui, ui)  # the learner's ~/ros2_ws (issue 22)
         self._run.on_click(ui.callback(lambda: self.run(self._command.value)))
         self._stop.on_click(ui.callback(self._cancel))
 
@@ -88,6 +90,7 @@ class ConsolePanel:
 
     def _finished(self, code: int) -> None:
         self._output.write(f"[exit code {code}]")
+        self._files.refresh()  # pkg create and colcon change the workspace
         self._running = None
         self._run.disabled = False
         self._stop.disabled = True

@@ -1,0 +1,132 @@
+"""File operations on the learner's workspace for the page: list, create, rename, delete, edit.
+
+Every path comes from the page and goes through ``LearnerWorkspace.confine``:
+nothing outside the workspace is touched, and the workspace root itself is
+never renamed or deleted. Writes are atomic (``write_atomically``), so a
+failing save leaves the previous file.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+from app.learner_ws.folder import LearnerWorkspace
+from app.ros.errors import Ros2Error
+
+MAX_TEXT_BYTES = 200_000
+MAX_LISTED = 300
+HIDDEN_IN_TREE = {"build", "install", "log", ".colcon", "__pycache__"}
+
+
+class FileError(Ros2Error):
+    """A file operation the page asked for that cannot be done; one line for the learner."""
+
+
+def write_atomically(path: Path, text: str) -> None:
+    """Temporary file, fsync, rename: a reader sees the old text or the new, never half."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}-", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as handle:
+            handle.write(text)
+            handle.flush()
+            os.fsync(handle.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def tree(ws: LearnerWorkspace, limit: int = MAX_LISTED) -> list[str]:
+    """The workspace as indented lines (folders end with '/'); colcon's output folders folded."""
+    root = ws.root
+    lines: list[str] = []
+    for folder, subfolders, files in os.walk(root):
+        depth = len(Path(folder).relative_to(root).parts)
+        folded = sorted(d for d in subfolders if depth == 0 and d in HIDDEN_IN_TREE)
+        subfolders[:] = sorted(
+            d for d in subfolders if not (depth == 0 and d in HIDDEN_IN_TREE) and d[0] != "."
+        )
+        if depth:
+            lines.append("  " * (depth - 1) + Path(folder).name + "/")
+        for name in folded:
+            lines.append(f"{name}/ (colcon's; not listed)")
+        lines += ["  " * depth + name for name in sorted(files)]
+        if len(lines) >= limit:
+            return lines[:limit] + [f"... (more than {limit} entries)"]
+    return lines
+
+
+def _inside(ws: LearnerWorkspace, text: str) -> Path:
+    path = ws.confine(text.strip())
+    if path == ws.root.resolve():
+        raise FileError("that is the workspace itself; name a file or folder inside it")
+    return path
+
+
+def create_file(ws: LearnerWorkspace, text: str) -> Path:
+    path = _inside(ws, text)
+    if path.exists():
+        raise FileError(f"{ws.shown(path)} already exists")
+    write_atomically(path, "")
+    return path
+
+
+def create_folder(ws: LearnerWorkspace, text: str) -> Path:
+    path = _inside(ws, text)
+    if path.exists():
+        raise FileError(f"{ws.shown(path)} already exists")
+    path.mkdir(parents=True)
+    return path
+
+
+def rename(ws: LearnerWorkspace, old: str, new: str) -> Path:
+    source, target = _inside(ws, old), _inside(ws, new)
+    if not source.exists():
+        raise FileError(f"{old}: no such file or folder")
+    if target.exists():
+        raise FileError(f"{ws.shown(target)} already exists")
+    if target == source or source in target.parents:
+        raise FileError("a folder cannot move into itself")
+    target.parent.mkdir(parents=True, exist_ok=True)
+    source.rename(target)
+    return target
+
+
+def delete(ws: LearnerWorkspace, text: str) -> Path:
+    path = _inside(ws, text)
+    if path.is_symlink() or path.is_file():
+        path.unlink()
+    elif path.is_dir():
+        shutil.rmtree(path)
+    else:
+        raise FileError(f"{text}: no such file or folder")
+    return path
+
+
+def read_text(ws: LearnerWorkspace, text: str) -> str:
+    path = _inside(ws, text)
+    if not path.is_file():
+        raise FileError(f"{text}: not a file")
+    if path.stat().st_size > MAX_TEXT_BYTES:
+        raise FileError(f"{text} is larger than {MAX_TEXT_BYTES // 1000} kB; open it elsewhere")
+    data = path.read_bytes()
+    if b"\x00" in data:
+        raise FileError(f"{text} is not a text file")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise FileError(f"{text} is not UTF-8 text") from None
+
+
+def write_text(ws: LearnerWorkspace, text: str, content: str) -> Path:
+    path = _inside(ws, text)
+    if len(content.encode("utf-8")) > MAX_TEXT_BYTES:
+        raise FileError(f"the text is larger than {MAX_TEXT_BYTES // 1000} kB")
+    if path.is_dir():
+        raise FileError(f"{text} is a folder")
+    write_atomically(path, content)
+    return path
