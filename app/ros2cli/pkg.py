@@ -41,6 +41,7 @@ FIRST_WORDS_WITHOUT_DDS = ("colcon", "source")
 SETUP_FILES = ("setup.bash", "setup.sh", "setup.zsh", "local_setup.bash", "local_setup.sh")
 POLL_SEC = 0.1
 DISK_CHECK_SEC = 1.0
+PROGRESS_SEC = 5.0  # a progress line after this long without output
 
 
 def no_dds(words: list[str]) -> bool:
@@ -226,10 +227,18 @@ def follow_build(ctx: CallContext, programs: Any, key: str, ws: LearnerWorkspace
     started = time.monotonic()
     shown = 0
     next_disk_check = started + DISK_CHECK_SEC
+    last_news = started
     reason: str | None = None
     try:
         while True:
+            before = shown
             shown = _write_new(ctx, programs, key, shown)
+            if shown != before:
+                last_news = time.monotonic()
+            elif time.monotonic() - last_news >= PROGRESS_SEC:
+                # colcon is quiet while CMake or setup.py work: say it is alive.
+                last_news = time.monotonic()
+                ctx.write(f"(building for {last_news - started:.0f} s: {_progress(programs, key)})")
             status = programs.status(key)
             if not status.active:
                 shown = _write_new(ctx, programs, key, shown)
@@ -267,6 +276,14 @@ def follow_build(ctx: CallContext, programs: Any, key: str, ws: LearnerWorkspace
     _write_new(ctx, programs, key, shown)
     ctx.write(f"error: {reason}")
     return 1
+
+
+def _progress(programs: Any, key: str) -> str:
+    """How many packages colcon started and finished so far, from its own lines."""
+    lines = programs.output(key)
+    began = sum(line.startswith("Starting >>> ") for line in lines)
+    done = sum(line.startswith(("Finished <<< ", "Failed   <<< ")) for line in lines)
+    return f"{done} of {began} started packages done"
 
 
 def _explain_dash_spelling(ctx: CallContext, lines: list[str]) -> None:

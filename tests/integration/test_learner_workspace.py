@@ -10,6 +10,7 @@ at it from outside with no module of ours imported.
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 import textwrap
@@ -196,6 +197,8 @@ def test_colcon_build_builds_everything(built):
     assert log["build_code"] == "0", log["build"]
     for package in ("my_package", "my_interfaces", "typo_pkg", "dash_pkg"):
         assert f"Finished <<< {package}" in log["build"], log["build"]
+    # While CMake works quietly the Console says the build is alive, and how far it is.
+    assert re.search(r"\(building for \d+ s: \d of \d started packages done\)", log["build"])
     for name in ("build", "install", "log"):
         assert (ws.root / name).is_dir()
     assert (ws.root / "install" / "setup.bash").is_file()
