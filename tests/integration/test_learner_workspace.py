@@ -417,3 +417,33 @@ def test_ament_copyright_finds_files_without_a_notice(tmp_path):
         [sys.executable, "-c", script, str(tmp_path)], capture_output=True, text=True, timeout=30
     )
     assert (done.returncode, done.stdout.strip()) == (0, "No problems found")
+
+
+def test_tutorial_package_names_are_in_the_ament_index(built, probe):
+    """demo_nodes_py talker through the ament index alone: the prefix's script starts the node."""
+    _ws, console, _log = built
+    prefix = console("ros2 pkg prefix demo_nodes_py")[1]
+    assert "/var/ament/tutorial_packages-" in prefix, prefix
+    assert "demo_nodes_py talker" in console("ros2 pkg executables demo_nodes_py")[1]
+    find = (
+        "import os; from ament_index_python import get_package_prefix; "
+        "print(os.path.join(get_package_prefix('demo_nodes_py'), 'lib/demo_nodes_py/talker'))"
+    )
+    script = subprocess.run(
+        [sys.executable, "-c", find], capture_output=True, text=True, timeout=30, check=True
+    ).stdout.strip()
+    node = subprocess.Popen([script], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 30
+        names: list[str] = []
+        while time.monotonic() < deadline and "talker" not in names:
+            names = [n for n, _ns in probe.node.get_node_names_and_namespaces()]
+            time.sleep(0.2)
+        assert "talker" in names, names
+    finally:
+        node.send_signal(2)
+        try:
+            node.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            node.kill()
+            node.wait()
