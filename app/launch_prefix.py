@@ -154,9 +154,18 @@ ROS2LAUNCH_MAIN = Path(ros2launch.__file__ or "ros2launch").resolve().parent / "
 
 
 def launch_env(env: Mapping[str, str] | None = None) -> dict[str, str]:
-    """What a launch program adds to the supervisor's environment: the ament prefixes."""
-    full = with_catalog_prefix(os.environ if env is None else env)
-    return {PREFIX_ENV: full[PREFIX_ENV]}
+    """What a launch program adds to the supervisor's environment, as a sourced shell would.
+
+    The ament prefixes (the Console's sourced workspaces first, the catalog last),
+    and the sourced packages' Python and library folders: a learner's node that
+    imports the learner's own interface package needs all three.
+    """
+    from app.learner_ws.overlay import child_env
+
+    base = os.environ if env is None else env
+    sourced = child_env(base) if env is None else {}
+    full = with_catalog_prefix({**base, **sourced})
+    return {**sourced, PREFIX_ENV: full[PREFIX_ENV]}
 
 
 class LaunchFileNotFound(LookupError):

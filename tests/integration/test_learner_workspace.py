@@ -56,6 +56,17 @@ def main(args=None):
     node.destroy_node()
     rclpy.try_shutdown()
 """
+BOTH_LAUNCH = """\
+from launch import LaunchDescription
+from launch_ros.actions import Node
+
+
+def generate_launch_description():
+    return LaunchDescription([
+        Node(package='my_package', executable='my_node', output='screen'),
+        Node(package='my_package', executable='num_node'),
+    ])
+"""
 
 
 class Console:
@@ -130,6 +141,20 @@ def built(tmp_path_factory):
             pkg / "package.xml",
             "  <test_depend>",
             "  <depend>my_interfaces</depend>\n\n  <test_depend>",
+        )
+        # A launch file installed to share/, as the launch tutorial's setup.py does.
+        (pkg / "launch").mkdir()
+        (pkg / "launch" / "both_launch.py").write_text(BOTH_LAUNCH)
+        _edit(
+            pkg / "setup.py",
+            "from setuptools import",
+            "from glob import glob\n\nfrom setuptools import",
+        )
+        _edit(
+            pkg / "setup.py",
+            "        ('share/' + package_name, ['package.xml']),\n",
+            "        ('share/' + package_name, ['package.xml']),\n"
+            "        ('share/' + package_name + '/launch', glob('launch/*_launch.py')),\n",
         )
         _interface_package(console, src)
         # A typo in console_scripts: the entry names my_nod, the learner runs my_node.
@@ -221,6 +246,26 @@ def test_tutorial_run_needs_source_then_prints_hi(built, probe):
     code, out = console("ros2 run my_package my_node")
     assert code == 0, out
     assert "Hi from my_package." in out.splitlines()
+
+
+def test_launch_file_of_the_learners_package_runs_its_nodes(built, probe):
+    """ros2 launch of an own package: the nodes find the package and its own interfaces."""
+    from app.exercises.runner import RunPolicy
+
+    _ws, console, _log = built
+    console.node = probe.node
+    console.programs.learner_policy = RunPolicy()  # loopback: the learner's own machine
+    console("source install/setup.bash")
+    try:
+        code, out = console("ros2 launch my_package both_launch.py")
+        assert code == 0, out
+        # print() goes to stdout, which launch shows only for output='screen' (as upstream).
+        assert re.search(r"\[my_node-1\] Hi from my_package\.", out), out
+        # num_node imports my_interfaces: PYTHONPATH and LD_LIBRARY_PATH of the overlay.
+        assert 'Publishing: "7", request sums to 6' in out, out
+    finally:
+        console("ros2 launch --stop my_package both_launch.py")
+        console.programs.learner_policy = None
 
 
 def test_pkg_verbs_include_the_sourced_workspace(built):
