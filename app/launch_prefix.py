@@ -160,12 +160,17 @@ def launch_env(env: Mapping[str, str] | None = None) -> dict[str, str]:
     and the sourced packages' Python and library folders: a learner's node that
     imports the learner's own interface package needs all three.
     """
-    from app.learner_ws.overlay import child_env
+    from app.learner_ws.overlay import child_env, overlay
 
     base = os.environ if env is None else env
-    sourced = child_env(base) if env is None else {}
-    full = with_catalog_prefix({**base, **sourced})
-    return {**sourced, PREFIX_ENV: full[PREFIX_ENV]}
+    if env is not None:
+        return {PREFIX_ENV: with_catalog_prefix(base)[PREFIX_ENV]}
+    # Not child_env's whole search path: its fallback underlay (the venv, whose
+    # turtlesim holds only interfaces) must not hide the catalog's turtlesim.
+    front = [str(p) for p in overlay()]
+    rest = [p for p in base.get(PREFIX_ENV, "").split(os.pathsep) if p and p not in front]
+    full = with_catalog_prefix({PREFIX_ENV: os.pathsep.join(front + rest)})
+    return {**child_env(base), PREFIX_ENV: full[PREFIX_ENV]}
 
 
 class LaunchFileNotFound(LookupError):
