@@ -3,9 +3,10 @@
 viser's HTML element has no click callback, yet a drawing is often the best
 control: the lifecycle state machine's edges *are* the transitions. A link
 can still reach us. It points at ``classroom/act/<secret>/<name>`` (relative
-to the page, so it works under any base path) on viser's own web server, which runs the action registered under ``name`` and
-answers ``204 No Content``; the link targets a hidden frame, so the page
-never navigates away whatever the answer.
+to the page, so it works under any base path) on viser's own web server,
+which runs the action registered under ``name`` and answers ``204 No
+Content``; the link targets a hidden frame, so the page never navigates away
+whatever the answer.
 
 The secret is random per dashboard and only ever travels inside panels' HTML
 over the dashboard's own websocket, so another web site cannot forge a link

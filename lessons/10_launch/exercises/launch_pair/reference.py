@@ -27,4 +27,3 @@ def generate_launch_description():
             ),
         ]
     )
-

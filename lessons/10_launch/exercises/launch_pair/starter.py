@@ -23,4 +23,3 @@ def generate_launch_description():
             #         "chatter" remapped to "greeting".
         ]
     )
-
