@@ -69,11 +69,6 @@ class ArgumentUsageError(UsageError):
         self.as_ros2 = f"{prog}: error: {message}"
 
 
-# Groups whose argparse mistakes still read as one 'error: ...' line (not yet
-# compared with ros2cli's; their owners decide).
-_ONE_LINE_ERRORS = {"run", "launch", "pkg", "bag"}
-
-
 def split_command(text: str) -> list[str]:
     """Split like a shell would quote, never run one; drop a leading 'ros2'."""
     try:
@@ -265,11 +260,9 @@ def run_argv(
             settle_discovery(ctx)
         return args.handler(ctx, args)
     except ArgumentUsageError as exc:
-        if argv[:1] and argv[0] in _ONE_LINE_ERRORS:
-            ctx.write(f"error: {exc}")
-        else:
-            for line in [*exc.usage.rstrip("\n").split("\n"), exc.as_ros2]:
-                (note or ctx.write)(line)
+        # Every verb as ros2's argparse says it: the usage, then 'ros2 VERB: error: ...'.
+        for line in [*exc.usage.rstrip("\n").split("\n"), exc.as_ros2]:
+            (note or ctx.write)(line)
         return EXIT_USAGE
     except UsageError as exc:
         ctx.write(f"error: {exc}")
