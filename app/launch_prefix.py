@@ -145,7 +145,12 @@ def with_catalog_prefix(env: Mapping[str, str], prefix: Path | None = None) -> d
     prefix = prefix or catalog_prefix()
     out = dict(env)
     paths = [p for p in out.get(PREFIX_ENV, "").split(os.pathsep) if p and p != str(prefix)]
-    out[PREFIX_ENV] = os.pathsep.join([*paths, str(prefix)])
+    # Before the venv's own prefix, never after it: the wheels' turtlesim there
+    # holds only the interfaces, and would hide the catalog's turtlesim (its
+    # executables and launch files), as one package of a real install would not.
+    wheels = os.path.realpath(sys.prefix)
+    at = next((i for i, p in enumerate(paths) if os.path.realpath(p) == wheels), len(paths))
+    out[PREFIX_ENV] = os.pathsep.join([*paths[:at], str(prefix), *paths[at:]])
     return out
 
 

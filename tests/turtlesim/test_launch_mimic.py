@@ -113,7 +113,8 @@ def test_multisim_runs_two_turtlesims_and_mimic_couples_them(console, probe, sup
 def test_bad_launch_commands_give_one_error_line(console, supervisor, text, message):  # noqa: F811
     code, out = console(text)
     assert code != 0
-    errors = [line for line in out if line.startswith("error:")]
+    # Our errors read 'error: ...'; argparse's, as ros2 prints them, 'ros2 launch: error: ...'.
+    errors = [line for line in out if line.startswith(("error:", "ros2 launch: error:"))]
     assert len(errors) == 1 and message in errors[0], out
     assert not supervisor.statuses()  # nothing was started
 

@@ -104,3 +104,15 @@ def test_launch_print_shows_the_launch_file():
     assert result.returncode == 0, result.stderr
     assert result.stdout == launch_file_text("fibonacci")
     assert 'executable="fibonacci_action_client"' in result.stdout
+
+
+def test_catalog_turtlesim_is_found_before_the_wheels_turtlesim(monkeypatch):
+    """Once something set AMENT_PREFIX_PATH to the venv (as `ros2 interface` does),
+    the wheels' turtlesim (interfaces only) must not hide the catalog's launch files."""
+    import sys
+
+    from app.launch_prefix import find_launch_file
+
+    monkeypatch.setenv("AMENT_PREFIX_PATH", sys.prefix)
+    found = find_launch_file("turtlesim", "multisim.launch.py")
+    assert found.name == "multisim.launch.py" and found.is_file()
