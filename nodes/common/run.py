@@ -13,7 +13,9 @@ what was made (a signal can arrive at any point of start-up). A node's
 
 from __future__ import annotations
 
+import signal
 import sys
+import threading
 from collections.abc import Callable
 from typing import TypeVar
 
@@ -50,6 +52,8 @@ def spin_node(
     """
     node: NodeT | None = None
     spinner: Executor | None = None
+    spinning = threading.Event()
+    _sigint_ends_spin_quietly(spinning)
     try:
         rclpy.init(args=args)
         try:
@@ -59,6 +63,7 @@ def spin_node(
                 raise
             print(f"{program}: error: {exc}", file=sys.stderr)
             raise SystemExit(EXIT_BAD_PARAMETER) from None
+        spinning.set()
         if executor is None:
             rclpy.spin(node)
         else:
@@ -79,6 +84,28 @@ def spin_node(
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
+
+
+def _sigint_ends_spin_quietly(spinning: threading.Event) -> None:
+    """Ctrl+C while spinning ends the spin the way SIGTERM does, not by KeyboardInterrupt.
+
+    rclpy's own signal handler shuts the context down, so spin() returns by
+    ExternalShutdownException. Python's default handler would also raise
+    KeyboardInterrupt at whatever line runs at that moment; inside rclpy's
+    executor that can be halfway through building a Task, whose ``__del__``
+    then prints a traceback as the process ends. Before spinning (start-up),
+    Ctrl+C stays a KeyboardInterrupt. Set before ``rclpy.init``, which
+    chains its handler to this one (setting a handler afterwards would
+    replace rclpy's).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return
+
+    def on_sigint(signum: int, frame: object) -> None:
+        if not spinning.is_set():
+            raise KeyboardInterrupt
+
+    signal.signal(signal.SIGINT, on_sigint)
 
 
 def _make_executor(factory: type[Executor] | Callable[[NodeT], Executor], node: NodeT) -> Executor:

@@ -8,9 +8,7 @@ part against what a Gazebo user would expect of the robot's drivers.
 
 from __future__ import annotations
 
-import json
 import math
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -20,8 +18,7 @@ import pytest
 
 from app import PROJECT_ROOT
 from app.catalog import lookup_group
-from app.dds import configure_dds_env
-from tests.conftest import ARTIFACTS, _domain_ids, fail_on_leftover_nodes, in_private_netns
+from tests.outside_report import part, private_dds_env, run_outside_client
 
 pytestmark = pytest.mark.ros
 
@@ -32,53 +29,14 @@ LIDAR_NOISE = 0.01  # m, the scanner's standard deviation
 
 @pytest.fixture(scope="module")
 def env() -> dict[str, str]:
-    if not in_private_netns():
-        pytest.fail("DDS tests must run inside a private network namespace (tests/run.py)")
-    env = dict(os.environ)
-    configure_dds_env(env, domain_id=next(_domain_ids) % 100 + 1, network=False)
-    return env
+    return private_dds_env()
 
 
 @pytest.fixture(scope="module")
 def report(env, tmp_path_factory) -> dict:
-    from app.supervisor import Supervisor
-
-    supervisor = Supervisor(env)
-    try:
-        for member in lookup_group("sim_drive").members:  # sim_world and the teleop
-            supervisor.start(member)
-        clean = {k: v for k, v in env.items() if k not in ("PYTHONPATH", "PYTHONSTARTUP")}
-        done = subprocess.run(
-            [sys.executable, "-I", str(CLIENT)],
-            cwd=tmp_path_factory.mktemp("outside"),
-            env={**clean, "PYTHONUNBUFFERED": "1"},
-            capture_output=True,
-            text=True,
-            timeout=150,
-            check=False,
-        )
-        log = supervisor.output("sim_world")
-        status = supervisor.status("sim_world")
-    finally:
-        supervisor.shutdown()
-    fail_on_leftover_nodes("the sim_world tests")
-    ARTIFACTS.mkdir(exist_ok=True)
-    (ARTIFACTS / "sim-client.out").write_text(f"{done.stdout}\n{done.stderr}")
-    assert done.returncode == 0, done.stderr[-3000:]
-    result = json.loads(done.stdout.strip().splitlines()[-1])
-    result["node_log"] = log
-    result["node_alive_at_end"] = status.active
-    (ARTIFACTS / "sim-client.json").write_text(json.dumps(result, indent=1))
-    return result
-
-
-def part(report: dict, name: str) -> dict:
-    data = report.get(name)
-    assert data is not None, f"scenario {name} did not run"
-    assert "error" not in data, f"{name}: {data['error']}\nnode log:\n" + "\n".join(
-        report["node_log"][-30:]
-    )
-    return data
+    members = list(lookup_group("sim_drive").members)  # sim_world and the teleop
+    folder = tmp_path_factory.mktemp("outside")
+    return run_outside_client(env, folder, CLIENT, members, "sim_world", "sim")
 
 
 def test_the_client_is_plain_rclpy_and_the_world_survived_everything(report):

@@ -10,18 +10,13 @@ upstream's behaviour.
 
 from __future__ import annotations
 
-import json
 import math
-import os
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
-from app.dds import configure_dds_env
-from tests.conftest import ARTIFACTS, _domain_ids, fail_on_leftover_nodes, in_private_netns
+from tests.outside_report import part, private_dds_env, run_outside_client
 
 pytestmark = pytest.mark.ros
 
@@ -34,47 +29,11 @@ UNPAINTED = [255, 255, 255]
 
 @pytest.fixture(scope="module")
 def report(tmp_path_factory) -> dict:
-    if not in_private_netns():
-        pytest.fail("DDS tests must run inside a private network namespace (tests/run.py)")
-    from app.supervisor import Supervisor
-
-    env = dict(os.environ)
-    configure_dds_env(env, domain_id=next(_domain_ids) % 100 + 1, network=False)
-    supervisor = Supervisor(env)
-    try:
-        supervisor.start("turtlesim_node")
-        clean = {k: v for k, v in env.items() if k not in ("PYTHONPATH", "PYTHONSTARTUP")}
-        done = subprocess.run(
-            [sys.executable, "-I", str(CLIENT)],  # -I: no user site, no cwd on sys.path
-            cwd=tmp_path_factory.mktemp("outside"),
-            env={**clean, "PYTHONUNBUFFERED": "1"},
-            capture_output=True,
-            text=True,
-            timeout=150,
-            check=False,
-        )
-        log = supervisor.output("turtlesim_node")
-        status = supervisor.status("turtlesim_node")
-    finally:
-        supervisor.shutdown()
-    fail_on_leftover_nodes("the turtlesim tests")
-    ARTIFACTS.mkdir(exist_ok=True)
-    (ARTIFACTS / "turtlesim-client.out").write_text(f"{done.stdout}\n{done.stderr}")
-    assert done.returncode == 0, done.stderr[-3000:]
-    result = json.loads(done.stdout.strip().splitlines()[-1])
-    result["node_log"] = log
-    result["node_alive_at_end"] = status.active
-    (ARTIFACTS / "turtlesim-client.json").write_text(json.dumps(result, indent=1))
-    return result
-
-
-def part(report: dict, name: str) -> dict:
-    data = report.get(name)
-    assert data is not None, f"scenario {name} did not run: {report}"
-    assert "error" not in data, f"{name}: {data['error']}\nnode log:\n" + "\n".join(
-        report["node_log"][-30:]
+    folder = tmp_path_factory.mktemp("outside")
+    env = private_dds_env()
+    return run_outside_client(
+        env, folder, CLIENT, ["turtlesim_node"], "turtlesim_node", "turtlesim"
     )
-    return data
 
 
 def test_the_client_is_plain_rclpy_and_the_node_survived(report):
