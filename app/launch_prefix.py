@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import hashlib
 import os
-import shutil
 import sys
 import tempfile
 from collections.abc import Mapping
@@ -32,6 +31,7 @@ from typing import Protocol
 
 import ros2launch
 
+from app.ament_prefix import write_prefix
 from app.catalog import ENTRIES, GROUPS, CatalogEntry
 from app.launch import PACKAGE, launch_file_text
 from app.supervisor import LearnerProgram
@@ -115,29 +115,7 @@ def catalog_prefix(parent: Path | None = None) -> Path:
         repr(sorted(files.items())).encode() + sys.executable.encode()
     ).hexdigest()[:16]
     parent = parent or Path(tempfile.gettempdir()) / f"ros2_classroom_ament_{os.getuid()}"
-    prefix = parent / digest
-    if (prefix / ".complete").is_file():
-        return prefix
-    parent.mkdir(parents=True, exist_ok=True)
-    parent.chmod(0o755)
-    staging = Path(tempfile.mkdtemp(prefix=".staging-", dir=parent))
-    try:
-        for relative, content in files.items():
-            path = staging / relative
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(content, encoding="utf-8")
-            path.chmod(0o755 if relative.startswith("lib/") else 0o644)
-        (staging / ".complete").write_text("", encoding="utf-8")
-        for folder, _dirs, _files_in in os.walk(staging):
-            os.chmod(folder, 0o755)
-        try:
-            staging.rename(prefix)
-        except OSError:  # another process finished first: theirs is the same
-            shutil.rmtree(staging, ignore_errors=True)
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise
-    return prefix
+    return write_prefix(parent / digest, files)
 
 
 def with_catalog_prefix(env: Mapping[str, str], prefix: Path | None = None) -> dict[str, str]:

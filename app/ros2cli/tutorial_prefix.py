@@ -18,14 +18,12 @@ app.ros2cli.tutorial_prefix`` writes it and prints the path.
 from __future__ import annotations
 
 import hashlib
-import os
 import shlex
-import shutil
 import sys
-import tempfile
 from pathlib import Path
 
 from app import PROJECT_ROOT
+from app.ament_prefix import write_prefix
 from app.catalog import lookup
 from app.ros2cli.run import _UPSTREAM
 
@@ -75,28 +73,7 @@ def tutorial_prefix(parent: Path = PARENT) -> Path:
     """The prefix for the current catalog, written if missing (atomic rename)."""
     content = files()
     digest = hashlib.sha256(repr(sorted(content.items())).encode()).hexdigest()[:12]
-    prefix = parent / f"tutorial_packages-{digest}"
-    if (prefix / ".complete").is_file():
-        return prefix
-    parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=".staging-", dir=parent))
-    try:
-        for relative, text in content.items():
-            path = staging / relative
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(text, encoding="utf-8")
-            path.chmod(0o755 if relative.startswith("lib/") else 0o644)
-        (staging / ".complete").write_text("", encoding="utf-8")
-        for folder, _dirs, _names in os.walk(staging):
-            os.chmod(folder, 0o755)
-        try:
-            staging.rename(prefix)
-        except OSError:  # another process wrote the same prefix first
-            shutil.rmtree(staging, ignore_errors=True)
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise
-    return prefix
+    return write_prefix(parent / f"tutorial_packages-{digest}", content)
 
 
 if __name__ == "__main__":
