@@ -56,13 +56,8 @@ def strategy(p: argparse.ArgumentParser) -> None:
     )
 
 
-def add_node(v: Any, verb: Verb) -> None:
-    p = verb(
-        v,
-        "list",
-        "Output a list of available nodes",
-        lambda c, a: graph_verbs.node_list(c, a.all, a.count_nodes),
-    )
+def _node_listing_options(p: Any) -> None:
+    """`ros2 node list` and `ros2 lifecycle nodes` take the same options."""
     strategy(p)
     p.add_argument("-a", "--all", action="store_true", help="Display all nodes even hidden ones")
     p.add_argument(
@@ -72,6 +67,16 @@ def add_node(v: Any, verb: Verb) -> None:
         help="Only display the number of nodes discovered",
     )
     unsupported(p, *_STRATEGY_UNSUPPORTED)
+
+
+def add_node(v: Any, verb: Verb) -> None:
+    p = verb(
+        v,
+        "list",
+        "Output a list of available nodes",
+        lambda c, a: graph_verbs.node_list(c, a.all, a.count_nodes),
+    )
+    _node_listing_options(p)
     p = verb(
         v,
         "info",
@@ -618,15 +623,7 @@ def add_lifecycle(v: Any, verb: Verb) -> None:
         "Output a list of nodes with lifecycle",
         lambda c, a: lifecycle.verb_nodes(c, a.count_nodes, a.all),
     )
-    strategy(p)
-    p.add_argument("-a", "--all", action="store_true", help="Display all nodes even hidden ones")
-    p.add_argument(
-        "-c",
-        "--count-nodes",
-        action="store_true",
-        help="Only display the number of nodes discovered",
-    )
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
+    _node_listing_options(p)
 
     p = verb(
         v,
