@@ -140,6 +140,10 @@ FAILING_CHECKS = [
     ),
     Spec("rosout_contains", {"node": "/nobody_here", "text": "hello"}),
     Spec("moves_like", {"topic": "/silent", "type": "turtlesim/msg/Pose", "like": "/silent2"}),
+    Spec("tf_frame", {"frame": "base", "parent": "world"}),
+    Spec("tf_transform", {"target": "world", "source": "base", "tolerance": 0.01}),
+    Spec("tf_moves", {"frame": "base", "at_least": 0.1}),
+    Spec("tf_late_joiner", {"frame": "base"}),
     Spec("quiz", {"question": "2+2?", "options": ["3", "4"], "answer": "4"}),
 ]
 
