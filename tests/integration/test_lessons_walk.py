@@ -7,11 +7,14 @@ also fail: a check that cannot fail is a defect.
 
 from __future__ import annotations
 
+import os
 import threading
 
 import pytest
 
 from app.bags import folder as bag_folder
+from app.learner_ws import folder as ws_folder
+from app.learner_ws import overlay
 from app.lessons.kinds import CHECK_KINDS
 from app.lessons.runtime import FAIL, PASS, LessonRuntime
 from app.lessons.schema import Spec, load_course
@@ -73,8 +76,43 @@ def live(dashboard_node, supervisor, tmp_path, monkeypatch):
     thread.join()
 
 
+# Kinds that read or write the learner's own workspace (~/ros2_ws): a lesson with one
+# gets a fresh workspace, as the dashboard gives each learner.
+WORKSPACE_KINDS = {
+    "workspace_command", "workspace_write", "workspace_edit", "stop_own", "package_created",
+    "package_built", "package_sourced", "workspace_file", "own_node",
+}  # fmt: skip
+
+
+@pytest.fixture
+def learner_workspace(tmp_path, supervisor):
+    """The dashboard's learner workspace (app.ros2cli.pkg.setup_workspace), undone after."""
+    from app.exercises.runner import RunPolicy
+    from app.ros2cli.pkg import setup_workspace
+
+    saved, underlay = os.environ.get(overlay.PREFIX_ENV), overlay.underlay()
+    supervisor.learner_policy = RunPolicy()  # the dashboard on loopback: the learner's machine
+    try:
+        yield setup_workspace(tmp_path / "progress" / "ada.json", remote=False)
+    finally:
+        overlay.forget()
+        overlay.set_underlay(underlay)
+        ws_folder.configure(None)
+        if saved is None:
+            os.environ.pop(overlay.PREFIX_ENV, None)
+        else:
+            os.environ[overlay.PREFIX_ENV] = saved
+
+
+def _uses_workspace(lesson) -> bool:
+    specs = [spec for step in lesson.steps for spec in (*step.actions, *step.checks)]
+    return any(spec.kind in WORKSPACE_KINDS for spec in specs)
+
+
 @pytest.mark.parametrize("lesson", COURSE.lessons, ids=lambda lesson: lesson.id)
-def test_every_step_of_the_lesson_passes_on_real_nodes(live, lesson):
+def test_every_step_of_the_lesson_passes_on_real_nodes(live, lesson, request):
+    if _uses_workspace(lesson):
+        request.getfixturevalue("learner_workspace")
     for index, step in enumerate(lesson.steps):
         for action in step.actions:
             if action.kind == "send_goal" or action.kind.startswith("call"):
@@ -144,11 +182,16 @@ FAILING_CHECKS = [
     Spec("tf_transform", {"target": "world", "source": "base", "tolerance": 0.01}),
     Spec("tf_moves", {"frame": "base", "at_least": 0.1}),
     Spec("tf_late_joiner", {"frame": "base"}),
+    Spec("package_created", {"package": "no_such_pkg"}),
+    Spec("package_built", {"package": "no_such_pkg"}),
+    Spec("package_sourced", {"package": "no_such_pkg"}),
+    Spec("workspace_file", {"path": "src/nothing.txt"}),
+    Spec("own_node", {"ros_node": "/minimal_publisher"}),
     Spec("quiz", {"question": "2+2?", "options": ["3", "4"], "answer": "4"}),
 ]
 
 
-def test_every_check_kind_can_fail(live):
+def test_every_check_kind_can_fail(live, learner_workspace):
     assert {spec.kind for spec in FAILING_CHECKS} == set(CHECK_KINDS)
     live.quiz_answers[FAILING_CHECKS[-1].key] = "3"
     wait_until(lambda: live.graph.has_node("/classroom_dashboard"), what="our node in the graph")
