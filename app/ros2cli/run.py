@@ -246,7 +246,8 @@ def program_args(entry: CatalogEntry, words: list[str]) -> tuple[str, ...]:
         return tool_args.check_words(entry.module, words)
     if not words:
         return entry.args
-    if entry.module == "robot_state_publisher" and len(words) == 1 and words[0].endswith(".urdf"):
+    urdf_file = len(words) == 1 and words[0].endswith((".urdf", ".urdf.xml"))
+    if entry.module == "robot_state_publisher" and urdf_file:
         return (str(Path(words[0]).expanduser()),)  # upstream's URDF-file fallback (cwd: project)
     if len(words) != len(entry.args) or not all(re.fullmatch(r"-?\d+", w) for w in words):
         takes = f"{len(entry.args)} whole numbers" if entry.args else "no arguments"
