@@ -8,7 +8,7 @@ fields the loader validates) and ``PROBES`` (the code).
 
 from __future__ import annotations
 
-from app.exercises.probes import behaviour, core, perception
+from app.exercises.probes import behaviour, core, perception, tf
 from app.exercises.probes.base import Probe, ProbeContext
 from app.exercises.report import Result
 from app.lessons.kinds import Kind
@@ -19,7 +19,7 @@ PROBE_KINDS: dict[str, Kind] = {}
 PROBES: dict[str, Probe] = {}
 # Inputs a kind draws in its own code (not from ranges in the data), in words for teachers.
 PROBE_DRAWS: dict[str, str] = {}
-for _module in (core, perception, behaviour):
+for _module in (core, perception, behaviour, tf):
     if set(_module.KINDS) != set(_module.PROBES) or set(_module.KINDS) & set(PROBE_KINDS):
         raise RuntimeError(f"{_module.__name__}: probe kinds without code, or defined twice")
     PROBE_KINDS.update(_module.KINDS)

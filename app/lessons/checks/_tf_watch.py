@@ -88,9 +88,21 @@ class TfWatch:
             return sorted(self.frames)
 
     def close(self) -> None:
-        for subscription in self._subscriptions:
-            self.node.destroy_subscription(subscription)
+        """Destroy the watch's subscriptions and any a check made (late joiners)."""
+        extra = [m["joiner"].subscription for m in self.memory.values() if isinstance(m, dict)
+                 and getattr(m.get("joiner"), "subscription", None) is not None]  # fmt: skip
+        for subscription in [*self._subscriptions, *extra]:
+            try:
+                self.node.destroy_subscription(subscription)
+            except Exception:  # the node is gone already: nothing left to free
+                pass
         self._subscriptions = []
+        self.memory.clear()
+
+    def parent_of_others(self, name: str) -> list[str]:
+        """The children that name ``name`` as their parent."""
+        with self.lock:
+            return sorted(child for child, info in self.frames.items() if info.parent == name)
 
 
 _WATCHES: weakref.WeakKeyDictionary[LessonRuntime, TfWatch] = weakref.WeakKeyDictionary()
@@ -103,6 +115,8 @@ def watch_of(rt: LessonRuntime) -> TfWatch:
         watch = _WATCHES.get(rt)
         if watch is None:
             watch = _WATCHES[rt] = TfWatch(rt.node)
+            # The runtime's life is the watch's: its subscriptions go when the runtime goes.
+            weakref.finalize(rt, watch.close)
         return watch
 
 

@@ -23,6 +23,13 @@ def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
     if info is None:
         if nobody_publishes(rt):
             return CheckResult(FAIL, "nobody publishes /tf or /tf_static")
+        children = watch.parent_of_others(c["frame"])
+        if children:
+            return CheckResult(
+                WAITING,
+                f"'{c['frame']}' is only a parent so far (of {', '.join(children)}): "
+                "child_frame_id names the frame described, header.frame_id its parent",
+            )
         return CheckResult(WAITING, f"no frame '{c['frame']}' yet ({known_text(watch)})")
     where = "/tf_static" if info.static else "/tf"
     if info.parent != c["parent"]:

@@ -1,0 +1,260 @@
+"""Probes for the tf2 exercises: the grader moves turtles and judges the frames and turtles.
+
+``turtle_frame``: the grader teleports a turtle to poses drawn at grading
+time and compares the learner's ``world -> turtle`` transform on /tf with
+each pose. ``turtle_follow``: the grader puts the leader turtle at random
+places, one after another, and the follower (steered by the learner's tf2
+listener) must come within a bound of it each time.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from dataclasses import dataclass
+
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from tf2_msgs.msg import TFMessage
+from turtlesim.msg import Pose
+from turtlesim.srv import TeleportAbsolute
+
+from app.exercises.probes.base import Probe, ProbeContext
+from app.exercises.report import Result
+from app.lessons.kinds import make_kind
+from app.lessons.schema import Spec
+from app.ros.calls import call_service
+from app.ros.errors import Ros2Error
+from app.ros.monitor import TopicMonitor
+
+WORLD_MIN, WORLD_MAX = 1.5, 9.5  # teleport targets: inside turtlesim's 11 m world, off the walls
+STATIC_QOS = QoSProfile(
+    depth=100, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+)
+
+
+@dataclass(frozen=True)
+class Seen:
+    """One transform as it arrived: when, its parent, translation and yaw."""
+
+    arrival: float
+    parent: str
+    x: float
+    y: float
+    z: float
+    yaw: float
+    unit: bool  # the quaternion has length 1 (within 1e-3)
+
+
+def yaw_of(x: float, y: float, z: float, w: float) -> float:
+    """Yaw of a quaternion (normalised first, so a wrong length cannot hide a wrong angle)."""
+    n = math.sqrt(x * x + y * y + z * z + w * w) or 1.0
+    x, y, z, w = x / n, y / n, z / n, w / n
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def angle_between(a: float, b: float) -> float:
+    return abs(math.atan2(math.sin(a - b), math.cos(a - b)))
+
+
+class FrameTap:
+    """Every transform on /tf and /tf_static, newest per child frame (executor thread writes)."""
+
+    def __init__(self, ctx: ProbeContext) -> None:
+        self._node = ctx.call.node
+        self._lock = threading.Lock()
+        self.newest: dict[str, Seen] = {}
+        self._subs = [
+            self._node.create_subscription(TFMessage, "/tf", self._on_tf, 100),
+            self._node.create_subscription(TFMessage, "/tf_static", self._on_tf, STATIC_QOS),
+        ]
+
+    def _on_tf(self, msg: TFMessage) -> None:
+        now = time.monotonic()
+        with self._lock:
+            for t in msg.transforms:
+                v, r = t.transform.translation, t.transform.rotation
+                length = math.sqrt(r.x**2 + r.y**2 + r.z**2 + r.w**2)
+                self.newest[t.child_frame_id] = Seen(
+                    now,
+                    t.header.frame_id,
+                    v.x,
+                    v.y,
+                    v.z,
+                    yaw_of(r.x, r.y, r.z, r.w),
+                    abs(length - 1.0) < 1e-3,
+                )
+
+    def get(self, child: str) -> Seen | None:
+        with self._lock:
+            return self.newest.get(child)
+
+    def children_of(self) -> dict[str, str]:
+        with self._lock:
+            return {child: seen.parent for child, seen in self.newest.items()}
+
+    def close(self) -> None:
+        for sub in self._subs:
+            self._node.destroy_subscription(sub)
+
+
+def _teleport(ctx: ProbeContext, turtle: str, x: float, y: float, theta: float) -> None:
+    request = TeleportAbsolute.Request(x=x, y=y, theta=theta)
+    call_service(ctx.call, f"/{turtle}/teleport_absolute", TeleportAbsolute, request, timeout=3.0)
+
+
+def _pose_text(x: float, y: float, yaw: float) -> str:
+    return f"(x={x:.2f}, y={y:.2f}, yaw={yaw:.2f})"
+
+
+def _frame_mistake(seen: Seen, x: float, y: float, theta: float, tol: float) -> str:
+    """What a wrong transform most likely got wrong, in words."""
+    if not seen.unit:
+        return (
+            "the rotation is not a unit quaternion: compute it from theta with sin/cos of theta/2"
+        )
+    if math.hypot(seen.x - y, seen.y - x) < tol and math.hypot(seen.x - x, seen.y - y) >= tol:
+        return "x and y are swapped"
+    if math.hypot(seen.x - x, seen.y - y) >= tol:
+        return "the translation is not the turtle's position"
+    if angle_between(seen.yaw, -theta) < 0.05:
+        return "the heading has the wrong sign"
+    return "the heading (rotation about z) is not the turtle's theta"
+
+
+def turtle_frame(ctx: ProbeContext, p: Spec) -> Result:
+    """Teleport the turtle to random poses; /tf must carry parent -> turtle at each pose."""
+    turtle, parent = p.get("turtle", "turtle1"), p.get("parent", "world")
+    tol, count = float(p.get("tolerance", 0.01)), int(p.get("poses", 4))
+    name = f"frame {parent} -> {turtle} follows the pose"
+    tap = FrameTap(ctx)
+    tried: list[str] = []
+    try:
+        for _ in range(count):
+            x = round(ctx.rng.uniform(WORLD_MIN, WORLD_MAX), 2)
+            y = round(ctx.rng.uniform(WORLD_MIN, WORLD_MAX), 2)
+            theta = round(ctx.rng.uniform(-3.0, 3.0), 2)
+            asked = time.monotonic()
+            try:
+                _teleport(ctx, turtle, x, y, theta)
+            except Ros2Error as exc:
+                return Result(name, False, f"could not teleport {turtle}: {exc}")
+            deadline = asked + float(p.get("within", 3.0))
+            seen = None
+            while time.monotonic() < deadline:
+                seen = tap.get(turtle)
+                if seen is not None and seen.arrival > asked + 0.1 and seen.parent == parent:
+                    if (
+                        math.hypot(seen.x - x, seen.y - y) < tol
+                        and abs(seen.z) < tol
+                        and angle_between(seen.yaw, theta) < 0.02
+                        and seen.unit
+                    ):
+                        break
+                ctx.call.sleep(0.05)
+            else:
+                want = _pose_text(x, y, theta)
+                if seen is None:
+                    frames = tap.children_of()
+                    heard = ", ".join(f"{a} -> {c}" for c, a in frames.items()) or "nothing"
+                    return Result(
+                        name, False, f"no transform for the child frame '{turtle}' on /tf "
+                        f"(heard: {heard})"
+                    )  # fmt: skip
+                if seen.parent != parent:
+                    return Result(
+                        name,
+                        False,
+                        f"'{turtle}' has the parent '{seen.parent}' on /tf; expected the parent "
+                        f"'{parent}' (header.frame_id is the parent, child_frame_id the turtle)",
+                    )
+                if seen.arrival <= asked + 0.1:
+                    return Result(
+                        name, False, f"teleported {turtle} to {want}; no new transform came after"
+                    )
+                got = _pose_text(seen.x, seen.y, seen.yaw)
+                return Result(
+                    name,
+                    False,
+                    f"teleported {turtle} to {want}; /tf says {got}: "
+                    f"{_frame_mistake(seen, x, y, theta, tol)}",
+                )
+            tried.append(_pose_text(x, y, theta))
+        return Result(name, True, f"{count} random poses, each on /tf, e.g. {tried[0]}")
+    finally:
+        tap.close()
+
+
+def _distance(leader: TopicMonitor, follower: TopicMonitor) -> float | None:
+    a, b = leader.message(), follower.message()
+    if a is None or b is None:
+        return None
+    return math.hypot(a[1].x - b[1].x, a[1].y - b[1].y)
+
+
+def turtle_follow(ctx: ProbeContext, p: Spec) -> Result:
+    """Put the leader at random places; each time the follower must come within ``bound``."""
+    lead, follow = p.get("leader", "turtle1"), p.get("follower", "turtle2")
+    bound, within = float(p.get("bound", 1.0)), float(p.get("within", 15.0))
+    name = f"{follow} follows {lead}"
+    node = ctx.call.node
+    leader = TopicMonitor(node, f"/{lead}/pose", Pose, keep=5, qos=10)
+    follower = TopicMonitor(node, f"/{follow}/pose", Pose, keep=5, qos=10)
+    done: list[str] = []
+    try:
+        deadline = time.monotonic() + float(p.get("spawn_within", 10.0))
+        while follower.message() is None or leader.message() is None:
+            if time.monotonic() > deadline:
+                return Result(
+                    name, False, f"no pose on /{follow}/pose: spawn {follow} (the /spawn service)"
+                )
+            ctx.call.sleep(0.2)
+        for move in range(int(p.get("moves", 2))):
+            newest = follower.message()
+            assert newest is not None
+            fx, fy = newest[1].x, newest[1].y
+            while True:  # a place at least 3 m from the follower: a real chase
+                x = round(ctx.rng.uniform(WORLD_MIN, WORLD_MAX), 2)
+                y = round(ctx.rng.uniform(WORLD_MIN, WORLD_MAX), 2)
+                if math.hypot(x - fx, y - fy) >= 3.0:
+                    break
+            try:
+                _teleport(ctx, lead, x, y, round(ctx.rng.uniform(-3.0, 3.0), 2))
+            except Ros2Error as exc:
+                return Result(name, False, f"could not teleport {lead}: {exc}")
+            start = time.monotonic()
+            ctx.call.sleep(0.3)
+            trace = [_distance(leader, follower) or 0.0]
+            closest = trace[0]
+            while (d := _distance(leader, follower) or math.inf) > bound:
+                closest = min(closest, d)
+                if time.monotonic() - start > within:
+                    trace.append(d)
+                    way = "grew" if trace[-1] > trace[0] + 0.2 else "did not close"
+                    return Result(
+                        name,
+                        False,
+                        f"move {move + 1}: put {lead} at ({x:.2f}, {y:.2f}); in {within:g} s the "
+                        f"distance {way}: {trace[0]:.2f} m -> {trace[-1]:.2f} m (closest "
+                        f"{closest:.2f} m, needed below {bound:g} m)",
+                    )
+                ctx.call.sleep(0.1)
+            done.append(f"{trace[0]:.1f} m -> {d:.2f} m in {time.monotonic() - start:.1f} s")
+        return Result(name, True, f"{follow} caught up after every move: {'; '.join(done)}")
+    finally:
+        leader.close()
+        follower.close()
+
+
+DRAWS = {
+    "turtle_frame": "random turtle poses (x, y in [1.5, 9.5] m, theta in [-3, 3] rad)",
+    "turtle_follow": "a random path for the leader (places in [1.5, 9.5] m, 3 m or more away)",
+}
+KINDS = {
+    "turtle_frame": make_kind("", "turtle parent poses tolerance within"),
+    "turtle_follow": make_kind("", "leader follower moves bound within spawn_within"),
+}
+PROBES: dict[str, Probe] = {
+    "turtle_frame": turtle_frame,
+    "turtle_follow": turtle_follow,
+}
