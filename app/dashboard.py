@@ -39,6 +39,7 @@ from app.ros.graph import GraphSnapshot, snapshot
 from app.ros.rosout import RosoutLog
 from app.ros.runtime import RosRuntime
 from app.ros2cli.console_panel import ConsolePanel
+from app.stage.window import Stage
 from app.supervisor import Supervisor
 from app.ui import TAB_NAMES, MarkdownView, Panel
 from app.ui.loop import UiLoop
@@ -110,6 +111,8 @@ class Dashboard:
         side_window = gui.add_panel()
         side_window.dock_left()
         side_window.set_width(560)
+        # The stage: what the current step is about (the live graph, ...), chosen by the lesson.
+        stage = Stage(gui, ui, node, side_window)
         builders: dict[str, Callable[[], Panel]] = {
             "Lessons": lambda: LessonsPanel(
                 gui,
@@ -119,6 +122,7 @@ class Dashboard:
                 self.progress,
                 side_window,
                 self._exercise_marks,
+                stage.show,
             ),
             "Exercise": lambda: ExercisePanel(
                 gui,
@@ -154,7 +158,7 @@ class Dashboard:
         # A lesson's `console` buttons type their command into the Console tab.
         console = next(p for p in panels if isinstance(p, ConsolePanel))
         self.lessons.console = console.run_for_lesson
-        return panels
+        return [stage, *panels]
 
     def _exercise_marks(self, lesson_id: str) -> str:
         """The outline's exercise column: ✓ for each exercise passed, ○ for each open."""

@@ -84,6 +84,7 @@ class LessonsPanel:
         progress: ProgressStore,
         side_window: Any,
         exercise_marks: Callable[[str], str] = lambda _lesson_id: "",
+        show_stage: Callable[[str], None] = lambda _stage: None,
     ) -> None:
         self._gui = gui
         self._ui = ui
@@ -91,6 +92,7 @@ class LessonsPanel:
         self._live = live
         self._progress = progress
         self._exercise_marks = exercise_marks
+        self._show_stage = show_stage  # the stage shows what each step names
         self._dynamic: list[Any] = []
         by_label = {_label(lesson): lesson for lesson in course.lessons}
         self._by_label = by_label
@@ -159,6 +161,7 @@ class LessonsPanel:
         self._picture.show(picture_html(current.image, current.image_alt) if current.image else "")
         self._command.show(f"In a terminal: `{current.command}`" if current.command else "")
         self._code.show(self._source_listing(lesson))
+        self._show_stage(current.stage or lesson.stage)
         self._message.show("")
         self._rebuild_step_widgets()
         self._back.disabled = step == 0

@@ -23,6 +23,7 @@ from app import PROJECT_ROOT
 from app.catalog import ENTRIES, GROUPS
 from app.lessons.kinds import ACTION_KINDS, CHECK_KINDS, Kind
 from app.ros.runtime import DASHBOARD_NODE_NAME
+from app.stage import DEFAULT_STAGE, STAGES
 from app.ui import TAB_NAMES
 
 LESSONS_DIR = PROJECT_ROOT / "lessons"
@@ -68,6 +69,7 @@ class Step:
     checks: tuple[Spec, ...] = ()
     image: str = ""  # a file in static/, shown under the text
     image_alt: str = ""  # what the picture shows, for a screen reader (required with image)
+    stage: str = ""  # what the centre of the screen shows; "" = the unit's stage
 
 
 @dataclass(frozen=True)
@@ -79,6 +81,7 @@ class Lesson:
     goals: tuple[str, ...]
     steps: tuple[Step, ...]
     code: tuple[str, ...] = ()  # project-relative source files shown beside the text
+    stage: str = DEFAULT_STAGE  # what the centre of the screen shows (app.stage.STAGES)
     path: Path = field(default=LESSONS_DIR, compare=False)
 
 
@@ -190,6 +193,16 @@ def _step_image(raw: dict, where: str) -> tuple[str, str]:
     return image, alt.strip()
 
 
+def _stage(table: dict, where: str, default: str) -> str:
+    """The optional ``stage`` field: one of the names the stage knows."""
+    if "stage" not in table:
+        return default
+    stage = _require(table, "stage", str, where)
+    if stage not in STAGES:
+        raise LessonError(f"{where}: unknown stage '{stage}' (stages: {', '.join(STAGES)})")
+    return stage
+
+
 def load_lesson(directory: Path) -> Lesson:
     toml_path = directory / "lesson.toml"
     where = f"{directory.name}/lesson.toml"
@@ -210,6 +223,7 @@ def load_lesson(directory: Path) -> Lesson:
         if not isinstance(source, str):
             raise LessonError(f"{where}: code[{i}] must be a string")
         inside(PROJECT_ROOT, source, f"{where}: code[{i}]")
+    stage = _stage(data, where, DEFAULT_STAGE)
     raw_steps = _require(data, "steps", list, where)
     if not raw_steps:
         raise LessonError(f"{where}: field 'steps' must list at least one step")
@@ -239,6 +253,7 @@ def load_lesson(directory: Path) -> Lesson:
                 checks=tuple(checks),
                 image=image,
                 image_alt=image_alt,
+                stage=_stage(raw, step_where, ""),
             )
         )
     return Lesson(
@@ -249,6 +264,7 @@ def load_lesson(directory: Path) -> Lesson:
         goals=tuple(goals),
         steps=tuple(steps),
         code=tuple(code),
+        stage=stage,
         path=directory,
     )
 

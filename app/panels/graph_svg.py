@@ -183,11 +183,11 @@ def layout(vertices: list[Vertex], edges: list[Edge], per_row: int = PER_ROW) ->
     return placed
 
 
-def _short(text: str, limit: int = MAX_LABEL) -> str:
+def short(text: str, limit: int = MAX_LABEL) -> str:
     return text if len(text) <= limit else text[: limit - 1] + "…"
 
 
-def _edge_path(a: Placed, b: Placed) -> tuple[str, float, float]:
+def edge_path(a: Placed, b: Placed) -> tuple[str, float, float]:
     """A cubic curve from a's bottom to b's top (or around the side when b is not below)."""
     x0, y0 = a.x + BOX_W / 2, a.y + BOX_H
     x3, y3 = b.x + BOX_W / 2, b.y
@@ -226,7 +226,7 @@ def render_svg(vertices: list[Vertex], edges: list[Edge], per_row: int = PER_ROW
         a, b = where.get(edge.source), where.get(edge.target)
         if a is None or b is None or a is b:
             continue
-        path, mx, my = _edge_path(a, b)
+        path, mx, my = edge_path(a, b)
         dash = ' stroke-dasharray="5,4"' if edge.dashed else ""
         parts.append(
             f'<path class="rg-edge" data-source="{escape(a.vertex.name)}" '
@@ -248,16 +248,16 @@ def render_svg(vertices: list[Vertex], edges: list[Edge], per_row: int = PER_ROW
         parts.append(
             f'<g class="rg-vertex" data-kind="{v.kind}" data-name="{escape(v.name)}">'
             # A tooltip only for cut names: a hidden title would shadow the visible text.
-            + (f"<title>{escape(title)}</title>" if _short(v.name) != v.name else "")
+            + (f"<title>{escape(title)}</title>" if short(v.name) != v.name else "")
             + f'<rect x="{p.x:.0f}" y="{p.y:.0f}" width="{BOX_W}" height="{BOX_H}" rx="{radius}" '
             f'fill="{fill}" stroke="{stroke}" stroke-width="1.5"/>'
             f'<text x="{cx:.0f}" y="{name_y:.0f}" font-size="12" text-anchor="middle" '
-            f'fill="#111">{escape(_short(v.name))}</text>'
+            f'fill="#111">{escape(short(v.name))}</text>'
         )
         if v.detail:
             parts.append(
                 f'<text x="{cx:.0f}" y="{p.y + 28:.0f}" font-size="10" text-anchor="middle" '
-                f'fill="#555">{escape(_short(v.detail, 32))}</text>'
+                f'fill="#555">{escape(short(v.detail, 32))}</text>'
             )
         parts.append("</g>")
     parts += labels  # on top of boxes and curves
@@ -299,6 +299,11 @@ def _short_type(type_text: str) -> str:
     return f"{parts[0]}/{parts[-1]}" if len(parts) == 3 else type_text
 
 
+def hidden_node(name: str) -> bool:
+    """A node ROS tools hide by default: some part of its name starts with '_'."""
+    return any(part.startswith("_") for part in name.split("/"))
+
+
 def graph_picture(
     nodes: list[NodeEndpoints],
     rates: dict[str, str] | None = None,
@@ -323,6 +328,8 @@ def graph_picture(
     def quiet_service(name: str) -> bool:
         return ACTION_MARKER in name or (not show_quiet and name.endswith(PARAMETER_SERVICES))
 
+    # Hidden nodes (a name part starting with '_', as `ros2 node list` hides them) too.
+    nodes = [n for n in nodes if show_quiet or not hidden_node(n.name)]
     for node in nodes:
         me = add("node", node.name)
         for topic, kind in sorted(node.publishes.items()):

@@ -19,6 +19,7 @@ WRONG = (EXERCISE.path / "mistakes" / "adds.py").read_text(encoding="utf-8")
 def _open_editor(page: Page):
     open_tab(page, "Exercise")
     choose(page, "Exercise", f"{EXERCISE.unit:02d} · {EXERCISE.title}")
+    choose(page, "On stage", "Code")  # lesson 1 has the graph on stage
     page.get_by_role("tab", name="Your code").click()
     frame_locator = page.frame_locator(f"iframe[src*='slug={EXERCISE.slug}']")
     return frame_locator, _frame(page)
@@ -77,6 +78,7 @@ def test_wrong_then_right_then_survives_reload_and_sigkill(page, dashboard, ros_
         page.goto(again.url)
         open_tab(page, "Exercise")
         choose(page, "Exercise", f"{EXERCISE.unit:02d} · {EXERCISE.title}  ✓")
+        choose(page, "On stage", "Code")  # a new dashboard: lesson 1's stage again
         page.get_by_role("tab", name="Your code").click()
         frame = _frame(page)
         assert _editor_text(frame) == EXERCISE.reference

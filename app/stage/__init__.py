@@ -1,0 +1,16 @@
+"""The stage: the centre of the screen shows what the current lesson step is about.
+
+Only names live here, so the lesson schema can validate a lesson's ``stage``
+without importing any front end; the window itself is ``app.stage.window``.
+"""
+
+from __future__ import annotations
+
+# What can be on stage, as lesson.toml names it -> the label a learner picks.
+STAGES: dict[str, str] = {
+    "graph": "Live ROS graph",
+    "turtlesim": "Turtlesim",
+    "scene": "3D scene",
+    "code": "Code",
+}
+DEFAULT_STAGE = "graph"  # a unit that names none: units 1-11 are about the graph

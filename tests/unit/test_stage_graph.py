@@ -1,0 +1,116 @@
+"""The stage: lessons name it (validated), and its graph keeps places and times its dots."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+
+from app.lessons.schema import LESSONS_DIR, LessonError, load_course, load_lesson
+from app.panels.graph_svg import Edge, Vertex, graph_picture
+from app.ros.graph import NodeEndpoints
+from app.stage import DEFAULT_STAGE, STAGES
+from app.stage.graph_view import MAX_DOTS, StablePlaces, dot_timing, stage_svg
+
+
+def test_every_lesson_names_a_known_stage():
+    course = load_course()
+    assert course.errors == ()
+    for lesson in course.lessons:
+        text = (lesson.path / "lesson.toml").read_text(encoding="utf-8")
+        named = re.search(r'^stage = "(\w+)"', text, re.MULTILINE)
+        assert lesson.stage == (named.group(1) if named else DEFAULT_STAGE)
+        assert lesson.stage in STAGES
+
+
+def _copy(tmp_path: Path, stage_line: str, step_stage: str = "") -> Path:
+    source = LESSONS_DIR / "03_topics"
+    target = tmp_path / source.name
+    shutil.copytree(source, target)
+    toml = target / "lesson.toml"
+    text = re.sub(r'^stage = "\w+"\n', "", toml.read_text(encoding="utf-8"), flags=re.MULTILINE)
+    text = text.replace("unit = 3\n", f"unit = 3\n{stage_line}", 1)
+    if step_stage:
+        text = text.replace("[[steps]]\n", f"[[steps]]\n{step_stage}", 1)
+    toml.write_text(text, encoding="utf-8")
+    return target
+
+
+def test_a_unit_without_stage_gets_the_default_and_a_step_can_override(tmp_path):
+    lesson = load_lesson(_copy(tmp_path, "", 'stage = "code"\n'))
+    assert lesson.stage == DEFAULT_STAGE
+    assert lesson.steps[0].stage == "code"
+    assert lesson.steps[1].stage == ""  # the unit's
+
+
+def test_an_unknown_stage_is_a_clear_error(tmp_path):
+    with pytest.raises(LessonError, match=r"unknown stage 'movie' \(stages: graph, turtlesim"):
+        load_lesson(_copy(tmp_path, 'stage = "movie"\n'))
+    with pytest.raises(LessonError, match=r"steps\[0\]: unknown stage 'tf'"):
+        load_lesson(_copy(tmp_path / "b", 'stage = "graph"\n', 'stage = "tf"\n'))
+    with pytest.raises(LessonError, match="field 'stage' must be str"):
+        load_lesson(_copy(tmp_path / "c", "stage = 3\n"))
+
+
+def _endpoints(name: str, publishes=(), subscribes=()) -> NodeEndpoints:
+    kind = "std_msgs/msg/String"
+    return NodeEndpoints(
+        name=name,
+        publishes={t: kind for t in publishes},
+        subscribes={t: kind for t in subscribes},
+        servers={},
+        clients={},
+        action_servers={},
+        action_clients={},
+    )
+
+
+def test_a_new_node_moves_no_other():
+    places = StablePlaces()
+    talker = _endpoints("/talker", publishes=["/chatter"])
+    listener = _endpoints("/listener", subscribes=["/chatter"])
+    first = {p.vertex.key: (p.x, p.y) for p in places.place(*graph_picture([talker, listener]))}
+    more = [
+        _endpoints("/a_first", publishes=["/aaa"]),
+        talker,
+        _endpoints("/aa_listener", subscribes=["/chatter", "/aaa"]),
+        listener,
+    ]
+    second = {p.vertex.key: (p.x, p.y) for p in places.place(*graph_picture(more))}
+    for key, at in first.items():
+        assert second[key] == at, key
+    spots = list(second.values())
+    assert len(spots) == len(set(spots)), "no two boxes on one spot"
+
+
+def test_hidden_nodes_and_quiet_topics_are_folded_unless_asked():
+    nodes = [
+        _endpoints("/talker", publishes=["/chatter", "/rosout"]),
+        _endpoints("/_ros2cli_daemon", subscribes=["/chatter"]),
+    ]
+    names = {v.name for v in graph_picture(nodes)[0]}
+    assert names == {"/talker", "/chatter"}
+    names = {v.name for v in graph_picture(nodes, show_quiet=True)[0]}
+    assert names == {"/talker", "/chatter", "/rosout", "/_ros2cli_daemon"}
+
+
+def test_dots_follow_the_rate_and_are_capped():
+    assert dot_timing(0.0) == []
+    (slow,) = dot_timing(0.5)  # one dot, travels 1 s, waits 1 s
+    assert slow == (2.0, 0.0, 0.5)
+    two = dot_timing(2.0)
+    assert [begin for _d, begin, _s in two] == [0.0, -0.5]
+    assert len(dot_timing(1000.0)) == MAX_DOTS
+
+
+def test_the_svg_animates_dots_on_both_edges_of_a_topic():
+    vertices = [Vertex("node", "/talker"), Vertex("topic", "/chatter"), Vertex("node", "/l")]
+    edges = [Edge("node:/talker", "topic:/chatter", "2.0 Hz"), Edge("topic:/chatter", "node:/l")]
+    svg = stage_svg(StablePlaces().place(vertices, edges), edges, {"/chatter": 2.0})
+    assert svg.count('class="sg-dot" data-topic="/chatter"') == 4
+    assert svg.count("<animateMotion") == 4
+    assert "2.0 Hz" in svg
+    quiet = stage_svg(StablePlaces().place(vertices, edges), edges, {})
+    assert "sg-dot" not in quiet
