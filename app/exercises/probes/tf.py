@@ -4,7 +4,9 @@
 time and compares the learner's ``world -> turtle`` transform on /tf with
 each pose. ``turtle_follow``: the grader puts the leader turtle at random
 places, one after another, and the follower (steered by the learner's tf2
-listener) must come within a bound of it each time.
+listener) must come within a bound of it each time. ``static_frame``: the
+grader sets the learner's frame parameters to drawn names and offsets, then
+joins /tf_static late and reads the frame there.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from app.exercises.probes.base import Probe, ProbeContext
 from app.exercises.report import Result
 from app.lessons.kinds import make_kind
 from app.lessons.schema import Spec
+from app.ros import params
 from app.ros.calls import call_service
 from app.ros.errors import Ros2Error
 from app.ros.monitor import TopicMonitor
@@ -44,6 +47,7 @@ class Seen:
     z: float
     yaw: float
     unit: bool  # the quaternion has length 1 (within 1e-3)
+    static: bool = False  # came on /tf_static
 
 
 def yaw_of(x: float, y: float, z: float, w: float) -> float:
@@ -60,16 +64,20 @@ def angle_between(a: float, b: float) -> float:
 class FrameTap:
     """Every transform on /tf and /tf_static, newest per child frame (executor thread writes)."""
 
-    def __init__(self, ctx: ProbeContext) -> None:
+    def __init__(self, ctx: ProbeContext, static_only: bool = False) -> None:
         self._node = ctx.call.node
         self._lock = threading.Lock()
         self.newest: dict[str, Seen] = {}
         self._subs = [
-            self._node.create_subscription(TFMessage, "/tf", self._on_tf, 100),
-            self._node.create_subscription(TFMessage, "/tf_static", self._on_tf, STATIC_QOS),
+            self._node.create_subscription(TFMessage, "/tf_static", self._on_static, STATIC_QOS)
         ]
+        if not static_only:
+            self._subs.append(self._node.create_subscription(TFMessage, "/tf", self._on_tf, 100))
 
-    def _on_tf(self, msg: TFMessage) -> None:
+    def _on_static(self, msg: TFMessage) -> None:
+        self._on_tf(msg, static=True)
+
+    def _on_tf(self, msg: TFMessage, static: bool = False) -> None:
         now = time.monotonic()
         with self._lock:
             for t in msg.transforms:
@@ -83,6 +91,7 @@ class FrameTap:
                     v.z,
                     yaw_of(r.x, r.y, r.z, r.w),
                     abs(length - 1.0) < 1e-3,
+                    static,
                 )
 
     def get(self, child: str) -> Seen | None:
@@ -246,15 +255,91 @@ def turtle_follow(ctx: ProbeContext, p: Spec) -> Result:
         follower.close()
 
 
+CHILD_WORDS = ("lidar", "camera", "imu", "gps", "sonar", "bumper", "antenna")
+PARENT_WORDS = ("world", "map", "odom", "base_link")
+
+
+def _late_joiner_frames(ctx: ProbeContext, within: float, child: str) -> dict[str, Seen]:
+    """What a fresh transient-local /tf_static subscriber receives within ``within`` s."""
+    tap = FrameTap(ctx, static_only=True)
+    try:
+        deadline = time.monotonic() + within
+        while time.monotonic() < deadline and tap.get(child) is None:
+            ctx.call.sleep(0.1)
+        return dict(tap.newest)
+    finally:
+        tap.close()
+
+
+def static_frame(ctx: ProbeContext, p: Spec) -> Result:
+    """Set the node's frame parameters to drawn values; a late /tf_static joiner must get it."""
+    target = p.get("node", ctx.learner_node)
+    child = f"{ctx.rng.choice(CHILD_WORDS)}_{ctx.rng.randint(10, 99)}"
+    parent = ctx.rng.choice(PARENT_WORDS)
+    values: dict[str, float | str] = {"child_frame": child, "parent_frame": parent}
+    for axis in ("x", "y", "z"):
+        values[axis] = round(ctx.rng.uniform(-2.0, 2.0), 3)
+    values["yaw"] = round(ctx.rng.uniform(-3.0, 3.0), 3)
+    name = f"static frame {parent} -> {child}"
+    asked = ", ".join(f"{k}={v!r}" for k, v in values.items())
+    dynamic = FrameTap(ctx)  # hears /tf too: a frame sent there is a likely mistake
+    try:
+        for key, value in values.items():
+            try:
+                ok, reason = params.set_value(ctx.call, target, key, value)
+            except Ros2Error as exc:
+                return Result(name, False, f"could not set the parameter {key}: {exc}")
+            if not ok:
+                return Result(name, False, f"{target} refused {key}={value!r}: {reason}")
+        ctx.call.sleep(float(p.get("settle", 1.5)))  # sent by now; the next reader joins late
+        frames = _late_joiner_frames(ctx, float(p.get("within", 8.0)), child)
+        seen = frames.get(child)
+        if seen is None:
+            heard = ", ".join(sorted(frames)) or "nothing"
+            on_tf = dynamic.get(child)
+            if on_tf is not None and not on_tf.static:
+                return Result(
+                    name,
+                    False,
+                    f"set {asked}; '{child}' went out on /tf, not /tf_static: a subscriber "
+                    "that joins later never gets it (use StaticTransformBroadcaster)",
+                )
+            return Result(
+                name,
+                False,
+                f"set {asked}; a subscriber that joined /tf_static late got no '{child}' "
+                f"(it got: {heard}): send the frame again whenever the parameters change",
+            )
+        want = (float(values["x"]), float(values["y"]), float(values["z"]))
+        got = f"(x={seen.x:.3f}, y={seen.y:.3f}, z={seen.z:.3f}, yaw={seen.yaw:.3f})"
+        if seen.parent != parent:
+            return Result(name, False, f"set {asked}; '{child}' has the parent '{seen.parent}'")
+        if math.dist((seen.x, seen.y, seen.z), want) > 1e-3:
+            return Result(name, False, f"set {asked}; a late joiner got {got}: wrong translation")
+        if not seen.unit or angle_between(seen.yaw, float(values["yaw"])) > 1e-3:
+            return Result(
+                name,
+                False,
+                f"set {asked}; a late joiner got {got}: the heading (yaw) is wrong"
+                + ("" if seen.unit else ", and the quaternion is not of length 1"),
+            )
+        return Result(name, True, f"set {asked}; a late joiner got {parent} -> {child} {got}")
+    finally:
+        dynamic.close()
+
+
 DRAWS = {
     "turtle_frame": "random turtle poses (x, y in [1.5, 9.5] m, theta in [-3, 3] rad)",
     "turtle_follow": "a random path for the leader (places in [1.5, 9.5] m, 3 m or more away)",
+    "static_frame": "random frame names and offsets (x, y, z in [-2, 2] m, yaw in [-3, 3] rad)",
 }
 KINDS = {
     "turtle_frame": make_kind("", "turtle parent poses tolerance within"),
     "turtle_follow": make_kind("", "leader follower moves bound within spawn_within"),
+    "static_frame": make_kind("", "node settle within"),
 }
 PROBES: dict[str, Probe] = {
     "turtle_frame": turtle_frame,
     "turtle_follow": turtle_follow,
+    "static_frame": static_frame,
 }
