@@ -14,7 +14,7 @@ import os
 import sys
 from pathlib import Path
 
-from app.exercises.model import ExerciseError, load_exercises
+from app.exercises.model import Exercise, ExerciseError, load_exercises
 
 EXIT_FAILED = 1
 
@@ -55,6 +55,8 @@ def cmd_check(slug: str | None, file: Path | None, seed: int | None = None) -> i
 
     exercise = load_exercises().get(slug or "")
     assert file is not None
+    if exercise.is_package:
+        return _check_package(exercise, file, seed)
     try:
         code = file.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
@@ -80,6 +82,43 @@ def cmd_check(slug: str | None, file: Path | None, seed: int | None = None) -> i
     print(report.summary())
     if report.seed is not None and not report.problem:
         print(f"replay: exercise check {exercise.slug} {file} --seed {report.seed}")
+    return 0 if report.passed else EXIT_FAILED
+
+
+def _check_package(exercise: Exercise, folder: Path, seed: int | None) -> int:
+    """FILE is the package folder (~/ros2_ws/src/PKG): built, started and graded."""
+    import tempfile
+
+    from app.exercises.grader import Grader
+    from app.exercises.package_grading import grade_package
+    from app.ros.runtime import RosRuntime
+    from app.supervisor import Supervisor
+
+    if not (folder / "package.xml").is_file():
+        raise ExerciseError(
+            f"{folder}: `exercise check {exercise.slug}` grades a package folder "
+            f"(your {exercise.package} in ~/ros2_ws/src), and this one has no package.xml"
+        )
+    runtime = RosRuntime("classroom_grader")
+    supervisor = Supervisor(os.environ)
+    try:
+        with tempfile.TemporaryDirectory(prefix="classroom_grading_") as scratch:
+            report = grade_package(
+                Grader(runtime.node, supervisor),
+                exercise,
+                folder.resolve(),
+                Path(scratch),
+                on_result=lambda r: print(r.line(), flush=True),
+                seed=seed,
+            )
+    finally:
+        supervisor.shutdown(timeout=3.0)
+        runtime.shutdown()
+    if report.problem:
+        print(f"FAIL  {exercise.slug}: {report.problem}")
+    print(report.summary())
+    if report.seed is not None and not report.problem:
+        print(f"replay: exercise check {exercise.slug} {folder} --seed {report.seed}")
     return 0 if report.passed else EXIT_FAILED
 
 

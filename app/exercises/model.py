@@ -67,6 +67,20 @@ class Exercise:
     # The statement's example as data (never the tested input): the test suite
     # generates a solution that replays it, and that solution must fail.
     example: dict[str, Any] = field(default_factory=dict)
+    # A package exercise: the learner's ROS package of this name is graded; the
+    # grader builds it with colcon, then `ros2 run package run` or `ros2 launch
+    # package launch` (app.exercises.package_grading). Starter, reference and
+    # mistakes are then package folders; ``starter``/``reference`` hold their text.
+    package: str = ""
+    run: str = ""
+    launch: str = ""
+    starter_dir: Path | None = None
+    reference_dir: Path | None = None
+    main_file: str = ""  # the node's module inside the package, e.g. py_doubler/doubler.py
+
+    @property
+    def is_package(self) -> bool:
+        return bool(self.package)
 
     @property
     def program_name(self) -> str:
@@ -134,17 +148,34 @@ def load_exercise(directory: Path) -> Exercise:
     )
     if not checks and not probes:
         raise ExerciseError(f"{where}: an exercise needs at least one check or probe")
+    package = _field(data, "package", str, where, "")
+    find = _package_folder if package else inside
     mistakes = []
     for i, raw in enumerate(_field(data, "mistakes", list, where, [])):
         mistake_where = f"{where}: mistakes[{i}]"
         if not isinstance(raw, dict):
             raise ExerciseError(f"{mistake_where}: must be a table")
-        path = inside(directory, _field(raw, "file", str, mistake_where), mistake_where)
+        path = find(directory, _field(raw, "file", str, mistake_where), mistake_where)
         mistakes.append(Mistake(path, _field(raw, "reason", str, mistake_where)))
+    folders: dict[str, Path] = {}
 
     def text(key: str) -> str:
         name = _field(data, key, str, where)
+        if package and key in ("starter", "reference"):
+            folders[key] = _package_folder(directory, name, f"{where}: {key}")
+            return package_text(folders[key])
         return inside(directory, name, f"{where}: {key}").read_text(encoding="utf-8")
+
+    run, launch, main_file = (
+        _field(data, k, str, where, "") for k in ("run", "launch", "main_file")
+    )
+    if package and (not _PACKAGE.match(package) or bool(run) == bool(launch) or not main_file):
+        raise ExerciseError(
+            f"{where}: a package exercise names a valid package, exactly one of 'run' "
+            "(an executable) or 'launch' (a launch file), and its 'main_file'"
+        )
+    if not package and (run or launch or main_file):
+        raise ExerciseError(f"{where}: 'run', 'launch' and 'main_file' need 'package'")
 
     return Exercise(
         slug=directory.name,
@@ -164,7 +195,44 @@ def load_exercise(directory: Path) -> Exercise:
         mistakes=tuple(mistakes),
         path=directory,
         example=dict(_field(data, "example", dict, where, {})),
+        package=package,
+        run=run,
+        launch=launch,
+        starter_dir=folders.get("starter"),
+        reference_dir=folders.get("reference"),
+        main_file=main_file,
     )
+
+
+_PACKAGE = re.compile(r"^[a-z][a-z0-9_]*$")
+_SKIPPED = {"build", "install", "log", "__pycache__"}
+
+
+def _package_folder(base: Path, relative: str, where: str) -> Path:
+    """A package folder of the exercise (it holds package.xml), inside the exercise."""
+    candidate = (base / relative).resolve()
+    if not candidate.is_relative_to(base.resolve()):
+        raise ExerciseError(f"{where}: path '{relative}' leaves {base.name}/")
+    if not (candidate / "package.xml").is_file():
+        raise ExerciseError(f"{where}: '{relative}' is not a package folder (no package.xml)")
+    return candidate
+
+
+def package_files(folder: Path) -> list[Path]:
+    """The package's text files, sorted, without build products."""
+    return sorted(
+        p for p in folder.rglob("*")
+        if p.is_file() and not _SKIPPED & set(p.relative_to(folder).parts)
+    )  # fmt: skip
+
+
+def package_text(folder: Path) -> str:
+    """A package folder as one text: each file under a line naming it."""
+    parts = []
+    for path in package_files(folder):
+        body = path.read_text(encoding="utf-8", errors="replace")
+        parts.append(f"# ==== {folder.name}/{path.relative_to(folder)} ====\n{body}")
+    return "\n".join(parts)
 
 
 @dataclass(frozen=True)

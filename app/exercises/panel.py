@@ -16,7 +16,7 @@ from typing import Any
 
 import viser
 
-from app.exercises import runner
+from app.exercises import package_grading, runner
 from app.exercises.editor_server import EditorHub, editor_url
 from app.exercises.explain import panel_line
 from app.exercises.grader import Grader
@@ -183,6 +183,9 @@ class ExercisePanel:
         exercise = self._exercise
         if exercise is None:
             return
+        if exercise.is_package:
+            self._message = package_grading.run_hint(exercise)
+            return
         self._message = "Saving and checking your code…"
         self._ui.run_job(lambda: self._run_work(exercise), self._ran, self._failed, lane=LANE)
 
@@ -244,6 +247,15 @@ class ExercisePanel:
             self._ui.post(lambda: self._results.append(result))
 
         def work() -> tuple[Report, bool]:
+            if exercise.is_package:  # the package in the learner's ~/ros2_ws/src, built here
+                policy = self._settings.policy
+                scratch = self._workspace.scratch
+                report = package_grading.grade_learner_package(
+                    self._grader, exercise, scratch, policy, on_result
+                )
+                if not report.problem:
+                    self._workspace.record_check(exercise, report.passed)
+                return report, False
             self._hub.flush(exercise.slug)
             script = self._workspace.scratch / f"{exercise.slug}.py"
             report = self._grader.grade(exercise, script, on_result)

@@ -39,6 +39,7 @@ def main() -> int:
 
     from app.dds import configure_dds_env
     from app.exercises.grader import Grader
+    from app.exercises.package_grading import grade_package
     from app.ros.runtime import RosRuntime
     from app.supervisor import Supervisor
 
@@ -56,22 +57,30 @@ def main() -> int:
         for exercise in exercises:
             cases = []
             if args.which in ("reference", "all"):
-                cases.append(("reference", exercise.reference, True))
+                cases.append(("reference", exercise.reference, True, exercise.reference_dir))
             if args.which in ("mistakes", "all"):
-                cases += [(m.path.stem, m.path.read_text(), False) for m in exercise.mistakes]
-            for name, code, should_pass in cases:
+                cases += [
+                    (m.path.parent.name, "", False, m.path)
+                    if exercise.is_package
+                    else (m.path.stem, m.path.read_text(), False, None)
+                    for m in exercise.mistakes
+                ]
+            for name, code, should_pass, folder in cases:
                 right, wrong_seeds = 0, []
                 for _ in range(args.runs):
                     seed = random.SystemRandom().randrange(1, 1_000_000)
-                    script = scratch / f"{exercise.slug}.py"
-                    script.write_text(code, encoding="utf-8")
-                    runner.start(supervisor, exercise, script)
-                    try:
-                        report = grader.grade(exercise, script, seed=seed)
-                    finally:
-                        runner.stop(supervisor, exercise)
-                        for setup in exercise.setup:
-                            supervisor.stop(setup).result()
+                    if exercise.is_package:  # built with colcon, then run or launched
+                        report = grade_package(grader, exercise, folder, scratch, seed=seed)
+                    else:
+                        script = scratch / f"{exercise.slug}.py"
+                        script.write_text(code, encoding="utf-8")
+                        runner.start(supervisor, exercise, script)
+                        try:
+                            report = grader.grade(exercise, script, seed=seed)
+                        finally:
+                            runner.stop(supervisor, exercise)
+                            for setup in exercise.setup:
+                                supervisor.stop(setup).result()
                     if report.passed == should_pass:
                         right += 1
                     else:

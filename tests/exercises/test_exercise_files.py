@@ -22,9 +22,21 @@ def test_an_exercise_for_every_unit_from_2_to_14_and_15_in_all():
 def test_each_exercise_has_a_plausible_mistake_and_runnable_code():
     for exercise in book.exercises:
         assert exercise.mistakes, f"{exercise.slug}: no [[mistakes]]"
-        for name, code in (("starter", exercise.starter), ("reference", exercise.reference)):
+        for name, code in _python_sources(exercise):
             assert not refuses_to_run(lint(code)), f"{exercise.slug}: {name} does not compile"
         assert "TODO" in exercise.starter, f"{exercise.slug}: the starter marks no part to fill in"
+
+
+def _python_sources(exercise):
+    """The starter's and reference's Python: one file, or each .py file of a package."""
+    if not exercise.is_package:
+        return [("starter", exercise.starter), ("reference", exercise.reference)]
+    folders = (("starter", exercise.starter_dir), ("reference", exercise.reference_dir))
+    return [
+        (f"{name} {path.name}", path.read_text(encoding="utf-8"))
+        for name, folder in folders
+        for path in sorted(folder.rglob("*.py"))
+    ]
 
 
 def test_every_exercise_that_takes_input_shows_an_example_that_is_not_the_test():

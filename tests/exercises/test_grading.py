@@ -10,12 +10,15 @@ node names, and every learner process is stopped after its case.
 from __future__ import annotations
 
 import os
+import shutil
+from pathlib import Path
 
 import pytest
 
 from app.exercises import runner
 from app.exercises.grader import Grader
 from app.exercises.model import Exercise, load_exercises
+from app.exercises.package_grading import grade_package
 from app.exercises.report import Report
 from tests.conftest import fail_on_leftover_nodes
 from tests.exercises.cheats import cheat_code, input_probe
@@ -30,9 +33,9 @@ def _cases():
         if input_probe(exercise):
             yield pytest.param(exercise, "cheat", None, id=f"{exercise.slug}-cheat")
         for mistake in exercise.mistakes:
-            yield pytest.param(
-                exercise, "mistake", mistake, id=f"{exercise.slug}-{mistake.path.stem}"
-            )
+            # A package mistake is a folder named for the package: its parent names the mistake.
+            name = mistake.path.parent.name if exercise.is_package else mistake.path.stem
+            yield pytest.param(exercise, "mistake", mistake, id=f"{exercise.slug}-{name}")
 
 
 @pytest.fixture(scope="module")
@@ -70,13 +73,43 @@ def _grade(grading_env, exercise: Exercise, code: str) -> Report:
         fail_on_leftover_nodes("this case")  # e.g. the nodes a launch file started
 
 
+def _grade_package(grading_env, exercise: Exercise, folder: Path) -> Report:
+    """A package exercise: the grader builds the folder with colcon, then runs or launches it."""
+    grader, _supervisor, scratch = grading_env
+    try:
+        return grade_package(grader, exercise, folder, scratch, seed=7)
+    finally:
+        fail_on_leftover_nodes("this case")
+
+
+def _package_source(exercise: Exercise, which: str, mistake, scratch: Path) -> Path:
+    if which == "mistake":
+        return mistake.path
+    if which != "cheat":
+        folder = exercise.reference_dir if which == "reference" else exercise.starter_dir
+        assert folder is not None
+        return folder
+    # The cheat: the reference package with its node module replaced by the replayer.
+    assert exercise.reference_dir is not None
+    folder = scratch / "cheat" / exercise.reference_dir.name
+    shutil.rmtree(folder, ignore_errors=True)
+    shutil.copytree(exercise.reference_dir, folder)
+    (folder / exercise.main_file).write_text(cheat_code(exercise), encoding="utf-8")
+    return folder
+
+
 def _text(report: Report) -> str:
     return "\n".join([report.problem, *(r.line() for r in report.results)])
 
 
 @pytest.mark.parametrize(("exercise", "which", "mistake"), list(_cases()))
 def test_grading(grading_env, exercise, which, mistake):
-    if which == "reference":
+    if exercise.is_package:
+        source = _package_source(exercise, which, mistake, grading_env[2])
+        report = _grade_package(grading_env, exercise, source)
+        expected = mistake.reason if mistake is not None else ""
+        _judge(exercise, which, report, expected)
+    elif which == "reference":
         report = _grade(grading_env, exercise, exercise.reference)
         assert report.passed, _text(report)
     elif which == "starter":
@@ -94,3 +127,13 @@ def test_grading(grading_env, exercise, which, mistake):
             f"{mistake.path.name} fails, but not for the recorded reason {mistake.reason!r}:\n"
             + _text(report)
         )
+
+
+def _judge(exercise: Exercise, which: str, report: Report, reason: str) -> None:
+    """The same verdicts as for a single file, for a graded package."""
+    if which == "reference":
+        assert report.passed, _text(report)
+        return
+    assert not report.passed, f"{exercise.slug} {which} passes:\n{_text(report)}"
+    failing = "\n".join([report.problem, *(r.detail for r in report.failures())])
+    assert reason in failing, f"not for the recorded reason {reason!r}:\n{_text(report)}"

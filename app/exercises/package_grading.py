@@ -1,0 +1,276 @@
+"""Grading a package the learner builds: colcon build, then `ros2 run` or `ros2 launch` it.
+
+A package exercise grades the learner's ROS package, not one file. The
+grader copies the package folder into a fresh colcon workspace of its own
+(so nothing of the learner's workspace is touched or reused), builds it with
+the same colcon the Console runs (``app.learner_ws.build``: options fixed,
+files capped, time bounded), and starts what the exercise names exactly as
+``ros2 run PACKAGE EXECUTABLE`` or ``ros2 launch PACKAGE FILE`` would find
+it in the install space. Each of these steps is a result line: a build that
+fails, an executable that was never installed, a launch file left out of
+``data_files`` are what the learner reads, never a crash. Then the usual
+checks and probes run on the live graph (``app.exercises.grader``).
+
+A build runs the learner's setup.py, i.e. their code: it happens only where
+their other code may run uncontained (the learner's own machine).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import shutil
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from app.exercises import runner
+from app.exercises.grader import Grader
+from app.exercises.model import Exercise, package_files
+from app.exercises.report import Report, Result
+from app.exercises.runner import RunPolicy, RunRefused
+from app.learner_ws import build, folder
+from app.learner_ws.folder import BuildLimits, LearnerWorkspace
+from app.supervisor import LearnerProgram, Supervisor
+
+BUILD_SECONDS = 300.0  # an ament_python package builds in a few seconds; a loop does not end
+POLL_SEC = 0.2
+STDERR_LINES = 20  # of a failed build, shown in the result
+
+
+def _copy_package(source: Path, workspace: Path) -> Path:
+    """``workspace/src/<folder>``: a fresh copy of the package's files (no build products)."""
+    if workspace.exists():
+        shutil.rmtree(workspace)
+    target = workspace / "src" / source.name
+    for path in package_files(source):
+        destination = target / path.relative_to(source)
+        destination.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(path, destination)
+    return target
+
+
+def _build(supervisor: Supervisor, exercise: Exercise, ws: LearnerWorkspace) -> Result:
+    """colcon build in the grader's workspace, waited for; the result names what failed."""
+    name = f"{build.PROGRAM_PREFIX}exercise:{exercise.slug}"
+    program = dataclasses.replace(build.colcon_program(ws, ["build"]), name=name)
+    started = time.monotonic()
+    supervisor.start_program(program)
+    while supervisor.status(name).active:
+        if time.monotonic() - started > ws.limits.seconds:
+            supervisor.stop(name).result(timeout=15.0)
+            return Result(
+                "colcon build", False, f"the build ran longer than {ws.limits.seconds:g} s"
+            )
+        time.sleep(POLL_SEC)
+    status = supervisor.status(name)
+    lines = supervisor.output(name)
+    seconds = time.monotonic() - started
+    if status.exit_code == 0 and (ws.root / "install" / exercise.package).is_dir():
+        return Result("colcon build", True, f"{exercise.package} built in {seconds:.1f} s")
+    if status.exit_code == 0:
+        return Result(
+            "colcon build",
+            False,
+            f"colcon found no package named {exercise.package} (is <name> in package.xml "
+            f"{exercise.package}?); it built: "
+            + (", ".join(p.name for p in (ws.root / "install").iterdir() if p.is_dir()) or "none"),
+        )
+    shown = "\n".join(build_errors(lines)[:STDERR_LINES])
+    return Result(
+        "colcon build", False, f"the build failed (exit code {status.exit_code}):\n{shown}"
+    )
+
+
+def build_errors(lines: list[str]) -> list[str]:
+    """What of colcon's output is about the learner's files: frames inside colcon,
+    setuptools or Python itself are left out, long lines are cut.
+
+    colcon runs setup.py's text, so its frames read ``File "<string>", line N``:
+    that is setup.py's line N.
+    """
+    kept: list[str] = []
+    inside_tools = False
+    for line in lines:
+        text = line.strip()
+        if text.startswith('File "'):
+            inside_tools = "/site-packages/" in text or "/lib/python3" in text
+            if inside_tools:
+                continue
+        elif inside_tools and line.startswith("    "):
+            continue  # the source line (and its ^^^ marks) of a tools' frame
+        else:
+            inside_tools = False
+        if not text or set(text) <= set("^~ ") or text.startswith(("Traceback", "Starting >>>")):
+            continue
+        kept.append(line if len(line) <= 160 else line[:157] + "...")
+    if any('File "<string>"' in line for line in kept):
+        kept.append('(File "<string>", line N: colcon ran setup.py, so that is setup.py\'s line N)')
+    return kept
+
+
+def _python_dirs(prefix: Path) -> list[str]:
+    version = f"python{sys.version_info.major}.{sys.version_info.minor}"
+    found = [prefix / "lib" / version / "site-packages", prefix / "local" / "lib" / version]
+    return [str(p) for p in found if p.is_dir()]
+
+
+def _sourced_env(prefix: Path, base: dict[str, str] | None = None) -> dict[str, str]:
+    """What `source install/setup.bash` gives a program: this prefix in front of the paths."""
+    base = dict(os.environ) if base is None else base
+
+    def front(name: str, paths: list[str]) -> str:
+        rest = [p for p in base.get(name, "").split(os.pathsep) if p and p not in paths]
+        return os.pathsep.join(paths + rest)
+
+    return {
+        "AMENT_PREFIX_PATH": front("AMENT_PREFIX_PATH", [str(prefix)]),
+        "PYTHONPATH": front("PYTHONPATH", _python_dirs(prefix)),
+    }
+
+
+def _program(exercise: Exercise, ws: LearnerWorkspace, policy: RunPolicy) -> LearnerProgram:
+    """What `ros2 run`/`ros2 launch` would start from the install space, or RunRefused."""
+    prefix = ws.root / "install" / exercise.package
+    if exercise.run:
+        folder = prefix / "lib" / exercise.package
+        path = folder / exercise.run
+        if not (path.is_file() and os.access(path, os.X_OK)):
+            present = sorted(p.name for p in folder.iterdir()) if folder.is_dir() else []
+            raise RunRefused(
+                "No executable found: the build installed "
+                + (", ".join(present) if present else "no executable")
+                + f" in lib/{exercise.package}; `ros2 run` needs a console_scripts line "
+                f"'{exercise.run} = {exercise.package}.MODULE:main' in setup.py"
+            )
+        return LearnerProgram(
+            exercise.program_name,
+            exercise.node,
+            (str(path),),
+            ws.root,
+            env=_sourced_env(prefix),
+        )
+    share = prefix / "share" / exercise.package
+    found = sorted(share.rglob(exercise.launch)) if share.is_dir() else []
+    if not found:
+        raise RunRefused(
+            f"file '{exercise.launch}' was not found in the share directory of package "
+            f"'{exercise.package}' ({share}): setup.py's data_files must install the launch "
+            "folder into share/<package>/launch"
+        )
+    from app.launch_prefix import LaunchRefused, launch_program
+
+    try:
+        program = launch_program(
+            exercise.program_name, exercise.node, [str(found[0])], ws.root, policy, trusted=False
+        )
+    except LaunchRefused as exc:
+        raise RunRefused(str(exc)) from None
+    env = dict(program.env or {})
+    return dataclasses.replace(program, env={**env, **_sourced_env(prefix, {**os.environ, **env})})
+
+
+def grade_package(
+    grader: Grader,
+    exercise: Exercise,
+    source: Path,
+    scratch: Path,
+    *,
+    policy: RunPolicy = runner.LOOPBACK_POLICY,
+    on_result: Callable[[Result], None] | None = None,
+    seed: int | None = None,
+) -> Report:
+    """Build ``source`` (a package folder), start it, grade it; the learner's process is
+    stopped before this returns."""
+    supervisor = grader.supervisor
+    results: list[Result] = []
+
+    def record(result: Result) -> None:
+        results.append(result)
+        if on_result is not None:
+            on_result(result)
+
+    if not policy.allowed or policy.contained:
+        return Report(
+            exercise.slug,
+            problem=policy.refusal()
+            if not policy.allowed
+            else "a package exercise builds your package with colcon, which runs your setup.py "
+            "uncontained: grade it on your own machine's dashboard",
+            seed=seed,
+        )
+    if not (source / "package.xml").is_file():
+        return Report(exercise.slug, problem=f"{source} is not a package folder (no package.xml)")
+    workspace = LearnerWorkspace(
+        scratch / f"{exercise.slug}_ws", limits=BuildLimits(seconds=BUILD_SECONDS)
+    )
+    _copy_package(source, workspace.root)
+    built = _build(supervisor, exercise, workspace.ensure())
+    record(built)
+    if not built.passed:
+        return Report(exercise.slug, results, seed=seed)
+    how = f"ros2 {'run' if exercise.run else 'launch'} {exercise.package} "
+    how += exercise.run or exercise.launch
+    try:
+        program = _program(exercise, workspace, policy)
+    except RunRefused as exc:
+        record(Result(how, False, str(exc)))
+        return Report(exercise.slug, results, seed=seed)
+    record(Result(how, True, "started"))
+    script = workspace.root / "src" / source.name / exercise.main_file
+    if (
+        exercise.program_name in supervisor.statuses()
+        and supervisor.status(exercise.program_name).active
+    ):
+        supervisor.stop(exercise.program_name).result()
+    supervisor.start_program(program)
+    try:
+        report = grader.grade(exercise, script, on_result=on_result, seed=seed)
+    finally:
+        runner.stop(supervisor, exercise)
+    report.results[:0] = results
+    return report
+
+
+def run_hint(exercise: Exercise) -> str:
+    """What the Run button says for a package exercise: the learner runs it in the Console."""
+    how = (
+        f"ros2 run {exercise.package} {exercise.run}"
+        if exercise.run
+        else (f"ros2 launch {exercise.package} {exercise.launch}")
+    )
+    return (
+        f"This exercise grades your package `{exercise.package}` in ~/ros2_ws/src. Try it in "
+        f"the Console tab: `colcon build --packages-select {exercise.package}`, "
+        f"`source install/setup.bash`, `{how}`. **Check** builds and starts it by itself."
+    )
+
+
+def grade_learner_package(
+    grader: Grader,
+    exercise: Exercise,
+    scratch: Path,
+    policy: RunPolicy,
+    on_result: Callable[[Result], None] | None = None,
+) -> Report:
+    """The Check button: the package of that name in the learner's workspace src/."""
+    ws = folder.current()
+    if ws is None:
+        return Report(exercise.slug, problem="this dashboard has no learner workspace")
+    source = next(
+        (
+            p.parent
+            for p in sorted(ws.src.glob("**/package.xml"))
+            if p.parent.name == exercise.package
+        ),
+        None,
+    )
+    if source is None:
+        return Report(
+            exercise.slug,
+            problem=f"no package {exercise.package} in ~/ros2_ws/src yet: create it in the "
+            "Console with `ros2 pkg create --build-type ament_python --license Apache-2.0 "
+            f"{exercise.package}`",
+        )
+    return grade_package(grader, exercise, source, scratch, policy=policy, on_result=on_result)
