@@ -26,7 +26,7 @@ from app.lessons.schema import load_course
 from app.panels.actions_panel import ActionsPanel
 from app.panels.bags_panel import BagsPanel
 from app.panels.echo_panel import EchoPanel
-from app.panels.graph_panel import GraphPanel
+from app.panels.graph_panel import GraphPanel, SharedRates
 from app.panels.lifecycle_panel import LifecyclePanel
 from app.panels.logs_panel import LogsPanel
 from app.panels.nodes_panel import NodesPanel
@@ -112,7 +112,8 @@ class Dashboard:
         side_window.dock_left()
         side_window.set_width(560)
         # The stage: what the current step is about (the live graph, ...), chosen by the lesson.
-        stage = Stage(gui, ui, node, side_window)
+        self._rates = SharedRates(node)  # the stage and the Graph tab measure a topic once
+        stage = Stage(gui, ui, node, side_window, self._rates.client())
         builders: dict[str, Callable[[], Panel]] = {
             "Lessons": lambda: LessonsPanel(
                 gui,
@@ -137,7 +138,7 @@ class Dashboard:
             ),
             "Nodes": lambda: NodesPanel(gui, ui, self.supervisor),
             "Turtlesim": lambda: TurtlesimPanel(gui, ui, node, self.supervisor, self.page_links),
-            "Graph": lambda: GraphPanel(gui, node),
+            "Graph": lambda: GraphPanel(gui, node, self._rates.client()),
             "Echo": lambda: EchoPanel(gui, node),
             "3D view": lambda: ScenePanel(self.server, ui, node),
             "Topics": lambda: TopicsPanel(gui, ui, node),
@@ -210,5 +211,6 @@ class Dashboard:
                 panel.close()
             except Exception:  # shutting down: close the others anyway
                 log.exception("close of %s failed", type(panel).__name__)
+        self._rates.close()
         self.lessons.close()
         self.rosout.close()

@@ -42,6 +42,7 @@ RUNS: tuple[tuple[str, list[str]], ...] = (
     ("turtlesim_rate", ["--seconds", "8"]),
     ("sim_world", ["--seconds", "8"]),
     ("urdf_draw", ["--seconds", "5"]),
+    ("stage_graph", ["--seconds", "5", "--rounds", "2"]),
     ("tf2_lookup", ["--seconds", "5", "--lookups", "3000"]),
     ("hub_spawn", ["--counts", "1,5", "--seconds", "6"]),  # 20 learners: run it alone
     ("colcon_build", ["--python-rounds", "4", "--interface-rounds", "2", "--run-rounds", "4"]),
@@ -378,6 +379,22 @@ ROWS += (
         "",
         None,
     ),
+    (
+        "Stage graph, 30 nodes / 60 topics (one at 1 kHz): page frame rate (stage off beside)",
+        "stage_graph",
+        "stage_graph_fps|stage_off_fps",
+        "frames/s",
+        "> 30",
+        lambda v: v > 30,
+    ),
+    (
+        "Stage graph on: dashboard's extra CPU over the same page with the stage off",
+        "stage_graph",
+        "stage_extra_cpu_percent",
+        "% core",
+        "< 5",
+        lambda v: v < 5,
+    ),
 )
 
 ROWS += (
@@ -456,6 +473,8 @@ HEADLINE = {
     "sim_rtf": ("sim_world", "sim_rtf"),
     "sim_camera_rate_ratio": ("sim_world", "sim_camera_rate_ratio"),
     "urdf_draw_ratio": ("urdf_draw", "urdf_draw_ratio"),
+    "stage_graph_fps": ("stage_graph", "stage_graph_fps"),
+    "stage_extra_cpu_percent": ("stage_graph", "stage_extra_cpu_percent"),
     "tf2_lookup_p50_us": ("tf2_lookup", "tf2_lookup_p50_us"),
     "tf2_ingest_cpu_percent": ("tf2_lookup", "tf2_ingest_cpu_percent"),
     "hub_spawn_p50_s": ("hub_spawn", "hub_spawn_p50_s"),

@@ -14,6 +14,7 @@ from typing import Any
 import viser
 from rclpy.node import Node
 
+from app.panels.graph_panel import SharedRatesClient
 from app.panels.graph_svg import graph_picture, topics_to_measure
 from app.ros.graph import GraphSnapshot, node_endpoints
 from app.ros.rates import RateBoard, rate_text
@@ -32,10 +33,17 @@ _TURTLESIM_NOTE = (
 
 
 class Stage:
-    def __init__(self, gui: viser.GuiApi, ui: UiLoop, node: Node, code_window: Any) -> None:
+    def __init__(
+        self,
+        gui: viser.GuiApi,
+        ui: UiLoop,
+        node: Node,
+        code_window: Any,
+        rates: SharedRatesClient | None = None,
+    ) -> None:
         self._node = node
         self._code_window = code_window
-        self._rates = RateBoard(node)
+        self._rates: RateBoard | SharedRatesClient = rates or RateBoard(node)
         self._places = StablePlaces()
         self._shown_rates: dict[str, float] = {}
         self._last_picture = 0.0
