@@ -6,7 +6,10 @@ each pose. ``turtle_follow``: the grader puts the leader turtle at random
 places, one after another, and the follower (steered by the learner's tf2
 listener) must come within a bound of it each time. ``static_frame``: the
 grader sets the learner's frame parameters to drawn names and offsets, then
-joins /tf_static late and reads the frame there.
+joins /tf_static late and reads the frame there. ``joint_motion``: the grader
+publishes drawn joint values on /joint_states and checks, through a tf2
+lookup, that the joint's child (or a frame fixed on it) sits where the URDF
+joint puts it (robot_state_publisher's job, from the learner's URDF).
 """
 
 from __future__ import annotations
@@ -15,9 +18,13 @@ import math
 import threading
 import time
 from dataclasses import dataclass
+from typing import Any
 
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.time import Time
+from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
+from tf2_ros import Buffer, TransformException, TransformListener
 from turtlesim.msg import Pose
 from turtlesim.srv import TeleportAbsolute
 
@@ -328,18 +335,151 @@ def static_frame(ctx: ProbeContext, p: Spec) -> Result:
         dynamic.close()
 
 
+def _axis_angle(axis: tuple[float, float, float], angle: float) -> tuple[float, ...]:
+    """The quaternion (x, y, z, w) turning ``angle`` about ``axis`` (normalised here)."""
+    n = math.sqrt(sum(a * a for a in axis)) or 1.0
+    s = math.sin(angle / 2.0) / n
+    return (axis[0] * s, axis[1] * s, axis[2] * s, math.cos(angle / 2.0))
+
+
+def _rotate(q: tuple[float, ...], v: tuple[float, float, float]) -> tuple[float, float, float]:
+    """``v`` turned by the unit quaternion ``q``."""
+    x, y, z, w = q
+    # v' = v + 2w (u x v) + 2 u x (u x v), u = (x, y, z)
+    cx, cy, cz = y * v[2] - z * v[1], z * v[0] - x * v[2], x * v[1] - y * v[0]
+    dx, dy, dz = y * cz - z * cy, z * cx - x * cz, x * cy - y * cx
+    return (v[0] + 2 * (w * cx + dx), v[1] + 2 * (w * cy + dy), v[2] + 2 * (w * cz + dz))
+
+
+def _quat_angle(a: tuple[float, ...], b: tuple[float, ...]) -> float:
+    dot = abs(sum(p * q for p, q in zip(a, b, strict=True)))
+    return 2.0 * math.acos(min(1.0, dot))
+
+
+def expected_joint_pose(
+    joint_type: str,
+    origin: tuple[float, float, float],
+    axis: tuple[float, float, float],
+    value: float,
+    offset: tuple[float, float, float] = (0.0, 0.0, 0.0),
+) -> tuple[tuple[float, float, float], tuple[float, ...]]:
+    """Where a point ``offset`` of the child sits in the parent, and the child's rotation.
+
+    URDF: the child frame is the joint origin, then the motion along/about the axis.
+    """
+    if joint_type == "prismatic":
+        n = math.sqrt(sum(a * a for a in axis)) or 1.0
+        shift = tuple(o + a / n * value for o, a in zip(origin, axis, strict=True))
+        point = tuple(p + q for p, q in zip(shift, offset, strict=True))
+        return (point[0], point[1], point[2]), (0.0, 0.0, 0.0, 1.0)
+    q = _axis_angle(axis, value)
+    turned = _rotate(q, offset)
+    point = tuple(o + t for o, t in zip(origin, turned, strict=True))
+    return (point[0], point[1], point[2]), q
+
+
+def _vec3(value: Any) -> tuple[float, float, float]:
+    x, y, z = (float(v) for v in value)
+    return (x, y, z)
+
+
+def _judge_joint(ctx: ProbeContext, buffer: Buffer, publisher: Any, p: Spec, value: float) -> str:
+    """'' when the judged frame follows ``value`` within 3 s, else what is wrong."""
+    joint, parent = p["joint"], p["parent"]
+    frame = p.get("frame", p["child"])  # the frame judged: the child, or one fixed on it
+    jtype, axis = p.get("type", "revolute"), _vec3(p["axis"])
+    origin, offset = _vec3(p.get("origin", [0, 0, 0])), _vec3(p.get("offset", [0, 0, 0]))
+    want_xyz, want_q = expected_joint_pose(jtype, origin, axis, value, offset)
+    node = ctx.call.node
+    sent = time.monotonic()
+    pose: tuple[tuple[float, float, float], tuple[float, ...]] | None = None
+    error = "no transform yet"
+    while time.monotonic() - sent < float(p.get("within", 3.0)):
+        msg = JointState(name=[joint], position=[value])
+        msg.header.stamp = node.get_clock().now().to_msg()
+        publisher.publish(msg)
+        ctx.call.sleep(0.1)
+        try:
+            t = buffer.lookup_transform(parent, frame, Time())
+        except TransformException as exc:
+            error = str(exc)
+            continue
+        v, r = t.transform.translation, t.transform.rotation
+        pose = ((v.x, v.y, v.z), (r.x, r.y, r.z, r.w))
+        if math.dist(pose[0], want_xyz) < 1e-3 and _quat_angle(pose[1], want_q) < 1e-3:
+            return ""
+    if pose is None:
+        return f"set {joint}={value}; no transform from {frame} to {parent}: {error}"
+    turned = _quat_angle(pose[1], (0, 0, 0, 1))
+    if jtype != "prismatic" and turned < 1e-3 and abs(value) > 0.01:
+        why = f"'{frame}' does not turn with {joint}: is it attached to another link?"
+    else:
+        why = f"'{frame}' is not where {joint}'s origin, axis and value put it"
+    where = "({:.3f}, {:.3f}, {:.3f})".format(*pose[0])
+    want = "({:.3f}, {:.3f}, {:.3f})".format(*want_xyz)
+    return (
+        f"set {joint}={value}; {frame} in {parent} is at {where}, {_turn_text(pose[1])}; "
+        f"expected {want}, {_turn_text(want_q)}: {why}"
+    )
+
+
+def _turn_text(q: tuple[float, ...]) -> str:
+    """A rotation in words: its angle and axis."""
+    angle = _quat_angle(q, (0, 0, 0, 1))
+    s = math.sqrt(max(0.0, 1.0 - q[3] * q[3])) or 1.0
+    if angle < 1e-6:
+        return "not turned"
+    sign = 1.0 if q[3] >= 0 else -1.0
+    axis = ", ".join(f"{sign * v / s:.2f}" for v in q[:3])
+    return f"turned {angle:.3f} rad about ({axis})"
+
+
+def joint_motion(ctx: ProbeContext, p: Spec) -> Result:
+    """Publish drawn values of one joint on /joint_states; its child must follow the URDF."""
+    joint, parent = p["joint"], p["parent"]
+    low, high = (float(v) for v in p["range"])
+    frame = p.get("frame", p["child"])
+    name = f"joint {joint} moves {frame}"
+    node = ctx.call.node
+    buffer = Buffer()
+    listener = TransformListener(buffer, node)
+    publisher = node.create_publisher(JointState, "/joint_states", 10)
+    tried: list[str] = []
+    try:
+        deadline = time.monotonic() + 5.0
+        while publisher.get_subscription_count() == 0:
+            if time.monotonic() > deadline:
+                return Result(name, False, "nothing subscribes to /joint_states")
+            ctx.call.sleep(0.1)
+        for _ in range(int(p.get("samples", 3))):
+            value = round(ctx.rng.uniform(low, high), 3)
+            wrong = _judge_joint(ctx, buffer, publisher, p, value)
+            if wrong:
+                return Result(name, False, wrong)
+            tried.append(f"{joint}={value}")
+        return Result(name, True, f"{frame} in {parent} right for {', '.join(tried)}")
+    finally:
+        listener.unregister()
+        node.destroy_publisher(publisher)
+
+
 DRAWS = {
     "turtle_frame": "random turtle poses (x, y in [1.5, 9.5] m, theta in [-3, 3] rad)",
     "turtle_follow": "a random path for the leader (places in [1.5, 9.5] m, 3 m or more away)",
     "static_frame": "random frame names and offsets (x, y, z in [-2, 2] m, yaw in [-3, 3] rad)",
+    "joint_motion": "random joint values inside the probe's range",
 }
 KINDS = {
     "turtle_frame": make_kind("", "turtle parent poses tolerance within"),
     "turtle_follow": make_kind("", "leader follower moves bound within spawn_within"),
     "static_frame": make_kind("", "node settle within"),
+    "joint_motion": make_kind(
+        "joint parent child axis range", "type origin frame offset samples within"
+    ),
 }
 PROBES: dict[str, Probe] = {
     "turtle_frame": turtle_frame,
     "turtle_follow": turtle_follow,
     "static_frame": static_frame,
+    "joint_motion": joint_motion,
 }
