@@ -3,7 +3,9 @@ from launch_ros.actions import Node
 
 
 def generate_launch_description():
-    return LaunchDescription([
-        Node(package='py_pulse', executable='heartbeat', name='pulse'),
-        Node(package='py_pulse', executable='monitor', output='screen'),
-    ])
+    return LaunchDescription(
+        [
+            Node(package='py_pulse', executable='heartbeat', name='pulse'),
+            Node(package='py_pulse', executable='monitor', output='screen'),
+        ]
+    )
