@@ -34,7 +34,9 @@ from app.learner_ws import build, folder
 from app.learner_ws.folder import BuildLimits, LearnerWorkspace
 from app.supervisor import LearnerProgram, Supervisor
 
-BUILD_SECONDS = 300.0  # an ament_python package builds in a few seconds; a loop does not end
+# An exercise package (ament_python) builds in a few seconds; a setup.py that loops does not.
+BUILD_SECONDS = 120.0
+DISK_BYTES = 256 * 1024**2  # build/ install/ log/ of one exercise package
 POLL_SEC = 0.2
 STDERR_LINES = 20  # of a failed build, shown in the result
 
@@ -58,10 +60,17 @@ def _build(supervisor: Supervisor, exercise: Exercise, ws: LearnerWorkspace) -> 
     started = time.monotonic()
     supervisor.start_program(program)
     while supervisor.status(name).active:
-        if time.monotonic() - started > ws.limits.seconds:
+        too_long = time.monotonic() - started > ws.limits.seconds
+        too_big = build.disk_usage(ws.root) > ws.limits.disk_bytes
+        if too_long or too_big:
             supervisor.stop(name).result(timeout=15.0)
+            limit = (
+                f"ran longer than {ws.limits.seconds:g} s (does setup.py loop forever?)"
+                if too_long
+                else f"wrote more than {ws.limits.disk_bytes // 2**20} MiB"
+            )
             return Result(
-                "colcon build", False, f"the build ran longer than {ws.limits.seconds:g} s"
+                "colcon build", False, f"the build {limit}, the limit here, and was stopped"
             )
         time.sleep(POLL_SEC)
     status = supervisor.status(name)
@@ -202,9 +211,8 @@ def grade_package(
         )
     if not (source / "package.xml").is_file():
         return Report(exercise.slug, problem=f"{source} is not a package folder (no package.xml)")
-    workspace = LearnerWorkspace(
-        scratch / f"{exercise.slug}_ws", limits=BuildLimits(seconds=BUILD_SECONDS)
-    )
+    limits = BuildLimits(seconds=BUILD_SECONDS, disk_bytes=DISK_BYTES)
+    workspace = LearnerWorkspace(scratch / f"{exercise.slug}_ws", limits=limits)
     _copy_package(source, workspace.root)
     built = _build(supervisor, exercise, workspace.ensure())
     record(built)
