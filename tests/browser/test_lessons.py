@@ -74,3 +74,11 @@ def test_complete_the_bags_lesson_whose_buttons_type_into_the_console(page):
     complete_by_clicking(page, COURSE.lesson("16_bags"))
     open_tab(page, "Console")  # shows the last command, still looping
     expect_text(page, "$ ros2 bag play talker_bag -r 2 -l")
+
+
+def test_complete_the_workspace_lesson_building_and_running_the_learners_own_package(page):
+    """Unit 15 by clicking: pkg create, files written, colcon build, source, ros2 run,
+    'No executable found', the fix, a launch file, an interface package; real colcon."""
+    complete_by_clicking(page, COURSE.lesson("15_workspaces_packages"))
+    open_tab(page, "Console")
+    expect_text(page, "$ ros2 run py_pubsub num_talker")
