@@ -186,3 +186,22 @@ def test_a_failed_build_shows_the_learners_lines_not_colcons_internals():
     assert "TypeError: 'tuple' object is not callable" in lines
     assert '  File "<string>", line 10, in <module>' in lines
     assert "setup.py's line N" in lines[-1]
+
+
+def test_check_button_builds_the_package_of_that_name_in_the_learners_src(ws, tmp_path):
+    """The Exercise tab's Check: ~/ros2_ws/src/py_adder is found, copied and built."""
+    import shutil
+
+    from app.exercises.grader import Grader
+
+    workspace, rt, _console = ws
+    exercise = load_exercises().get("package_adder")
+    broken = next(m.path for m in exercise.mistakes if m.path.parent.name == "setup_syntax_error")
+    shutil.copytree(broken, workspace.src / "py_adder")
+    grader = Grader(None, rt.supervisor)  # type: ignore[arg-type]  (the build fails first)
+    report = grade_learner_package(grader, exercise, tmp_path, RunPolicy())
+    [result] = report.results
+    assert result.name == "colcon build" and not result.passed
+    assert "TypeError: 'tuple' object is not callable" in result.detail
+    assert (workspace.src / "py_adder" / "setup.py").is_file()  # the learner's copy untouched
+    assert not (workspace.src / "py_adder" / "build").exists()
