@@ -45,4 +45,4 @@ def perform(rt: LessonRuntime, action: Spec) -> str:
     temporary = path.with_name(f".{path.name}.lesson")
     temporary.write_text(content, encoding="utf-8")
     temporary.replace(path)
-    return f"Wrote {shown}: open it in the Console tab's file tree to read it."
+    return f"Wrote {shown}: open it in the Console tab's workspace files to read it."
