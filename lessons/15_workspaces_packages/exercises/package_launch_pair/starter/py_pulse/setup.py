@@ -26,7 +26,7 @@ setup(
     entry_points={
         'console_scripts': [
             'heartbeat = py_pulse.heartbeat:main',
-            'monitor = py_pulse.monitor:main',
+            'relay = py_pulse.relay:main',
         ],
     },
 )

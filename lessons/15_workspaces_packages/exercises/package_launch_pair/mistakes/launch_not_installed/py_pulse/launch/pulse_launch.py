@@ -6,6 +6,11 @@ def generate_launch_description():
     return LaunchDescription(
         [
             Node(package='py_pulse', executable='heartbeat', name='pulse'),
-            Node(package='py_pulse', executable='monitor', name='pulse_monitor', output='screen'),
+            Node(
+                package='py_pulse',
+                executable='relay',
+                name='pulse_relay',
+                remappings=[('input', 'numbers'), ('output', 'plus_one')],
+            ),
         ]
     )
