@@ -99,6 +99,18 @@ class TfWatch:
         self._subscriptions = []
         self.memory.clear()
 
+    def all_static(self, *frames: str) -> bool:
+        """Whether every frame from these up to their roots came on /tf_static."""
+        with self.lock:
+            for frame in frames:
+                seen: set[str] = set()
+                while frame in self.frames and frame not in seen:
+                    seen.add(frame)
+                    if not self.frames[frame].static:
+                        return False
+                    frame = self.frames[frame].parent
+        return True
+
     def parent_of_others(self, name: str) -> list[str]:
         """The children that name ``name`` as their parent."""
         with self.lock:

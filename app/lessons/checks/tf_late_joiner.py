@@ -86,7 +86,7 @@ def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
         return CheckResult(
             FAIL, f"a late subscriber got '{frame}' with the parent '{got}'; expected '{parent}'"
         )
-    heard = joiner.frames and f" (it got: {', '.join(sorted(joiner.frames))})" or ""
+    heard = f" (it got: {', '.join(sorted(joiner.frames))})" if joiner.frames else ""
     return CheckResult(
         FAIL,
         f"a subscriber that joined /tf_static late got no '{frame}' in {within:g} s{heard}: "
