@@ -19,7 +19,7 @@ def lesson_label(lesson) -> str:
     return f"{lesson.unit:02d} · {lesson.title}"
 
 
-def complete_by_clicking(page, lesson) -> None:
+def complete_by_clicking(page, lesson, done_within_ms: int = 45_000) -> None:
     open_tab(page, "Lessons")
     choose(page, "Lesson", lesson_label(lesson))
     for index, step in enumerate(lesson.steps):
@@ -30,7 +30,7 @@ def complete_by_clicking(page, lesson) -> None:
         for check in step.checks:
             if check.kind == "quiz":
                 choose(page, check["question"], check["answer"])
-        expect(page.get_by_text("✓ step done")).to_be_visible(timeout=45_000)
+        expect(page.get_by_text("✓ step done")).to_be_visible(timeout=done_within_ms)
         if index + 1 < len(lesson.steps):
             click(page, "Next")
 
@@ -79,6 +79,7 @@ def test_complete_the_bags_lesson_whose_buttons_type_into_the_console(page):
 def test_complete_the_workspace_lesson_building_and_running_the_learners_own_package(page):
     """Unit 15 by clicking: pkg create, files written, colcon build, source, ros2 run,
     'No executable found', the fix, a launch file, an interface package; real colcon."""
-    complete_by_clicking(page, COURSE.lesson("15_workspaces_packages"))
+    # An interface package's build (CMake, rosidl, a compiler) takes 10-60 s on 2 busy cores.
+    complete_by_clicking(page, COURSE.lesson("15_workspaces_packages"), done_within_ms=180_000)
     open_tab(page, "Console")
     expect_text(page, "$ ros2 run py_pubsub num_talker")
