@@ -84,6 +84,15 @@ def topics_lesson(page: Page) -> None:
     page.screenshot(path=str(IMAGES / "lesson.png"))
 
 
+def stage_graph(page: Page) -> None:
+    """The same moment on a school laptop's 1366x768: the lesson's stage, the live graph."""
+    page.set_viewport_size({"width": 1366, "height": 768})
+    expect(page.locator('svg.stage-graph g[data-name="/listener2"]')).to_be_visible()
+    page.wait_for_timeout(2500)  # rates settle, dots on their way
+    page.screenshot(path=str(IMAGES / "stage.png"))
+    page.set_viewport_size({"width": 1500, "height": 900})
+
+
 def live_graph(page: Page) -> None:
     """The talker and both listeners as the Graph tab draws them (the nodes keep running)."""
     page.get_by_role("tab", name="Graph").click()
@@ -110,7 +119,7 @@ def arm_scene(page: Page) -> None:
     page.get_by_role("button", name="Start group", exact=True).click()
     page.get_by_role("tab", name="3D view").click()
     expect(page.get_by_text("gripper at").first).to_be_visible(timeout=60_000)
-    page.mouse.click(551, 8)  # fold the code window away («): the scene gets the room
+    _choose(page, "On stage", "3D scene")  # the stage steps aside: the scene gets the room
     page.wait_for_timeout(500)
     page.mouse.move(1000, 480)
     for _ in range(4):  # zoom in towards the arm, as a scroll wheel does
@@ -148,6 +157,7 @@ def exercise_graded(page: Page) -> None:
     wrong = (exercise.path / "mistakes" / "adds.py").read_text(encoding="utf-8")
     page.get_by_role("tab", name="Exercise").click()
     _choose(page, "Exercise", f"{exercise.unit:02d} · {exercise.title}")
+    _choose(page, "On stage", "Code")
     page.get_by_role("tab", name="Your code").click()
     editor = page.frame_locator(f"iframe[src*='slug={exercise.slug}']")
     editor.locator(".ace_content").click()
@@ -200,7 +210,8 @@ def learner_dashboard(browser: Browser, env: dict[str, str], tmp: str) -> None:
     with _running(argv, env, Path(tmp) / "dashboard.log", "is ready"):
         page = _open(browser, f"http://127.0.0.1:{PORT}/")
         try:
-            takes = (topics_lesson, live_graph, lifecycle_drawing, turtlesim_drive, exercise_graded)
+            takes = (topics_lesson, stage_graph, live_graph, lifecycle_drawing, turtlesim_drive)
+            takes += (exercise_graded,)
             for take in (*takes, arm_scene):  # the scene folds the code away
                 take(page)
         except Exception:

@@ -19,12 +19,17 @@ from app.panels.graph_svg import graph_picture, topics_to_measure
 from app.ros.graph import GraphSnapshot, node_endpoints
 from app.ros.rates import RateBoard, rate_text
 from app.stage import DEFAULT_STAGE, STAGES
-from app.stage.graph_view import StablePlaces, stage_legend, stage_svg
+from app.stage.graph_view import PER_ROW, STEP_X, StablePlaces, stage_legend, stage_svg
 from app.ui import MarkdownView, assign
 from app.ui.loop import UiLoop
 
 PICTURE_PERIOD_SEC = 1.0
-STAGE_WIDTH = 560
+STAGE_WIDTH = 560  # until the browser says how wide its window is
+CONTROL_PANEL_ROOM = 412  # the control panel ("large", floating on the right) and its margin
+MIN_WIDTH, MAX_WIDTH = 480, 1400
+REFIT_PX = 24  # a smaller change of the window is not worth moving the stage
+SETTLE_SEC = 1.5  # after the stage changes, the browser's reports describe the old layout
+_DOCKED = ("graph", "turtlesim", "code")  # stages shown in a docked window
 RATE_CHANGE = 0.15  # a rate must move this much (share) before the dots are re-timed
 _TURTLESIM_NOTE = (
     "### Turtlesim\nTurtlesim's window is in the **Turtlesim** tab of the panel on the "
@@ -42,11 +47,15 @@ class Stage:
         rates: SharedRatesClient | None = None,
     ) -> None:
         self._node = node
+        self._ui = ui
         self._code_window = code_window
+        self.width = STAGE_WIDTH
+        self._settled = 0.0
         self._rates: RateBoard | SharedRatesClient = rates or RateBoard(node)
         self._places = StablePlaces()
         self._shown_rates: dict[str, float] = {}
         self._last_picture = 0.0
+        self._drawn_nodes: tuple[str, ...] = ()
         self._svg = ""
         self.current = DEFAULT_STAGE
         by_label = {label: name for name, label in STAGES.items()}
@@ -66,11 +75,51 @@ class Stage:
                 self._picture = gui.add_html(stage_svg([], [], {}))
                 self._show_quiet = gui.add_checkbox(
                     # (no word "node" here: tests and learners find the Node dropdown by label)
-                    "Show the plumbing: /rosout, /parameter_events, _hidden, parameter services",
+                    "Show ROS plumbing",
                     False,
+                    hint="/rosout, /parameter_events, hidden _names and parameter services",
                 )
             self._note = MarkdownView(gui, _TURTLESIM_NOTE, visible=False)
         self.show(DEFAULT_STAGE)
+
+    def follow_window(self, server: viser.ViserServer) -> None:
+        """Size the stage to the browser's window: all the room the control panel leaves.
+
+        Every camera message carries the canvas's width: the window minus the
+        docked windows, except the first one of a page, sent before the docks
+        are laid out, which is the whole window (seen: 1366, then 408 with a
+        954 px dock, at 1366x768).
+        """
+
+        def on_connect(client: viser.ClientHandle) -> None:
+            first = [True]
+
+            def on_camera(camera: viser.CameraHandle) -> None:
+                whole, first[0] = first[0], False
+                self._ui.post(lambda: self._fit(camera.image_width, whole))
+
+            client.camera.on_update(on_camera)
+
+        server.on_client_connect(on_connect)
+
+    def _fit(self, canvas: int, whole_window: bool) -> None:
+        if canvas <= 0:
+            return
+        if whole_window:
+            window = canvas
+        elif time.monotonic() < self._settled:
+            return  # sent before our last change: it describes the old layout
+        else:
+            window = canvas + (self.width if self.current in _DOCKED else 0)
+        wanted = max(MIN_WIDTH, min(MAX_WIDTH, window - CONTROL_PANEL_ROOM))
+        if abs(wanted - self.width) >= REFIT_PX:
+            self.width = wanted
+            self._window.set_width(wanted)
+            self._code_window.set_width(wanted)
+            self._settled = time.monotonic() + SETTLE_SEC
+            # Wider stage, more boxes a row (boxes already placed stay where they are).
+            self._places.per_row = max(PER_ROW, (wanted - 40) // STEP_X)
+            self._last_picture = 0.0
 
     def show(self, stage: str) -> None:
         """Put ``stage`` on (an unknown name is ignored: lessons are validated at load)."""
@@ -82,6 +131,7 @@ class Stage:
         self._graph_box.visible = stage == "graph"
         self._note.handle.visible = stage == "turtlesim"
         self._code_window.visible = stage == "code"
+        self._settled = time.monotonic() + SETTLE_SEC
         self._last_picture = 0.0  # draw at once
         if stage != "graph":
             self._rates.watch({})  # no subscriptions for a picture nobody sees
@@ -90,9 +140,11 @@ class Stage:
         if self.current != "graph":
             return
         now = time.monotonic()
-        if now - self._last_picture < PICTURE_PERIOD_SEC:
+        joined_or_left = graph.nodes != self._drawn_nodes  # drawn at once, not on the next tick
+        if now - self._last_picture < PICTURE_PERIOD_SEC and not joined_or_left:
             return
         self._last_picture = now
+        self._drawn_nodes = tuple(graph.nodes)
         own = self._node.get_fully_qualified_name()
         endpoints = [
             found
