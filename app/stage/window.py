@@ -25,8 +25,11 @@ from app.ui.loop import UiLoop
 
 PICTURE_PERIOD_SEC = 1.0
 STAGE_WIDTH = 560  # until the browser says how wide its window is
-CONTROL_PANEL_ROOM = 412  # the control panel ("large", floating on the right) and its margin
-MIN_WIDTH, MAX_WIDTH = 480, 1400
+# The control panel (lesson text, tools) floats on the right: ~65 characters a line of
+# lesson text at viser's 14 px font, the 60-80 a reading column wants.
+CONTROL_WIDTH = 480
+CONTROL_PANEL_ROOM = CONTROL_WIDTH + 28  # and its margins
+MIN_WIDTH, MAX_WIDTH = 400, 3000  # up to the panel: no 3D scene peeks out between
 REFIT_PX = 24  # a smaller change of the window is not worth moving the stage
 SETTLE_SEC = 1.5  # after the stage changes, the browser's reports describe the old layout
 _DOCKED = ("graph", "turtlesim", "code")  # stages shown in a docked window
@@ -34,6 +37,12 @@ RATE_CHANGE = 0.15  # a rate must move this much (share) before the dots are re-
 _TURTLESIM_NOTE = (
     "### Turtlesim\nTurtlesim's window is in the **Turtlesim** tab of the panel on the "
     "right: start `turtlesim_node` there and drive with the arrow keys."
+)
+
+
+_TOAST_STYLE = (
+    "<style>.mantine-Notifications-root{top:auto!important;bottom:12px!important;"
+    "left:12px!important;right:auto!important;transform:none!important}</style>"
 )
 
 
@@ -65,6 +74,10 @@ class Stage:
         self._selector.on_update(
             ui.callback(lambda: self.show(by_label.get(self._selector.value, self.current)))
         )
+        # viser's toasts (e.g. "software WebGL") open at the canvas's top-left, which is
+        # the control panel's edge once the stage fills the room: they would cover the
+        # tabs. Bottom-left, over the stage's free space, they hide nothing one clicks.
+        gui.add_html(_TOAST_STYLE)
         self._window = gui.add_panel()
         self._window.dock_left()
         self._window.set_width(STAGE_WIDTH)
@@ -101,6 +114,7 @@ class Stage:
             client.camera.on_update(on_camera)
 
         server.on_client_connect(on_connect)
+        server.gui.main_panel.set_width(CONTROL_WIDTH)
 
     def _fit(self, canvas: int, whole_window: bool) -> None:
         if canvas <= 0:
