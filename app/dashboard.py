@@ -113,7 +113,7 @@ class Dashboard:
         side_window.set_width(560)
         # The stage: what the current step is about (the live graph, ...), chosen by the lesson.
         self._rates = SharedRates(node)  # the stage and the Graph tab measure a topic once
-        stage = Stage(gui, ui, node, side_window, self._rates.client())
+        stage = Stage(gui, ui, node, side_window, self._rates.client(), self.page_links)
         stage.follow_window(self.server)
         builders: dict[str, Callable[[], Panel]] = {
             "Lessons": lambda: LessonsPanel(

@@ -7,6 +7,7 @@ a new picture only when the graph or a rate changes, never per frame.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from html import escape
 
 from app.panels.graph_svg import (
@@ -125,8 +126,16 @@ def _shape(p: Placed) -> str:
     return box
 
 
-def stage_svg(placed: list[Placed], edges: list[Edge], rates: dict[str, float]) -> str:
-    """The picture; ``rates`` (topic -> Hz) sets how many dots move on its edges."""
+def stage_svg(
+    placed: list[Placed],
+    edges: list[Edge],
+    rates: dict[str, float],
+    link: Callable[[int, str, str], str] | None = None,
+) -> str:
+    """The picture; ``rates`` (topic -> Hz) sets how many dots move on its edges.
+
+    ``link(i, content, title)`` wraps the i-th box (``placed`` order) in a link.
+    """
     where = {p.vertex.key: p for p in placed}
     right = max((p.x for p in placed), default=0) + BOX_W + MARGIN
     width = max(right, 2 * MARGIN + PER_ROW * BOX_W + (PER_ROW - 1) * GAP_X)
@@ -175,22 +184,26 @@ def stage_svg(placed: list[Placed], edges: list[Edge], rates: dict[str, float]) 
                 'text-anchor="middle" fill="#222" stroke="white" stroke-width="3" '
                 f'paint-order="stroke">{escape(edge.label)}</text>'
             )
-    for p in placed:
+    for i, p in enumerate(placed):
         v = p.vertex
         cx = p.x + BOX_W / 2
         name_y = p.y + (14 if v.detail else 21)
-        parts.append(
-            f'<g class="sg-vertex" data-kind="{v.kind}" data-name="{escape(v.name)}">'
-            f"<title>{escape(v.kind)} {escape(v.name)}</title>{_shape(p)}"
-            f'<text x="{cx:.0f}" y="{name_y:.0f}" font-size="12" text-anchor="middle" '
-            f'fill="#111">{escape(short(v.name))}</text>'
+        body = (
+            f'{_shape(p)}<text x="{cx:.0f}" y="{name_y:.0f}" font-size="12" '
+            f'text-anchor="middle" fill="#111">{escape(short(v.name))}</text>'
         )
         if v.detail:
-            parts.append(
+            body += (
                 f'<text x="{cx:.0f}" y="{p.y + 28:.0f}" font-size="10" text-anchor="middle" '
                 f'fill="#444">{escape(short(v.detail, 30))}</text>'
             )
-        parts.append("</g>")
+        title = f"{v.kind} {v.name}"
+        body = (
+            link(i, body, f"Inspect {title}") if link else f"<title>{escape(title)}</title>{body}"
+        )
+        parts.append(
+            f'<g class="sg-vertex" data-kind="{v.kind}" data-name="{escape(v.name)}">{body}</g>'
+        )
     parts += dots + labels  # dots above the curves, labels on top of all
     parts.append("</svg>")
     return "".join(parts)

@@ -9,21 +9,24 @@ drawn in a window docked on the left; "code" shows the code window instead;
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from typing import Any
 
 import viser
 from rclpy.node import Node
 
 from app.panels.graph_panel import SharedRatesClient
-from app.panels.graph_svg import graph_picture, topics_to_measure
-from app.ros.graph import GraphSnapshot, node_endpoints
+from app.panels.graph_svg import Vertex, graph_picture, topics_to_measure
+from app.ros.graph import GraphSnapshot, NodeEndpoints, node_endpoints
 from app.ros.rates import RateBoard, rate_text
 from app.stage import DEFAULT_STAGE, STAGES
 from app.stage.graph_view import PER_ROW, STEP_X, StablePlaces, stage_legend, stage_svg
 from app.ui import MarkdownView, assign
 from app.ui.loop import UiLoop
+from app.ui.page_links import SINK_FRAME, PageLinks
 
 PICTURE_PERIOD_SEC = 1.0
+MAX_PICKS = 300  # boxes that answer a click (a larger graph: the first ones)
 STAGE_WIDTH = 560  # until the browser says how wide its window is
 # The control panel (lesson text, tools) floats on the right: ~65 characters a line of
 # lesson text at viser's 14 px font, the 60-80 a reading column wants.
@@ -54,8 +57,16 @@ class Stage:
         node: Node,
         code_window: Any,
         rates: SharedRatesClient | None = None,
+        links: PageLinks | None = None,
     ) -> None:
         self._node = node
+        self._links = links
+        self._picked: list[Vertex] = []  # the boxes in the picture, in link order
+        self._inspected = ""  # Vertex.key the learner clicked
+        self._endpoints: list[NodeEndpoints] = []
+        if links is not None:  # a click on a box runs stage.pick.<its index>
+            for i in range(MAX_PICKS):
+                links.register(f"stage.pick.{i}", self._picker(i))
         self._ui = ui
         self._code_window = code_window
         self.width = STAGE_WIDTH
@@ -91,6 +102,9 @@ class Stage:
                     "Show ROS plumbing",
                     False,
                     hint="/rosout, /parameter_events, hidden _names and parameter services",
+                )
+                self._inspector = MarkdownView(
+                    gui, "_Click a box in the graph to see what it offers and uses._"
                 )
             self._note = MarkdownView(gui, _TURTLESIM_NOTE, visible=False)
         self.show(DEFAULT_STAGE)
@@ -171,10 +185,73 @@ class Stage:
         rates = {topic: self._steady_rate(topic) for topic in self._rates.watched()}
         labels = {topic: rate_text(rate) for topic, rate in rates.items()}
         vertices, edges = graph_picture(endpoints, labels, show_quiet=quiet)
-        svg = stage_svg(self._places.place(vertices, edges), edges, rates)
+        placed = self._places.place(vertices, edges)
+        self._picked = [p.vertex for p in placed]
+        self._endpoints = endpoints
+        link = self._link if self._links is not None else None
+        svg = stage_svg(placed, edges, rates, link)
+        if self._links is not None:
+            svg = SINK_FRAME + svg
         if svg != self._svg:
             self._svg = svg
             self._picture.content = svg
+        self._inspector.show(self._inspection(labels))
+
+    def _picker(self, index: int) -> Callable[[], None]:
+        """The link's action: runs in viser's asyncio thread, so it only posts."""
+        return lambda: self._ui.post(lambda: self._pick(index))
+
+    def _link(self, index: int, content: str, title: str) -> str:
+        if self._links is None or index >= MAX_PICKS:
+            return content
+        return self._links.anchor(f"stage.pick.{index}", content, title)
+
+    def _pick(self, index: int) -> None:
+        if 0 <= index < len(self._picked):
+            self._inspected = self._picked[index].key
+            self._last_picture = 0.0  # answer at once
+
+    def _inspection(self, labels: dict[str, str]) -> str:
+        """What the clicked box offers and uses, as `ros2 node info` / `topic info` say."""
+        kind, _, name = self._inspected.partition(":")
+        if not name:
+            return "_Click a box in the graph to see what it offers and uses._"
+        if kind == "node":
+            found = next((e for e in self._endpoints if e.name == name), None)
+            if found is None:
+                return f"**{name}** has left the graph."
+            parts = [f"**Node `{name}`** · `ros2 node info {name}`"]
+            for title, table in (
+                ("Publishers", found.publishes), ("Subscribers", found.subscribes),
+                ("Service servers", found.servers), ("Service clients", found.clients),
+                ("Action servers", found.action_servers),
+                ("Action clients", found.action_clients),
+            ):  # fmt: skip
+                if table:
+                    items = ", ".join(f"`{t}` [{kind}]" for t, kind in sorted(table.items()))
+                    parts.append(f"- {title}: {items}")
+            return "\n".join(parts)
+        users: dict[str, list[str]] = {"pub": [], "sub": [], "serve": [], "use": []}
+        for e in self._endpoints:
+            if name in e.publishes or name in e.servers or name in e.action_servers:
+                users["pub" if kind == "topic" else "serve"].append(e.name)
+            if name in e.subscribes or name in e.clients or name in e.action_clients:
+                users["sub" if kind == "topic" else "use"].append(e.name)
+        rate = labels.get(name, "")
+        if kind == "topic":
+            return (
+                f"**Topic `{name}`** · `ros2 topic info {name}`"
+                + (f" · {rate}" if rate else "")
+                + f"\n- publishers: {', '.join(users['pub']) or 'none'}"
+                + f"\n- subscribers: {', '.join(users['sub']) or 'none'}"
+                + "\n\nSee its messages in the **Echo** tab, its rate in **Topics**."
+            )
+        return (
+            f"**{kind.capitalize()} `{name}`**"
+            + f"\n- served by: {', '.join(users['serve']) or 'none'}"
+            + f"\n- used by: {', '.join(users['use']) or 'none'}"
+            + f"\n\nCall it from the **{'Actions' if kind == 'action' else 'Services'}** tab."
+        )
 
     def _steady_rate(self, topic: str) -> float:
         """The measured rate, changed only when it moves by RATE_CHANGE: a new picture

@@ -95,15 +95,15 @@ def test_the_graph_grows_and_messages_move_on_chatter(browser, dashboard, probe,
         # From the moment DDS lists /talker (a probe node sees it) to the box on stage.
         on_ros_graph = on_stage = None
         deadline = time.monotonic() + 20
-        while on_stage is None and time.monotonic() < deadline:
+        while (on_stage is None or on_ros_graph is None) and time.monotonic() < deadline:
             now = time.monotonic()
             if on_ros_graph is None and "/talker" in _node_names(probe.node):
                 on_ros_graph = now
-            if talker.count():
+            if on_stage is None and talker.count():
                 on_stage = now
             page.wait_for_timeout(30)
         assert on_ros_graph is not None and on_stage is not None, "/talker never showed"
-        grew = on_stage - on_ros_graph
+        grew = on_stage - on_ros_graph  # negative: the stage saw it before the probe did
         assert grew < 1.0, f"/talker on stage {grew:.2f} s after it joined the ROS graph"
         start_node(page, "listener")
         expect(page.locator('svg.stage-graph g.sg-vertex[data-name="/listener"]')).to_be_visible()
@@ -123,6 +123,12 @@ def test_the_graph_grows_and_messages_move_on_chatter(browser, dashboard, probe,
         page.wait_for_timeout(3000)
         alive = page.evaluate("() => document.querySelector('svg.stage-graph').getCurrentTime()")
         assert alive > 2.5, f"the picture was replaced {alive:.1f} s ago"
+        # A click on a box inspects it, as `ros2 topic info` / `ros2 node info` would.
+        page.locator('svg.stage-graph g.sg-vertex[data-name="/chatter"] a').click()
+        expect(page.get_by_text("publishers: /talker").filter(visible=True)).to_be_visible()
+        expect(page.get_by_text("subscribers: /listener").filter(visible=True)).to_be_visible()
+        page.locator('svg.stage-graph g.sg-vertex[data-name="/listener"] a').click()
+        expect(page.get_by_text("Node /listener").filter(visible=True)).to_be_visible()
         open_tab(page, "Nodes")  # the stage stays while the learner uses the tools
         expect(talker).to_be_visible()
     finally:
