@@ -8,6 +8,7 @@ drawn in a window docked on the left; "code" shows the code window instead;
 
 from __future__ import annotations
 
+import html
 import time
 from collections.abc import Callable
 from typing import Any
@@ -23,7 +24,7 @@ from app.stage import DEFAULT_STAGE, STAGES
 from app.stage.graph_view import PER_ROW, STEP_X, StablePlaces, stage_legend, stage_svg
 from app.ui import MarkdownView, assign
 from app.ui.loop import UiLoop
-from app.ui.page_links import SINK_FRAME, PageLinks
+from app.ui.page_links import SINK, SINK_FRAME, PageLinks
 
 PICTURE_PERIOD_SEC = 1.0
 MAX_PICKS = 300  # boxes that answer a click (a larger graph: the first ones)
@@ -204,7 +205,10 @@ class Stage:
     def _link(self, index: int, content: str, title: str) -> str:
         if self._links is None or index >= MAX_PICKS:
             return content
-        return self._links.anchor(f"stage.pick.{index}", content, title)
+        # Named by its <title> and text, not aria-label: tests and screen readers find the
+        # control panel's fields by label ("Topic", "Node"), which box names often contain.
+        href = html.escape(self._links.href(f"stage.pick.{index}"))
+        return f'<a href="{href}" target="{SINK}"><title>{html.escape(title)}</title>{content}</a>'
 
     def _pick(self, index: int) -> None:
         if 0 <= index < len(self._picked):
