@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 
 from app.exercises.model import Exercise, ExerciseError, load_exercises
+from app.exercises.report import Report
 
 EXIT_FAILED = 1
 
@@ -77,12 +78,7 @@ def cmd_check(slug: str | None, file: Path | None, seed: int | None = None) -> i
     finally:
         supervisor.shutdown(timeout=3.0)
         runtime.shutdown()
-    if report.problem:
-        print(f"FAIL  {exercise.slug}: {report.problem}")
-    print(report.summary())
-    if report.seed is not None and not report.problem:
-        print(f"replay: exercise check {exercise.slug} {file} --seed {report.seed}")
-    return 0 if report.passed else EXIT_FAILED
+    return _print_verdict(exercise, report, file)
 
 
 def _check_package(exercise: Exercise, folder: Path, seed: int | None) -> int:
@@ -114,11 +110,16 @@ def _check_package(exercise: Exercise, folder: Path, seed: int | None) -> int:
     finally:
         supervisor.shutdown(timeout=3.0)
         runtime.shutdown()
+    return _print_verdict(exercise, report, folder)
+
+
+def _print_verdict(exercise: Exercise, report: Report, graded: Path) -> int:
+    """The last lines of a check, and its exit status; a replay line for a seeded grading."""
     if report.problem:
         print(f"FAIL  {exercise.slug}: {report.problem}")
     print(report.summary())
     if report.seed is not None and not report.problem:
-        print(f"replay: exercise check {exercise.slug} {folder} --seed {report.seed}")
+        print(f"replay: exercise check {exercise.slug} {graded} --seed {report.seed}")
     return 0 if report.passed else EXIT_FAILED
 
 

@@ -45,9 +45,10 @@ def _check_name(check: Spec) -> str:
         ),
         "",
     )
-    if check.kind == "log_contains":
+    if check.kind == "log_contains":  # "log of your node contains 'beat 3'"
         who = check.get("catalog_node")
-        subject = f"{'your node' if who == LEARNER_PROGRAM else who}: {subject!r}"
+        who = "your node" if who == LEARNER_PROGRAM else who
+        return f"log of {who} contains {check.get('text')!r}"
     return f"{check.kind.replace('_', ' ')} {subject}".strip()
 
 
