@@ -136,6 +136,7 @@ class Dashboard:
                 self.editor_hub,
                 side_window,
                 self.exercise_settings,
+                open_code=lambda: stage.show("code"),
             ),
             "Nodes": lambda: NodesPanel(gui, ui, self.supervisor),
             "Turtlesim": lambda: TurtlesimPanel(gui, ui, node, self.supervisor, self.page_links),

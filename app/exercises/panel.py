@@ -10,6 +10,7 @@ one by one, so a learner sees progress during a slow probe.
 from __future__ import annotations
 
 import html
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -83,8 +84,11 @@ class ExercisePanel:
         hub: EditorHub,
         side_window: Any,
         settings: ExerciseSettings | None = None,
+        open_code: Callable[[], None] | None = None,
     ) -> None:
+        """``open_code``: put the code window on stage (the editor lives there)."""
         self._gui, self._ui, self._book = gui, ui, book
+        self._open_code = open_code
         self._workspace, self._supervisor, self._grader = workspace, supervisor, grader
         self._hub, self._settings = hub, settings or ExerciseSettings()
         hub.attach(self._load_code, self._save_code)
@@ -108,6 +112,10 @@ class ExercisePanel:
         self._crash_text = ""
 
         self._selector = gui.add_dropdown("Exercise", self._options())
+        # The editor is on the stage's code window; picking an exercise opens it too.
+        self._open_code_button = gui.add_button(
+            "Open my code", icon=viser.Icon.PENCIL, visible=open_code is not None
+        )
         self._header = MarkdownView(gui)
         with gui.add_folder("Task", expand_by_default=True):
             self._statement = MarkdownView(gui)
@@ -132,6 +140,8 @@ class ExercisePanel:
             self._editor = gui.add_html("")
 
         self._selector.on_update(ui.callback(self._on_pick))
+        if open_code is not None:
+            self._open_code_button.on_click(ui.callback(open_code))
         self._run.on_click(ui.callback(self._on_run))
         self._stop.on_click(ui.callback(self._on_stop))
         self._check.on_click(ui.callback(self._on_check))
@@ -162,6 +172,8 @@ class ExercisePanel:
         exercise = self._labels.get(self._selector.value)
         if exercise is not None and exercise is not self._exercise:
             self._show(exercise)
+            if self._open_code is not None:
+                self._open_code()
 
     def _show(self, exercise: Exercise) -> None:
         self._exercise = exercise

@@ -156,6 +156,7 @@ def test_the_dashboard_works_under_the_proxy_and_only_through_it(jupyter, browse
         # The exercise editor's frame and its own websocket, under the base path.
         open_tab(page, "Exercise")
         choose(page, "Exercise", f"{EXERCISE.unit:02d} · {EXERCISE.title}")
+        page.get_by_role("button", name="Open my code").click()  # the editor goes on stage
         page.get_by_role("tab", name="Your code").click()
         frame = page.frame_locator("iframe[src*='editor.html']")
         expect(frame.locator("#status")).to_have_text(re.compile("saved|connected"), timeout=30_000)
