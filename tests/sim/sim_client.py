@@ -166,7 +166,9 @@ def trajectory(names: list[str], points: list[tuple[list[float], float]]) -> Joi
 
 
 def start(c: SimClient) -> dict:
-    for topic in ("/clock", "/scan", "/odom", "/camera/image_raw", "/imu", "/tf"):
+    # Each topic is waited for: camera_info may trail the first image on a loaded machine.
+    topics = ("/clock", "/scan", "/odom", "/camera/image_raw", "/camera/camera_info", "/imu")
+    for topic in (*topics, "/tf", "/joint_states"):
         wait(lambda t=topic: c.get(t), what=topic)
     image, info, scan = c.get("/camera/image_raw"), c.get("/camera/camera_info"), c.get("/scan")
     wait(lambda: c.get("/real_time_factor"), what="/real_time_factor")
