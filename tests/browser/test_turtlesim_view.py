@@ -52,13 +52,14 @@ def pixels(page: Page, x: float = 0.0, y: float = 0.0) -> dict | None:
 def wait_pixels(page: Page, test: str, x: float = 0.0, y: float = 0.0, timeout: float = 20_000):
     """Wait until ``test`` (JS, on the statistics ``s``) holds for the drawn image."""
     arg = [PEN, TURTLE_BODY, x * METER, (WORLD - y) * METER]
-    page.wait_for_function(
-        f"(arg) => {{ const s = ({PIXELS_JS})(arg); return !!s && ({test}); }}",
+    # The statistics that met the test (a second read could land between two frames).
+    handle = page.wait_for_function(
+        f"(arg) => {{ const s = ({PIXELS_JS})(arg); return s && ({test}) ? s : null; }}",
         arg=arg,
         polling=200,
         timeout=timeout,
     )
-    return pixels(page, x, y)
+    return handle.json_value()
 
 
 def choose(page: Page, label: str, option: str) -> None:
@@ -67,14 +68,17 @@ def choose(page: Page, label: str, option: str) -> None:
 
 def settled_pen_pixels(page: Page) -> int:
     """The trail's pixel count once it stopped growing."""
-    count = -1
-    for _ in range(20):
+    count: int | None = None
+    for _ in range(30):
         page.wait_for_timeout(700)
-        now = (pixels(page) or {}).get("penPixels", -1)
+        seen = pixels(page)
+        if seen is None:  # read while the next frame was loading: not a reading
+            continue
+        now: int = seen["penPixels"]
         if now == count:
-            return count
+            return now
         count = now
-    pytest.fail("the trail kept growing")
+    pytest.fail(f"the trail never settled (last count {count})")
 
 
 def expect_status(page: Page, pattern: str, timeout: float = 30_000) -> None:
