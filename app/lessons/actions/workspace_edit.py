@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from app.lessons.actions.workspace_write import learner_workspace
+from app.lessons.checks._own_workspace import workspace
 from app.lessons.registry import register_action
 from app.ros.errors import Ros2Error
 
@@ -20,7 +20,7 @@ if TYPE_CHECKING:
     words="replace a piece of a file in your workspace, as the tutorial edits it",
 )
 def perform(rt: LessonRuntime, action: Spec) -> str:
-    ws = learner_workspace()
+    ws = workspace()
     path = ws.confine(action["path"])
     shown = ws.shown(path)
     if not path.is_file():

@@ -9,20 +9,12 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from app.learner_ws import folder
+from app.lessons.checks._own_workspace import workspace
 from app.lessons.registry import register_action
-from app.ros.errors import Ros2Error
 
 if TYPE_CHECKING:
     from app.lessons.runtime import LessonRuntime
     from app.lessons.schema import Spec
-
-
-def learner_workspace() -> folder.LearnerWorkspace:
-    ws = folder.current()
-    if ws is None:
-        raise Ros2Error("no learner workspace here (the dashboard gives each learner ~/ros2_ws)")
-    return ws
 
 
 @register_action(
@@ -33,7 +25,7 @@ def learner_workspace() -> folder.LearnerWorkspace:
 )
 def perform(rt: LessonRuntime, action: Spec) -> str:
     """``replace = true``: overwrite what is there (a file the lesson itself broke on purpose)."""
-    ws = learner_workspace()
+    ws = workspace()
     path = ws.confine(action["path"])
     shown = ws.shown(path)
     content = action["content"]
