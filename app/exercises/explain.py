@@ -12,7 +12,7 @@ from __future__ import annotations
 from typing import Any
 
 from app.exercises.model import Exercise
-from app.exercises.probes import PROBE_DRAWS
+from app.exercises.probes import PROBES
 from app.exercises.probes.base import is_range, range_text
 from app.lessons.kinds import CHECKS
 from app.lessons.schema import Spec
@@ -54,8 +54,8 @@ def drawn_fields(spec: Spec) -> list[str]:
     walk(spec.fields, "")
     if "walk" in spec.fields:
         found = [f for f in found if f != "walk"] + ["the order of lifecycle requests"]
-    if spec.kind in PROBE_DRAWS:
-        found.append(PROBE_DRAWS[spec.kind])
+    if spec.kind in PROBES and PROBES[spec.kind].draws:
+        found.append(PROBES[spec.kind].draws)
     return found
 
 
@@ -68,9 +68,10 @@ def explain(exercise: Exercise) -> list[str]:
         words = CHECKS[check.kind].words if check.kind in CHECKS else ""
         lines.append(f"check  {spec_line(check)}" + (f" ({words})" if words else ""))
     for probe in exercise.probes:
-        lines.append(f"probe  {spec_line(probe)}")
-        if probe.kind in PROBE_DRAWS:
-            lines.append(f"       draws {PROBE_DRAWS[probe.kind]}")
+        kind = PROBES[probe.kind]
+        lines.append(f"probe  {spec_line(probe)} ({kind.words})")
+        if kind.draws:
+            lines.append(f"       draws {kind.draws}")
     lines.append(HOW_INPUTS_ARE_DRAWN)
     return lines
 

@@ -62,7 +62,7 @@ def test_a_seed_replays_the_drawn_inputs_and_another_seed_changes_them():
     import random
 
     from app.exercises.probes.base import draw
-    from app.exercises.probes.core import lifecycle_walk
+    from app.exercises.probes.lifecycle_sequence import lifecycle_walk
 
     def inputs(seed):
         rng = random.Random(seed)
@@ -84,3 +84,21 @@ def test_a_teacher_can_read_how_each_exercise_is_graded_without_the_values():
     assert "--seed" in text
     assert "random" in panel_line(book.get("lifecycle_beacon"))
     assert "random images" in "\n".join(explain(book.get("red_mask")))
+
+
+def test_each_probe_kind_is_one_module_of_its_name_and_a_name_registers_once():
+    """A new probe kind is a new module in app/exercises/probes and nothing else."""
+    import pytest
+
+    from app.exercises.probes import PROBES
+    from app.exercises.probes.base import register_probe
+    from app.lessons.kinds import CHECKS
+
+    for name, kind in PROBES.items():
+        assert kind.run.__module__ == f"app.exercises.probes.{name}", name
+        assert kind.words, f"probe kind {name} has no words for the learner"
+    assert not set(PROBES) & set(CHECKS), "a probe kind named like a check kind"
+    with pytest.raises(RuntimeError, match="registered twice"):
+        register_probe("topic_feed", required="", words="again")(PROBES["topic_feed"].run)
+    with pytest.raises(RuntimeError, match="already a check kind"):
+        register_probe("topic_rate", required="", words="a check's name")(lambda ctx, p: None)

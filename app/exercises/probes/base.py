@@ -1,9 +1,13 @@
-"""What every probe shares: its context, the author's formulas, comparisons.
+"""What every probe shares: the registry, its context, the author's formulas, comparisons.
 
 Every probe is bounded in time and runs on the grader's worker thread (never
 the executor thread): calls go through ``app.ros.calls``. A probe's result
 says what was tried and what came back, e.g. "/multiply answered sum=8 for
 a=3, b=5; expected 15".
+
+Probe kinds register here as check kinds do in ``app.lessons.registry`` (one
+family, one name space): ``@register_probe(name, required=..., optional=...,
+words=...)`` on ``def run(ctx, probe) -> Result`` in a module of their own.
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from app.exercises.report import Result
+from app.lessons.registry import CHECKS, Kind, add_kind, make_kind
 from app.lessons.schema import Spec
 from app.ros.context import CallContext
 
@@ -102,3 +107,33 @@ def without_kind(table: dict[str, Any]) -> dict[str, Any]:
 
 
 Probe = Callable[[ProbeContext, Spec], Result]
+
+
+@dataclass(frozen=True)
+class ProbeKind:
+    """One probe kind: its fields, its code, and its words for the learner and the teacher."""
+
+    name: str
+    fields: Kind
+    run: Probe
+    words: str  # what it judges ("calls the service with random requests ...")
+    draws: str = ""  # what it draws at grading time, in words (`exercise explain` shows it)
+
+
+PROBES: dict[str, ProbeKind] = {}
+
+
+def register_probe(
+    name: str, *, required: str, optional: str = "", words: str, draws: str = ""
+) -> Callable[[Probe], Probe]:
+    """Decorator: ``run(ctx, probe) -> Result`` is the probe kind ``name``."""
+
+    def add(run: Probe) -> Probe:
+        if name in CHECKS:
+            raise RuntimeError(f"probe kind '{name}' is already a check kind")
+        add_kind(
+            PROBES, "probe", name, ProbeKind(name, make_kind(required, optional), run, words, draws)
+        )
+        return run
+
+    return add
