@@ -93,6 +93,7 @@ class _TopicRow:
     def __init__(self, gui: viser.GuiApi, label: str, offer: _Offer) -> None:
         self.offer = offer
         self.chosen_by_learner = False
+        self.automatic = True  # False: the row waits for the learner's pick
         self._select: Callable[[str], None] = lambda _topic: None
         self._options: tuple[str, ...] = (picker.NONE,)
         self.dropdown = gui.add_dropdown(
@@ -114,7 +115,9 @@ class _TopicRow:
         if opts != self._options:
             self._options = opts
             self.dropdown.options = opts
-        if not self.chosen_by_learner and self.dropdown.value == picker.NONE and len(opts) > 1:
+        if self.chosen_by_learner or not self.automatic:
+            return
+        if self.dropdown.value == picker.NONE and len(opts) > 1:
             choice = next((t for t in self.offer.preferred if t in opts), None)
             if choice is None:
                 choice = next((t for t in opts[1:] if t not in self.offer.avoid), None)
@@ -270,6 +273,7 @@ class ScenePanel:
         """
         scene = self._server.scene
         self._light.visible = shown
+        self._pause_desk_arm(shown)
         assign(self._frame_names, not shown)
         assign(self._frame_axes, not shown)
         self._on_frame_display()
@@ -295,6 +299,15 @@ class ScenePanel:
             return
         initial.position, initial.look_at = (tf.as_xyz(v) for v in view)
         self.drive.move_cameras(*view)  # the world has just appeared: show it whole
+
+    def _pause_desk_arm(self, paused: bool) -> None:
+        """The desk arm's joint row stops following /joint_states by itself while a world is
+        drawn (the world's robots move on TF; the hidden desk arm would only cost CPU)."""
+        row = self._joint_row
+        row.automatic = not paused
+        if paused and not row.chosen_by_learner and row.dropdown.value != picker.NONE:
+            assign(row.dropdown, picker.NONE)
+            self._select_joints(picker.NONE)
 
     def _on_frame_display(self) -> None:
         self.tf_view.set_display(
