@@ -56,8 +56,10 @@ def test_sensors_publish_what_a_real_robot_publishes(report):
         assert joint in start["joint_names"]
     assert ["world", "odom"] in start["tf"] and ["odom", "base_link"] in start["tf"]
     assert start["tf_static"] == ["world", "arm_base_link", [1.4, 1.4], True]  # room/world.xml
-    assert 8.5 <= start["rates"]["scan"] <= 11.5, start["rates"]
-    assert start["rates"]["camera"] >= 0.8 * 15, start["rates"]
+    # Rates in simulation time (header stamps): one scan each 0.1 s, no frame skipped
+    # beyond what a busy renderer drops (the wall-clock side: the real-time factor).
+    assert 9.5 <= start["rates"]["scan"] <= 10.5, start["rates"]
+    assert 0.8 * 15 <= start["rates"]["camera"] <= 15.5, start["rates"]
     assert 0.8 <= start["rtf"] <= 1.2
 
 
