@@ -158,7 +158,7 @@ class DriveControls:
         self._keys = node.create_publisher(String, KEY_TOPIC, 10)
         self.presses = 0
         self.status = MarkdownView(gui)
-        MarkdownView(gui, HELP)
+        self._help = MarkdownView(gui, HELP)
         self._drive = gui.add_button_group("Drive", list(BUTTONS))
         gui.add_html(key_listener())
         self.follow = gui.add_checkbox(
@@ -173,6 +173,7 @@ class DriveControls:
         self._drive.on_click(lambda event: self._press(str(event.target.value)))
         self._look.on_click(self._on_look)
         self._following = False
+        self._shown: bool | None = None
         self.follow.on_update(ui.callback(self._on_follow))
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="scene-follow", daemon=True)
@@ -199,6 +200,10 @@ class DriveControls:
     # --- UI thread ---
     def refresh(self, graph: GraphSnapshot) -> None:
         sim, teleop = graph.has_node(SIM_NODE), graph.has_node(TELEOP_NODE)
+        if sim != self._shown:  # without a world the folder is one line: how to start one
+            self._shown = sim
+            for handle in (self._drive, self.follow, self._look, self._help.handle):
+                handle.visible = sim
         if sim and teleop:
             self.status.show(f"`{SIM_NODE}` and `{TELEOP_NODE}` are running: drive away.")
         elif sim:
