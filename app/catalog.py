@@ -287,6 +287,26 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         package="sim_world",
     ),
     CatalogEntry(
+        "sim_robot_state_publisher",
+        "model_state_publisher",
+        "/robot_state_publisher",
+        "robot_state_publisher with the sim robot's URDF: /robot_description, its frames on /tf.",
+        args=("nodes/robots/diffbot/robot.urdf",),
+        package="sim_world",
+    ),
+    # Two robots, two descriptions: the arm's robot_state_publisher lives in the /arm
+    # namespace (/arm/robot_description), as multi-robot launch files do; both read the
+    # one /joint_states the simulator publishes and ignore the other robot's joints.
+    CatalogEntry(
+        "sim_arm_state_publisher",
+        "model_state_publisher",
+        "/arm/robot_state_publisher",
+        "robot_state_publisher for the sim's arm, in /arm: /arm/robot_description, links on /tf.",
+        args=("nodes/robots/arm/robot.urdf",),
+        ros_args=("-r", "__ns:=/arm", "-r", "joint_states:=/joint_states"),
+        package="sim_world",
+    ),
+    CatalogEntry(
         "sim_teleop_key",
         "turtle_teleop_key",
         "/sim_teleop_key",
@@ -540,8 +560,8 @@ GROUPS: tuple[LaunchGroup, ...] = (
     # --- the MuJoCo world (issue 26) ---
     LaunchGroup(
         "sim_drive",
-        "the MuJoCo room and the arrow-key teleop on /cmd_vel: drive the robot",
-        ("sim_world", "sim_teleop_key"),
+        "the MuJoCo room, its robots' state publishers and the arrow-key teleop: drive the robot",
+        ("sim_world", "sim_robot_state_publisher", "sim_arm_state_publisher", "sim_teleop_key"),
     ),
     # --- tf2 (issue 23): the turtle_tf2_py demo launch files ---
     LaunchGroup(
