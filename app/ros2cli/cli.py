@@ -20,7 +20,11 @@ from app.ros2cli.common import TerminalContext
 from app.ros2cli.parser import needs_ros, run_argv
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
-EXIT_INTERRUPTED = 130
+# ros2cli's exit code after Ctrl+C: rclpy's SIGINT handler shuts its context down,
+# the verb ends with ExternalShutdownException, and `ros2` returns SIGTERM's number.
+EXIT_INTERRUPTED = int(signal.SIGTERM)
+ROS2CLI_GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface")
+EXIT_INTERRUPTED_OTHER = 130  # our other commands (bag, run, ...): the shell's convention
 
 
 def _print(line: str) -> None:
@@ -55,7 +59,10 @@ def main(argv: list[str]) -> int:
     )
     try:
         code = run_argv(ctx, argv, "ros2-classroom")
-        return EXIT_INTERRUPTED if cancel.is_set() else code
+        if not cancel.is_set():
+            return code
+        ros2cli_verb = argv[:1] and argv[0] in ROS2CLI_GROUPS
+        return EXIT_INTERRUPTED if ros2cli_verb else EXIT_INTERRUPTED_OTHER
     finally:
         runtime.shutdown()
         for sig, handler in previous.items():

@@ -8,7 +8,10 @@ from dataclasses import dataclass
 from typing import Any
 
 import yaml
+from rclpy.exceptions import InvalidTopicNameException
+from rclpy.expand_topic_name import expand_topic_name
 from rclpy.qos import DurabilityPolicy, ReliabilityPolicy
+from rclpy.validate_full_topic_name import validate_full_topic_name
 
 from app.ros.context import CallContext
 from app.ros.convert import (
@@ -20,12 +23,13 @@ from app.ros.convert import (
     parse_yaml,
 )
 from app.ros.errors import Ros2Error
-from app.ros.graph import resolve_topic_type, topic_types, wait_for_graph
+from app.ros.graph import topic_types, wait_for_graph
 from app.ros.monitor import TopicMonitor
 from app.ros.qos import MEASURE_QOS
 from app.ros2cli.common import (
     Ros2cliMessage,
     SilentFailure,
+    ros2_type,
     visible,
     write_names,
     write_text,
@@ -134,14 +138,55 @@ def qos_fallback_lines(publishers: list[Any]) -> list[str]:
     return lines
 
 
+def _full_topic_name(ctx: CallContext, topic: str) -> str:
+    """The name as ros2cli looks it up: relative to the CLI's node, and valid, or its words."""
+    try:
+        expanded = expand_topic_name(topic, ctx.node.get_name(), ctx.node.get_namespace())
+        validate_full_topic_name(expanded)
+    except (ValueError, InvalidTopicNameException) as exc:
+        raise Ros2cliMessage(str(exc)) from None
+    return expanded
+
+
+def _known_type(ctx: CallContext, topic: str) -> str | None:
+    types = topic_types(ctx.node, include_hidden=True).get(topic)
+    if types and len(types) > 1:
+        raise Ros2cliMessage(
+            f"Cannot echo topic '{topic}', as it contains more than one type: [{', '.join(types)}]"
+        )
+    return types[0] if types else None
+
+
+def not_published_yet(topic: str) -> str:
+    return f"WARNING: topic [{topic}] does not appear to be published yet"
+
+
 def _echo_type(ctx: CallContext, topic: str, type_text: str | None) -> type:
     if type_text:
-        return import_type(type_text, "msg")
-    wait_for_graph(ctx, lambda: topic in topic_types(ctx.node, include_hidden=True))
-    types = topic_types(ctx.node, include_hidden=True).get(topic)
-    if not types:
+        return ros2_type(type_text, "msg")
+    full = _full_topic_name(ctx, topic)
+    wait_for_graph(ctx, lambda: full in topic_types(ctx.node, include_hidden=True))
+    found = _known_type(ctx, full)
+    if found is None:
+        ctx.write(not_published_yet(topic))
         raise Ros2cliMessage("Could not determine the type for the passed topic")
-    return import_type(types[0], "msg")
+    return import_type(found, "msg")
+
+
+def _measured_type(ctx: CallContext, topic: str) -> type | None:
+    """`topic hz`/`bw` of a topic not on the graph yet: say so once, then wait for it."""
+    full = _full_topic_name(ctx, topic)
+    wait_for_graph(ctx, lambda: full in topic_types(ctx.node, include_hidden=True))
+    found = _known_type(ctx, full)
+    if found is None:
+        ctx.write(not_published_yet(topic))
+        deadline = _deadline(ctx)
+        while (found := _known_type(ctx, full)) is None:
+            if time.monotonic() > deadline:
+                return None  # the Console's own bound: nothing to measure
+            ctx.check_cancel()
+            ctx.sleep(0.1)
+    return import_type(found, "msg")
 
 
 def _selected(msg: Any, field: list[str] | None, field_text: str) -> Any:
@@ -229,7 +274,10 @@ def echo(
 def _measure(
     ctx: CallContext, topic: str, type_text: str | None, window: int, report, first: str = ""
 ) -> int:
-    msg_type = resolve_topic_type(ctx, topic, type_text)
+    msg_type = ros2_type(type_text, "msg") if type_text else _measured_type(ctx, topic)
+    if msg_type is None:
+        ctx.write(f"(no messages on {topic}, or too few to measure)")
+        return 0
     # Best effort, as ros2 hz/bw subscribe: measuring must not slow a reliable publisher.
     monitor = TopicMonitor(ctx.node, topic, msg_type, window=window, keep=1, qos=MEASURE_QOS)
     if first:
@@ -350,7 +398,7 @@ def pub(
     """`ros2 topic pub`: wait for subscribers if asked, then publish and print as ros2cli."""
     if not rate > 0 or not math.isfinite(rate):
         raise Ros2Error(f"rate must be a positive number of Hz, got {rate}")
-    msg_type = import_type(type_text, "msg")
+    msg_type = ros2_type(type_text, "msg")
     try:
         loaded = yaml.safe_load(values or "{}")
     except yaml.YAMLError:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 
+import pytest
 from geometry_msgs.msg import Twist
 from rcl_interfaces.msg import (
     FloatingPointRange,
@@ -24,7 +25,7 @@ from app.ros.context import CallContext
 from app.ros2cli.common import is_hidden_name, visible, write_text
 from app.ros2cli.msg_yaml import message_to_yaml
 from app.ros2cli.param import describe_lines
-from app.ros2cli.parser import parse, run_argv
+from app.ros2cli.parser import UsageError, parse, run_argv
 from app.ros2cli.topic import EchoStyle, bandwidth_text, echo_text, qos_fallback_lines
 
 
@@ -134,6 +135,10 @@ def test_help_names_upstream_options_and_what_is_not_supported():
     assert "Not supported here (Jazzy's ros2 has them): --stdin, -n/--node-name, --qos-profile" in (
         " ".join(text.split())
     )
+    # ...and listed as ros2 lists them, so -h reads as upstream's; typing one is refused
+    assert "  --stdin               Read values from standard input" in text
+    with pytest.raises(UsageError, match="argument --stdin: not supported here"):
+        parse(["topic", "pub", "--stdin", "/x", "std_msgs/msg/String"], [].append)
     text = "\n".join(_help(["node", "info", "-h"]))
     assert "--include-hidden" in text
     text = "\n".join(_help(["param", "describe", "-h"]))
@@ -186,7 +191,7 @@ def test_interface_proto_prints_a_quoted_default_instance():
 
 
 def test_echo_options_no_arr_no_str_flow_style_and_csv():
-    from geometry_msgs.msg import Polygon
+    from geometry_msgs.msg import Point32, Polygon
     from sensor_msgs.msg import Imu
 
     msg = UInt8MultiArray(data=[1, 2, 3])
@@ -200,7 +205,14 @@ def test_echo_options_no_arr_no_str_flow_style_and_csv():
     assert echo_text(Polygon(), EchoStyle(no_arr=True)) == (
         "points: '<sequence type: geometry_msgs/msg/Point32, length: 0>'\n---"
     )
-    assert echo_text(String(data="hi"), EchoStyle(flow_style=True)) == "{data: hi}\n---"
+    # --flow-style: lists in flow style, messages (mappings) still in block style
+    assert echo_text(String(data="hi"), EchoStyle(flow_style=True)) == "data: hi\n---"
+    assert echo_text(Polygon(points=[Point32(x=1.0)]), EchoStyle(flow_style=True)) == (
+        "points: [{x: 1.0, y: 0.0, z: 0.0}]\n---"
+    )
+    assert echo_text(UInt8MultiArray(data=[1, 2]), EchoStyle(flow_style=True)) == (
+        "layout:\n  dim: []\n  data_offset: 0\ndata: [1, 2]\n---"
+    )
     twist = Twist()
     twist.linear.x = 2.0
     assert echo_text(twist, EchoStyle(csv=True)) == "2.0,0.0,0.0,0.0,0.0,0.0"
