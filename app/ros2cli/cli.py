@@ -20,9 +20,6 @@ from app.ros2cli.common import TerminalContext
 from app.ros2cli.parser import needs_ros, run_argv
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
-# ros2cli's exit code after Ctrl+C: rclpy's SIGINT handler shuts its context down,
-# the verb ends with ExternalShutdownException, and `ros2` returns SIGTERM's number.
-EXIT_INTERRUPTED = int(signal.SIGTERM)
 ROS2CLI_GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface")
 EXIT_INTERRUPTED_OTHER = 130  # our other commands (bag, run, ...): the shell's convention
 
@@ -59,10 +56,9 @@ def main(argv: list[str]) -> int:
     )
     try:
         code = run_argv(ctx, argv, "ros2-classroom")
-        if not cancel.is_set():
-            return code
-        ros2cli_verb = argv[:1] and argv[0] in ROS2CLI_GROUPS
-        return EXIT_INTERRUPTED if ros2cli_verb else EXIT_INTERRUPTED_OTHER
+        if cancel.is_set() and not (argv[:1] and argv[0] in ROS2CLI_GROUPS):
+            return EXIT_INTERRUPTED_OTHER
+        return code  # ros2cli's verbs: as `ros2` ends after Ctrl+C (parser.EXIT_INTERRUPTED)
     finally:
         runtime.shutdown()
         for sig, handler in previous.items():

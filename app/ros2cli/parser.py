@@ -27,6 +27,9 @@ log = logging.getLogger(__name__)
 
 GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface", "bag", "pkg")
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
+# ros2cli's exit code after Ctrl+C: rclpy's SIGINT handler shuts its context down,
+# the verb ends with ExternalShutdownException, and `ros2` returns SIGTERM's number.
+EXIT_INTERRUPTED = 15
 
 
 class UsageError(Ros2Error):
@@ -107,16 +110,14 @@ def commands(parser: argparse.ArgumentParser, dest: str) -> Any:
     return sub
 
 
-def finish_commands(parser: argparse.ArgumentParser, sub: Any, group: str = "") -> None:
+def finish_commands(parser: argparse.ArgumentParser, sub: Any) -> None:
     """One line per command (its description), sorted, as ros2cli's -h lists them.
 
     The choices are sorted too (argparse's "invalid choice" error names them in
     that order), and the per-command help lines argparse would add are dropped.
     """
     described = {a.dest: a.help for a in sub._choices_actions}
-    lines = {name: p.description or described.get(name) or "" for name, p in sub.choices.items()}
-    missing = NOT_HERE_VERBS.get(group, {})
-    shown = {**lines, **{n: f"{text} ({NOT_HERE})" for n, text in missing.items()}}
+    shown = {name: p.description or described.get(name) or "" for name, p in sub.choices.items()}
     width = max(map(len, shown))
     section = next(g for g in parser._action_groups if sub in g._group_actions)
     section.description = "".join(f"{n.ljust(width)}  {shown[n]}\n" for n in sorted(shown))
@@ -206,9 +207,27 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
     run.add_command(groups, write)  # `ros2 run PKG EXE`: a command, not a group of verbs
     launch_verb.add_command(groups, write)  # `ros2 launch PKG FILE`: the same
     for g, verbs, name in groups_done:
-        finish_commands(g, verbs, name)
+        for missing, description in NOT_HERE_VERBS.get(name, {}).items():
+            p = verbs.add_parser(
+                missing,
+                description=f"{description} ({NOT_HERE})",
+                formatter_class=RAW,
+                write=write,
+            )
+            p.add_argument("words", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
+            p.set_defaults(handler=_not_here_verb(f"{name} {missing}"))
+        finish_commands(g, verbs)
     finish_commands(parser, groups)
     return parser
+
+
+def _not_here_verb(words: str) -> Handler:
+    """A verb of Jazzy's ros2 we do not offer: listed, and a clear refusal (exit code 2)."""
+
+    def refuse(_ctx: CallContext, _args: argparse.Namespace) -> int:
+        raise UsageError(f"`ros2 {words}` is {NOT_HERE}")
+
+    return refuse
 
 
 def _print_help(ctx: CallContext, parser: argparse.ArgumentParser) -> int:
@@ -219,7 +238,8 @@ def _print_help(ctx: CallContext, parser: argparse.ArgumentParser) -> int:
 
 
 _NO_DDS = (
-    {("interface", v) for v in ("list", "packages", "package", "show")}
+    {(group, verb) for group, verbs in NOT_HERE_VERBS.items() for verb in verbs}
+    | {("interface", v) for v in ("list", "packages", "package", "show")}
     | {("interface", "proto")}
     | pkg.NO_DDS
     | {("bag", v) for v in bag.NO_DDS_VERBS}
@@ -351,8 +371,9 @@ def run_argv(
         ctx.write(f"error: {exc}")
         return EXIT_USAGE
     except Cancelled:
-        if not isinstance(ctx, TerminalContext):
-            ctx.write("(stopped)")  # the Console says why the output ends; ros2 says nothing
+        if isinstance(ctx, TerminalContext):
+            return EXIT_INTERRUPTED  # as ros2 ends on Ctrl+C: nothing printed
+        ctx.write("(stopped)")  # the Console says why the output ends
         return EXIT_FAILED
     except SilentFailure as exc:  # ros2 prints nothing; say why where it does not disturb
         (note or ctx.write)(f"({exc})" if note is None else str(exc))

@@ -23,7 +23,7 @@ from app.ros.convert import (
     parse_yaml,
 )
 from app.ros.errors import Ros2Error
-from app.ros.graph import topic_types, wait_for_graph
+from app.ros.graph import topic_types
 from app.ros.monitor import TopicMonitor
 from app.ros.qos import MEASURE_QOS
 from app.ros2cli.common import (
@@ -165,8 +165,7 @@ def _echo_type(ctx: CallContext, topic: str, type_text: str | None) -> type:
     if type_text:
         return ros2_type(type_text, "msg")
     full = _full_topic_name(ctx, topic)
-    wait_for_graph(ctx, lambda: full in topic_types(ctx.node, include_hidden=True))
-    found = _known_type(ctx, full)
+    found = _known_type(ctx, full)  # no wait: the CLI has let its node discover the graph
     if found is None:
         ctx.write(not_published_yet(topic))
         raise Ros2cliMessage("Could not determine the type for the passed topic")
@@ -174,18 +173,19 @@ def _echo_type(ctx: CallContext, topic: str, type_text: str | None) -> type:
 
 
 def _measured_type(ctx: CallContext, topic: str) -> type | None:
-    """`topic hz`/`bw` of a topic not on the graph yet: say so once, then wait for it."""
+    """`topic hz`/`bw` of a topic not on the graph yet: say so once, then wait for it.
+
+    None when the wait ends first (the Console's bound, or Ctrl+C: ros2 then ends
+    quietly with exit code 0, its wait loop simply stops).
+    """
     full = _full_topic_name(ctx, topic)
-    wait_for_graph(ctx, lambda: full in topic_types(ctx.node, include_hidden=True))
     found = _known_type(ctx, full)
     if found is None:
         ctx.write(not_published_yet(topic))
         deadline = _deadline(ctx)
         while (found := _known_type(ctx, full)) is None:
-            if time.monotonic() > deadline:
-                return None  # the Console's own bound: nothing to measure
-            ctx.check_cancel()
-            ctx.sleep(0.1)
+            if time.monotonic() > deadline or ctx.cancel.wait(0.1):
+                return None
     return import_type(found, "msg")
 
 
@@ -276,7 +276,8 @@ def _measure(
 ) -> int:
     msg_type = ros2_type(type_text, "msg") if type_text else _measured_type(ctx, topic)
     if msg_type is None:
-        ctx.write(f"(no messages on {topic}, or too few to measure)")
+        if not ctx.cancel.is_set():
+            ctx.write(f"(no messages on {topic}, or too few to measure)")
         return 0
     # Best effort, as ros2 hz/bw subscribe: measuring must not slow a reliable publisher.
     monitor = TopicMonitor(ctx.node, topic, msg_type, window=window, keep=1, qos=MEASURE_QOS)

@@ -196,8 +196,8 @@ def test_bad_input_gives_one_clear_line(probe, ros2):
         ], lines
         assert lines[-1] == (
             "ros2 topic: error: argument Call `ros2 topic <command> -h` for more detailed "
-            "usage.: invalid choice: 'frobnicate' (choose from 'bw', 'echo', 'find', 'hz', "
-            "'info', 'list', 'pub', 'type')"
+            "usage.: invalid choice: 'frobnicate' (choose from 'bw', 'delay', 'echo', 'find', "
+            "'hz', 'info', 'list', 'pub', 'type')"
         ), lines
     finally:
         release.set()
