@@ -239,3 +239,65 @@ def test_echo_says_when_it_falls_back_to_best_effort_or_volatile():
         "Some, but not all, publishers are offering QoSDurabilityPolicy.TRANSIENT_LOCAL. Falling "
         "back to QoSDurabilityPolicy.VOLATILE as it will connect to all publishers",
     ]
+
+
+# What the real Jazzy `ros2` printed at 100 columns (bench/results/ros2cli_compare.md).
+NODE_HELP = """\
+usage: ros2 node [-h] Call `ros2 node <command> -h` for more detailed usage. ...
+
+Various node related sub-commands
+
+options:
+  -h, --help            show this help message and exit
+
+Commands:
+  info  Output information about a node
+  list  Output a list of available nodes
+
+  Call `ros2 node <command> -h` for more detailed usage."""
+
+HZ_HELP = """\
+usage: ros2 topic hz [-h] [--window WINDOW] [--filter EXPR] [--wall-time] [--spin-time SPIN_TIME]
+                     [-s]
+                     topic_name
+
+Print the average publishing rate to screen
+
+positional arguments:
+  topic_name            Name of the ROS topic to listen to (e.g. '/chatter')
+
+options:
+  -h, --help            show this help message and exit
+  --window WINDOW, -w WINDOW
+                        window size, in # of messages, for calculating rate (default: 10000)
+  --filter EXPR         only measure messages matching the specified Python expression
+  --wall-time           calculates rate using wall time which can be helpful when clock is not
+                        published during simulation
+  --spin-time SPIN_TIME
+                        Spin time in seconds to wait for discovery (only applies when not using an
+                        already running daemon)
+  -s, --use-sim-time    Enable ROS simulation time"""
+
+
+def test_help_is_ros2s_own_text(monkeypatch):
+    monkeypatch.setenv("COLUMNS", "100")
+    assert "\n".join(_help(["node", "-h"])) == NODE_HELP
+    ours_only = (
+        "",
+        "Not supported here (Jazzy's ros2 has them): --filter, --wall-time, -s/--use-sim-time. "
+        "Using one gives a usage error.",
+    )
+    assert _help(["topic", "hz", "-h"]) == [*HZ_HELP.split("\n"), *ours_only]
+    # `ros2 node` alone: the same help, on the output, exit code 0 (as ros2cli)
+    lines: list[str] = []
+    args = parse(["node"], lines.append)
+    assert args is not None
+    assert args.handler(CallContext(None, lines.append), args) == 0  # type: ignore[arg-type]
+    assert "\n".join(lines) == NODE_HELP
+    # a verb ros2 has and we do not: a choice (ros2's list of choices), refused clearly
+    with pytest.raises(UsageError, match="invalid choice: 'nope' .*'delay', 'echo'"):
+        parse(["topic", "nope"], [].append)
+    args = parse(["topic", "delay", "/x"], [].append)
+    assert args is not None
+    with pytest.raises(UsageError, match="`ros2 topic delay` is not supported here"):
+        args.handler(CallContext(None, [].append), args)  # type: ignore[arg-type]
