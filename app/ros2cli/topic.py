@@ -8,9 +8,19 @@ from dataclasses import dataclass
 from typing import Any
 
 import yaml
+from rclpy.duration import Duration
 from rclpy.exceptions import InvalidTopicNameException
 from rclpy.expand_topic_name import expand_topic_name
-from rclpy.qos import DurabilityPolicy, ReliabilityPolicy
+from rclpy.qos import (
+    DurabilityPolicy,
+    QoSDurabilityPolicy,
+    QoSHistoryPolicy,
+    QoSLivelinessPolicy,
+    QoSPresetProfiles,
+    QoSProfile,
+    QoSReliabilityPolicy,
+    ReliabilityPolicy,
+)
 from rclpy.validate_full_topic_name import validate_full_topic_name
 
 from app.ros.context import CallContext
@@ -138,6 +148,70 @@ def qos_fallback_lines(publishers: list[Any]) -> list[str]:
     return lines
 
 
+@dataclass(frozen=True)
+class QosOptions:
+    """`topic echo`/`pub`'s --qos-* options: a preset by its short key, and overrides."""
+
+    profile: str
+    reliability: str | None = None
+    durability: str | None = None
+    depth: int | None = None
+    history: str | None = None
+    liveliness: str | None = None
+    lease_seconds: float | None = None
+
+    def overridden(self) -> bool:
+        overrides = (self.reliability, self.durability, self.depth, self.history)
+        return any(v is not None for v in (*overrides, self.liveliness, self.lease_seconds))
+
+    def profile_with_overrides(self) -> QoSProfile:
+        """The preset with each given policy in its place, as ros2cli builds it."""
+        qos = QoSPresetProfiles.get_from_short_key(self.profile)
+        if self.history:
+            qos.history = QoSHistoryPolicy.get_from_short_key(self.history)
+        if self.durability:
+            qos.durability = QoSDurabilityPolicy.get_from_short_key(self.durability)
+        if self.reliability:
+            qos.reliability = QoSReliabilityPolicy.get_from_short_key(self.reliability)
+        if self.liveliness:
+            qos.liveliness = QoSLivelinessPolicy.get_from_short_key(self.liveliness)
+        if self.lease_seconds and self.lease_seconds >= 0:
+            qos.liveliness_lease_duration = Duration(seconds=self.lease_seconds)
+        if self.depth and self.depth >= 0:
+            qos.depth = self.depth
+        elif qos.durability == DurabilityPolicy.TRANSIENT_LOCAL and qos.depth == 0:
+            qos.depth = 1
+        return qos
+
+
+ECHO_QOS = QosOptions("sensor_data")
+PUB_QOS = QosOptions("default")
+
+
+def _echo_qos(ctx: CallContext, topic: str, options: QosOptions) -> QoSProfile | None:
+    """The subscription's QoS, as ros2cli's echo chooses it (None: our matching default).
+
+    With an override, exactly the asked profile; else the preset, made reliable or
+    transient local only when every publisher offers it (and saying so when some do).
+    """
+    if options.overridden():
+        return options.profile_with_overrides()
+    publishers = ctx.node.get_publishers_info_by_topic(topic)
+    for line in qos_fallback_lines(publishers):
+        ctx.write(line)
+    if options.profile == ECHO_QOS.profile:
+        return None  # the same choice, made by app.ros.qos.matching_qos
+    qos = QoSPresetProfiles.get_from_short_key(options.profile)
+    if publishers:
+        reliable = all(p.qos_profile.reliability == ReliabilityPolicy.RELIABLE for p in publishers)
+        latched = all(
+            p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for p in publishers
+        )
+        qos.reliability = ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT
+        qos.durability = DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE
+    return qos
+
+
 def _full_topic_name(ctx: CallContext, topic: str) -> str:
     """The name as ros2cli looks it up: relative to the CLI's node, and valid, or its words."""
     try:
@@ -232,6 +306,7 @@ def echo(
     count: int | None = None,
     style: EchoStyle = EchoStyle(),
     timeout: float | None = None,
+    qos: QosOptions = ECHO_QOS,
 ) -> int:
     parts = None
     if field is not None:
@@ -239,10 +314,9 @@ def echo(
         if not parts:
             raise Ros2cliMessage(f"Invalid field value '{field}'")
     msg_type = _echo_type(ctx, topic, type_text)
-    for line in qos_fallback_lines(ctx.node.get_publishers_info_by_topic(topic)):
-        ctx.write(line)
+    profile = _echo_qos(ctx, topic, qos)
     limit = 1 if once else count or ctx.limits.max_messages
-    monitor = TopicMonitor(ctx.node, topic, msg_type, keep=200, window=16)
+    monitor = TopicMonitor(ctx.node, topic, msg_type, keep=200, window=16, qos=profile)
     shown = 0
     deadline = _deadline(ctx)
     if timeout is not None:
@@ -395,6 +469,7 @@ def pub(
     print_nth: int = 1,
     max_wait_time: float | None = None,
     keep_alive: float = 0.1,
+    qos: QosOptions = PUB_QOS,
 ) -> int:
     """`ros2 topic pub`: wait for subscribers if asked, then publish and print as ros2cli."""
     if not rate > 0 or not math.isfinite(rate):
@@ -420,7 +495,7 @@ def pub(
     existing = topic_types(ctx.node, include_hidden=True).get(topic)
     if existing and type_text and import_type(existing[0]) is not msg_type:
         raise Ros2Error(f"topic '{topic}' already carries {existing[0]}, not {type_text}")
-    publisher = ctx.node.create_publisher(msg_type, topic, 10)
+    publisher = ctx.node.create_publisher(msg_type, topic, qos.profile_with_overrides())
     try:
         _wait_for_subscribers(ctx, publisher, wait_matching, max_wait_time)
         ctx.write("publisher: beginning loop")

@@ -109,67 +109,63 @@ def strategy(p: argparse.ArgumentParser) -> None:
 
 
 def qos_options(p: argparse.ArgumentParser, verb: str, default_profile: str) -> None:
-    """`topic echo` and `topic pub`'s QoS options (not offered here: shown, refused)."""
+    """`topic echo` and `topic pub`'s QoS options (read back by ``qos_of``)."""
     history = QoSPresetProfiles.get_from_short_key(default_profile).history.short_key
     compatible = "default: Compatible profile with running endpoints )"
-    for flags, kw in (
-        (
-            ("--qos-profile",),
-            dict(
-                choices=QoSPresetProfiles.short_keys(),
-                help=f"Quality of service preset profile to {verb} with "
-                f"(default: {default_profile})",
-            ),
-        ),
-        (
-            ("--qos-depth",),
-            dict(
-                metavar="N",
-                help=f"Queue size setting to {verb} with "
-                "(overrides depth value of --qos-profile option)",
-            ),
-        ),
-        (
-            ("--qos-history",),
-            dict(
-                choices=QoSHistoryPolicy.short_keys(),
-                help=f"History of samples setting to {verb} with (overrides history value of "
-                f"--qos-profile option, default: {history})",
-            ),
-        ),
-        (
-            ("--qos-reliability",),
-            dict(
-                choices=QoSReliabilityPolicy.short_keys(),
-                help=f"Quality of service reliability setting to {verb} with (overrides "
-                f"reliability value of --qos-profile option, {compatible}",
-            ),
-        ),
-        (
-            ("--qos-durability",),
-            dict(
-                choices=QoSDurabilityPolicy.short_keys(),
-                help=f"Quality of service durability setting to {verb} with (overrides "
-                f"durability value of --qos-profile option, {compatible}",
-            ),
-        ),
-        (
-            ("--qos-liveliness",),
-            dict(
-                choices=QoSLivelinessPolicy.short_keys(),
-                help=f"Quality of service liveliness setting to {verb} with (overrides "
-                "liveliness value of --qos-profile option",
-            ),
-        ),
-        (
-            ("--qos-liveliness-lease-duration-seconds",),
-            dict(
-                help=f"Quality of service liveliness lease duration setting to {verb} with "
-                "(overrides liveliness lease duration value of --qos-profile option",
-            ),
-        ),
-    ):
-        not_here(p, *flags, **kw)
+    p.add_argument(
+        "--qos-profile",
+        choices=QoSPresetProfiles.short_keys(),
+        default=default_profile,
+        help=f"Quality of service preset profile to {verb} with (default: {default_profile})",
+    )
+    p.add_argument(
+        "--qos-depth",
+        metavar="N",
+        type=int,
+        help=f"Queue size setting to {verb} with (overrides depth value of --qos-profile option)",
+    )
+    p.add_argument(
+        "--qos-history",
+        choices=QoSHistoryPolicy.short_keys(),
+        help=f"History of samples setting to {verb} with (overrides history value of "
+        f"--qos-profile option, default: {history})",
+    )
+    p.add_argument(
+        "--qos-reliability",
+        choices=QoSReliabilityPolicy.short_keys(),
+        help=f"Quality of service reliability setting to {verb} with (overrides "
+        f"reliability value of --qos-profile option, {compatible}",
+    )
+    p.add_argument(
+        "--qos-durability",
+        choices=QoSDurabilityPolicy.short_keys(),
+        help=f"Quality of service durability setting to {verb} with (overrides "
+        f"durability value of --qos-profile option, {compatible}",
+    )
+    p.add_argument(
+        "--qos-liveliness",
+        choices=QoSLivelinessPolicy.short_keys(),
+        help=f"Quality of service liveliness setting to {verb} with (overrides "
+        "liveliness value of --qos-profile option",
+    )
+    p.add_argument(
+        "--qos-liveliness-lease-duration-seconds",
+        type=float,
+        help=f"Quality of service liveliness lease duration setting to {verb} with "
+        "(overrides liveliness lease duration value of --qos-profile option",
+    )
+
+
+def qos_of(a: argparse.Namespace) -> topic.QosOptions:
+    return topic.QosOptions(
+        a.qos_profile,
+        reliability=a.qos_reliability,
+        durability=a.qos_durability,
+        depth=a.qos_depth,
+        history=a.qos_history,
+        liveliness=a.qos_liveliness,
+        lease_seconds=a.qos_liveliness_lease_duration_seconds,
+    )
 
 
 def _node_listing_options(p: Any) -> None:
@@ -348,6 +344,7 @@ def _add_echo(v: Any, verb: Verb) -> None:
                 csv=a.csv,
             ),
             timeout=a.timeout,
+            qos=qos_of(a),
         ),
     )
     strategy(p)
@@ -436,6 +433,7 @@ def _add_pub(v: Any, verb: Verb) -> None:
             print_nth=a.print,
             max_wait_time=a.max_wait_time_secs,
             keep_alive=a.keep_alive,
+            qos=qos_of(a),
         ),
     )
     p.add_argument("topic_name", help="Name of the ROS topic to publish to (e.g. '/chatter')")

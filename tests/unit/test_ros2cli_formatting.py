@@ -132,9 +132,11 @@ def test_help_names_upstream_options_and_what_is_not_supported():
         assert option in text, text
     assert "--wait-matching-subscriptions" in text and "--max-wait-time-secs" in text
     assert "--keep-alive N" in text
-    assert "Not supported here (Jazzy's ros2 has them): --stdin, -n/--node-name, --qos-profile" in (
-        " ".join(text.split())
+    assert (
+        "Not supported here (Jazzy's ros2 has them): --stdin, -n/--node-name, -s/--use-sim-time"
+        in (" ".join(text.split()))
     )
+    assert "--qos-reliability {system_default,reliable,best_effort,unknown,best_available}" in text
     # ...and listed as ros2 lists them, so -h reads as upstream's; typing one is refused
     assert "  --stdin               Read values from standard input" in text
     with pytest.raises(UsageError, match="argument --stdin: not supported here"):
@@ -301,3 +303,30 @@ def test_help_is_ros2s_own_text(monkeypatch):
     assert args is not None
     with pytest.raises(UsageError, match="`ros2 topic delay` is not supported here"):
         args.handler(CallContext(None, [].append), args)  # type: ignore[arg-type]
+
+
+def test_qos_options_build_the_profile_as_ros2cli_does():
+    from rclpy.qos import DurabilityPolicy, HistoryPolicy, ReliabilityPolicy
+
+    from app.ros2cli.topic import ECHO_QOS, PUB_QOS, QosOptions
+
+    assert not ECHO_QOS.overridden() and not PUB_QOS.overridden()
+    pub = PUB_QOS.profile_with_overrides()  # the 'default' preset: what `ros2 topic pub` uses
+    assert (pub.reliability, pub.durability, pub.depth) == (
+        ReliabilityPolicy.RELIABLE,
+        DurabilityPolicy.VOLATILE,
+        10,
+    )
+    qos = QosOptions("sensor_data", reliability="reliable", depth=3, history="keep_all")
+    profile = qos.profile_with_overrides()
+    assert qos.overridden()
+    assert (profile.reliability, profile.depth, profile.history) == (
+        ReliabilityPolicy.RELIABLE,
+        3,
+        HistoryPolicy.KEEP_ALL,
+    )
+    # transient local with no depth keeps the one last message
+    latched = QosOptions("system_default", durability="transient_local", depth=0)
+    assert latched.profile_with_overrides().depth == 1
+    with pytest.raises(UsageError, match="argument --qos-profile: invalid choice: 'nope'"):
+        parse(["topic", "echo", "--qos-profile", "nope", "/x"], [].append)
