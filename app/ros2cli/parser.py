@@ -256,6 +256,11 @@ def needs_ros(argv: list[str]) -> bool:
     return tuple(words[:2]) not in _NO_DDS and not pkg.no_dds(words)
 
 
+# ros2cli's `service call` makes its client right away, in a brand-new node, and prints
+# "waiting for service to become available..." while it has not matched the server yet:
+# no look at the graph first, so a terminal shows that line when ros2 would.
+_FRESH_CLIENT = {("service", "call")}
+
 _HELP_WITHOUT_DDS = {"node", "topic", "service", "action", "param", "lifecycle", "interface"}
 
 
@@ -359,7 +364,7 @@ def run_argv(
         args = parse(argv, ctx.write, prog)
         if args is None:
             return EXIT_OK
-        if needs_ros(argv):
+        if needs_ros(argv) and tuple(argv[:2]) not in _FRESH_CLIENT:
             settle_discovery(ctx, getattr(args, "spin_time", None))
         return args.handler(ctx, args)
     except ArgumentUsageError as exc:
