@@ -27,6 +27,7 @@ from app.ros.calls import (
 )
 from app.ros.context import CallContext
 from app.ros.convert import from_yaml, message_repr
+from app.ros.errors import Cancelled
 from app.ros.graph import all_nodes, wait_for_graph
 from app.ros.names import split_node_name
 from app.ros2cli.common import (
@@ -262,7 +263,12 @@ def action_send_goal(
             with lock:
                 write_message_block(ctx, "Feedback", message, 4)
 
-    send_goal(ctx, run, on_feedback, on_accepted)
+    try:
+        send_goal(ctx, run, on_feedback, on_accepted)
+    except Cancelled:
+        if run.goal_id:  # accepted and running: send_goal has asked the server to cancel it
+            ctx.write("Canceling goal...")
+        raise
     if run.status == "REJECTED":
         ctx.write("Goal was rejected.")
         return 0
