@@ -1,0 +1,291 @@
+"""What the simulation probes share (registers no kind): the world's controls, a recorder
+of the robot's ground truth, random start poses, and the verdict's numbers.
+
+A simulation probe grades behaviour, the way Duckietown and JdeRobot grade:
+it puts the robot at a start pose the learner does not choose (drawn from the
+exercise's ranges with the grading's seed, and redrawn until the room allows
+it), lets the learner's node drive, and measures what the robot really did
+from ``/ground_truth/odom`` and the world file's floor plan, never from the
+learner's own outputs.
+
+One trial:
+
+1. wait for ``/sim_world`` (the exercise's setup starts it) and read its
+   world, start pose and real-time factor;
+2. set ``use_sim_time`` on the learner's node, as a simulator's launch file
+   does, so its timers count simulated seconds;
+3. pause the physics, set the start pose (and anything the learner's node is
+   told, such as a goal), reset the world, set the grading's real-time
+   factor (faster than real time: judged in simulated seconds, it changes
+   nothing but the wait) and go on;
+4. record the ground truth until the probe has seen enough;
+5. put back what was changed: the world's parameters and ``use_sim_time``.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Any
+
+from nav_msgs.msg import Odometry
+from rcl_interfaces.msg import Parameter
+from rcl_interfaces.srv import SetParameters
+from std_srvs.srv import Empty
+
+from app.exercises.probes.base import ProbeContext, draw
+from app.lessons.checks._sim_topics import SIM_NODE, Pose, pose_of, world_map, wrap
+from app.lessons.checks._world_map import WorldMap
+from app.ros import params
+from app.ros.calls import call_service
+from app.ros.errors import Ros2Error
+
+READY_WAIT_SEC = 30.0  # a world starting on a busy machine: MuJoCo, the model, the camera
+SERVICE_SEC = 5.0
+TOUCH = 0.01  # m: the body this close to an obstacle touches it
+STILL_SPEED = 0.02  # m/s (and 0.05 rad/s): slower than this, the robot stands still
+DEFAULT_RTF = 2.0
+WORLD_PARAMS = ("x", "y", "yaw", "real_time_factor")
+
+
+@dataclass(frozen=True)
+class Sample:
+    """One ground-truth pose: simulation time, position, heading."""
+
+    t: float
+    x: float
+    y: float
+    yaw: float
+
+
+class Recorder:
+    """Every /ground_truth/odom and /odom message as planar poses (the executor thread writes)."""
+
+    def __init__(self, ctx: ProbeContext) -> None:
+        self._node = ctx.call.node
+        self._lock = threading.Lock()
+        self.truth: list[Sample] = []
+        self.odom: list[Pose] = []
+        self._subs = [
+            self._node.create_subscription(Odometry, "/ground_truth/odom", self._on_truth, 50),
+            self._node.create_subscription(Odometry, "/odom", self._on_odom, 50),
+        ]
+
+    def _on_truth(self, msg: Odometry) -> None:
+        pose = pose_of(msg)
+        with self._lock:
+            self.truth.append(Sample(pose.t, pose.x, pose.y, pose.yaw))
+
+    def _on_odom(self, msg: Odometry) -> None:
+        with self._lock:
+            self.odom.append(pose_of(msg))
+
+    def newest(self) -> Sample | None:
+        with self._lock:
+            return self.truth[-1] if self.truth else None
+
+    def since(self, t0: float) -> list[Sample]:
+        with self._lock:
+            return [s for s in self.truth if s.t > t0]
+
+    def odom_since(self, t0: float) -> list[Pose]:
+        with self._lock:
+            return [p for p in self.odom if p.t > t0]
+
+    def close(self) -> None:
+        for sub in self._subs:
+            self._node.destroy_subscription(sub)
+
+
+def _parameter(name: str, value: Any) -> Parameter:
+    return Parameter(name=name, value=params.parameter_value(value))
+
+
+def set_parameters(ctx: ProbeContext, node: str, values: dict[str, Any]) -> None:
+    """Set several parameters in one request; a refusal raises with the node's reason."""
+    request = SetParameters.Request(parameters=[_parameter(k, v) for k, v in values.items()])
+    response = call_service(
+        ctx.call, f"{node}/set_parameters", SetParameters, request, timeout=SERVICE_SEC
+    )
+    for name, result in zip(values, response.results, strict=False):
+        if not result.successful:
+            raise Ros2Error(f"{node} refused {name}={values[name]!r}: {result.reason}")
+
+
+def call_empty(ctx: ProbeContext, service: str) -> None:
+    call_service(ctx.call, service, Empty, Empty.Request(), timeout=SERVICE_SEC)
+
+
+@dataclass
+class World:
+    """The running simulation as the probe found it: its floor plan and what to put back."""
+
+    name: str
+    plan: WorldMap
+    saved: dict[str, Any]
+    rtf: float
+
+
+def _wait_for_world(ctx: ProbeContext, recorder: Recorder) -> None:
+    deadline = time.monotonic() + READY_WAIT_SEC
+    names: set[str] = set()
+    while recorder.newest() is None or f"{SIM_NODE}/set_parameters" not in names:
+        if time.monotonic() > deadline:
+            raise Ros2Error(
+                f"no simulation: {SIM_NODE} did not publish /ground_truth/odom within "
+                f"{READY_WAIT_SEC:g} s (the exercise starts it: is another world running?)"
+            )
+        ctx.call.sleep(0.2)
+        names = {name for name, _ in ctx.call.node.get_service_names_and_types()}
+
+
+@contextmanager
+def simulation(ctx: ProbeContext, rtf: float) -> Iterator[tuple[World, Recorder]]:
+    """The world, ready for trials; afterwards its parameters and the learner's clock as before."""
+    recorder = Recorder(ctx)
+    learner_sim_time: bool | None = None
+    world: World | None = None
+    try:
+        _wait_for_world(ctx, recorder)
+        names = ["world", *WORLD_PARAMS]
+        values = [params.python_value(v) for v in params.get_values(ctx.call, SIM_NODE, names)]
+        current = dict(zip(names, values, strict=True))
+        name = str(current.pop("world"))
+        world = World(name, world_map(name), current, rtf)
+        try:
+            [value] = params.get_values(ctx.call, ctx.learner_node, ["use_sim_time"])
+            learner_sim_time = bool(params.python_value(value))
+            set_parameters(ctx, ctx.learner_node, {"use_sim_time": True})
+        except Ros2Error as exc:
+            raise Ros2Error(
+                f"could not set use_sim_time on {ctx.learner_node}: {exc} (is its executor busy?)"
+            ) from None
+        yield world, recorder
+    finally:
+        try:
+            if world is not None:
+                set_parameters(ctx, SIM_NODE, world.saved)
+            if learner_sim_time is not None:
+                set_parameters(ctx, ctx.learner_node, {"use_sim_time": learner_sim_time})
+        except Ros2Error:
+            pass  # the world or the node is gone: nothing to put back
+        recorder.close()
+
+
+def release(
+    ctx: ProbeContext,
+    world: World,
+    recorder: Recorder,
+    start: tuple[float, float, float],
+    learner: dict[str, Any] | None = None,
+) -> float:
+    """Put the robot at ``start`` (paused), tell the learner's node ``learner``, and go.
+
+    Returns the simulation time the trial starts at: later samples are the trial's.
+    """
+    call_empty(ctx, "/pause_physics")
+    newest = recorder.newest()
+    assert newest is not None
+    x, y, yaw = start
+    set_parameters(ctx, SIM_NODE, {"x": x, "y": y, "yaw": yaw, "real_time_factor": world.rtf})
+    call_empty(ctx, "/reset_world")  # the robot at the start, odometry at zero, time goes on
+    if learner:
+        set_parameters(ctx, ctx.learner_node, learner)
+    ctx.call.sleep(0.2)  # what the learner's node heard arrives before time moves
+    t0 = newest.t
+    call_empty(ctx, "/unpause_physics")
+    return t0
+
+
+def draw_pose(
+    ctx: ProbeContext,
+    ranges: dict[str, Any],
+    fits: Callable[[float, float, float], bool],
+    tries: int = 20000,
+) -> tuple[float, float, float]:
+    """A pose drawn from ``{x, y, yaw}`` ranges, drawn again until ``fits`` accepts it."""
+    for _ in range(tries):
+        x, y, yaw = (float(draw(ctx.rng, ranges[k])) for k in ("x", "y", "yaw"))
+        if fits(x, y, yaw):
+            return x, y, yaw
+    raise ValueError(f"no pose drawn from {ranges} fits the world in {tries} tries")
+
+
+def run_until(
+    ctx: ProbeContext,
+    recorder: Recorder,
+    t0: float,
+    sim_seconds: float,
+    rtf: float,
+    done: Callable[[list[Sample]], bool],
+) -> tuple[list[Sample], str]:
+    """Samples from ``t0`` until ``done`` says so or ``sim_seconds`` of simulation pass.
+
+    The wall-clock bound is generous (a busy machine runs the world slower than asked);
+    past it, the second value says how far the simulation got.
+    """
+    wall_limit = sim_seconds / max(rtf, 0.25) * 4.0 + 20.0
+    deadline = time.monotonic() + wall_limit
+    while True:
+        samples = recorder.since(t0)
+        if samples and (samples[-1].t - t0 >= sim_seconds or done(samples)):
+            return samples, ""
+        if time.monotonic() > deadline:
+            got = samples[-1].t - t0 if samples else 0.0
+            return samples, (
+                f"the simulation ran only {got:.1f} of {sim_seconds:g} s in {wall_limit:.0f} s "
+                "of wall-clock time (the machine is too busy to grade now)"
+            )
+        ctx.call.sleep(0.1)
+
+
+def elapsed(samples: list[Sample], t0: float) -> float:
+    return samples[-1].t - t0 if samples else 0.0
+
+
+def at_rest(samples: list[Sample], seconds: float) -> bool:
+    """The robot stood still (position and heading) over the last ``seconds``."""
+    if not samples or samples[-1].t - samples[0].t < seconds:
+        return False
+    end = samples[-1]
+    window = [s for s in samples if s.t >= end.t - seconds]
+    first = window[0]
+    moved = math.hypot(end.x - first.x, end.y - first.y)
+    turned = abs(wrap(end.yaw - first.yaw))
+    return moved <= STILL_SPEED * seconds and turned <= 0.05 * seconds
+
+
+def path_length(samples: list[Sample]) -> float:
+    return sum(math.hypot(b.x - a.x, b.y - a.y) for a, b in zip(samples, samples[1:], strict=False))
+
+
+@dataclass(frozen=True)
+class Touch:
+    """Where the body came closest to the room: distance, what, when (s into the trial)."""
+
+    distance: float
+    name: str
+    at: float
+
+
+def closest_touch(plan: WorldMap, samples: list[Sample], t0: float) -> Touch:
+    best = Touch(math.inf, "", 0.0)
+    for s in samples:
+        near = plan.clearance(s.x, s.y, s.yaw)
+        if near.distance < best.distance:
+            best = Touch(near.distance, near.name, s.t - t0)
+    return best
+
+
+def touch_text(touch: Touch) -> str:
+    if touch.distance <= TOUCH:
+        return f"the robot touched {touch.name} at {touch.at:.1f} s"
+    return f"the body never came closer than {touch.distance:.2f} m to anything ({touch.name})"
+
+
+def pose_text(pose: tuple[float, float, float]) -> str:
+    return f"(x={pose[0]:.2f}, y={pose[1]:.2f}, yaw={pose[2]:.2f})"
