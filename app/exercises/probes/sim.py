@@ -32,6 +32,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
+from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import Parameter
 from rcl_interfaces.srv import SetParameters
@@ -47,8 +48,12 @@ from app.ros.errors import Ros2Error
 READY_WAIT_SEC = 30.0  # a world starting on a busy machine: MuJoCo, the model, the camera
 SERVICE_SEC = 5.0
 TOUCH = 0.01  # m: the body this close to an obstacle touches it
-STILL_SPEED = 0.02  # m/s (and 0.05 rad/s): slower than this, the robot stands still
+# Slower than this (m/s, rad/s) over a few seconds, the robot stands still: a slow final
+# approach (a few cm/s) still counts as moving.
+STILL_SPEED, STILL_TURN = 0.005, 0.01
+ASKED_SPEED, ASKED_TURN = 0.01, 0.02  # a /cmd_vel below both asks for no real motion
 DEFAULT_RTF = 2.0
+QUIET_WAIT = 3.0  # s at most for the samples sent before a pause to arrive
 WORLD_PARAMS = ("x", "y", "yaw", "real_time_factor")
 
 
@@ -63,17 +68,35 @@ class Sample:
 
 
 class Recorder:
-    """Every /ground_truth/odom and /odom message as planar poses (the executor thread writes)."""
+    """Every /ground_truth/odom and /odom message as planar poses, and when /cmd_vel last
+    asked for motion (the executor thread writes).
+
+    /cmd_vel only tells the probe when to stop watching (a robot that stands still while
+    its node still asks it to move was held up, e.g. by a busy machine, and is watched on);
+    the verdict comes from the ground truth.
+    """
 
     def __init__(self, ctx: ProbeContext) -> None:
         self._node = ctx.call.node
         self._lock = threading.Lock()
         self.truth: list[Sample] = []
         self.odom: list[Pose] = []
+        self.moving_asked = 0.0  # monotonic time /cmd_vel last asked for motion
         self._subs = [
             self._node.create_subscription(Odometry, "/ground_truth/odom", self._on_truth, 50),
             self._node.create_subscription(Odometry, "/odom", self._on_odom, 50),
+            self._node.create_subscription(Twist, "/cmd_vel", self._on_cmd_vel, 50),
         ]
+
+    def _on_cmd_vel(self, msg: Twist) -> None:
+        if abs(msg.linear.x) > ASKED_SPEED or abs(msg.angular.z) > ASKED_TURN:
+            with self._lock:
+                self.moving_asked = time.monotonic()
+
+    def asked_to_move(self, within: float = 1.0) -> bool:
+        """Whether /cmd_vel asked for motion in the last ``within`` s of wall-clock time."""
+        with self._lock:
+            return time.monotonic() - self.moving_asked < within
 
     def _on_truth(self, msg: Odometry) -> None:
         pose = pose_of(msg)
@@ -87,6 +110,10 @@ class Recorder:
     def newest(self) -> Sample | None:
         with self._lock:
             return self.truth[-1] if self.truth else None
+
+    def count(self) -> int:
+        with self._lock:
+            return len(self.truth)
 
     def since(self, t0: float) -> list[Sample]:
         with self._lock:
@@ -188,17 +215,23 @@ def release(
     Returns the simulation time the trial starts at: later samples are the trial's.
     """
     call_empty(ctx, "/pause_physics")
-    newest = recorder.newest()
-    assert newest is not None
     x, y, yaw = start
     set_parameters(ctx, SIM_NODE, {"x": x, "y": y, "yaw": yaw, "real_time_factor": world.rtf})
     call_empty(ctx, "/reset_world")  # the robot at the start, odometry at zero, time goes on
     if learner:
         set_parameters(ctx, ctx.learner_node, learner)
-    ctx.call.sleep(0.2)  # what the learner's node heard arrives before time moves
-    t0 = newest.t
+    # Paused, the world publishes nothing: once nothing has come for a while, what was on
+    # its way before the pause has arrived, and every later sample is the trial's.
+    count = recorder.count()
+    for _ in range(int(QUIET_WAIT / 0.1)):
+        ctx.call.sleep(0.1)
+        if recorder.count() == count:
+            break
+        count = recorder.count()
+    newest = recorder.newest()
+    assert newest is not None
     call_empty(ctx, "/unpause_physics")
-    return t0
+    return newest.t
 
 
 def draw_pose(
@@ -219,11 +252,13 @@ def run_until(
     ctx: ProbeContext,
     recorder: Recorder,
     t0: float,
+    start: tuple[float, float, float],
     sim_seconds: float,
     rtf: float,
     done: Callable[[list[Sample]], bool],
 ) -> tuple[list[Sample], str]:
-    """Samples from ``t0`` until ``done`` says so or ``sim_seconds`` of simulation pass.
+    """Samples from ``t0`` (the first at ``start``) until ``done`` says so or ``sim_seconds``
+    of simulation pass.
 
     The wall-clock bound is generous (a busy machine runs the world slower than asked);
     past it, the second value says how far the simulation got.
@@ -232,6 +267,9 @@ def run_until(
     deadline = time.monotonic() + wall_limit
     while True:
         samples = recorder.since(t0)
+        # A sample from before the reset that arrived late is not the trial's.
+        while samples and math.hypot(samples[0].x - start[0], samples[0].y - start[1]) > 0.03:
+            samples.pop(0)
         if samples and (samples[-1].t - t0 >= sim_seconds or done(samples)):
             return samples, ""
         if time.monotonic() > deadline:
@@ -256,7 +294,7 @@ def at_rest(samples: list[Sample], seconds: float) -> bool:
     first = window[0]
     moved = math.hypot(end.x - first.x, end.y - first.y)
     turned = abs(wrap(end.yaw - first.yaw))
-    return moved <= STILL_SPEED * seconds and turned <= 0.05 * seconds
+    return moved <= STILL_SPEED * seconds and turned <= STILL_TURN * seconds
 
 
 def path_length(samples: list[Sample]) -> float:

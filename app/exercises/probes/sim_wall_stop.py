@@ -93,9 +93,10 @@ def _trial(ctx: ProbeContext, p: Spec, world: World, recorder: Recorder) -> tupl
             if not reached and ahead(plan, s) <= reach:
                 reached.append(s.t - t0)
         seen[0] = len(samples)
-        return bool(reached) and samples[-1].t - t0 >= reached[0] + hold and at_rest(samples, hold)
+        settled = at_rest(samples, hold) and not recorder.asked_to_move()
+        return bool(reached) and samples[-1].t - t0 >= reached[0] + hold and settled
 
-    samples, stalled = run_until(ctx, recorder, t0, within + hold, world.rtf, done)
+    samples, stalled = run_until(ctx, recorder, t0, start, within + hold, world.rtf, done)
     began = f"start {pose_text(start)} with {wall.name} {wall.distance:.2f} m ahead"
     if stalled:
         return False, f"{began}; {stalled}"
