@@ -94,7 +94,9 @@ def _trial(ctx: ProbeContext, p: Spec, world: World, recorder: Recorder) -> tupl
                 reached.append(s.t - t0)
         seen[0] = len(samples)
         settled = at_rest(samples, hold) and not recorder.asked_to_move()
-        return bool(reached) and samples[-1].t - t0 >= reached[0] + hold and settled
+        if not reached:
+            return settled  # it stopped short: waiting on would change nothing
+        return samples[-1].t - t0 >= reached[0] + hold and settled
 
     samples, stalled = run_until(ctx, recorder, t0, start, within + hold, world.rtf, done)
     began = f"start {pose_text(start)} with {wall.name} {wall.distance:.2f} m ahead"
@@ -117,11 +119,17 @@ def _trial(ctx: ProbeContext, p: Spec, world: World, recorder: Recorder) -> tupl
         )
     if not reached:
         moved = math.hypot(last.x - start[0], last.y - start[1])
-        why = " (the base stops 0.5 s after the last /cmd_vel)" if moved < 0.1 else ""
-        problems.append(
-            f"it did not come within {reach:g} m of the wall in {within:g} s: it moved "
-            f"{moved:.2f} m{why}, nearest {nearest:.2f} m"
+        why = (
+            " (does your node keep publishing a forward /cmd_vel? The base stops 0.5 s after "
+            "the last one)"
+            if moved < 0.1
+            else ""
         )
+        if last.t - t0 >= within:
+            how = f" in {within:g} s: it moved {moved:.2f} m and ended {final:.2f} m from it"
+        else:
+            how = f": it came to rest {final:.2f} m from it after moving {moved:.2f} m"
+        problems.append(f"it did not come within {reach:g} m of the wall{how}{why}")
     elif not problems and not at_rest(samples, hold):
         problems.append(
             f"it came within {reach:g} m at {reached[0]:.1f} s but did not stand still for "
