@@ -63,11 +63,12 @@ def _thinned(samples: list[Sample]) -> list[Sample]:
 @register_probe(
     "sim_wall_follow",
     required="start",
-    optional="side band duration settle in_band min_travel wall_at real_time_factor",
+    optional="side band_min band_max duration settle in_band min_travel wall_at real_time_factor",
     words="resets the world with the robot at a random start beside a wall (on `side`) and "
     "lets your node drive for `duration` simulated seconds: after `settle` s, the nearest "
-    "obstacle on that side must stay within `band` for at least `in_band` of the time, the "
-    "robot must drive at least `min_travel` m and never touch anything",
+    "obstacle on that side must stay between `band_min` and `band_max` m away for at least "
+    "`in_band` of the time, the robot must drive at least `min_travel` m and never touch "
+    "anything",
     draws="a start pose (x, y, yaw from the ranges, redrawn until a wall (a box 1.5 m long or "
     "more) runs along the robot's side at a distance in `wall_at`, with 1 m free ahead)",
 )
@@ -76,7 +77,7 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
     if side not in ("right", "left"):
         raise ValueError(f"side must be 'right' or 'left', got {side!r}")
     sign = -1.0 if side == "right" else 1.0
-    low, high = (float(v) for v in p.get("band", [0.2, 0.7]))
+    low, high = float(p.get("band_min", 0.2)), float(p.get("band_max", 0.7))
     duration, settle = float(p.get("duration", 40.0)), float(p.get("settle", 5.0))
     in_band, min_travel = float(p.get("in_band", 0.85)), float(p.get("min_travel", 4.0))
     wall_low, wall_high = (float(v) for v in p.get("wall_at", [0.3, 0.6]))
