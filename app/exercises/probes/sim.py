@@ -35,18 +35,18 @@ from typing import Any
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import Parameter
-from rcl_interfaces.srv import SetParameters
+from rcl_interfaces.srv import GetParameters, SetParameters
 from std_srvs.srv import Empty
 
 from app.exercises.probes.base import ProbeContext, draw
 from app.lessons.checks._sim_topics import SIM_NODE, Pose, pose_of, world_map, wrap
 from app.lessons.checks._world_map import WorldMap
 from app.ros import params
-from app.ros.calls import call_service
+from app.ros.calls import wait_for_server, wait_future
 from app.ros.errors import Ros2Error
 
 READY_WAIT_SEC = 30.0  # a world starting on a busy machine: MuJoCo, the model, the camera
-SERVICE_SEC = 5.0
+SERVICE_SEC = 10.0  # a world stepping on a busy machine can be slow to answer
 TOUCH = 0.01  # m: the body this close to an obstacle touches it
 # Slower than this (m/s, rad/s) over a few seconds, the robot stands still: a slow final
 # approach (a few cm/s) still counts as moving.
@@ -132,29 +132,56 @@ def _parameter(name: str, value: Any) -> Parameter:
     return Parameter(name=name, value=params.parameter_value(value))
 
 
-def set_parameters(ctx: ProbeContext, node: str, values: dict[str, Any]) -> None:
-    """Set several parameters in one request; a refusal raises with the node's reason."""
-    request = SetParameters.Request(parameters=[_parameter(k, v) for k, v in values.items()])
-    response = call_service(
-        ctx.call, f"{node}/set_parameters", SetParameters, request, timeout=SERVICE_SEC
-    )
-    for name, result in zip(values, response.results, strict=False):
-        if not result.successful:
-            raise Ros2Error(f"{node} refused {name}={values[name]!r}: {result.reason}")
+class Services:
+    """Service clients kept for a whole probe: a fresh client per call would wait for
+    discovery each time, seconds on a busy machine."""
 
+    def __init__(self, ctx: ProbeContext) -> None:
+        self._ctx = ctx
+        self._clients: dict[tuple[str, type], Any] = {}
 
-def call_empty(ctx: ProbeContext, service: str) -> None:
-    call_service(ctx.call, service, Empty, Empty.Request(), timeout=SERVICE_SEC)
+    def call(self, name: str, srv_type: type, request: Any) -> Any:
+        key = (name, srv_type)
+        if key not in self._clients:
+            self._clients[key] = self._ctx.call.node.create_client(srv_type, name)
+        client = self._clients[key]
+        what = f"service '{name}'"
+        wait_for_server(self._ctx.call, client.service_is_ready, SERVICE_SEC, what)
+        return wait_future(self._ctx.call, client.call_async(request), SERVICE_SEC, what)
+
+    def get(self, node: str, names: list[str]) -> dict[str, Any]:
+        request = GetParameters.Request(names=names)
+        response = self.call(f"{node}/get_parameters", GetParameters, request)
+        values = [params.python_value(v) for v in response.values]
+        return dict(zip(names, values, strict=True))
+
+    def set(self, node: str, values: dict[str, Any]) -> None:
+        """Set several parameters in one request; a refusal raises with the node's reason."""
+        request = SetParameters.Request(parameters=[_parameter(k, v) for k, v in values.items()])
+        response = self.call(f"{node}/set_parameters", SetParameters, request)
+        for name, result in zip(values, response.results, strict=False):
+            if not result.successful:
+                raise Ros2Error(f"{node} refused {name}={values[name]!r}: {result.reason}")
+
+    def empty(self, name: str) -> None:
+        self.call(name, Empty, Empty.Request())
+
+    def close(self) -> None:
+        for client in self._clients.values():
+            self._ctx.call.node.destroy_client(client)
+        self._clients.clear()
 
 
 @dataclass
 class World:
-    """The running simulation as the probe found it: its floor plan and what to put back."""
+    """The running simulation as the probe found it: its floor plan, what to put back,
+    and the clients to drive it."""
 
     name: str
     plan: WorldMap
     saved: dict[str, Any]
     rtf: float
+    services: Services
 
 
 def _wait_for_world(ctx: ProbeContext, recorder: Recorder) -> None:
@@ -174,19 +201,18 @@ def _wait_for_world(ctx: ProbeContext, recorder: Recorder) -> None:
 def simulation(ctx: ProbeContext, rtf: float) -> Iterator[tuple[World, Recorder]]:
     """The world, ready for trials; afterwards its parameters and the learner's clock as before."""
     recorder = Recorder(ctx)
+    services = Services(ctx)
     learner_sim_time: bool | None = None
     world: World | None = None
     try:
         _wait_for_world(ctx, recorder)
-        names = ["world", *WORLD_PARAMS]
-        values = [params.python_value(v) for v in params.get_values(ctx.call, SIM_NODE, names)]
-        current = dict(zip(names, values, strict=True))
+        current = services.get(SIM_NODE, ["world", *WORLD_PARAMS])
         name = str(current.pop("world"))
-        world = World(name, world_map(name), current, rtf)
+        world = World(name, world_map(name), current, rtf, services)
         try:
-            [value] = params.get_values(ctx.call, ctx.learner_node, ["use_sim_time"])
-            learner_sim_time = bool(params.python_value(value))
-            set_parameters(ctx, ctx.learner_node, {"use_sim_time": True})
+            clock = services.get(ctx.learner_node, ["use_sim_time"])
+            learner_sim_time = bool(clock["use_sim_time"])
+            services.set(ctx.learner_node, {"use_sim_time": True})
         except Ros2Error as exc:
             raise Ros2Error(
                 f"could not set use_sim_time on {ctx.learner_node}: {exc} (is its executor busy?)"
@@ -195,11 +221,12 @@ def simulation(ctx: ProbeContext, rtf: float) -> Iterator[tuple[World, Recorder]
     finally:
         try:
             if world is not None:
-                set_parameters(ctx, SIM_NODE, world.saved)
+                services.set(SIM_NODE, world.saved)
             if learner_sim_time is not None:
-                set_parameters(ctx, ctx.learner_node, {"use_sim_time": learner_sim_time})
+                services.set(ctx.learner_node, {"use_sim_time": learner_sim_time})
         except Ros2Error:
             pass  # the world or the node is gone: nothing to put back
+        services.close()
         recorder.close()
 
 
@@ -214,12 +241,13 @@ def release(
 
     Returns the simulation time the trial starts at: later samples are the trial's.
     """
-    call_empty(ctx, "/pause_physics")
+    services = world.services
+    services.empty("/pause_physics")
     x, y, yaw = start
-    set_parameters(ctx, SIM_NODE, {"x": x, "y": y, "yaw": yaw, "real_time_factor": world.rtf})
-    call_empty(ctx, "/reset_world")  # the robot at the start, odometry at zero, time goes on
+    services.set(SIM_NODE, {"x": x, "y": y, "yaw": yaw, "real_time_factor": world.rtf})
+    services.empty("/reset_world")  # the robot at the start, odometry at zero, time goes on
     if learner:
-        set_parameters(ctx, ctx.learner_node, learner)
+        services.set(ctx.learner_node, learner)
     # Paused, the world publishes nothing: once nothing has come for a while, what was on
     # its way before the pause has arrived, and every later sample is the trial's.
     count = recorder.count()
@@ -230,7 +258,7 @@ def release(
         count = recorder.count()
     newest = recorder.newest()
     assert newest is not None
-    call_empty(ctx, "/unpause_physics")
+    services.empty("/unpause_physics")
     return newest.t
 
 

@@ -135,13 +135,14 @@ def _trial(ctx: ProbeContext, p: Spec, world: World, recorder: Recorder) -> tupl
         )
     touch = closest_touch(plan, samples, t0)
     problems = []
-    if touch.distance <= TOUCH:
+    touched = touch.distance <= TOUCH
+    if touched:
         problems.append(touch_text(touch))
     if off > position_tolerance:
         problems.append(f"position error {off:.3f} m is above {position_tolerance:g} m")
     if turned > heading_tolerance:
         problems.append(f"heading error {turned:.3f} rad is above {heading_tolerance:g} rad")
-    if not at_rest(samples, hold):
+    if not touched and not at_rest(samples, hold):
         problems.append(f"it did not come to rest within {within:g} s")
     if problems:
         return False, f"{began}; {figures}; " + "; ".join(problems)

@@ -108,19 +108,21 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
     inside = sum(low <= d <= high for d in distances)
     share = inside / len(distances) if distances else 0.0
     spent = samples[-1].t - t0
-    figures = (
-        f"drove {travel:.2f} m in {spent:.1f} s; after the first {settle:g} s the {side} wall "
-        f"was {min(distances, default=math.nan):.2f}-{max(distances, default=math.nan):.2f} m "
-        f"away (mean {sum(distances) / max(len(distances), 1):.2f} m), within {low:g}-{high:g} "
-        f"m {share:.0%} of the time"
-    )
+    figures = f"drove {travel:.2f} m in {spent:.1f} s"
+    if distances:
+        mean = sum(distances) / len(distances)
+        figures += (
+            f"; after the first {settle:g} s the {side} wall was {min(distances):.2f}-"
+            f"{max(distances):.2f} m away (mean {mean:.2f} m), within {low:g}-{high:g} m "
+            f"{share:.0%} of the time"
+        )
     problems = []
     if touch.distance <= TOUCH:
         problems.append(touch_text(touch))
     if travel < min_travel:
         still = f", and stood still for the last {STUCK:g} s" if at_rest(samples, STUCK) else ""
         problems.append(f"it drove only {travel:.2f} m ({min_travel:g} m needed){still}")
-    if share < in_band and spent >= settle:
+    if distances and share < in_band:
         problems.append(
             f"the wall was in the band only {share:.0%} of the time ({in_band:.0%} needed)"
         )
