@@ -191,6 +191,11 @@ FAILING_CHECKS = [
     Spec("package_sourced", {"package": "no_such_pkg"}),
     Spec("workspace_file", {"path": "src/nothing.txt"}),
     Spec("own_node", {"ros_node": "/minimal_publisher"}),
+    Spec("robot_moved", {"at_least": 0.5}),
+    Spec("odom_drift", {"at_least": 0.5}),
+    Spec("scan_nearest", {"below": 0.7, "tolerance": 0.05}),
+    Spec("sim_time_stamps", {"frame": "carrot1"}),
+    Spec("sim_paused", {}),
     Spec("quiz", {"question": "2+2?", "options": ["3", "4"], "answer": "4"}),
 ]
 
