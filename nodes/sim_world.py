@@ -225,14 +225,11 @@ class SimWorld(Node):
         self.camera_request: tuple[float, np.ndarray] | None = None
         self.camera_wake = threading.Event()
         self.threads = [threading.Thread(target=self.run_physics, name="physics", daemon=True)]
-        if float(g("camera_rate")) > 0:
-            self.streams.append([1.0 / float(g("camera_rate")), 0.0, self.request_frame])
-            self.threads.append(
-                threading.Thread(target=self.run_camera, name="camera", daemon=True)
-            )
         self.rtf_wall, self.rtf_sim = time.monotonic(), self.engine.time
         for thread in self.threads:
             thread.start()
+        if float(g("camera_rate")) > 0:
+            self.set_camera_rate(float(g("camera_rate")))
         self.get_logger().info(
             f"world {g('world')!r} loaded: timestep {self.engine.timestep * 1000:g} ms, "
             f"real_time_factor {self.rtf_target:g}, camera rendering through "
@@ -577,7 +574,21 @@ class SimWorld(Node):
                 self.get_logger().info(f"real_time_factor set to {value:g}")
             elif param.name == "cmd_vel_timeout":
                 self.cmd_vel_timeout = float(param.value)
+            elif param.name == "camera_rate":
+                self.set_camera_rate(float(param.value))
+                self.get_logger().info(f"camera_rate set to {float(param.value):g} Hz")
         return SetParametersResult(successful=True)
+
+    def set_camera_rate(self, rate: float) -> None:
+        """0 stops rendering (a grader running the world fast needs no pictures), > 0 resumes."""
+        with self.lock:
+            self.streams = [s for s in self.streams if s[2] != self.request_frame]
+            if rate > 0:
+                self.streams.append([1.0 / rate, self.engine.time, self.request_frame])
+        if rate > 0 and not any(t.name == "camera" for t in self.threads):
+            camera = threading.Thread(target=self.run_camera, name="camera", daemon=True)
+            self.threads.append(camera)
+            camera.start()
 
     def on_rtf_timer(self) -> None:
         now_wall = time.monotonic()
