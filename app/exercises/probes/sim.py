@@ -54,7 +54,7 @@ STILL_SPEED, STILL_TURN = 0.005, 0.01
 ASKED_SPEED, ASKED_TURN = 0.01, 0.02  # a /cmd_vel below both asks for no real motion
 DEFAULT_RTF = 2.0
 QUIET_WAIT = 3.0  # s at most for the samples sent before a pause to arrive
-WORLD_PARAMS = ("x", "y", "yaw", "real_time_factor")
+WORLD_PARAMS = ("x", "y", "yaw", "real_time_factor", "camera_rate")
 
 
 @dataclass(frozen=True)
@@ -244,7 +244,10 @@ def release(
     services = world.services
     services.empty("/pause_physics")
     x, y, yaw = start
-    services.set(SIM_NODE, {"x": x, "y": y, "yaw": yaw, "real_time_factor": world.rtf})
+    # No camera during a trial: nothing graded looks at it, and rendering at a faster
+    # real-time factor would take the cores the learner's node needs.
+    trial = {"x": x, "y": y, "yaw": yaw, "real_time_factor": world.rtf, "camera_rate": 0.0}
+    services.set(SIM_NODE, trial)
     services.empty("/reset_world")  # the robot at the start, odometry at zero, time goes on
     if learner:
         services.set(ctx.learner_node, learner)
