@@ -91,7 +91,12 @@ class ExercisePanel:
         self._open_code = open_code
         self._workspace, self._supervisor, self._grader = workspace, supervisor, grader
         self._hub, self._settings = hub, settings or ExerciseSettings()
-        hub.attach(self._load_code, self._save_code)
+        hub.attach(
+            self._load_code,
+            self._save_code,
+            policy=self._settings.policy,
+            scratch=workspace.scratch,
+        )
         # Open on the exercise of the lesson the learner is in.
         current = workspace.progress.current_lesson() or ""
         mine = book.for_lesson(current)

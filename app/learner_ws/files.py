@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import os
 import shutil
+import stat
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 
 from app.learner_ws.folder import LearnerWorkspace
@@ -25,11 +27,23 @@ class FileError(Ros2Error):
     """A file operation the page asked for that cannot be done; one line for the learner."""
 
 
+NEW_FILE_MODE = 0o644  # as an editor writes under the usual umask: builds (any uid) read it
+
+
 def write_atomically(path: Path, text: str) -> None:
-    """Temporary file, fsync, rename: a reader sees the old text or the new, never half."""
+    """Temporary file, fsync, rename: a reader sees the old text or the new, never half.
+
+    The file keeps its mode (an executable script stays executable); a new
+    file gets ``NEW_FILE_MODE``, not mkstemp's 0600.
+    """
     path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        mode = stat.S_IMODE(path.stat().st_mode)
+    except OSError:
+        mode = NEW_FILE_MODE
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}-", dir=path.parent)
     try:
+        os.fchmod(fd, mode)
         with os.fdopen(fd, "w", encoding="utf-8") as handle:
             handle.write(text)
             handle.flush()
@@ -58,6 +72,47 @@ def tree(ws: LearnerWorkspace, limit: int = MAX_LISTED) -> list[str]:
         if len(lines) >= limit:
             return lines[:limit] + [f"... (more than {limit} entries)"]
     return lines
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One row of a folder listing: its workspace-relative path, and whether it is a folder."""
+
+    path: str
+    folder: bool
+    note: str = ""  # e.g. colcon's output folders
+
+
+def relative(ws: LearnerWorkspace, text: str) -> str:
+    """The confined path of ``text`` relative to the workspace root (``src/pkg/setup.py``)."""
+    path = _inside(ws, text)
+    return path.relative_to(ws.root.resolve()).as_posix()
+
+
+def children(ws: LearnerWorkspace, text: str = "", limit: int = MAX_LISTED) -> list[Entry]:
+    """One folder's entries, folders first, hidden names (``.x``) left out; at most ``limit``.
+
+    A lazy tree for the code editor: a workspace of thousands of files costs
+    one folder at a time, never a walk of the whole tree.
+    """
+    folder = ws.confine(text) if text else ws.root.resolve()
+    if not folder.is_dir():
+        raise FileError(f"{text}: not a folder")
+    root = ws.root.resolve()
+    found: list[Entry] = []
+    with os.scandir(folder) as scan:
+        items = sorted(
+            (e for e in scan if not e.name.startswith(".")),
+            key=lambda e: (not e.is_dir(follow_symlinks=False), e.name),
+        )
+    for item in items[:limit]:
+        path = Path(item.path).relative_to(root).as_posix()
+        is_dir = item.is_dir(follow_symlinks=False)
+        colcons = is_dir and folder == root and item.name in HIDDEN_IN_TREE
+        found.append(Entry(path, is_dir, "colcon's output" if colcons else ""))
+    if len(items) > limit:
+        found.append(Entry("", False, f"... and {len(items) - limit} more"))
+    return found
 
 
 def _inside(ws: LearnerWorkspace, text: str) -> Path:

@@ -135,6 +135,12 @@ def _python_dirs(prefix: Path) -> list[Path]:
     ]  # fmt: skip
 
 
+def python_paths() -> list[Path]:
+    """The Python folders of the sourced workspaces, newest first (the code editor's Jedi
+    finds the learner's messages and modules there)."""
+    return [d for p in overlay() for d in _python_dirs(p)]
+
+
 def child_env(base: Mapping[str, str] | None = None) -> dict[str, str]:
     """The variables a sourced shell would hand a program it starts (only those four)."""
     base = os.environ if base is None else base
