@@ -9,13 +9,13 @@ failing save leaves the previous file.
 from __future__ import annotations
 
 import os
+import secrets
 import shutil
 import stat
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from app.learner_ws.folder import LearnerWorkspace
+from app.learner_ws.folder import LearnerWorkspace, OutsideWorkspace
 from app.ros.errors import Ros2Error
 
 MAX_TEXT_BYTES = 200_000
@@ -28,30 +28,58 @@ class FileError(Ros2Error):
 
 
 NEW_FILE_MODE = 0o644  # as an editor writes under the usual umask: builds (any uid) read it
+_DIR_FLAGS = os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC
 
 
-def write_atomically(path: Path, text: str) -> None:
-    """Temporary file, fsync, rename: a reader sees the old text or the new, never half.
+def _check_inside(ws: LearnerWorkspace, fd: int, shown: str) -> None:
+    """The object ``fd`` opened really is inside the workspace (closes it if not).
 
-    The file keeps its mode (an executable script stays executable); a new
-    file gets ``NEW_FILE_MODE``, not mkstemp's 0600.
+    ``confine`` resolved the path a moment ago; on a served dashboard the
+    learner's contained code may swap a folder of build/ for a link meanwhile.
+    The kernel's name for what was actually opened settles it.
+    """
+    real = Path(os.readlink(f"/proc/self/fd/{fd}"))
+    root = ws.root.resolve()
+    if real != root and root not in real.parents:
+        os.close(fd)
+        raise OutsideWorkspace(f"{shown}: outside your workspace (a link changed under it)")
+
+
+def write_atomically(ws: LearnerWorkspace, path: Path, text: str) -> None:
+    """Temporary file, fsync, rename, all through a checked folder descriptor.
+
+    A reader sees the old text or the new, never half; no link swapped in can
+    redirect the write. The file keeps its mode (an executable script stays
+    executable); a new file gets ``NEW_FILE_MODE``, not mkstemp's 0600.
     """
     path.parent.mkdir(parents=True, exist_ok=True)
+    folder = os.open(path.parent, _DIR_FLAGS)
+    _check_inside(ws, folder, ws.shown(path))
     try:
-        mode = stat.S_IMODE(path.stat().st_mode)
-    except OSError:
-        mode = NEW_FILE_MODE
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}-", dir=path.parent)
-    try:
-        os.fchmod(fd, mode)
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+        try:
+            info = os.stat(path.name, dir_fd=folder, follow_symlinks=False)
+            mode = stat.S_IMODE(info.st_mode) if stat.S_ISREG(info.st_mode) else NEW_FILE_MODE
+        except FileNotFoundError:
+            mode = NEW_FILE_MODE
+        temporary = f".{path.name}-{secrets.token_hex(4)}"
+        flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC
+        fd = os.open(temporary, flags, mode, dir_fd=folder)
+        try:
+            os.fchmod(fd, mode)  # not narrowed by the umask
+            with os.fdopen(fd, "w", encoding="utf-8") as handle:
+                handle.write(text)
+                handle.flush()
+                os.fsync(handle.fileno())
+            os.replace(temporary, path.name, src_dir_fd=folder, dst_dir_fd=folder)
+        except BaseException:
+            try:
+                os.unlink(temporary, dir_fd=folder)
+            except OSError:
+                pass
+            raise
+        os.fsync(folder)
+    finally:
+        os.close(folder)
 
 
 def tree(ws: LearnerWorkspace, limit: int = MAX_LISTED) -> list[str]:
@@ -126,7 +154,7 @@ def create_file(ws: LearnerWorkspace, text: str) -> Path:
     path = _inside(ws, text)
     if path.exists():
         raise FileError(f"{ws.shown(path)} already exists")
-    write_atomically(path, "")
+    write_atomically(ws, path, "")
     return path
 
 
@@ -164,11 +192,20 @@ def delete(ws: LearnerWorkspace, text: str) -> Path:
 
 def read_text(ws: LearnerWorkspace, text: str) -> str:
     path = _inside(ws, text)
-    if not path.is_file():
-        raise FileError(f"{text}: not a file")
-    if path.stat().st_size > MAX_TEXT_BYTES:
-        raise FileError(f"{text} is larger than {MAX_TEXT_BYTES // 1000} kB; open it elsewhere")
-    data = path.read_bytes()
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+    except FileNotFoundError:
+        raise FileError(f"{text}: not a file") from None
+    except OSError as exc:  # a folder, a link swapped in, a fifo...
+        raise FileError(f"{text}: not a file ({exc.strerror})") from None
+    _check_inside(ws, fd, text)
+    with os.fdopen(fd, "rb") as handle:
+        info = os.fstat(handle.fileno())
+        if not stat.S_ISREG(info.st_mode):
+            raise FileError(f"{text}: not a file")
+        if info.st_size > MAX_TEXT_BYTES:
+            raise FileError(f"{text} is larger than {MAX_TEXT_BYTES // 1000} kB; open it elsewhere")
+        data = handle.read(MAX_TEXT_BYTES + 1)
     if b"\x00" in data:
         raise FileError(f"{text} is not a text file")
     try:
@@ -183,5 +220,5 @@ def write_text(ws: LearnerWorkspace, text: str, content: str) -> Path:
         raise FileError(f"the text is larger than {MAX_TEXT_BYTES // 1000} kB")
     if path.is_dir():
         raise FileError(f"{text} is a folder")
-    write_atomically(path, content)
+    write_atomically(ws, path, content)
     return path
