@@ -159,9 +159,11 @@ def _fresh(parent: Path, name: str, kind: str, programs: Any) -> Path:
     return ws.root
 
 
-# CPU seconds of each counted build, by kind and path: the whole process tree (reaped
-# children) and, for the Console, this process too (it is the dashboard's side).
-CPU_SECONDS: dict[tuple[str, str], list[float]] = {}
+# Per counted build, by kind and path: (wall s, CPU s of the build's process tree, CPU s
+# of this process meanwhile). This process's own CPU is the dashboard's side of the
+# Console path; during a direct build it is only what its idle threads (the DDS
+# participant, the executor) spend, which the Console path pays too, per second.
+BUILDS: dict[tuple[str, str], list[tuple[float, float, float]]] = {}
 
 
 def _children_cpu() -> float:
@@ -174,8 +176,7 @@ def _own_cpu() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def _time_console_build(root: Path, programs: Any) -> tuple[float, float]:
-    """(wall seconds, CPU seconds of the colcon tree and of this process meanwhile)."""
+def _time_console_build(root: Path, programs: Any) -> tuple[float, float, float]:
     from app.learner_ws import folder
     from app.learner_ws.folder import LearnerWorkspace
 
@@ -183,27 +184,41 @@ def _time_console_build(root: Path, programs: Any) -> tuple[float, float]:
     cpu, own, started = _children_cpu(), _own_cpu(), time.monotonic()
     code, out = Console(programs)("colcon build")
     elapsed = time.monotonic() - started
-    used = _children_cpu() - cpu + _own_cpu() - own
     if code:
         raise RuntimeError(f"console colcon build failed:\n{out[-2000:]}")
-    return elapsed, used
+    return elapsed, _children_cpu() - cpu, _own_cpu() - own
 
 
-def _time_direct_build(root: Path) -> tuple[float, float]:
+def _time_direct_build(root: Path) -> tuple[float, float, float]:
     from app.learner_ws import build, folder
     from app.learner_ws.folder import LearnerWorkspace
 
     env = {**os.environ, **build.build_env(LearnerWorkspace(root))}
-    cpu, started = _children_cpu(), time.monotonic()
+    cpu, own, started = _children_cpu(), _own_cpu(), time.monotonic()
     done = subprocess.run(
         [sys.executable, "-m", "colcon", "build"], cwd=root, env=env, capture_output=True, text=True
     )
     elapsed = time.monotonic() - started
-    used = _children_cpu() - cpu
     folder.configure(None)
     if done.returncode:
         raise RuntimeError(f"direct colcon build failed:\n{done.stdout[-2000:]}")
-    return elapsed, used
+    return elapsed, _children_cpu() - cpu, _own_cpu() - own
+
+
+def cpu_figures(kind: str) -> dict[str, float]:
+    """CPU seconds of ``kind``'s counted builds: both trees, and the Console's own overhead
+    (this process's CPU during its builds, less the idle rate seen during direct builds)."""
+    console, direct = BUILDS[kind, "console"], BUILDS[kind, "direct"]
+    idle_rate = sum(own for _w, _c, own in direct) / sum(wall for wall, _c, _o in direct)
+    overhead = sum(max(0.0, own - idle_rate * wall) for wall, _c, own in console)
+    tree_console = sum(c for _w, c, _o in console)
+    tree_direct = sum(c for _w, c, _o in direct)
+    return {
+        f"{kind}_tree_cpu_console_s": tree_console,
+        f"{kind}_tree_cpu_direct_s": tree_direct,
+        f"{kind}_console_overhead_cpu_s": overhead,
+        f"{kind}_cpu_ratio": ratio(tree_console + overhead, tree_direct),
+    }
 
 
 def measure_builds(
@@ -229,8 +244,8 @@ def measure_builds(
         if i >= warmup:
             console_s.append(console[0])
             direct_s.append(direct[0])
-            CPU_SECONDS.setdefault((kind, "console"), []).append(console[1])
-            CPU_SECONDS.setdefault((kind, "direct"), []).append(direct[1])
+            BUILDS.setdefault((kind, "console"), []).append(console)
+            BUILDS.setdefault((kind, "direct"), []).append(direct)
     return min(console_s), min(direct_s)
 
 
@@ -320,14 +335,14 @@ def main(argv: list[str] | None = None) -> int:
                 except Exception as exc:  # a figure we cannot measure is a failure row
                     failures.append(f"{kind} build: {str(exc).splitlines()[0][:200]}")
             for kind in ("python", "interface"):
-                if (kind, "console") in CPU_SECONDS:
-                    figures[f"{kind}_cpu_ratio"] = ratio(
-                        sum(CPU_SECONDS[kind, "console"]), sum(CPU_SECONDS[kind, "direct"])
-                    )
-            cpu_console, cpu_direct = (
-                sum(sum(v) for (_k, path), v in CPU_SECONDS.items() if path == side)
-                for side in ("console", "direct")
+                if (kind, "console") in BUILDS:
+                    figures.update(cpu_figures(kind))
+            kinds = [k for k in ("python", "interface") if (k, "console") in BUILDS]
+            cpu_console = sum(
+                figures[f"{k}_tree_cpu_console_s"] + figures[f"{k}_console_overhead_cpu_s"]
+                for k in kinds
             )
+            cpu_direct = sum(figures[f"{k}_tree_cpu_direct_s"] for k in kinds)
             figures["build_cpu_ratio"] = ratio(cpu_console, cpu_direct)
             ratios = [figures.get(f"{k}_build_ratio", math.nan) for k in ("python", "interface")]
             figures["colcon_build_ratio"] = (
@@ -354,14 +369,16 @@ def main(argv: list[str] | None = None) -> int:
                 f"ratio {figures[f'{key}_build_ratio']:.3f} (aim <= 1.1)"
             )
     if not math.isnan(figures.get("build_cpu_ratio", math.nan)):
-        kinds = ", ".join(
-            f"{k} {figures[f'{k}_cpu_ratio']:.3f}"
+        per_kind = ", ".join(
+            f"{k} {figures[f'{k}_cpu_ratio']:.3f}: trees {figures[f'{k}_tree_cpu_console_s']:.1f}"
+            f" s against {figures[f'{k}_tree_cpu_direct_s']:.1f} s, the Console's own "
+            f"{figures[f'{k}_console_overhead_cpu_s']:.2f} s"
             for k in ("python", "interface")
             if f"{k}_cpu_ratio" in figures
         )
         print(
             "colcon build, CPU seconds (the build's processes, and the Console's own): ratio "
-            f"{figures['build_cpu_ratio']:.3f} ({kinds})"
+            f"{figures['build_cpu_ratio']:.3f} ({per_kind})"
         )
     if "own_node_run_s" in figures:
         print(

@@ -287,3 +287,25 @@ def test_a_served_workspace_is_readable_by_the_sandbox_group_only(classroom: Cla
         info = folder.stat()
         assert info.st_gid == SANDBOX_GID
         assert info.st_mode & 0o007 == 0, oct(info.st_mode)  # nothing for other users
+
+
+def test_the_editors_completion_worker_runs_contained_when_served(classroom: Classroom):
+    """Jedi imports compiled modules it finds on its path: served, it runs as learner code."""
+    from app.exercises import code_assist
+
+    policy = allowed(classroom)
+    worker = code_assist.AssistProcess(
+        lambda: code_assist.worker_argv(policy, classroom.scratch), classroom.scratch
+    )
+    try:
+        code = "import rclpy\nnode = rclpy.create_node('n')\nnode.create_pub"
+        answer = worker.request(
+            {"op": "complete", "code": code, "path": str(classroom.scratch / "x.py"),
+             "project": str(classroom.scratch), "line": 3, "column": 15, "sys_path": []}
+        ).result(120)  # fmt: skip
+        assert [item["name"] for item in answer["items"]] == ["create_publisher"], answer
+        pid = worker._proc.pid  # type: ignore[union-attr]
+        uid = int(Path(f"/proc/{pid}/status").read_text().split("Uid:")[1].split()[0])
+        assert uid > UID_BASE
+    finally:
+        worker.close()
