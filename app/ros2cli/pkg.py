@@ -293,8 +293,10 @@ def _point_at_errors(ctx: CallContext, lines: list[str], ws: LearnerWorkspace, c
     head = f"colcon ended with exit code {code}" if code else "nothing of it was built"
     if errors:
         ctx.write(f"({head}; where it failed:")
-        for error in errors[:8]:
-            ctx.write(f"  {error.line()}")
+        for error in errors[:8]:  # the place on a line of its own: the Console is narrow
+            if error.where:
+                ctx.write(f"  {error.where}:")
+            ctx.write(f"    {error.text}")
         ctx.write(f" the full logs are in {ws.shown(ws.root / 'log')})")
     else:
         ctx.write(f"({head}: the full logs are in {ws.shown(ws.root / 'log')})")

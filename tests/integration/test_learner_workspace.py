@@ -567,7 +567,8 @@ def test_a_failed_build_points_at_the_file_and_line_in_the_console(built):
     code, out = console("colcon build --packages-select broken_pkg")
     assert code == 1
     closing = out.split("where it failed:", 1)[1].splitlines()
-    assert closing[1].startswith(f"  ~/ros2_ws/src/broken_pkg/setup.py, line {at + 1}: "), out
+    assert closing[1] == f"  ~/ros2_ws/src/broken_pkg/setup.py, line {at + 1}:", out
+    assert closing[2].startswith("    SyntaxError: "), out
     _edit(setup, "setup(\n    name=package_name\n", "setup(\n")
     shutil_rmtree(ws.root / "build" / "broken_pkg")
 
