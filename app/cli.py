@@ -142,12 +142,22 @@ def cmd_serve(args: argparse.Namespace) -> int:
         raise CliError(f"port {args.port} on {args.host} became busy; pick another with --port")
     runtime = RosRuntime()
     # The learner's colcon workspace and the ament underlay, before the supervisor copies
-    # the environment (issue 22: app/ros2cli/pkg.py).
+    # the environment (issue 22: app/ros2cli/pkg.py). Served to other machines, builds
+    # are learner code: the workspace lives in the learner's scratch folder, the one
+    # place their contained code may write, hidden from every other learner's.
     from app.ros2cli.pkg import setup_workspace
 
-    setup_workspace(progress.path, remote=not _is_loopback(args.host))
-    supervisor = Supervisor(os.environ)
     scratch_root = args.scratch_dir or (args.progress_dir or DEFAULT_DIR).parent / "scratch"
+    remote = not _is_loopback(args.host)
+    if remote:
+        from app.exercises.contain import SANDBOX_GID
+
+        setup_workspace(
+            progress.path, remote=True, home=scratch_root / progress.path.stem, group=SANDBOX_GID
+        )
+    else:
+        setup_workspace(progress.path, remote=False)
+    supervisor = Supervisor(os.environ)
     workspace = Workspace(progress, scratch_root)
     settings = ExerciseSettings(
         _run_policy(args, progress.path.parent, workspace), args.reveal_solution_after
