@@ -31,7 +31,7 @@ from app.hub.reports import to_json
 from app.lessons.schema import load_course
 from app.teacher.record import LearnerRecord
 from tests.browser.helpers import choose, click, expect_text, open_tab
-from tests.browser.test_exercise import EXERCISE, _open_editor, _type_code
+from tests.browser.test_exercise import EXERCISE, _open_editor
 from tests.conftest import ARTIFACTS, fail_on_leftover_nodes, in_private_netns, wait_until
 from tests.hub.local_hub import PASSWORD, LocalHub
 
@@ -189,6 +189,14 @@ def test_each_learner_sees_only_their_own_nodes_and_the_teacher_sees_rows_move(h
     alice = room.classrooms["alice"]
     vertex(alice, OWN_NODE["alice"]).locator("a").click()
     expect(alice.get_by_text(f"Node /{OWN_NODE['alice']}").filter(visible=True)).to_be_visible()
+
+
+def _type_code(page: Page, frame_locator, code: str) -> None:
+    """Paste ``code`` into the editor and wait for its save (three learners save at once)."""
+    frame_locator.locator(".ace_content").click()
+    page.keyboard.press("Control+A")
+    page.keyboard.insert_text(code)
+    expect(frame_locator.locator("#status")).to_have_text("saved ✓", timeout=45_000)
 
 
 def test_each_learner_passes_a_lesson_step_and_an_exercise(hub, room):
