@@ -45,8 +45,8 @@ from typing import Any
 from bench._common import LOGS, configure_dds, percentile, require_private_netns, rounded, sample
 
 SETTLE_SEC = 4.0
-# Both hub modes (lab ~300 MB, lean ~160) and a classroom learner (~130), with headroom.
-MB_PER_LEARNER_ALL_SIDES = 900
+# The sides run one after another: the largest (a lab learner, ~300 MB) with headroom.
+MB_PER_LEARNER = 450
 MODES = ("lean", "lab")  # the first is the README's recommendation
 SINGLEUSER = {"lean": "dashboard", "lab": "lab"}
 
@@ -169,7 +169,7 @@ def _room_for(learners: int) -> str:
     import psutil
 
     available = psutil.virtual_memory().available / 2**20
-    needed = learners * MB_PER_LEARNER_ALL_SIDES
+    needed = learners * MB_PER_LEARNER
     if available < needed:
         return f"needs about {needed} MB free, the machine has {available:.0f} MB"
     return ""
