@@ -59,5 +59,11 @@ def setup_ros2_classroom() -> dict[str, Any]:
         "timeout": START_TIMEOUT_SEC,
         "absolute_url": False,  # the dashboard sees "/", whatever the hub's base path
         "new_browser_tab": True,
-        "launcher_entry": {"title": TITLE, "icon_path": str(ICON), "enabled": True},
+        # A section of its own in JupyterLab's launcher (not among the notebooks).
+        "launcher_entry": {
+            "title": TITLE,
+            "icon_path": str(ICON),
+            "enabled": True,
+            "category": "ROS 2",
+        },
     }

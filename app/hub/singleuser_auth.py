@@ -360,6 +360,9 @@ class HubLogin:
             except HubRefused as error:
                 log.warning("asking the hub failed: %s %s", error.status, error)
                 return _text(http.HTTPStatus.BAD_GATEWAY, f"Could not ask the hub: {error}\n")
+            except Exception:  # viser's server would hang up silently (it mutes these logs)
+                log.exception("serving %s failed", request.path.partition("?")[0])
+                return _text(http.HTTPStatus.INTERNAL_SERVER_ERROR, "The dashboard failed here.\n")
 
         return process_request
 
@@ -408,7 +411,13 @@ class HubLogin:
             return _text(http.HTTPStatus.FORBIDDEN, "Cross-site request.\n")
         self.activity.touch()
         request.path = "/" + rest + (f"?{query}" if query else "")  # as the routes expect
-        return inner(connection, request) if inner is not None else None
+        response = inner(connection, request) if inner is not None else None
+        if response is not None and "Connection" not in response.headers:
+            # websockets closes the connection after every HTTP answer. Unless the answer
+            # says so, the hub's proxy keeps the socket for its next request (a websocket's
+            # upgrade, say), which then meets a closed socket: "503 socket hang up".
+            response.headers["Connection"] = "close"
+        return response
 
     def _status(self) -> Response:
         body = json.dumps({"server": "ros2-classroom", "user": self.settings.user}).encode()

@@ -195,6 +195,10 @@ def test_another_learner_and_strangers_are_refused(hub, room):
     status, _, body = _get(f"{hub.base}/user/dora/", {"Authorization": f"token {tokens['dora']}"})
     assert status == 200 and "<html" in body.lower(), status
     assert _get(f"{hub.base}/user/erik/", {"Authorization": f"token {ADMIN_TOKEN}"})[0] == 200
+    # Every answer says the connection ends (websockets closes it): the hub's proxy must
+    # not keep the socket for a websocket upgrade ("503 socket hang up" otherwise).
+    status, headers, _ = _get(_service_url(hub, "erik"), {"Authorization": f"token {ADMIN_TOKEN}"})
+    assert status == 200 and headers.get("Connection") == "close", headers
     # Past the proxy, straight at Erik's port: without his cookie, no page and no websocket.
     status, headers, _ = _get(erik_url)
     assert status == 302 and "/hub/api/oauth2/authorize?" in headers["Location"], headers
