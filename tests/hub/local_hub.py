@@ -186,7 +186,9 @@ class LocalHub:
 
     def spawn(self, user: str) -> None:
         """Ask the hub to start ``user``'s server (the admin API, as the benchmark does)."""
-        status, body = self.api("POST", f"/hub/api/users/{user}/server")
+        # The hub answers once the spawn is done or 10 s have passed (slow_spawn_timeout);
+        # with a class arriving at once on busy cores that answer alone took over 15 s.
+        status, body = self.api("POST", f"/hub/api/users/{user}/server", timeout=120.0)
         if status not in (201, 202, 400):  # 400: already running
             raise RuntimeError(f"spawning {user}: {status} {body}")
 
