@@ -46,6 +46,7 @@ OWN_NODE = {"alice": "listener", "bob": "listener2", "carol": "minimal_node"}
 TEACHER = "teacher"
 SERVICE = "/services/classroom-teacher/"
 TILE = "ROS 2 Classroom"
+ICON_DRAWN = "t => [...t.querySelectorAll('img')].some(i => i.complete && i.naturalWidth > 0)"
 
 
 def vertex(page: Page, node: str):
@@ -133,6 +134,8 @@ def test_each_learner_opens_the_classroom_from_the_launcher(hub, room):
         lab.wait_for_url(f"**/user/{user}/lab**", timeout=120_000)
         tile = lab.locator(".jp-LauncherCard", has_text=TILE)
         expect(tile).to_be_visible(timeout=90_000)
+        # Its icon drawn (a blank tile is what a learner would not recognise).
+        wait_until(lambda tile=tile: tile.evaluate(ICON_DRAWN), timeout=30, what="the tile's icon")
         with room.contexts[user].expect_page(timeout=30_000) as new_tab:
             tile.click()  # the tile opens the dashboard in a new browser tab
         room.classrooms[user] = new_tab.value

@@ -135,7 +135,6 @@ def test_the_launcher_lists_the_classroom(jupyter):
     servers = {entry["name"]: entry for entry in json.loads(body)["server_processes"]}
     entry = servers["ros2-classroom"]
     assert entry["launcher_entry"]["title"] == "ROS 2 Classroom"
-    assert entry["launcher_entry"]["category"] == "ROS 2"  # a launcher section of its own
     assert entry["launcher_entry"]["enabled"]
     # The icon is served: the launcher would show a broken image otherwise.
     status, icon = jupyter.get(entry["launcher_entry"]["icon_url"])
