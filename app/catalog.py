@@ -367,6 +367,44 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         "Broadcasts carrot1 circling turtle1 at 10 m, at 10 Hz.",
         package="turtle_tf2_py",
     ),
+    # The tf2 time tutorials' listeners (nodes/turtle_tf2_listener_time.py), named /listener
+    # as the demo's, so they stand in for it.
+    CatalogEntry(
+        "turtle_tf2_listener_now",
+        "turtle_tf2_listener_time",
+        "/listener",
+        "Using time: looks up turtle1 at now() without waiting; tf2 says the data is too old.",
+        args=("now",),
+        ros_args=("-r", "__node:=listener"),
+        package="learning_tf2_py",
+    ),
+    CatalogEntry(
+        "turtle_tf2_listener_wait",
+        "turtle_tf2_listener_time",
+        "/listener",
+        "Using time: looks up turtle1 at now() and waits up to 50 ms: turtle2 follows.",
+        args=("wait",),
+        ros_args=("-r", "__node:=listener"),
+        package="learning_tf2_py",
+    ),
+    CatalogEntry(
+        "turtle_tf2_listener_past",
+        "turtle_tf2_listener_time",
+        "/listener",
+        "Traveling in time: lookup_transform 5 s ago, both frames in the past: turtle2 wanders.",
+        args=("past",),
+        ros_args=("-r", "__node:=listener", "-p", "target_frame:=carrot1"),
+        package="learning_tf2_py",
+    ),
+    CatalogEntry(
+        "turtle_tf2_listener_full",
+        "turtle_tf2_listener_time",
+        "/listener",
+        "Traveling in time: lookup_transform_full, carrot1 5 s ago seen from turtle2 now.",
+        args=("full",),
+        ros_args=("-r", "__node:=listener", "-p", "target_frame:=carrot1"),
+        package="learning_tf2_py",
+    ),
     # turtle_tf2_demo.launch.py: turtlesim as /sim, a broadcaster per turtle, the listener.
     CatalogEntry(
         "tf2_demo_sim",
