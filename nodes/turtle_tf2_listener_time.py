@@ -58,6 +58,7 @@ class PastListener(FrameListener):
 
     def lookup(self, to_frame_rel: str, from_frame_rel: str) -> TransformStamped:
         when = self.get_clock().now() - rclpy.time.Duration(seconds=5.0)
+        assert isinstance(when, rclpy.time.Time)  # Time - Duration is a Time (for mypy)
         return self.tf_buffer.lookup_transform(
             to_frame_rel, from_frame_rel, when, timeout=rclpy.duration.Duration(seconds=0.05)
         )
@@ -68,6 +69,7 @@ class TimeTravelListener(FrameListener):
 
     def lookup(self, to_frame_rel: str, from_frame_rel: str) -> TransformStamped:
         when = self.get_clock().now() - rclpy.time.Duration(seconds=5.0)
+        assert isinstance(when, rclpy.time.Time)  # Time - Duration is a Time (for mypy)
         return self.tf_buffer.lookup_transform_full(
             target_frame=to_frame_rel,
             target_time=rclpy.time.Time(),
