@@ -337,6 +337,23 @@ def check_errors_and_bad_input() -> None:
     )
     check(short.set_transform(msg("world", "m", 101 * NS, eye), "me") is False, "TF_OLD_DATA")
     check(short.can_transform("world", "m", Time(nanoseconds=104_000_000_000)), "recent data kept")
+    # A frame sent with a second parent: stored (the newest data wins), warned once per pair
+    two = tf2_ros.Buffer()
+    shifted = pt.transform_from(np.eye(3), np.array([0.0, 0.0, 1.0]))
+    check(two.set_transform(msg("world", "arm", 10 * NS, eye), "driver"), "first parent")
+    check(two.set_transform(msg("table", "arm", 11 * NS, shifted), "calibration"), "second parent")
+    check(two.set_transform(msg("table", "arm", 12 * NS, shifted), "calibration"), "again")
+    arm = two.lookup_transform("table", "arm", Time())
+    check(arm.transform.translation.z == 1.0, "the newest parent's transform wins")
+    raises(
+        tf2_ros.ConnectivityException,
+        "Could not find a connection between 'world' and 'arm' because they are not part of "
+        "the same tree.Tf has two or more unconnected trees.",
+        two.lookup_transform,
+        "world",
+        "arm",
+        Time(),
+    )
     # YAML and string views of the tree
     text = buf.all_frames_as_string()
     check("Frame a exists with parent world.\n" in text, text)
