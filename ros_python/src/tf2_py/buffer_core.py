@@ -90,6 +90,7 @@ class BufferCore:
         self._ids: dict[str, int] = {"NO_PARENT": 0}
         self._names: list[str] = ["NO_PARENT"]
         self._frames: list[TimeCache | StaticCache | None] = [None]
+        self._parents: list[int] = [0]  # each frame's newest parent (0: none), for _shortcut
         self._authority: dict[int, str] = {}
         self._parent_warned: set[tuple[int, int]] = set()
 
@@ -101,14 +102,30 @@ class BufferCore:
         return self._set(transform, authority, True)
 
     def _set(self, msg: TransformStamped, authority: str, is_static: bool) -> bool:
-        frame_id = msg.header.frame_id
-        child = msg.child_frame_id
+        tr, ro = msg.transform.translation, msg.transform.rotation
+        return self._set_fields(
+            msg.header.frame_id,
+            msg.child_frame_id,
+            msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec,
+            (tr.x, tr.y, tr.z),
+            (ro.x, ro.y, ro.z, ro.w),
+            authority,
+            is_static,
+        )
+
+    def _set_fields(
+        self,
+        frame_id: str,
+        child: str,
+        stamp: int,
+        t: Vec,
+        q: Quat,
+        authority: str,
+        is_static: bool,
+    ) -> bool:
+        """tf2's setTransform on the fields of one TransformStamped (stamp in ns)."""
         frame_id = frame_id[1:] if frame_id.startswith("/") else frame_id
         child = child[1:] if child.startswith("/") else child
-        tr, ro = msg.transform.translation, msg.transform.rotation
-        t: Vec = (tr.x, tr.y, tr.z)
-        q: Quat = (ro.x, ro.y, ro.z, ro.w)
-        stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
         ok = True
         if child == frame_id:
             _log(
@@ -168,6 +185,7 @@ class BufferCore:
                 )
                 return False
             self._authority[child_id] = authority
+            self._parents[child_id] = cache.latest_time_and_parent()[1]
         return True
 
     def _warn_new_parent(
@@ -201,6 +219,7 @@ class BufferCore:
             self._ids[name] = number
             self._names.append(name)
             self._frames.append(None)
+            self._parents.append(0)
         return number
 
     def _validate(self, function: str, frame_id: str) -> int:
@@ -391,6 +410,65 @@ class BufferCore:
             acc.q, acc.t = compose(inv_q, inv_t, acc.src_q, acc.src_t)
         return tc.NO_ERROR, time_ns, "", acc
 
+    def _shortcut(self, time_ns: int, target: int, source: int) -> tuple[Quat, Vec, int] | None:
+        """A successful walk's result, composing only the links below the common ancestor.
+
+        tf2's walk composes both paths all the way up to the root, where the
+        links above the frames' common ancestor cancel out. Here the tree's
+        shape is taken from each frame's newest parent (a list lookup), the
+        common ancestor found on it, and only the links below it are
+        interpolated and composed, each checked to have that parent at
+        ``time_ns``: the same transform for fewer operations. Whenever the
+        walk would not succeed that way (a missing link, another parent at
+        that time, no common ancestor, a loop) this returns None and tf2's own
+        walk runs, with its error and its message.
+        """
+        if time_ns == 0:
+            code, time_ns, _message = self._latest_common_time(target, source)
+            if code != tc.NO_ERROR:
+                return None
+        parents = self._parents
+        up: dict[int, int] = {}  # source and its ancestors (by newest parent)
+        frame = source
+        while frame and frame not in up:
+            up[frame] = parents[frame]
+            frame = parents[frame]
+        if frame:
+            return None  # a loop: tf2's walk says so
+        down: list[int] = []  # target and its ancestors below the common one
+        frame = target
+        while frame not in up:
+            if not frame or frame in down:
+                return None
+            down.append(frame)
+            frame = parents[frame]
+        common = frame
+        frames = self._frames
+        q: Quat = IDENTITY_Q
+        t: Vec = ZERO_V
+        first = True
+        for frame, parent in up.items():
+            if frame == common:
+                break
+            data = frames[frame].get_data(time_ns)  # type: ignore[union-attr]
+            if isinstance(data, CacheError) or data[0] != parent:
+                return None
+            if first:
+                q, t, first = data[1], data[2], False
+            else:
+                q, t = compose(data[1], data[2], q, t)
+        if down:
+            tq: Quat = IDENTITY_Q
+            tt: Vec = ZERO_V
+            for k, frame in enumerate(down):
+                data = frames[frame].get_data(time_ns)  # type: ignore[union-attr]
+                if isinstance(data, CacheError) or data[0] != parents[frame]:
+                    return None
+                tq, tt = (data[1], data[2]) if k == 0 else compose(data[1], data[2], tq, tt)
+            inv_q, inv_t = invert(tq, tt)
+            q, t = (inv_q, inv_t) if first else compose(inv_q, inv_t, q, t)
+        return q, t, time_ns
+
     # -- lookups -------------------------------------------------------------------
     def _lookup(self, target_frame: str, source_frame: str, time_ns: int) -> tuple[Quat, Vec, int]:
         with self._lock:
@@ -402,6 +480,9 @@ class BufferCore:
                 return IDENTITY_Q, ZERO_V, time_ns
             target = self._validate("lookupTransform argument target_frame", target_frame)
             source = self._validate("lookupTransform argument source_frame", source_frame)
+            found = self._shortcut(time_ns, target, source)
+            if found is not None:
+                return found
             code, used, message, acc = self._walk(time_ns, target, source, True)
         if code != tc.NO_ERROR or acc is None:
             raise _RAISE.get(code, TransformException)(message)
