@@ -24,6 +24,7 @@ from tf2_ros import TransformException
 from tf2_ros.tools.tf2_echo import format_transform
 
 from app.ros.graph import GraphSnapshot
+from app.scene import tf_sources
 from app.scene.tf_sources import FrameInfo, TfSources
 from app.supervisor import Supervisor
 from app.ui import MarkdownView, assign, code_block, set_options
@@ -44,6 +45,11 @@ def _age(seconds: float) -> str:
     return f"{seconds:.1f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
 
 
+def _rate(hz: float) -> str:
+    """Whole hertz from 10 Hz up: the text (re-sent on change) does not flicker."""
+    return f"{hz:.0f} Hz" if hz >= 10 else f"{hz:.1f} Hz"
+
+
 def describe(frame: FrameInfo) -> str:
     """One frame's line of the tree, in words a beginner can read."""
     name = f"**`{frame.frame}`**"
@@ -58,7 +64,7 @@ def describe(frame: FrameInfo) -> str:
             + ("" if frame.publisher_here or not frame.publisher else ", its publisher left")
         )
     else:
-        rate = f"{frame.rate:.1f} Hz" if frame.rate else "rate not known yet"
+        rate = _rate(frame.rate) if frame.rate else "rate not known yet"
         parts.append(f"dynamic · {rate} · last {_age(frame.age)} ago")
     if not frame.publisher:
         parts.append("publisher not known yet")
@@ -188,7 +194,7 @@ class TfPanel:
     def __init__(self, gui: viser.GuiApi, ui: UiLoop, node: Node, supervisor: Supervisor) -> None:
         self._ui = ui
         self._supervisor = supervisor
-        self.sources = TfSources(node)
+        self.sources = tf_sources.shared(node)  # the 3D view reads the same
         MarkdownView(gui, INTRO)
         self._tree = MarkdownView(gui)
         self._how = MarkdownView(gui)
@@ -273,4 +279,4 @@ class TfPanel:
         )
 
     def close(self) -> None:
-        self.sources.close()
+        tf_sources.release(self.sources)

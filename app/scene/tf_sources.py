@@ -14,8 +14,11 @@ topic: an honest "one of ..." otherwise.
 
 Every transform also goes into a real ``tf2_ros.Buffer`` with its
 publisher's name as the authority, so the panel's tf2_echo readout is a
-tf2 lookup. Threads: this module's thread writes; the UI thread reads
-copies (``frames()``) and calls the buffer (which has its own lock).
+tf2 lookup. The 3D view's TF layer gets the same transforms from here
+(``shared(node)`` and ``on_transforms``): /tf is taken and read once per
+dashboard. Threads: this module's thread writes and calls the
+``on_transforms`` sinks; the UI thread reads copies (``frames()``) and calls
+the buffer (which has its own lock).
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ import logging
 import threading
 import time
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -32,6 +36,7 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
 from tf2_msgs.msg import TFMessage
+from tf2_ros._wire import Entry, decode_tf_message
 from tf2_ros.buffer import Buffer
 
 from app.ros.names import node_fqn
@@ -101,6 +106,18 @@ def _loaded_library(name: str) -> str:
     raise OSError(f"{name} is not loaded")
 
 
+def _entry(t: Any) -> Entry:
+    """A TransformStamped as the fields tf2_ros._wire reads."""
+    v, r, stamp = t.transform.translation, t.transform.rotation, t.header.stamp
+    return (
+        t.header.frame_id,
+        t.child_frame_id,
+        stamp.sec * 1_000_000_000 + stamp.nanosec,
+        (v.x, v.y, v.z),
+        (r.x, r.y, r.z, r.w),
+    )
+
+
 class RclTaker:
     """``take(subscription)`` -> (CDR bytes, writer GID) or None when nothing waits."""
 
@@ -158,6 +175,33 @@ class RclpyTaker:
         pass
 
 
+Sink = Callable[[list[Entry], bool], None]  # (transforms of one message, static)
+_shared: dict[int, tuple[TfSources, int]] = {}  # id(node) -> (sources, users)
+_shared_lock = threading.Lock()
+
+
+def shared(node: Node) -> TfSources:
+    """The one TfSources of ``node`` (made on first use); give it back with ``release``."""
+    with _shared_lock:
+        sources, users = _shared.get(id(node), (None, 0))
+        if sources is None:
+            sources = TfSources(node)
+        _shared[id(node)] = (sources, users + 1)
+        return sources
+
+
+def release(sources: TfSources) -> None:
+    """One user fewer; the last one closes it."""
+    with _shared_lock:
+        for key, (held, users) in list(_shared.items()):
+            if held is sources:
+                if users > 1:
+                    _shared[key] = (held, users - 1)
+                    return
+                del _shared[key]
+    sources.close()
+
+
 # --- what the panel shows ---------------------------------------------------------------
 @dataclass(frozen=True)
 class FrameInfo:
@@ -207,6 +251,7 @@ class TfSources:
         self._present: set[bytes] = set()  # GIDs on the graph now
         self._topic_publishers: dict[str, list[str]] = {"/tf": [], "/tf_static": []}
         self.version = 0
+        self._sinks: list[Sink] = []
         self._taps = Node(
             TAPS_NODE, context=node.context, start_parameter_services=False, enable_rosout=False
         )
@@ -249,7 +294,23 @@ class TfSources:
             if got is None:
                 return
             data, gid = got
-            self._ingest(deserialize_message(data, TFMessage), gid, static, time.monotonic())
+            entries = decode_tf_message(data)
+            if entries is None:  # not the usual encoding: rclpy reads it
+                entries = [_entry(t) for t in deserialize_message(data, TFMessage).transforms]
+            self._ingest(entries, gid, static, time.monotonic())
+            for sink in list(self._sinks):
+                try:
+                    sink(entries, static)
+                except Exception:  # one consumer's bug stops no other
+                    log.exception("TF sink failed")
+
+    def on_transforms(self, sink: Sink) -> None:
+        """Call ``sink(transforms, static)`` (on this module's thread) for every message."""
+        self._sinks.append(sink)
+
+    def remove_sink(self, sink: Sink) -> None:
+        if sink in self._sinks:
+            self._sinks.remove(sink)
 
     def _read_graph(self) -> None:
         present: set[bytes] = set()
@@ -271,22 +332,17 @@ class TfSources:
             self._topic_publishers = topics
             self.version += 1
 
-    def _ingest(self, msg: TFMessage, gid: bytes, static: bool, now: float) -> None:
+    def _ingest(self, entries: list[Entry], gid: bytes, static: bool, now: float) -> None:
         with self._lock:
             known = gid in self._names
             authority = self._names.get(gid, "")
         if self.exact and not known:
             self._graph_due = min(self._graph_due, now + GRAPH_SOON_SEC)
-        for t in msg.transforms:
-            stored = (
-                self.buffer.set_transform_static(t, authority or "unknown_publisher")
-                if static
-                else self.buffer.set_transform(t, authority or "unknown_publisher")
-            )
-            if not stored:
+        who = authority or "unknown_publisher"
+        for frame_id, child_frame_id, stamp, t, q in entries:
+            if not self.buffer._set_fields(frame_id, child_frame_id, stamp, t, q, who, static):
                 continue  # tf2 refused it (and said why in the log): the panel follows tf2
-            parent = t.header.frame_id.lstrip("/")
-            child = t.child_frame_id.lstrip("/")
+            parent, child = frame_id.lstrip("/"), child_frame_id.lstrip("/")
             with self._lock:
                 record = self._frames.get(child)
                 if record is None:
@@ -303,6 +359,7 @@ class TfSources:
                 )
                 record.arrivals.append(now)
                 self.version += 1
+        self.buffer._call_new_data_callbacks()
 
     # --- any thread ---
     def frames(self, now: float | None = None) -> list[FrameInfo]:

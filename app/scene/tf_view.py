@@ -9,9 +9,11 @@ silent is shown stale. Bad input (a description that does not parse, a
 NaN or zero-length quaternion, a loop of frames) is one line in the status
 and in the log; nothing is drawn from it and nothing stops.
 
-Threads: the subscriptions' callbacks (executor) only store transforms or
-drop the description into a one-slot box; a drawing thread of this layer
-parses descriptions and moves scene nodes, at most ``MAX_HZ`` times a second.
+Threads: /tf and /tf_static come from the dashboard's one TF reader
+(``app.scene.tf_sources``, shared with the TF panel), whose thread only
+stores the transforms; the /robot_description callback (executor) drops the
+text into a one-slot box; a drawing thread of this layer parses
+descriptions and moves scene nodes, at most ``MAX_HZ`` times a second.
 """
 
 from __future__ import annotations
@@ -26,8 +28,9 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from robot_state_publisher.urdf_tree import UrdfError
 from std_msgs.msg import String
-from tf2_msgs.msg import TFMessage
+from tf2_ros._wire import Entry
 
+from app.scene import tf_sources
 from app.scene import transforms as tf
 from app.scene.qos import SCENE_CALLBACK_GROUP
 from app.scene.robot_model import RobotDrawing, SliderJoint, build_drawing
@@ -38,8 +41,6 @@ log = logging.getLogger(__name__)
 TF_PATH = "/tf_view"
 MAX_HZ = 30.0  # as the other layers; poses that did not change are not resent
 AXES_LENGTH = 0.08
-TF_QOS = QoSProfile(depth=100)
-STATIC_QOS = QoSProfile(depth=100, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 DESCRIPTION_QOS = QoSProfile(
     depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
 )
@@ -72,17 +73,9 @@ class TfView:
         self._root = server.scene.add_frame(TF_PATH, show_axes=False)
         self._wake = threading.Event()
         self._stop = threading.Event()
+        self._sources = tf_sources.shared(node)
+        self._sources.on_transforms(self._on_transforms)
         self._subscriptions = [
-            node.create_subscription(
-                TFMessage, "/tf", self._on_tf, TF_QOS, callback_group=SCENE_CALLBACK_GROUP
-            ),
-            node.create_subscription(
-                TFMessage,
-                "/tf_static",
-                self._on_tf_static,
-                STATIC_QOS,
-                callback_group=SCENE_CALLBACK_GROUP,
-            ),
             node.create_subscription(
                 String,
                 "/robot_description",
@@ -95,20 +88,10 @@ class TfView:
         self._thread = threading.Thread(target=self._run, name="scene-tf", daemon=True)
         self._thread.start()
 
-    # --- executor thread: store and hand over, nothing else ---
-    def _on_tf(self, msg: TFMessage) -> None:
-        self._store(msg, static=False)
-
-    def _on_tf_static(self, msg: TFMessage) -> None:
-        self._store(msg, static=True)
-
-    def _store(self, msg: TFMessage, *, static: bool) -> None:
-        for t in msg.transforms:
-            v, r = t.transform.translation, t.transform.rotation
-            self.store.add(
-                t.header.frame_id, t.child_frame_id, (v.x, v.y, v.z), (r.x, r.y, r.z, r.w),
-                static=static,
-            )  # fmt: skip
+    # --- the TF reader's thread, then the executor's: store and hand over, nothing else ---
+    def _on_transforms(self, entries: list[Entry], static: bool) -> None:
+        for frame_id, child, _stamp, t, q in entries:
+            self.store.add(frame_id, child, t, q, static=static)
         self._wake.set()
 
     def _on_description(self, msg: String) -> None:
@@ -268,5 +251,7 @@ class TfView:
         self._stop.set()
         self._wake.set()
         self._thread.join(timeout=2.0)
+        self._sources.remove_sink(self._on_transforms)
+        tf_sources.release(self._sources)
         for subscription in self._subscriptions:
             self._node.destroy_subscription(subscription)

@@ -18,7 +18,7 @@ def test_tree_puts_each_frame_under_its_parent():
         "3 frames in 1 tree · 1 static, 1 dynamic",
         "",
         "- **`world`** · root (no parent)",
-        "  - **`base_link`** · parent `world` · dynamic · 50.0 Hz · last 0.0 s ago · "
+        "  - **`base_link`** · parent `world` · dynamic · 50 Hz · last 0.0 s ago · "
         "by `/robot_state_publisher`",
         "    - **`camera`** · parent `base_link` · static (latched on /tf_static, sent 3.0 s ago)"
         " · by `/cam_tf`",
