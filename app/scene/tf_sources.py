@@ -45,7 +45,9 @@ from app.scene.tf_tree import STALE_MIN_SEC, STALE_PERIODS
 log = logging.getLogger(__name__)
 
 TAPS_NODE = "_classroom_tf_panel"  # hidden, as `ros2 node list` hides '_' names
-POLL_SEC = 0.02  # take what arrived 50 times a second
+POLL_SEC = 0.02  # take what arrived 50 times a second...
+IDLE_POLL_SEC = 0.1  # ...or 10 times while nothing has come for IDLE_AFTER_SEC
+IDLE_AFTER_SEC = 2.0
 MAX_TAKES = 400  # per topic and poll: a flood cannot starve the rest of the loop
 GRAPH_EVERY_SEC = 1.0  # re-read which GID belongs to which node...
 GRAPH_SOON_SEC = 0.25  # ...sooner when a sample came from a GID not known yet
@@ -277,22 +279,29 @@ class TfSources:
 
     # --- this module's thread ---
     def _run(self) -> None:
-        while not self._stop.wait(POLL_SEC):
+        last_data = 0.0
+        while not self._stop.wait(
+            POLL_SEC if time.monotonic() - last_data < IDLE_AFTER_SEC else IDLE_POLL_SEC
+        ):
             now = time.monotonic()
             if now >= self._graph_due:
                 self._read_graph()
                 self._graph_due = now + GRAPH_EVERY_SEC
             for subscription, static in self._subscriptions:
                 try:
-                    self._drain(subscription, static)
+                    if self._drain(subscription, static):
+                        last_data = now
                 except Exception:  # a bad sample or a closing context: keep the panel going
                     log.exception("TF panel: taking %s failed", subscription.topic_name)
 
-    def _drain(self, subscription: Any, static: bool) -> None:
+    def _drain(self, subscription: Any, static: bool) -> bool:
+        """Take and read what waits; whether anything did."""
+        took = False
         for _ in range(MAX_TAKES):
             got = self._taker.take(subscription)
             if got is None:
-                return
+                return took
+            took = True
             data, gid = got
             entries = decode_tf_message(data)
             if entries is None:  # not the usual encoding: rclpy reads it
@@ -303,6 +312,7 @@ class TfSources:
                     sink(entries, static)
                 except Exception:  # one consumer's bug stops no other
                     log.exception("TF sink failed")
+        return took
 
     def on_transforms(self, sink: Sink) -> None:
         """Call ``sink(transforms, static)`` (on this module's thread) for every message."""
