@@ -45,6 +45,10 @@ def _age(seconds: float) -> str:
     return f"{seconds:.1f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
 
 
+def _first_line(text: str) -> str:
+    return text.splitlines()[0] if text else ""
+
+
 def _rate(hz: float) -> str:
     """Whole hertz from 10 Hz up: the text (re-sent on change) does not flicker."""
     return f"{hz:.0f} Hz" if hz >= 10 else f"{hz:.1f} Hz"
@@ -59,10 +63,7 @@ def describe(frame: FrameInfo) -> str:
     if frame.static:
         parts.append(f"static (latched on /tf_static, sent {_age(frame.age)} ago)")
     elif frame.stale:
-        parts.append(
-            f"dynamic · ⚠️ **STALE**: no transform for {_age(frame.age)}"
-            + ("" if frame.publisher_here or not frame.publisher else ", its publisher left")
-        )
+        parts.append(f"dynamic · ⚠️ **STALE**: no transform for {_age(frame.age)}")
     else:
         rate = _rate(frame.rate) if frame.rate else "rate not known yet"
         parts.append(f"dynamic · {rate} · last {_age(frame.age)} ago")
@@ -72,10 +73,11 @@ def describe(frame: FrameInfo) -> str:
         parts.append(f"by `{frame.publisher}`")
     elif frame.static:
         parts.append(
-            f"by `{frame.publisher}` (gone: listeners started from now on will not get it)"
+            f"by `{frame.publisher}` (publisher gone: listeners started from now on will not "
+            "get it)"
         )
     else:
-        parts.append(f"by `{frame.publisher}` (gone from the graph)")
+        parts.append(f"by `{frame.publisher}` (that publisher is gone)")
     line = " · ".join(parts)
     if frame.conflict:
         line += f" · ⚠️ **two parents**: {frame.conflict} (tf2 warns TF_PARENT_CHANGED)"
@@ -231,7 +233,10 @@ class TfPanel:
 
     def refresh(self, graph: GraphSnapshot) -> None:
         frames = self.sources.frames()
-        self._tree.show(tree_markdown(frames))
+        problem = self.sources.buffer.last_problem
+        self._tree.show(
+            tree_markdown(frames) + (f"\n\n⚠️ tf2 says: {_first_line(problem)}" if problem else "")
+        )
         self._how.show(
             "Publishers: each message's sender (its DDS writer) looked up in the ROS graph."
             if self.sources.exact

@@ -31,15 +31,17 @@ def test_stale_gone_and_unknown_publishers_are_said_in_words():
         "base_link", "world", age=4.25, stale=True, publisher="/rsp", publisher_here=False
     )
     assert describe(gone) == (
-        "**`base_link`** · parent `world` · dynamic · ⚠️ **STALE**: no transform for 4.2 s, "
-        "its publisher left · by `/rsp` (gone from the graph)"
+        "**`base_link`** · parent `world` · dynamic · ⚠️ **STALE**: no transform for 4.2 s · "
+        "by `/rsp` (that publisher is gone)"
     )
     quiet = FrameInfo("base_link", "world", age=2.0, stale=True, publisher="/rsp")
     assert "**STALE**: no transform for 2.0 s · by `/rsp`" in describe(quiet)
     static_gone = FrameInfo(
         "camera", "base_link", static=True, publisher="/x", publisher_here=False
     )
-    assert "(gone: listeners started from now on will not get it)" in describe(static_gone)
+    assert "(publisher gone: listeners started from now on will not get it)" in describe(
+        static_gone
+    )
     assert "publisher not known yet" in describe(FrameInfo("a", "b"))
     two = FrameInfo(
         "a", "b", publisher="/p", conflict="also sent with parent `c` by `/q` 0.2 s ago"

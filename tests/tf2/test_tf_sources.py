@@ -92,6 +92,7 @@ def test_each_frame_is_named_with_its_broadcaster(probe, supervisor, capfd, monk
         probe.node.destroy_timer(timer)
         err = capfd.readouterr().err
         assert 'TF_PARENT_CHANGED: frame "carrot1" had parent ' in err, err
+        assert sources.buffer.last_problem.startswith("TF_PARENT_CHANGED"), sources.buffer
     finally:
         sources.close()
 

@@ -93,6 +93,12 @@ class BufferCore:
         self._parents: list[int] = [0]  # each frame's newest parent (0: none), for _shortcut
         self._authority: dict[int, str] = {}
         self._parent_warned: set[tuple[int, int]] = set()
+        self.last_problem = ""  # the newest warning or error logged (not upstream's API)
+
+    def _say(self, level: str, text: str) -> None:
+        """Log as tf2 does; keep the newest warning or error for tools that show it."""
+        self.last_problem = text
+        _log(level, text)
 
     # -- input -----------------------------------------------------------------
     def set_transform(self, transform: TransformStamped, authority: str) -> bool:
@@ -128,21 +134,21 @@ class BufferCore:
         child = child[1:] if child.startswith("/") else child
         ok = True
         if child == frame_id:
-            _log(
+            self._say(
                 "error",
                 f'TF_SELF_TRANSFORM: Ignoring transform from authority "{authority}" with '
                 f'frame_id and  child_frame_id "{child}" because they are the same',
             )
             ok = False
         if not child:
-            _log(
+            self._say(
                 "error",
                 f'TF_NO_CHILD_FRAME_ID: Ignoring transform from authority "{authority}" '
                 "because child_frame_id not set ",
             )
             ok = False
         if not frame_id:
-            _log(
+            self._say(
                 "error",
                 f'TF_NO_FRAME_ID: Ignoring transform with child_frame_id "{child}"  from '
                 f'authority "{authority}" because frame_id not set',
@@ -150,7 +156,7 @@ class BufferCore:
             ok = False
         total = t[0] + t[1] + t[2] + q[0] + q[1] + q[2] + q[3]
         if total != total and any(math.isnan(v) for v in (*t, *q)):  # cheap test first
-            _log(
+            self._say(
                 "error",
                 f'TF_NAN_INPUT: Ignoring transform for child_frame_id "{child}" from authority '
                 f'"{authority}" because of a nan value in the transform '
@@ -158,7 +164,7 @@ class BufferCore:
             )
             ok = False
         elif abs(quat_norm2(q) - 1.0) >= QUATERNION_NORMALIZATION_TOLERANCE:
-            _log(
+            self._say(
                 "error",
                 f'TF_DENORMALIZED_QUATERNION: Ignoring transform for child_frame_id "{child}" '
                 f'from authority "{authority}" because of an invalid quaternion in the '
@@ -177,7 +183,7 @@ class BufferCore:
             else:
                 self._warn_new_parent(cache, child_id, parent_id, authority)
             if not cache.insert(stamp, (parent_id, q, t)):
-                _log(
+                self._say(
                     "warning",
                     f"TF_OLD_DATA ignoring data from the past for frame {child} at time "
                     f"{display_time(stamp)} according to authority {authority}\n"
@@ -196,7 +202,7 @@ class BufferCore:
         if old in (0, parent_id) or (child_id, parent_id) in self._parent_warned:
             return
         self._parent_warned.add((child_id, parent_id))
-        _log(
+        self._say(
             "warning",
             f'TF_PARENT_CHANGED: frame "{self._names[child_id]}" had parent '
             f'"{self._names[old]}" and now gets parent "{self._names[parent_id]}" from '
