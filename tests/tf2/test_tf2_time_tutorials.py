@@ -13,9 +13,10 @@ by what a learner sees: the listener's log and where turtle2 goes.
 from __future__ import annotations
 
 import math
+import time
 
 import pytest
-import yaml
+from turtlesim.msg import Pose
 
 from tests.conftest import wait_until
 from tests.integration.core_helpers import DISCOVERY_TIMEOUT, node_names
@@ -33,35 +34,62 @@ def ok(console, text: str) -> list[str]:  # noqa: F811
     return out
 
 
-def pose(console, turtle: str) -> tuple[float, float]:  # noqa: F811
-    out = ok(console, f"ros2 topic echo --once /{turtle}/pose")
-    data = yaml.safe_load("\n".join(out[: out.index("---")]))
-    return data["x"], data["y"]
+class Poses:
+    """The newest pose of each turtle, from this test's own subscriptions (over DDS)."""
 
+    def __init__(self, probe) -> None:
+        self.newest: dict[str, tuple[float, float, float]] = {}  # turtle -> (time, x, y)
+        self.since = 0.0
+        for turtle in ("turtle1", "turtle2"):
+            probe.node.create_subscription(
+                Pose, f"/{turtle}/pose", lambda msg, t=turtle: self._on_pose(t, msg), 10
+            )
 
-def near(console, turtle: str, point: tuple[float, float], within: float) -> bool:  # noqa: F811
-    return math.dist(pose(console, turtle), point) < within
+    def _on_pose(self, turtle: str, msg: Pose) -> None:
+        self.newest[turtle] = (time.monotonic(), msg.x, msg.y)
+
+    def fresh(self) -> None:
+        """From now on, only poses that arrive later count (a new turtlesim)."""
+        self.since = time.monotonic()
+
+    def __call__(self, turtle: str) -> tuple[float, float]:
+        wait_until(
+            lambda: self.newest.get(turtle, (0.0,))[0] > self.since,
+            timeout=DISCOVERY_TIMEOUT,
+            what=f"a pose of {turtle}",
+        )
+        _t, x, y = self.newest[turtle]
+        return x, y
+
+    def near(self, turtle: str, point: tuple[float, float], within: float) -> bool:
+        return math.dist(self(turtle), point) < within
 
 
 def test_carrot_demo_launch_files(console, probe, supervisor):  # noqa: F811
+    pose = Poses(probe)
     ok(console, "ros2 launch learning_tf2_py turtle_tf2_fixed_frame_demo.launch.py")
     wait_until(
         lambda: {"/sim", "/listener", "/fixed_broadcaster"} <= set(node_names(probe)),
         timeout=DISCOVERY_TIMEOUT,
         what="the fixed-frame demo's nodes",
     )
-    wait_until(
-        lambda: "/turtle2/pose" in dict(probe.node.get_topic_names_and_types()),
-        timeout=DISCOVERY_TIMEOUT,
-        what="turtle2",
-    )
     # turtle1 stands still: turtle2 comes to rest on carrot1, 2 m to its left
     wait_until(
-        lambda: near(console, "turtle2", CARROT, 0.5),
+        lambda: pose.near("turtle2", CARROT, 0.5),
         timeout=40,
-        what=lambda: f"turtle2 at carrot1 {CARROT}: {pose(console, 'turtle2')}",
+        what=lambda: f"turtle2 at carrot1 {CARROT}: {pose('turtle2')}",
     )
     ok(console, "ros2 launch --stop learning_tf2_py turtle_tf2_fixed_frame_demo.launch.py")
+    wait_until(
+        lambda: (
+            not supervisor.status(
+                "launch:learning_tf2_py/turtle_tf2_fixed_frame_demo.launch.py"
+            ).active
+        ),
+        timeout=DISCOVERY_TIMEOUT,
+        what="the fixed-frame demo to end",
+    )
+    pose.fresh()
 
     ok(console, "ros2 launch turtle_tf2_py turtle_tf2_dynamic_frame_demo.launch.py")
     wait_until(
@@ -69,15 +97,10 @@ def test_carrot_demo_launch_files(console, probe, supervisor):  # noqa: F811
         timeout=DISCOVERY_TIMEOUT,
         what="the dynamic-frame demo's broadcaster",
     )
-    wait_until(
-        lambda: "/turtle2/pose" in dict(probe.node.get_topic_names_and_types()),
-        timeout=DISCOVERY_TIMEOUT,
-        what="turtle2",
-    )
     # carrot1 circles turtle1 at 10 m: turtle2 keeps chasing it, so it keeps moving
-    seen = [pose(console, "turtle2")]
+    seen = [pose("turtle2")]
     wait_until(
-        lambda: seen.append(pose(console, "turtle2")) or math.dist(seen[0], seen[-1]) > 2.0,
+        lambda: seen.append(pose("turtle2")) or math.dist(seen[0], seen[-1]) > 2.0,
         timeout=30,
         what=lambda: f"turtle2 chasing the moving carrot: {seen[-3:]}",
     )
@@ -85,6 +108,7 @@ def test_carrot_demo_launch_files(console, probe, supervisor):  # noqa: F811
 
 
 def test_using_time_and_traveling_in_time(console, probe, supervisor):  # noqa: F811
+    pose = Poses(probe)
     for name in ("tf2_demo_sim", "tf2_demo_broadcaster1", "tf2_demo_broadcaster2"):
         supervisor.start(name)
     try:
@@ -101,15 +125,15 @@ def test_using_time_and_traveling_in_time(console, probe, supervisor):  # noqa: 
             timeout=DISCOVERY_TIMEOUT,
             what=lambda: f"the future error: {supervisor.output('turtle_tf2_listener_now')[-5:]}",
         )
-        assert near(console, "turtle2", (4.0, 2.0), 0.01)  # spawned, never driven
+        assert pose.near("turtle2", (4.0, 2.0), 0.01)  # spawned, never driven
         ok(console, "ros2 run --stop /listener")
 
         # Using time, 2: a 50 ms timeout lets the data arrive; turtle2 follows turtle1.
         ok(console, "ros2 run learning_tf2_py turtle_tf2_listener_wait")
         wait_until(
-            lambda: near(console, "turtle2", (CENTRE, CENTRE), 1.0),
+            lambda: pose.near("turtle2", (CENTRE, CENTRE), 1.0),
             timeout=40,
-            what=lambda: f"turtle2 to reach turtle1: {pose(console, 'turtle2')}",
+            what=lambda: f"turtle2 to reach turtle1: {pose('turtle2')}",
         )
         ok(console, "ros2 run --stop /listener")
 
@@ -129,9 +153,9 @@ def test_using_time_and_traveling_in_time(console, probe, supervisor):  # noqa: 
         # lookup_transform_full: carrot1 5 s ago (turtle1 stands still: where it is now)
         ok(console, "ros2 run learning_tf2_py turtle_tf2_listener_full")
         wait_until(
-            lambda: near(console, "turtle2", CARROT, 0.5),
+            lambda: pose.near("turtle2", CARROT, 0.5),
             timeout=40,
-            what=lambda: f"turtle2 at carrot1's past spot {CARROT}: {pose(console, 'turtle2')}",
+            what=lambda: f"turtle2 at carrot1's past spot {CARROT}: {pose('turtle2')}",
         )
         ok(console, "ros2 run --stop /listener")
         ok(console, "ros2 run --stop /fixed_frame_tf2_broadcaster")
