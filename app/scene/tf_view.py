@@ -66,7 +66,8 @@ class TfView:
         self.robot_joints: tuple[SliderJoint, ...] = ()  # for the joint sliders (UI thread reads)
         self.robot_status = "No robot on /robot_description yet."
         self.robot_error = ""
-        self._frames: dict[str, tuple[viser.FrameHandle, viser.LabelHandle]] = {}
+        self._frames: dict[str, viser.FrameHandle] = {}
+        self._labels: dict[str, viser.LabelHandle] = {}  # while names are shown
         self._axes: viser.BatchedAxesHandle | None = None  # every frame's axes, instanced
         self._axes_count = 0
         self._placed: dict[str, tuple[Any, Any]] = {}  # frame -> (position, wxyz) last sent
@@ -178,14 +179,29 @@ class TfView:
             return
         with self._server.atomic():
             for frame in sorted(set(view.poses) | set(view.problems) | set(self._frames)):
-                node, label = self._frame(frame)
+                node = self._frame(frame)
                 self._place(frame, node, view.poses.get(frame))
-                text = f"{frame} (stale)" if frame in view.stale else frame
-                if label.text != text:
-                    label.text = text
-                if label.visible != self.show_names:
-                    label.visible = self.show_names
+                self._name(frame, node, f"{frame} (stale)" if frame in view.stale else frame)
             self._draw_axes(view)
+
+    def _name(self, frame: str, node: viser.FrameHandle, text: str) -> None:
+        """The frame's name while names are shown; no label node at all otherwise.
+
+        (A hidden label still costs the page work every frame; a robot's 30
+        of them, a third of the scene's nodes, showed in its frame time.)
+        """
+        label = self._labels.get(frame)
+        if not self.show_names:
+            if label is not None:
+                label.remove()
+                del self._labels[frame]
+            return
+        if label is None:
+            self._labels[frame] = self._server.scene.add_label(
+                f"{node.name}/name", text, font_screen_scale=0.8
+            )
+        elif label.text != text:
+            label.text = text
 
     def _draw_axes(self, view: TreeView) -> None:
         """Every frame's axes as one instanced node: one draw call, two messages per update.
@@ -214,17 +230,15 @@ class TfView:
         self._axes.batched_positions = positions
         self._axes.batched_wxyzs = wxyzs
 
-    def _frame(self, frame: str) -> tuple[viser.FrameHandle, viser.LabelHandle]:
-        """The node (its robot shapes hang under it) and name of a TF frame, made hidden."""
-        handles = self._frames.get(frame)
-        if handles is None:
+    def _frame(self, frame: str) -> viser.FrameHandle:
+        """The node of a TF frame (its robot shapes and name hang under it), made hidden."""
+        node = self._frames.get(frame)
+        if node is None:
             path = f"{TF_PATH}/frames/{scene_name(frame)}"
             node = self._server.scene.add_frame(path, show_axes=False, visible=False)
-            label = self._server.scene.add_label(f"{path}/name", frame, font_screen_scale=0.8)
             self._sent[path] = ("hidden",)
-            handles = (node, label)
-            self._frames[frame] = handles
-        return handles
+            self._frames[frame] = node
+        return node
 
     def _place(self, frame: str, handle: viser.FrameHandle, pose: np.ndarray | None) -> None:
         """Show ``handle`` at ``pose`` (hide it for None), sending only what changed."""
