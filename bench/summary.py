@@ -372,6 +372,14 @@ ROWS += (
         lambda v: v >= 0.9,
     ),
     (
+        "The same with the 31 TF frames' names and axes shown (as the view opens)",
+        "urdf_draw",
+        "urdf_draw_with_frames_ratio",
+        "x",
+        "",
+        None,
+    ),
+    (
         "30-link URDF at 50 Hz: robot poses shown per second, 3D view / plain viser scene",
         "urdf_draw",
         "dashboard_moves_per_s|baseline_moves_per_s",

@@ -27,8 +27,8 @@ from app.ros.graph import GraphSnapshot
 # The dashboard's tabs, in order. Lessons name them ("Open the Lifecycle tab")
 # and are checked against this list when they load.
 TAB_NAMES = (
-    "Lessons", "Exercise", "Nodes", "Turtlesim", "Graph", "Echo", "3D view", "Topics", "Parameters",
-    "Console", "Services", "Actions", "Lifecycle", "Logs", "Bags",
+    "Lessons", "Exercise", "Nodes", "Turtlesim", "Graph", "Echo", "3D view", "TF", "Topics",
+    "Parameters", "Console", "Services", "Actions", "Lifecycle", "Logs", "Bags",
 )  # fmt: skip
 
 

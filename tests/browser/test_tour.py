@@ -23,6 +23,7 @@ EXPECTED = {
     "Graph": "ros2 node list",
     "Echo": "data: 'Hello World:",
     "3D view": "draws live topics",
+    "TF": "No TF frames yet",
     "Topics": "/chatter",
     "Parameters": "A node's parameters are settings",
     "Console": "Type a command as the tutorials write it",
