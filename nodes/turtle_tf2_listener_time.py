@@ -21,16 +21,18 @@ Python note: a lookup with a timeout waits inside the timer callback, while
 the TransformListener's subscriptions must keep filling the buffer. With
 rclpy's single-threaded executor nothing else runs during the wait (so the
 wait cannot succeed); the waiting versions spin on a MultiThreadedExecutor,
-and the listener's subscriptions are in a reentrant callback group.
+and the listener's subscriptions are in a reentrant callback group (rclpy's
+executor, fixed for a bug of the Jazzy wheel that made it spin a whole core
+here: nodes/common/executors.py).
 """
 
 import sys
 
 import rclpy
 from geometry_msgs.msg import TransformStamped
-from rclpy.executors import MultiThreadedExecutor
 from rclpy.utilities import remove_ros_args
 
+from nodes.common.executors import SteadyMultiThreadedExecutor
 from nodes.common.run import spin_node
 from nodes.turtle_tf2_listener import FrameListener
 
@@ -96,7 +98,7 @@ def main(args=None) -> None:
             f"turtle_tf2_listener_time: say which version: {', '.join(VERSIONS)}", file=sys.stderr
         )
         raise SystemExit(2)
-    executor = None if version == "now" else MultiThreadedExecutor
+    executor = None if version == "now" else SteadyMultiThreadedExecutor
     spin_node(VERSIONS[version], args, executor=executor)
 
 

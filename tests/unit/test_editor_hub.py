@@ -4,6 +4,7 @@ learner types, completion from Jedi, ruff's format, confinement (no browser, no 
 from __future__ import annotations
 
 import asyncio
+import concurrent.futures
 import json
 import os
 import time
@@ -82,7 +83,10 @@ def run_with_editor(hub: EditorHub, test: Any, slug: str = "heartbeat_logger") -
                 await editor.expect("load", file=None)  # the exercise's code, as before
                 await test(editor, url)
 
-    asyncio.run(main())
+    # Its own thread: the session's Playwright (browser tests) keeps an asyncio loop
+    # running on the main thread, where asyncio.run would refuse to start.
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        pool.submit(asyncio.run, main()).result()
 
 
 @pytest.fixture
