@@ -19,6 +19,7 @@ import threading
 
 import rclpy
 from rclpy.context import Context
+from rclpy.exceptions import InvalidHandle
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
@@ -55,15 +56,24 @@ class RosRuntime:
             enable_rosout=not quiet,
         )
         self.executor = SingleThreadedExecutor(context=self.context)
+        self.lost_waits = 0  # waits lost to an entity destroyed meanwhile (see _spin)
         self.executor.add_node(self.node)
         self._thread = threading.Thread(target=self._spin, name=f"ros-{node_name}", daemon=True)
         self._thread.start()
 
     def _spin(self) -> None:
-        try:
-            self.executor.spin()
-        except (ExternalShutdownException, KeyboardInterrupt):
-            pass
+        while True:
+            try:
+                self.executor.spin()
+                return
+            except (ExternalShutdownException, KeyboardInterrupt):
+                return
+            except InvalidHandle:
+                # rclpy 7.1.6 race: another thread destroyed a publisher or subscription
+                # (its QoS event handler) while the executor was building its wait set;
+                # the handler is skipped when entered but still added to the set, which
+                # raises here. Only that one wait is lost: spin on, never die silently.
+                self.lost_waits += 1
 
     def shutdown(self, timeout: float = 2.0) -> None:
         """Executor first, then the node, then the context."""
