@@ -17,7 +17,8 @@ In one run, on the same machine:
    3D view draws it, so reported as not measured.
 
 A figure that cannot be measured is NaN (``null`` in the JSON) with the reason
-in ``errors``: never missing.
+in ``errors``, printed as a ``FAILED:`` line, and the benchmark exits 1: never
+missing, never quiet.
 
 Run: ``.venv/bin/python tests/run.py --bench sim_world [--seconds S]``.
 The last line printed is one JSON object (keys ``sim_rtf``, ``sim_camera_rate_ratio``, ...).
@@ -215,9 +216,9 @@ def main(argv: list[str] | None = None) -> int:
         f"{f['max_rtf_ratio_to_bare']:.2f} of the bare loop"
     )
     for error in f["errors"]:
-        print(f"not measured: {error}")
+        print(f"FAILED: not measured: {error}")  # summary.py shows it as the row's reason
     print(json.dumps(rounded(f, 3), sort_keys=True))
-    return 0
+    return 1 if f["errors"] else 0
 
 
 if __name__ == "__main__":
