@@ -39,23 +39,50 @@ def _python_sources(exercise):
     ]
 
 
-def test_every_exercise_that_takes_input_shows_an_example_that_is_not_the_test():
+def _leaves(value):
+    """The plain values inside an example (lists and tables opened)."""
+    if isinstance(value, dict):
+        return [leaf for inner in value.values() for leaf in _leaves(inner)]
+    if isinstance(value, list):
+        return [leaf for inner in value for leaf in _leaves(inner)]
+    return [value]
+
+
+def test_every_exercise_has_a_cheat_or_a_reasoned_exemption():
+    """A solution replaying the statement's example is generated for every exercise (and
+    test_grading runs it), unless the exercise is exempt, with a reason."""
+    from tests.exercises.cheats import EXEMPT, cheat_code, input_probe
+
+    for slug, reason in EXEMPT.items():
+        assert book.get(slug) and len(reason.split()) >= 5, f"{slug}: exempt without a reason"
+    for exercise in book.exercises:
+        if exercise.slug in EXEMPT:
+            continue
+        assert input_probe(exercise), (
+            f"{exercise.slug}: no probe with a cheat generator (tests/exercises/cheats.py) and "
+            "no exemption: a solution replaying the statement's example is never tried"
+        )
+        assert "class Cheat" in cheat_code(exercise)
+
+
+def test_every_exercise_shows_an_example_that_is_not_the_test():
     """The example (what the statement shows) is data, so a cheat replaying it can be made."""
     from app.exercises.explain import drawn_fields
-    from tests.exercises.cheats import input_probe
+    from app.exercises.probes import PROBES
+    from tests.exercises.cheats import EXEMPT
 
     for exercise in book.exercises:
-        if input_probe(exercise) is None:
+        if exercise.slug in EXEMPT:
             continue
         assert exercise.example, f"{exercise.slug}: no example table"
-        for value in exercise.example.values():
-            for item in value if isinstance(value, list) else [value]:
-                shown = f"{item:.2f}" if isinstance(item, float) else str(item)
-                assert shown in exercise.statement or str(item) in exercise.statement, (
-                    f"{exercise.slug}: example value {item!r} is not in the statement"
-                )
-        drawn = [name for p in exercise.probes for name in drawn_fields(p)]
-        assert drawn, f"{exercise.slug}: its probes draw nothing at grading time"
+        for item in _leaves(exercise.example):
+            shown = f"{item:.2f}" if isinstance(item, float) else str(item)
+            assert shown in exercise.statement or str(item) in exercise.statement, (
+                f"{exercise.slug}: example value {item!r} is not in the statement"
+            )
+        if any(PROBES[p.kind].feeds for p in exercise.probes):
+            drawn = [name for p in exercise.probes for name in drawn_fields(p)]
+            assert drawn, f"{exercise.slug}: its probes draw nothing at grading time"
 
 
 def test_a_seed_replays_the_drawn_inputs_and_another_seed_changes_them():
