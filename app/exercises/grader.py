@@ -138,7 +138,13 @@ class Grader:
                 record(Result(_check_name(check), passed, detail))
             programs = _Programs(self.supervisor, exercise)
             probe_ctx = ProbeContext(
-                call, exercise.node, wait_check, random.Random(seed), seed, programs
+                call,
+                exercise.node,
+                wait_check,
+                random.Random(seed),
+                seed,
+                programs,
+                exercise.example,
             )
             for probe in exercise.probes:
                 record(run_probe(probe_ctx, probe))

@@ -129,3 +129,21 @@ def test_each_probe_kind_is_one_module_of_its_name_and_a_name_registers_once():
         register_probe("topic_feed", required="", words="again")(PROBES["topic_feed"].run)
     with pytest.raises(RuntimeError, match="already a check kind"):
         register_probe("topic_rate", required="", words="a check's name")(lambda ctx, p: None)
+
+
+def test_a_random_lifecycle_order_is_never_the_statements_example():
+    """Unchecked, 18 % of the drawn orders accepted exactly the example's transitions (the
+    invalid requests aside), and a node replaying the example passed those gradings."""
+    import random
+
+    from app.exercises.probes.lifecycle_sequence import lifecycle_walk
+
+    beacon = book.get("lifecycle_beacon")
+    example = beacon.example["transitions"]
+    probe = next(p for p in beacon.probes if p.kind == "lifecycle_sequence")
+    low, high = probe["walk"]
+    for seed in range(3000):
+        rng = random.Random(seed)
+        steps = lifecycle_walk(rng, rng.randint(low, high), probe.get("end", "active"), example)
+        accepted = [s["transition"] for s in steps if s.get("succeeds", True)]
+        assert accepted != example, f"seed {seed} draws the example's order"

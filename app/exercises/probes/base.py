@@ -68,6 +68,8 @@ class ProbeContext:
     rng: random.Random
     seed: int = 0  # what ``rng`` was seeded with: shown with the result, to replay a grading
     programs: Programs | None = None  # None where no program may be restarted
+    # The statement's example (exercise data): a probe may avoid drawing it as the input.
+    example: dict[str, Any] = field(default_factory=dict)
 
 
 def expected_value(expression: str, names: dict[str, Any]) -> Any:
