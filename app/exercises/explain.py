@@ -13,7 +13,7 @@ from typing import Any
 
 from app.exercises.model import Exercise
 from app.exercises.probes import PROBES
-from app.exercises.probes.base import is_range, range_text
+from app.exercises.probes.base import is_drawn, range_text
 from app.lessons.kinds import CHECKS
 from app.lessons.schema import Spec
 
@@ -25,7 +25,7 @@ HOW_INPUTS_ARE_DRAWN = (
 
 
 def _field_text(value: Any) -> str:
-    if is_range(value):
+    if is_drawn(value):
         return range_text(value)
     if isinstance(value, dict):
         return "{" + ", ".join(f"{k}: {_field_text(v)}" for k, v in value.items()) + "}"
@@ -45,7 +45,7 @@ def drawn_fields(spec: Spec) -> list[str]:
     found: list[str] = []
 
     def walk(value: Any, path: str) -> None:
-        if is_range(value):
+        if is_drawn(value):
             found.append(path)
         elif isinstance(value, dict):
             for key, inner in value.items():

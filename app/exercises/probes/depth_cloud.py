@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from app.exercises.probes.base import ProbeContext, register_probe
+from app.exercises.probes.base import ProbeContext, draw, register_probe
 from app.exercises.probes.topics import SEND_QOS, exchange, fmt, listen, wait_subscribed
 from app.exercises.report import Result
 from app.lessons.schema import Spec
@@ -18,16 +18,18 @@ DEPTH_SIZE = (160, 120)  # width, height
 DEPTH_FRAME = "depth_camera_optical_frame"
 
 
-def _depth_scene(rng: np.random.Generator) -> np.ndarray:
+def _depth_scene(
+    rng: np.random.Generator, wall: float, box_depth: float, zero_columns: int, nan_share: float
+) -> np.ndarray:
     """A 32FC1 depth image in metres: a slanted wall, a box, and pixels without a reading."""
     width, height = DEPTH_SIZE
     v, u = np.mgrid[0:height, 0:width]
-    depth = 2.0 + 0.8 * v / height + 0.3 * u / width  # a wall, tilted
+    depth = wall + 0.8 * v / height + 0.3 * u / width  # a wall, tilted
     left, top = int(rng.integers(20, 90)), int(rng.integers(15, 60))
     box = (u >= left) & (u < left + 45) & (v >= top) & (v < top + 40)
-    depth[box] = round(float(rng.uniform(0.9, 1.4)), 3)
-    depth[:, : int(rng.integers(4, 12))] = 0.0  # too close to measure: 0
-    depth[rng.random((height, width)) < 0.03] = np.nan  # no echo: NaN
+    depth[box] = box_depth
+    depth[:, :zero_columns] = 0.0  # too close to measure: 0
+    depth[rng.random((height, width)) < nan_share] = np.nan  # no echo: NaN
     return depth.astype(np.float32)
 
 
@@ -140,10 +142,18 @@ def _cloud_verdict(cloud: Any, depth: np.ndarray, p: Spec, index: int) -> str:
 @register_probe(
     "depth_cloud",
     required="publish output fx fy cx cy",
-    optional="images tolerance",
+    optional="tolerance",
+    defaults={
+        "images": 2,
+        "wall_depth": [1.6, 2.6],
+        "box_depth": [0.9, 1.4],
+        "zero_columns": [4, 11],
+        "nan_share": 0.03,
+    },
     words="sends depth images (some pixels without a reading); each answer must be a point "
     "cloud of exactly the valid pixels, back-projected with the camera's fx, fy, cx, cy",
-    draws="random depth scenes (a box at 0.9-1.4 m, invalid pixels)",
+    draws="random depth scenes: a tilted wall (wall_depth), a box at a random place "
+    "(box_depth), a strip of zeros (zero_columns wide) and scattered NaN (nan_share)",
 )
 def run(ctx: ProbeContext, p: Spec) -> Result:
     """Send depth images; expect a PointCloud2 of the valid pixels, back-projected."""
@@ -162,8 +172,14 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
         if why:
             return Result(name, False, why)
         sizes = []
-        for index in range(1, p.get("images", 2) + 1):
-            depth = _depth_scene(rng)
+        for index in range(1, int(p["images"]) + 1):
+            depth = _depth_scene(
+                rng,
+                float(draw(ctx.rng, p["wall_depth"])),
+                float(draw(ctx.rng, p["box_depth"])),
+                int(draw(ctx.rng, p["zero_columns"])),
+                float(p["nan_share"]),
+            )
             msg = array_to_image(depth, "32FC1")
             msg.header.frame_id = DEPTH_FRAME
             cloud = exchange(ctx, publisher, monitor, msg, index)

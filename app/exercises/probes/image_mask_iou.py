@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from app.exercises.probes.base import ProbeContext, register_probe
+from app.exercises.probes.base import ProbeContext, draw, register_probe
 from app.exercises.probes.topics import SEND_QOS, exchange, listen, wait_subscribed
 from app.exercises.report import Result
 from app.lessons.schema import Spec
@@ -26,15 +26,21 @@ OTHER_COLOURS = (
     (200, 200, 40),  # cyan
     (190, 40, 190),  # magenta
 )
-IMAGE_SIZES = ((320, 240), (320, 240), (256, 192))  # width, height
 NOISE = 4  # +- grey levels on every channel
 
 
 class Scene:
     """A synthetic bgr8 image and what is where in it."""
 
-    def __init__(self, width: int, height: int, rng: np.random.Generator) -> None:
+    def __init__(
+        self,
+        width: int,
+        height: int,
+        rng: np.random.Generator,
+        shape_px: tuple[int, int] = (35, 70),
+    ) -> None:
         self.rng = rng
+        self.shape_px = shape_px
         rows = np.linspace(0.0, 1.0, height)[:, None, None]
         base = np.array(rng.choice([(95, 95, 95), (120, 90, 60), (70, 110, 80)]), float)
         self.pixels = base + (rows - 0.5) * 60.0 + np.zeros((height, width, 3))
@@ -57,9 +63,9 @@ class Scene:
         self.image = np.clip(self.pixels + noise, 0, 255).astype(np.uint8)
 
     def shape(self) -> np.ndarray:
-        """A random circle or rectangle, 35 to 70 pixels across, inside the image."""
+        """A random circle or rectangle, ``shape_px`` pixels across, inside the image."""
         height, width = self.red.shape
-        size = int(self.rng.integers(35, 71))
+        size = int(self.rng.integers(self.shape_px[0], self.shape_px[1] + 1))
         left = int(self.rng.integers(0, width - size))
         top = int(self.rng.integers(0, height - size))
         v, u = np.mgrid[0:height, 0:width]
@@ -116,9 +122,11 @@ def _mask_verdict(scene: Scene, mask: np.ndarray, index: int, min_iou: float) ->
     "image_mask_iou",
     required="publish output",
     optional="min_iou",
+    defaults={"images": 3, "width": [240, 360], "height": [180, 270], "shape_px": [35, 70]},
     words="sends synthetic camera images with red shapes; each answer must be a mono8 mask "
     "whose overlap (IoU) with the red pixels is high enough",
-    draws="random images (background, two other colours, red shapes 35-70 px)",
+    draws="random images of random size (width, height): a shaded background, two other "
+    "colours, a blue shape and two red ones (shape_px across)",
 )
 def run(ctx: ProbeContext, p: Spec) -> Result:
     """Send synthetic bgr8 images with red shapes; expect mono8 masks of the red pixels."""
@@ -138,8 +146,14 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
         if why:
             return Result(name, False, why)
         scores = []
-        for index, (width, height) in enumerate(IMAGE_SIZES, start=1):
-            scene = Scene(width, height, rng)
+        low, high = (int(v) for v in p["shape_px"])
+        if low < 4 or high < low:
+            raise ValueError(f"shape_px must be [low, high], 4 <= low <= high: {p['shape_px']}")
+        for index in range(1, int(p["images"]) + 1):
+            width, height = int(draw(ctx.rng, p["width"])), int(draw(ctx.rng, p["height"]))
+            if min(width, height) <= high:
+                raise ValueError(f"an image of {width}x{height} cannot hold shapes of {high} px")
+            scene = Scene(width, height, rng, (low, high))
             msg = array_to_image(scene.image, "bgr8")
             msg.header.frame_id = "camera"
             answer = exchange(ctx, publisher, monitor, msg, index)

@@ -41,7 +41,8 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
         monitor = TopicMonitor(ctx.call.node, p["topic"], import_type(p["type"], "msg"), qos=10)
     done: list[str] = []
     if "walk" in p.fields:
-        steps = lifecycle_walk(ctx.rng, int(draw(ctx.rng, p["walk"])), p.get("end", "active"))
+        length, end = int(draw(ctx.rng, p["walk"])), p.get("end", "active")
+        steps = lifecycle_walk(ctx.rng, length, end, avoid=ctx.example.get("transitions"))
     elif "steps" in p.fields:
         steps = p["steps"]
     else:
@@ -93,11 +94,15 @@ def _path(start: str, end: str) -> list[tuple[str, str]]:
     return paths[end]
 
 
-def lifecycle_walk(rng: random.Random, length: int, end: str = "active") -> list[dict[str, Any]]:
+def lifecycle_walk(
+    rng: random.Random, length: int, end: str = "active", avoid: list[str] | None = None
+) -> list[dict[str, Any]]:
     """A random order of lifecycle requests from unconfigured, invalid ones among them.
 
     Every walk has at least two invalid requests, reaches active, has a
-    cleanup later followed by a configure, and ends in ``end``.
+    cleanup later followed by a configure, and ends in ``end``. Its accepted
+    transitions are never ``avoid`` (the statement's example order): a node
+    that replays the example must not pass by luck.
     """
     if end not in _VALID_TRANSITIONS:
         raise ValueError(f"end must be one of {sorted(_VALID_TRANSITIONS)}, not {end!r}")
@@ -117,7 +122,8 @@ def lifecycle_walk(rng: random.Random, length: int, end: str = "active") -> list
         labels = [s["transition"] for s in steps if s.get("succeeds", True)]
         refused = sum(not s.get("succeeds", True) for s in steps)
         cleaned = "cleanup" in labels and "configure" in labels[labels.index("cleanup") :]
-        if refused >= 2 and cleaned and any(s["state"] == "active" for s in steps):
+        shown = avoid is not None and labels == list(avoid)
+        if refused >= 2 and cleaned and any(s["state"] == "active" for s in steps) and not shown:
             return steps
     raise ValueError(f"no lifecycle walk of {length} steps meets the rules; use at least 6")
 

@@ -6,6 +6,7 @@ from app.exercises.probes.base import (
     ProbeContext,
     draw,
     expected_value,
+    fill_template,
     register_probe,
     without_kind,
 )
@@ -21,8 +22,9 @@ RATE_JUDGED_SEC = 4.0  # a rate that follows a drawn value is judged on this lon
     "param_set",
     required="name value accept",
     optional="node reason_contains then within",
-    words="sets a parameter (to a random value where a range is given); the node must accept "
-    "it and show its effect, or refuse it with a reason",
+    words="sets a parameter (to a random value where a range or a list of words is given); "
+    "the node must accept it and show its effect (a check, which may name the value as "
+    "{value}), or refuse it with a reason",
 )
 def run(ctx: ProbeContext, p: Spec) -> Result:
     target, pname, value = p.get("node", ctx.learner_node), p["name"], draw(ctx.rng, p["value"])
@@ -47,7 +49,11 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
     then = p.get("then")
     if then is None:
         return Result(name, True, f"{target} accepted {pname}={value!r}")
-    check = without_kind(then)
+    # "{value}" in a text of the check is the value set ("I heard: {value} from").
+    check = {
+        k: fill_template(v, {"value": value}) if isinstance(v, str) and k != "expect_hz" else v
+        for k, v in without_kind(then).items()
+    }
     if "expect_hz" in check:
         # A rate that follows the drawn value: the window is derived from it.
         hz = float(expected_value(check.pop("expect_hz"), {"value": value}))

@@ -14,6 +14,7 @@ from app.lessons.schema import Spec
 
 @register_probe(
     "publisher_count",
+    feeds=False,
     required="topic count",
     optional="node after within",
     words="counts the node's publishers on the topic (e.g. one, not two, after a cleanup "

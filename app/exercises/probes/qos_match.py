@@ -19,6 +19,7 @@ GRAPH_WAIT_SEC = 3.0  # a fresh subscription needs a moment to show on the graph
 
 @register_probe(
     "qos_match",
+    feeds=False,
     required="topic",
     optional="node",
     words="the node's subscription on the topic must be compatible with the QoS every "

@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 import time
 
-from app.exercises.probes.base import ProbeContext, register_probe
+from app.exercises.probes.base import ProbeContext, draw, register_probe
 from app.exercises.probes.tf import FrameTap, Seen, angle_between
 from app.exercises.report import Result
 from app.lessons.schema import Spec
@@ -34,19 +34,28 @@ def _late_joiner_frames(ctx: ProbeContext, within: float, child: str) -> dict[st
     "static_frame",
     required="",
     optional="node settle within",
+    defaults={
+        "child_frames": list(CHILD_WORDS),
+        "child_number": [10, 99],
+        "parent_frames": list(PARENT_WORDS),
+        "x": [-2.0, 2.0],
+        "y": [-2.0, 2.0],
+        "z": [-2.0, 2.0],
+        "yaw": [-3.0, 3.0],
+    },
     words="sets the node's frame parameters to random names and offsets; a subscriber that "
     "joins /tf_static late must then get that frame",
-    draws="random frame names and offsets (x, y, z in [-2, 2] m, yaw in [-3, 3] rad)",
+    draws="a random frame: parent from parent_frames, child from child_frames with a "
+    "number (child_number), offsets x, y, z and heading yaw",
 )
 def run(ctx: ProbeContext, p: Spec) -> Result:
     """Set the node's frame parameters to drawn values; a late /tf_static joiner must get it."""
     target = p.get("node", ctx.learner_node)
-    child = f"{ctx.rng.choice(CHILD_WORDS)}_{ctx.rng.randint(10, 99)}"
-    parent = ctx.rng.choice(PARENT_WORDS)
+    child = f"{draw(ctx.rng, p['child_frames'])}_{draw(ctx.rng, p['child_number'])}"
+    parent = str(draw(ctx.rng, p["parent_frames"]))
     values: dict[str, float | str] = {"child_frame": child, "parent_frame": parent}
-    for axis in ("x", "y", "z"):
-        values[axis] = round(ctx.rng.uniform(-2.0, 2.0), 3)
-    values["yaw"] = round(ctx.rng.uniform(-3.0, 3.0), 3)
+    for axis in ("x", "y", "z", "yaw"):
+        values[axis] = float(draw(ctx.rng, p[axis]))
     name = f"static frame {parent} -> {child}"
     asked = ", ".join(f"{k}={v!r}" for k, v in values.items())
     dynamic = FrameTap(ctx)  # hears /tf too: a frame sent there is a likely mistake

@@ -4,38 +4,19 @@ subscriber that joins late and asks for transient-local history.
 
 from __future__ import annotations
 
-from typing import Any
-
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
-from app.exercises.probes.base import ProbeContext, register_probe, same
-from app.exercises.probes.topics import publishers_note, with_note
+from app.exercises.probes.base import ProbeContext, register_probe
+from app.exercises.probes.topics import difference, publishers_note, with_note
 from app.exercises.report import Result
 from app.lessons.schema import Spec
 from app.ros.convert import import_type, to_plain
 from app.ros.monitor import TopicMonitor
 
 
-def _difference(actual: Any, expected: Any, tolerance: float, path: str) -> str:
-    """'' when ``actual`` has every expected field (deeply), else the first that differs."""
-    if isinstance(expected, dict):
-        if not isinstance(actual, dict):
-            return f"{path} = {actual!r}, expected {expected!r}"
-        for key, want in expected.items():
-            where = f"{path}.{key}" if path else key
-            if key not in actual:
-                return f"the message has no field {where}"
-            found = _difference(actual[key], want, tolerance, where)
-            if found:
-                return found
-        return ""
-    if same(actual, expected, tolerance):
-        return ""
-    return f"{path} = {actual!r}, expected {expected!r}"
-
-
 @register_probe(
     "topic_message",
+    feeds=False,
     required="topic type expect",
     optional="within delay durability tolerance",
     words="subscribes (late, asking for the kept history, when durability is transient_local) "
@@ -74,8 +55,8 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
         note = publishers_note(node, topic, type_text, durability)
         return Result(name, False, with_note(text, note))
     got = to_plain(newest[1])
-    difference = _difference(got, p["expect"], p.get("tolerance", 1e-6), "")
-    if difference:
-        return Result(name, False, f"in the message on {topic}: {difference}")
+    wrong = difference(got, p["expect"], p.get("tolerance", 1e-6), "")
+    if wrong:
+        return Result(name, False, f"in the message on {topic}: {wrong}")
     fields = ", ".join(sorted(p["expect"]))
     return Result(name, True, f"{topic} carried the expected {fields}")

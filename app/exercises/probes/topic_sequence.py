@@ -12,6 +12,7 @@ from app.ros.monitor import TopicMonitor
 
 @register_probe(
     "topic_sequence",
+    feeds=False,
     required="topic type field expect",
     optional="count within tolerance",
     words="reads a random number of consecutive messages; each one's field must follow "

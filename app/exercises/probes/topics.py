@@ -10,7 +10,7 @@ from typing import Any
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile
 
-from app.exercises.probes.base import ProbeContext
+from app.exercises.probes.base import ProbeContext, same
 from app.ros.monitor import TopicMonitor
 from app.ros.names import node_fqn
 from app.ros.qos import matching_qos
@@ -103,3 +103,21 @@ def publishers_note(node: Node, topic: str, type_text: str, durability: str = ""
 
 def with_note(text: str, note: str) -> str:
     return f"{text} ({note})" if note else text
+
+
+def difference(actual: Any, expected: Any, tolerance: float, path: str) -> str:
+    """'' when ``actual`` has every expected field (deeply), else the first that differs."""
+    if isinstance(expected, dict):
+        if not isinstance(actual, dict):
+            return f"{path} = {actual!r}, expected {expected!r}"
+        for key, want in expected.items():
+            where = f"{path}.{key}" if path else key
+            if key not in actual:
+                return f"the message has no field {where}"
+            found = difference(actual[key], want, tolerance, where)
+            if found:
+                return found
+        return ""
+    if same(actual, expected, tolerance):
+        return ""
+    return f"{path} = {actual!r}, expected {expected!r}"

@@ -9,7 +9,7 @@ import time
 
 from turtlesim.msg import Pose
 
-from app.exercises.probes.base import ProbeContext, register_probe
+from app.exercises.probes.base import ProbeContext, draw, register_probe
 from app.exercises.probes.tf import WORLD_MAX, WORLD_MIN, teleport
 from app.exercises.report import Result
 from app.lessons.schema import Spec
@@ -28,9 +28,16 @@ def _distance(leader: TopicMonitor, follower: TopicMonitor) -> float | None:
     "turtle_follow",
     required="",
     optional="leader follower moves bound within spawn_within",
+    defaults={
+        "x": [WORLD_MIN, WORLD_MAX],
+        "y": [WORLD_MIN, WORLD_MAX],
+        "theta": [-3.0, 3.0],
+        "min_jump": 3.0,
+    },
     words="puts the leader turtle at random places, one after another; each time the "
     "follower must come within the bound of it",
-    draws="a random path for the leader (places in [1.5, 9.5] m, 3 m or more away)",
+    draws="a random path for the leader (places x, y, headings theta; each at least "
+    "min_jump from the follower)",
 )
 def run(ctx: ProbeContext, p: Spec) -> Result:
     """Put the leader at random places; each time the follower must come within ``bound``."""
@@ -53,13 +60,15 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
             newest = follower.message()
             assert newest is not None
             fx, fy = newest[1].x, newest[1].y
-            while True:  # a place at least 3 m from the follower: a real chase
-                x = round(ctx.rng.uniform(WORLD_MIN, WORLD_MAX), 2)
-                y = round(ctx.rng.uniform(WORLD_MIN, WORLD_MAX), 2)
-                if math.hypot(x - fx, y - fy) >= 3.0:
+            for _ in range(1000):  # a place at least min_jump from the follower: a real chase
+                x = round(float(draw(ctx.rng, p["x"])), 2)
+                y = round(float(draw(ctx.rng, p["y"])), 2)
+                if math.hypot(x - fx, y - fy) >= float(p["min_jump"]):
                     break
+            else:
+                raise ValueError(f"no place in x, y is {p['min_jump']} m from the follower")
             try:
-                teleport(ctx, lead, x, y, round(ctx.rng.uniform(-3.0, 3.0), 2))
+                teleport(ctx, lead, x, y, round(float(draw(ctx.rng, p["theta"])), 2))
             except Ros2Error as exc:
                 return Result(name, False, f"could not teleport {lead}: {exc}")
             start = time.monotonic()

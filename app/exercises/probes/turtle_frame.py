@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 import time
 
-from app.exercises.probes.base import ProbeContext, register_probe
+from app.exercises.probes.base import ProbeContext, draw, register_probe
 from app.exercises.probes.tf import (
     WORLD_MAX,
     WORLD_MIN,
@@ -39,11 +39,12 @@ def _frame_mistake(seen: Seen, x: float, y: float, theta: float, tol: float) -> 
 
 @register_probe(
     "turtle_frame",
-    optional="turtle parent poses tolerance within",
     required="",
+    optional="turtle parent poses tolerance within",
+    defaults={"x": [WORLD_MIN, WORLD_MAX], "y": [WORLD_MIN, WORLD_MAX], "theta": [-3.0, 3.0]},
     words="teleports the turtle to random poses; after each, /tf must carry parent -> turtle "
     "at that pose (position and heading)",
-    draws="random turtle poses (x, y in [1.5, 9.5] m, theta in [-3, 3] rad)",
+    draws="random turtle poses (x, y, theta)",
 )
 def run(ctx: ProbeContext, p: Spec) -> Result:
     """Teleport the turtle to random poses; /tf must carry parent -> turtle at each pose."""
@@ -54,9 +55,7 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
     tried: list[str] = []
     try:
         for _ in range(count):
-            x = round(ctx.rng.uniform(WORLD_MIN, WORLD_MAX), 2)
-            y = round(ctx.rng.uniform(WORLD_MIN, WORLD_MAX), 2)
-            theta = round(ctx.rng.uniform(-3.0, 3.0), 2)
+            x, y, theta = (round(float(draw(ctx.rng, p[k])), 2) for k in ("x", "y", "theta"))
             asked = time.monotonic()
             try:
                 teleport(ctx, turtle, x, y, theta)
