@@ -333,8 +333,8 @@ ROWS += (
         "sim_world",
         "sim_rtf",
         "x",
-        "≥ 1.0 (0.98: /clock timing)",
-        lambda v: v >= 0.98,
+        "≥ 1.0 (read to two decimals)",
+        lambda v: round(v, 2) >= 1.0,
     ),
     (
         "MuJoCo world: camera's published rate / its 15 Hz target",

@@ -15,6 +15,7 @@ import textwrap
 from typing import Any
 
 from app.exercises.model import Exercise
+from tests.exercises.cheats_sim import GENERATORS as SIM_GENERATORS
 
 _MAIN = """
 def main():
@@ -539,6 +540,7 @@ GENERATORS = {
     "turtle_follow": _turtle_follow,
     "joint_motion": _joint_motion,
     "depth_cloud": _depth_cloud,
+    **SIM_GENERATORS,  # the "Drive a robot" unit's (they replay the example drive)
 }
 
 # Exercises for which no cheat can be generated, each with the reason (none today).

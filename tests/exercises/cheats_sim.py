@@ -8,11 +8,7 @@ random starts and goals must make them fail.
 
 Each generator returns a node body (a ``class Cheat(Node)`` named as the
 exercise's node), in the form ``tests/exercises/cheats.py`` wraps with its
-imports and ``main``. To use them there::
-
-    from tests.exercises.cheats_sim import GENERATORS as SIM_GENERATORS
-
-    GENERATORS = {..., **SIM_GENERATORS}
+imports and ``main`` (its GENERATORS include these).
 """
 
 from __future__ import annotations
