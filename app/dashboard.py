@@ -41,9 +41,10 @@ from app.ros.runtime import RosRuntime
 from app.ros2cli.console_panel import ConsolePanel
 from app.stage.window import Stage
 from app.supervisor import Supervisor
-from app.ui import TAB_NAMES, MarkdownView, Panel
+from app.ui import GROUP_OF, TAB_NAMES, TOOL_GROUPS, MarkdownView, Panel
 from app.ui.loop import UiLoop
 from app.ui.page_links import PageLinks
+from app.ui.tab_opener import TabOpener
 
 log = logging.getLogger(__name__)
 
@@ -58,6 +59,10 @@ _ICONS = {
     "Parameters": viser.Icon.ADJUSTMENTS, "Console": viser.Icon.TERMINAL,
     "Services": viser.Icon.ARROWS_EXCHANGE, "Actions": viser.Icon.ROCKET,
     "Lifecycle": viser.Icon.PROGRESS, "Logs": viser.Icon.FILE_TEXT, "Bags": viser.Icon.DATABASE,
+}  # fmt: skip
+_GROUP_ICONS = {
+    "Learn": viser.Icon.SCHOOL, "Run": viser.Icon.PLAYER_PLAY, "Inspect": viser.Icon.ZOOM_IN,
+    "Interact": viser.Icon.HAND_CLICK, "See": viser.Icon.EYE, "Record": viser.Icon.PLAYER_RECORD,
 }  # fmt: skip
 
 
@@ -101,10 +106,10 @@ class Dashboard:
         self.server.scene.configure_default_lights(cast_shadow=False)
         self.server.scene.add_grid("/grid", width=4.0, height=4.0, cell_size=0.25)
         self.server.scene.add_frame("/world", axes_length=0.3, axes_radius=0.01)
+        # One line: where am I (the domain learners compare when two dashboards share a room).
         gui.add_markdown(
-            "## ROS 2 Classroom\n"
-            f"Domain id **{os.environ.get('ROS_DOMAIN_ID', '0')}** · "
-            "this dashboard is the ROS node `/classroom_dashboard`."
+            f"**ROS 2 Classroom** · Domain id **{os.environ.get('ROS_DOMAIN_ID', '0')}** · "
+            "node `/classroom_dashboard`"
         )
         self.notice = MarkdownView(gui)  # in a classroom: the teacher's latest message
         # One window docked on the left: the lesson's code and the learner's own.
@@ -115,6 +120,10 @@ class Dashboard:
         self._rates = SharedRates(node)  # the stage and the Graph tab measure a topic once
         stage = Stage(gui, ui, node, side_window, self._rates.client(), self.page_links)
         stage.follow_window(self.server)
+        # The current step's title, buttons, checks and Back/Next: above the tools, so they
+        # stay in view whichever tool is open (the step's text is in Learn › Lessons).
+        step_card = gui.add_folder("This step")
+        opener = TabOpener(gui, {name: [GROUP_OF[name], name] for name in TAB_NAMES})
         builders: dict[str, Callable[[], Panel]] = {
             "Lessons": lambda: LessonsPanel(
                 gui,
@@ -125,6 +134,8 @@ class Dashboard:
                 side_window,
                 self._exercise_marks,
                 stage.show,
+                step_card=step_card,
+                open_tool=opener.open,
             ),
             "Exercise": lambda: ExercisePanel(
                 gui,
@@ -152,12 +163,17 @@ class Dashboard:
             "Logs": lambda: LogsPanel(gui, self.rosout),
             "Bags": lambda: BagsPanel(gui, ui, node),
         }
-        assert tuple(builders) == TAB_NAMES, "every tab lessons may name has a panel"
-        tabs = gui.add_tab_group()
-        panels: list[Panel] = []
-        for name in TAB_NAMES:
-            with tabs.add_tab(name, _ICONS[name]):
-                panels.append(builders[name]())
+        assert set(builders) == set(TAB_NAMES), "every tool lessons may name has a panel"
+        # Tools grouped as a learner thinks of them: a tab per group, a tab per tool inside.
+        groups = gui.add_tab_group()
+        built: dict[str, Panel] = {}
+        for group, names in TOOL_GROUPS.items():
+            with groups.add_tab(group, _GROUP_ICONS[group]):
+                tools = gui.add_tab_group()
+                for name in names:
+                    with tools.add_tab(name, _ICONS[name]):
+                        built[name] = builders[name]()
+        panels = [built[name] for name in TAB_NAMES]
         # A lesson's `console` buttons type their command into the Console tab.
         console = next(p for p in panels if isinstance(p, ConsolePanel))
         self.lessons.console = console.run_for_lesson

@@ -9,6 +9,7 @@ drawn in a window docked on the left; "code" shows the code window instead;
 from __future__ import annotations
 
 import html
+import json
 import time
 from collections.abc import Callable
 from typing import Any
@@ -25,6 +26,7 @@ from app.stage.graph_view import PER_ROW, STEP_X, StablePlaces, stage_legend, st
 from app.ui import MarkdownView, assign
 from app.ui.loop import UiLoop
 from app.ui.page_links import SINK, SINK_FRAME, PageLinks
+from app.ui.page_script import page_script
 
 PICTURE_PERIOD_SEC = 1.0
 MAX_PICKS = 300  # boxes that answer a click (a larger graph: the first ones)
@@ -35,8 +37,19 @@ CONTROL_WIDTH = 480
 CONTROL_PANEL_ROOM = CONTROL_WIDTH + 28  # and its margins
 MIN_WIDTH, MAX_WIDTH = 400, 3000  # up to the panel: no 3D scene peeks out between
 REFIT_PX = 24  # a smaller change of the window is not worth moving the stage
-SETTLE_SEC = 1.5  # after the stage changes, the browser's reports describe the old layout
-_DOCKED = ("graph", "turtlesim", "code")  # stages shown in a docked window
+# Runs in the page (app.ui.page_script): report the window's width now and after resizes.
+_REPORT_WIDTH = """
+const url = new URL(%s, parent.location.href).href;
+const report = () => fetch(url + '/' + Math.round(parent.innerWidth), {cache: 'no-store'})
+  .catch(() => {});
+let timer = 0;
+const onResize = () => { clearTimeout(timer); timer = setTimeout(report, 150); };
+if (parent.__stageWidthOff) parent.__stageWidthOff();
+parent.addEventListener('resize', onResize);
+parent.__stageWidthOff = () => parent.removeEventListener('resize', onResize);
+window.addEventListener('pagehide', () => parent.__stageWidthOff && parent.__stageWidthOff());
+report();
+"""
 RATE_CHANGE = 0.15  # a rate must move this much (share) before the dots are re-timed
 _TURTLESIM_NOTE = (
     "### Turtlesim\nTurtlesim's window is in the **Turtlesim** tab of the panel on the "
@@ -71,7 +84,7 @@ class Stage:
         self._ui = ui
         self._code_window = code_window
         self.width = STAGE_WIDTH
-        self._settled = 0.0
+        self._fitted = False
         self._rates: RateBoard | SharedRatesClient = rates or RateBoard(node)
         self._places = StablePlaces()
         self._shown_rates: dict[str, float] = {}
@@ -113,39 +126,29 @@ class Stage:
     def follow_window(self, server: viser.ViserServer) -> None:
         """Size the stage to the browser's window: all the room the control panel leaves.
 
-        Every camera message carries the canvas's width: the window minus the
-        docked windows, except the first one of a page, sent before the docks
-        are laid out, which is the whole window (seen: 1366, then 408 with a
-        954 px dock, at 1366x768).
+        The page reports its window's width through a page link when it loads
+        and after each resize (the camera messages' canvas width cannot tell:
+        it is the window minus whatever the docks were at that moment).
         """
-
-        def on_connect(client: viser.ClientHandle) -> None:
-            first = [True]
-
-            def on_camera(camera: viser.CameraHandle) -> None:
-                whole, first[0] = first[0], False
-                self._ui.post(lambda: self._fit(camera.image_width, whole))
-
-            client.camera.on_update(on_camera)
-
-        server.on_client_connect(on_connect)
         server.gui.main_panel.set_width(CONTROL_WIDTH)
-
-    def _fit(self, canvas: int, whole_window: bool) -> None:
-        if canvas <= 0:
+        if self._links is None:
             return
-        if whole_window:
-            window = canvas
-        elif time.monotonic() < self._settled:
-            return  # sent before our last change: it describes the old layout
-        else:
-            window = canvas + (self.width if self.current in _DOCKED else 0)
+        href = self._links.register_value("stage.window", self._on_window_width)
+        server.gui.add_html(page_script(_REPORT_WIDTH % json.dumps(href), "window width"))
+
+    def _on_window_width(self, value: str) -> None:
+        """The link's action (viser's asyncio thread): only checks and posts."""
+        if value.isdigit() and len(value) <= 5:
+            width = int(value)
+            self._ui.post(lambda: self._fit(width))
+
+    def _fit(self, window: int) -> None:
         wanted = max(MIN_WIDTH, min(MAX_WIDTH, window - CONTROL_PANEL_ROOM))
-        if abs(wanted - self.width) >= REFIT_PX:
+        if abs(wanted - self.width) >= REFIT_PX or not self._fitted:
+            self._fitted = True
             self.width = wanted
             self._window.set_width(wanted)
             self._code_window.set_width(wanted)
-            self._settled = time.monotonic() + SETTLE_SEC
             # Wider stage, more boxes a row (boxes already placed stay where they are).
             self._places.per_row = max(PER_ROW, (wanted - 40) // STEP_X)
             self._last_picture = 0.0
@@ -160,7 +163,6 @@ class Stage:
         self._graph_box.visible = stage == "graph"
         self._note.handle.visible = stage == "turtlesim"
         self._code_window.visible = stage == "code"
-        self._settled = time.monotonic() + SETTLE_SEC
         self._last_picture = 0.0  # draw at once
         if stage != "graph":
             self._rates.watch({})  # no subscriptions for a picture nobody sees

@@ -9,9 +9,15 @@ import pytest
 from playwright.sync_api import Page, expect
 from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
+from app.ui import GROUP_OF
+
 
 def open_tab(page: Page, name: str) -> None:
-    page.get_by_role("tab", name=name).click()
+    """Open a tool's tab as a learner does: its group's tab first (Inspect, then Echo)."""
+    group = GROUP_OF.get(name)
+    if group is not None:
+        page.get_by_role("tab", name=group, exact=True).click()
+    page.get_by_role("tab", name=name, exact=True).click()
 
 
 def choose(page: Page, label: str, option: str) -> None:
