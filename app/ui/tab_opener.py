@@ -6,7 +6,8 @@ itself, as a learner does with the keyboard: an Enter key event on a tab
 activates it. So the opener is an HTML widget whose content, each time the
 server changes it, runs a small page script (``app.ui.page_script``) that
 presses Enter on each named tab in turn (a tool's tab appears once its group
-is open), then scrolls the last one into view.
+is open), then scrolls the panel back to its top, where the step card and the
+tools' tabs are.
 
 A page that connects later replays the last content, so it opens the same
 tab: the one the lesson last pointed at.
@@ -25,13 +26,21 @@ _SCRIPT = """
 const names = %s;
 const start = Date.now();
 let i = 0;
+// The panel scrolled to its top (the step card, the tool's tabs under it), unless
+// that would hide the tab itself.
+const show = (tab) => {
+  for (let box = tab.parentElement; box; box = box.parentElement)
+    if (/(auto|scroll)/.test(parent.getComputedStyle(box).overflowY)) box.scrollTop = 0;
+  const r = tab.getBoundingClientRect();
+  if (r.bottom > parent.innerHeight || r.top < 0) tab.scrollIntoView({block: 'nearest'});
+};
 const tick = () => {
   const tabs = parent.document.querySelectorAll('[role=tab][data-dock-tab]');
   const tab = [...tabs].find((t) => t.title === names[i]);
   if (tab) {
     if (tab.getAttribute('aria-selected') !== 'true')
       tab.dispatchEvent(new parent.KeyboardEvent('keydown', {key: 'Enter', bubbles: true}));
-    if (++i === names.length) { tab.scrollIntoView({block: 'nearest'}); return; }
+    if (++i === names.length) { show(tab); return; }
   }
   if (Date.now() - start < %d) setTimeout(tick, 20);
 };

@@ -10,7 +10,7 @@ from playwright.sync_api import Page, expect
 
 from app.lessons.schema import load_course
 from app.stage import STAGES
-from tests.browser.helpers import choose, open_tab, start_node
+from tests.browser.helpers import choose, open_tab, out_of_view, start_node, step_controls
 from tests.conftest import ARTIFACTS
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -75,8 +75,10 @@ def test_every_lesson_puts_its_stage_on_and_the_learner_can_switch(browser, dash
         for lesson in load_course().lessons:
             choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
             _wait_stage(page, lesson.stage)
-            # The step's controls stay in view: Next is on screen without scrolling the page.
-            expect(page.get_by_role("button", name="Next", exact=True)).to_be_visible()
+            # Every control of the step is in view without scrolling: title, buttons,
+            # answers, checks, Back and Next.
+            hidden = out_of_view(page, step_controls(page, lesson, 0))
+            assert not hidden, f"{lesson.id} at {size}: " + "; ".join(hidden)
         for name, label in STAGES.items():  # the learner's own choice
             choose(page, "On stage", label)
             _wait_stage(page, name)
