@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from app.lessons.schema import LESSONS_DIR, LessonError, load_course, load_lesson
-from app.panels.graph_svg import Edge, Vertex, graph_picture
+from app.panels.graph_svg import Edge, Vertex, graph_picture, topics_to_measure
 from app.ros.graph import NodeEndpoints
 from app.stage import DEFAULT_STAGE, STAGES
 from app.stage.graph_view import MAX_DOTS, StablePlaces, dot_timing, stage_svg
@@ -94,6 +94,31 @@ def test_hidden_nodes_and_quiet_topics_are_folded_unless_asked():
     assert names == {"/talker", "/chatter"}
     names = {v.name for v in graph_picture(nodes, show_quiet=True)[0]}
     assert names == {"/talker", "/chatter", "/rosout", "/_ros2cli_daemon"}
+
+
+def test_hidden_topics_and_services_are_folded_and_not_measured_unless_asked():
+    """turtlesim's pen trails and teleop's key topic are plumbing: no box, no rate counted."""
+    sim = _endpoints("/turtlesim", publishes=["/turtle1/pose", "/turtlesim/_trails"])
+    sim = NodeEndpoints(
+        **{
+            **sim.__dict__,
+            "servers": {"/spawn": "turtlesim/srv/Spawn", "/turtlesim/_snap": "x/srv/S"},
+        }
+    )
+    teleop = _endpoints("/teleop_turtle", publishes=["/turtle1/cmd_vel", "/teleop_turtle/_key"])
+    follower = _endpoints("/follower", subscribes=["/turtlesim/_trails"])
+    nodes = [sim, teleop, follower]
+    picture = graph_picture(nodes)
+    names = {v.name for v in picture[0]}
+    assert "/turtlesim/_trails" not in names and "/teleop_turtle/_key" not in names
+    assert "/turtlesim/_snap" not in names and "/spawn" in names
+    assert {"/turtle1/pose", "/turtle1/cmd_vel", "/follower"} <= names
+    assert set(topics_to_measure(picture, nodes)) == {"/turtle1/pose", "/turtle1/cmd_vel"}
+    shown = graph_picture(nodes, show_quiet=True)
+    assert {"/turtlesim/_trails", "/teleop_turtle/_key", "/turtlesim/_snap"} <= {
+        v.name for v in shown[0]
+    }
+    assert "/turtlesim/_trails" in topics_to_measure(shown, nodes)
 
 
 def test_dots_follow_the_rate_and_are_capped():
