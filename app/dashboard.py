@@ -14,6 +14,7 @@ from collections.abc import Callable
 
 import viser
 
+from app.catalog import UnknownNodeError, lookup
 from app.exercises.editor_server import EditorHub
 from app.exercises.grader import Grader
 from app.exercises.model import load_exercises
@@ -40,7 +41,7 @@ from app.ros.rosout import RosoutLog
 from app.ros.runtime import RosRuntime
 from app.ros2cli.console_panel import ConsolePanel
 from app.stage.window import Stage
-from app.supervisor import Supervisor
+from app.supervisor import NodeState, Supervisor
 from app.ui import GROUP_OF, TAB_NAMES, TOOL_GROUPS, MarkdownView, Panel
 from app.ui.loop import UiLoop
 from app.ui.page_links import PageLinks
@@ -118,7 +119,15 @@ class Dashboard:
         side_window.set_width(560)
         # The stage: what the current step is about (the live graph, ...), chosen by the lesson.
         self._rates = SharedRates(node)  # the stage and the Graph tab measure a topic once
-        stage = Stage(gui, ui, node, side_window, self._rates.client(), self.page_links)
+        stage = Stage(
+            gui,
+            ui,
+            node,
+            side_window,
+            self._rates.client(),
+            self.page_links,
+            starting=self._starting_nodes,
+        )
         stage.follow_window(self.server)
         # The current step's title, buttons, checks and Back/Next: above the tools, so they
         # stay in view whichever tool is open (the step's text is in Learn › Lessons).
@@ -178,6 +187,17 @@ class Dashboard:
         console = next(p for p in panels if isinstance(p, ConsolePanel))
         self.lessons.console = console.run_for_lesson
         return [stage, *panels]
+
+    def _starting_nodes(self) -> list[str]:
+        """Catalog nodes whose process runs but that have not joined the ROS graph yet."""
+        names = []
+        for name, status in self.supervisor.statuses().items():
+            if status.state is NodeState.STARTING:
+                try:
+                    names.append(lookup(name).node_name)
+                except UnknownNodeError:  # a learner's own program: drawn once it joins
+                    pass
+        return names
 
     def _exercise_marks(self, lesson_id: str) -> str:
         """The outline's exercise column: ✓ for each exercise passed, ○ for each open."""

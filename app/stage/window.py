@@ -18,11 +18,20 @@ import viser
 from rclpy.node import Node
 
 from app.panels.graph_panel import SharedRatesClient
-from app.panels.graph_svg import Vertex, graph_picture, topics_to_measure
+from app.panels.graph_svg import Edge, Vertex, graph_picture, topics_to_measure
 from app.ros.graph import GraphSnapshot, NodeEndpoints, node_endpoints
 from app.ros.rates import RateBoard, rate_text
 from app.stage import DEFAULT_STAGE, STAGES
-from app.stage.graph_view import PER_ROW, STEP_X, StablePlaces, stage_legend, stage_svg
+from app.stage.graph_view import (
+    PER_ROW,
+    STARTING,
+    STEP_X,
+    PulseView,
+    StablePlaces,
+    stage_legend,
+    stage_svg,
+)
+from app.stage.pulses import CallWatch, Pulse, caller_of
 from app.ui import MarkdownView, assign
 from app.ui.loop import UiLoop
 from app.ui.page_links import SINK, SINK_FRAME, PageLinks
@@ -72,8 +81,12 @@ class Stage:
         code_window: Any,
         rates: SharedRatesClient | None = None,
         links: PageLinks | None = None,
+        starting: Callable[[], list[str]] = lambda: [],
     ) -> None:
+        """``starting()``: nodes whose process was just started and that the ROS graph does
+        not list yet (drawn at once, marked 'starting…', so a click on Start shows)."""
         self._node = node
+        self._starting = starting
         self._links = links
         self._picked: list[Vertex] = []  # the boxes in the picture, in link order
         self._inspected = ""  # Vertex.key the learner clicked
@@ -87,6 +100,10 @@ class Stage:
         self._fitted = False
         self._rates: RateBoard | SharedRatesClient = rates or RateBoard(node)
         self._places = StablePlaces()
+        # Calls and goals as pulses: an event wakes the UI loop, which draws it at once.
+        self._calls = CallWatch(node, on_event=lambda: ui.post(lambda: None))
+        self._drawn_pulses: set[tuple[str, str, float]] = set()
+        self._callers: dict[tuple[str, str], str] = {}
         self._shown_rates: dict[str, float] = {}
         self._last_picture = 0.0
         self._drawn_nodes: tuple[str, ...] = ()
@@ -166,16 +183,21 @@ class Stage:
         self._last_picture = 0.0  # draw at once
         if stage != "graph":
             self._rates.watch({})  # no subscriptions for a picture nobody sees
+            self._calls.watch({}, {})
 
     def refresh(self, graph: GraphSnapshot) -> None:
         if self.current != "graph":
             return
         now = time.monotonic()
-        joined_or_left = graph.nodes != self._drawn_nodes  # drawn at once, not on the next tick
-        if now - self._last_picture < PICTURE_PERIOD_SEC and not joined_or_left:
+        starting = tuple(n for n in self._starting() if n not in graph.nodes)
+        # A node that joined, left or was just started is drawn at once, not on the next tick.
+        joined_or_left = (*graph.nodes, *starting) != self._drawn_nodes
+        pulses = self._calls.recent(now)
+        fresh = {(p.kind, p.name, p.shown_at) for p in pulses} - self._drawn_pulses
+        if now - self._last_picture < PICTURE_PERIOD_SEC and not (joined_or_left or fresh):
             return
         self._last_picture = now
-        self._drawn_nodes = tuple(graph.nodes)
+        self._drawn_nodes = (*graph.nodes, *starting)
         own = self._node.get_fully_qualified_name()
         endpoints = [
             found
@@ -188,17 +210,40 @@ class Stage:
         rates = {topic: self._steady_rate(topic) for topic in self._rates.watched()}
         labels = {topic: rate_text(rate) for topic, rate in rates.items()}
         vertices, edges = graph_picture(endpoints, labels, show_quiet=quiet)
+        vertices += [Vertex("node", name, STARTING) for name in starting]
         placed = self._places.place(vertices, edges)
         self._picked = [p.vertex for p in placed]
         self._endpoints = endpoints
+        self._calls.watch(*_calls_to_watch(vertices, endpoints))
+        self._drawn_pulses = {(p.kind, p.name, p.shown_at) for p in pulses}
+        views = [
+            PulseView(p.kind, p.name, self._caller(p, edges), now - p.shown_at) for p in pulses
+        ]
         link = self._link if self._links is not None else None
-        svg = stage_svg(placed, edges, rates, link)
+        svg = stage_svg(placed, edges, rates, link, views, frozenset(starting))
         if self._links is not None:
             svg = SINK_FRAME + svg
         if svg != self._svg:
             self._svg = svg
             self._picture.content = svg
         self._inspector.show(self._inspection(labels))
+
+    def _caller(self, pulse: Pulse, edges: list[Edge]) -> str:
+        """The node drawn as the one who called or sent the goal; '' when unknown."""
+        if pulse.caller_id:  # a service event names its caller
+            key = (pulse.name, pulse.caller_id)
+            if key not in self._callers:
+                if len(self._callers) > MAX_PICKS:
+                    self._callers.clear()
+                self._callers[key] = caller_of(self._node, pulse.name, pulse.caller_id)
+            return self._callers[key]
+        # An action's goal does not: the one client on the graph, unless this dashboard
+        # (not drawn) may have sent it from its Actions tool.
+        users = {e.source for e in edges if e.dashed and e.target == f"action:{pulse.name}"}
+        own = node_endpoints(self._node, self._node.get_fully_qualified_name())
+        if len(users) != 1 or (own is not None and pulse.name in own.action_clients):
+            return ""
+        return next(iter(users)).partition(":")[2]
 
     def _picker(self, index: int) -> Callable[[], None]:
         """The link's action: runs in viser's asyncio thread, so it only posts."""
@@ -224,6 +269,11 @@ class Stage:
             return "_Click a box in the graph to see what it offers and uses._"
         if kind == "node":
             found = next((e for e in self._endpoints if e.name == name), None)
+            if found is None and name in self._drawn_nodes:
+                return (
+                    f"**Node `{name}`** is starting: its process runs, and the ROS graph "
+                    "lists it once discovery has found it (usually within a second or two)."
+                )
             if found is None:
                 return f"**{name}** has left the graph."
             parts = [f"**Node `{name}`** · `ros2 node info {name}`"]
@@ -271,3 +321,22 @@ class Stage:
 
     def close(self) -> None:
         self._rates.close()
+        self._calls.close()
+
+
+def _calls_to_watch(
+    vertices: list[Vertex], endpoints: list[NodeEndpoints]
+) -> tuple[dict[str, str], dict[str, str]]:
+    """The services and actions in the picture, with their full types."""
+    shown = {v.name for v in vertices if v.kind in ("service", "action")}
+    services: dict[str, str] = {}
+    actions: dict[str, str] = {}
+    for e in endpoints:
+        for table, out in (
+            (e.servers, services), (e.clients, services),
+            (e.action_servers, actions), (e.action_clients, actions),
+        ):  # fmt: skip
+            for name, kind in table.items():
+                if name in shown:
+                    out.setdefault(name, kind)
+    return services, actions
