@@ -44,6 +44,7 @@ from app.stage.window import Stage
 from app.supervisor import NodeState, Supervisor
 from app.ui import GROUP_OF, TAB_NAMES, TOOL_GROUPS, MarkdownView, Panel
 from app.ui.loop import UiLoop
+from app.ui.page_fixes import page_fixes_html
 from app.ui.page_links import PageLinks
 from app.ui.tab_opener import TabOpener
 
@@ -99,7 +100,10 @@ class Dashboard:
 
     def _build_gui(self) -> list[Panel]:
         gui, ui, node = self.server.gui, self.ui, self.runtime.node
-        gui.configure_theme(titlebar_content=None, control_width="large", show_share_button=False)
+        gui.configure_theme(
+            titlebar_content=None, control_width="large", show_share_button=False, show_logo=False
+        )
+        gui.add_html(page_fixes_html())  # contrast and button names viser leaves out
         # Both cost a lot where WebGL runs in software (no GPU: headless
         # browsers, many classroom VMs). The shadow pass of the arm on the grid
         # alone stalled the page ~100 ms on every redraw (measured; findings.md).

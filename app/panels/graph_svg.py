@@ -267,15 +267,17 @@ def render_svg(vertices: list[Vertex], edges: list[Edge], per_row: int = PER_ROW
 
 def legend_html() -> str:
     """One line explaining colours and dashes, above the picture."""
+    # Dark text on the light chips in both colour schemes; the note in the theme's own
+    # dimmed colour (a fixed gray was unreadable in dark mode).
     chips = "".join(
         f'<span style="background:{fill};border:1px solid {stroke};border-radius:{radius}px;'
-        f'padding:1px 6px;margin-right:6px">{kind}</span>'
+        f'padding:1px 6px;margin-right:6px;color:#111">{kind}</span>'
         for kind, (fill, stroke, radius) in STYLE.items()
     )
     return (
         f'<div style="font-family:sans-serif;font-size:12px;margin-bottom:4px">{chips}'
-        '<span style="color:#555">arrows: publisher → topic → subscriber, '
-        "server → service/action; dashed: client</span></div>"
+        '<span style="color:var(--mantine-color-dimmed)">arrows: publisher → topic → '
+        "subscriber, server → service/action; dashed: client</span></div>"
     )
 
 

@@ -237,7 +237,7 @@ def stage_svg(
     width = max(right, 2 * MARGIN + PER_ROW * BOX_W + (PER_ROW - 1) * GAP_X)
     height = max((p.y for p in placed), default=0) + BOX_H + MARGIN + (0 if placed else 30)
     parts = [
-        f'<svg class="stage-graph" xmlns="http://www.w3.org/2000/svg" role="img" '
+        f'<svg class="stage-graph" xmlns="http://www.w3.org/2000/svg" role="group" '
         f'aria-label="Live ROS graph: {len(placed)} items" viewBox="0 0 {width:.0f} '
         f'{height:.0f}" width="100%" style="font-family:sans-serif;max-width:{width:.0f}px">',
         f"<style>{STAGE_CSS}</style>",
