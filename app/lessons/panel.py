@@ -24,6 +24,21 @@ from app.ui.code_view import python_listing
 from app.ui.loop import UiLoop
 
 _MARKS = {PASS: "✓", FAIL: "✗", "waiting": "…"}
+# A step button's icon says what it does; the label says it in words.
+_ACTION_ICONS = {
+    "open_panel": viser.Icon.EXTERNAL_LINK,
+    "stop": viser.Icon.PLAYER_STOP,
+    "stop_group": viser.Icon.PLAYER_STOP,
+    "stop_own": viser.Icon.PLAYER_STOP,
+    "console": viser.Icon.TERMINAL,
+    "workspace_command": viser.Icon.TERMINAL,
+    "workspace_edit": viser.Icon.PENCIL,
+    "workspace_write": viser.Icon.PENCIL,
+    "call_service": viser.Icon.SEND,
+    "send_goal": viser.Icon.SEND,
+    "publish": viser.Icon.SEND,
+    "set_param": viser.Icon.ADJUSTMENTS,
+}
 _CHOOSE = "(choose an answer)"
 
 
@@ -196,8 +211,8 @@ class LessonsPanel:
         with self._actions:
             for action in step.actions:
                 label = action.get("label") or f"{action.kind.replace('_', ' ')}"
-                icon = viser.Icon.EXTERNAL_LINK if action.kind == "open_panel" else None
-                button = self._gui.add_button(label, icon=icon or viser.Icon.PLAYER_PLAY)
+                icon = _ACTION_ICONS.get(action.kind, viser.Icon.PLAYER_PLAY)
+                button = self._gui.add_button(label, icon=icon)
                 button.on_click(self._ui.callback(self._perform, action))
                 self._dynamic.append(button)
             for check in step.checks:
