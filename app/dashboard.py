@@ -46,6 +46,7 @@ from app.ui import GROUP_OF, TAB_NAMES, TOOL_GROUPS, MarkdownView, Panel
 from app.ui.loop import UiLoop
 from app.ui.page_fixes import page_fixes_html
 from app.ui.page_links import PageLinks
+from app.ui.starting import StartRequests
 from app.ui.tab_opener import TabOpener
 
 log = logging.getLogger(__name__)
@@ -94,6 +95,7 @@ class Dashboard:
         self.lessons = LessonRuntime(runtime.node, supervisor)
         self.rosout = RosoutLog(runtime.node)
         self._stop = threading.Event()
+        self.start_requests = StartRequests()  # Start clicks the stage shows at once
         self.graph = GraphSnapshot()
         self._panels: list[Panel] = self._build_gui()
         self._ui_thread = threading.Thread(target=self._ui_loop, name="ui-refresh", daemon=True)
@@ -149,6 +151,7 @@ class Dashboard:
                 stage.show,
                 step_card=step_card,
                 open_tool=opener.open,
+                start_requests=self.start_requests,
             ),
             "Exercise": lambda: ExercisePanel(
                 gui,
@@ -162,7 +165,7 @@ class Dashboard:
                 self.exercise_settings,
                 open_code=lambda: stage.show("code"),
             ),
-            "Nodes": lambda: NodesPanel(gui, ui, self.supervisor),
+            "Nodes": lambda: NodesPanel(gui, ui, self.supervisor, self.start_requests),
             "Turtlesim": lambda: TurtlesimPanel(gui, ui, node, self.supervisor, self.page_links),
             "Graph": lambda: GraphPanel(gui, node, self._rates.client()),
             "Echo": lambda: EchoPanel(gui, node),
@@ -193,15 +196,24 @@ class Dashboard:
         return [stage, *panels]
 
     def _starting_nodes(self) -> list[str]:
-        """Catalog nodes whose process runs but that have not joined the ROS graph yet."""
-        names = []
-        for name, status in self.supervisor.statuses().items():
-            if status.state is NodeState.STARTING:
-                try:
-                    names.append(lookup(name).node_name)
-                except UnknownNodeError:  # a learner's own program: drawn once it joins
-                    pass
-        return names
+        """Catalog nodes that are starting: clicked (until the supervisor has the process),
+        or whose process runs but has not joined the ROS graph yet."""
+        statuses = self.supervisor.statuses()
+        names = {name for name, status in statuses.items() if status.state is NodeState.STARTING}
+        for name, asked_at in self.start_requests.pending().items():
+            status = statuses.get(name)
+            taken = status is not None and (status.started_at or 0.0) >= asked_at - 0.5
+            if taken or (status is not None and status.state is NodeState.RUNNING):
+                self.start_requests.done(name)  # the supervisor's state says the rest
+            else:
+                names.add(name)
+        found = []
+        for name in sorted(names):
+            try:
+                found.append(lookup(name).node_name)
+            except UnknownNodeError:  # a learner's own program: drawn once it joins
+                pass
+        return found
 
     def _exercise_marks(self, lesson_id: str) -> str:
         """The outline's exercise column: ✓ for each exercise passed, ○ for each open."""

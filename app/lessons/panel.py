@@ -15,6 +15,7 @@ from typing import Any
 import viser
 
 from app import PROJECT_ROOT
+from app.catalog import UnknownNodeError, lookup_group
 from app.lessons.progress import ProgressStore
 from app.lessons.runtime import FAIL, PASS, LessonRuntime
 from app.lessons.schema import IMAGE_TYPES, STATIC_DIR, Course, Lesson, Spec
@@ -22,6 +23,7 @@ from app.ros.graph import GraphSnapshot
 from app.ui import MarkdownView, assign
 from app.ui.code_view import python_listing
 from app.ui.loop import UiLoop
+from app.ui.starting import StartRequests
 
 _MARKS = {PASS: "✓", FAIL: "✗", "waiting": "…"}
 # A step button's icon says what it does; the label says it in words.
@@ -85,6 +87,18 @@ class _HtmlView:
         return self._content
 
 
+def _started_by(action: Spec) -> list[str]:
+    """The catalog nodes a step button starts (the stage draws them at the click)."""
+    if action.kind == "start":
+        return [action["catalog_node"]]
+    if action.kind == "start_group":
+        try:
+            return list(lookup_group(action["group"]).members)
+        except UnknownNodeError:
+            return []
+    return []
+
+
 def _label(lesson: Lesson) -> str:
     return f"{lesson.unit:02d} · {lesson.title}"
 
@@ -103,6 +117,7 @@ class LessonsPanel:
         *,
         step_card: Any = None,
         open_tool: Callable[[str], None] = lambda _tool: None,
+        start_requests: StartRequests | None = None,
     ) -> None:
         """``step_card``: a folder for the step's title, buttons, checks and Back/Next (the
         dashboard puts it above its tools, so they stay in view); made here when None.
@@ -115,6 +130,7 @@ class LessonsPanel:
         self._exercise_marks = exercise_marks
         self._show_stage = show_stage  # the stage shows what each step names
         self._open_tool = open_tool
+        self._requests = start_requests or StartRequests()  # the stage shows a Start at once
         self._dynamic: list[Any] = []
         by_label = {_label(lesson): lesson for lesson in course.lessons}
         self._by_label = by_label
@@ -230,11 +246,17 @@ class LessonsPanel:
     def _perform(self, action: Spec) -> None:
         if action.kind == "open_panel":  # at once, on this thread: the page opens the tab
             self._open_tool(action["panel"])
+        starting = _started_by(action)
+        for name in starting:
+            self._requests.asked(name)
+
+        def failed(text: str) -> None:
+            for name in starting:
+                self._requests.done(name)
+            self._message.show(f"⚠ {text}")
+
         self._ui.run_job(
-            lambda: self._live.perform(action),
-            self._message.show,
-            lambda text: self._message.show(f"⚠ {text}"),
-            lane="lessons",
+            lambda: self._live.perform(action), self._message.show, failed, lane="lessons"
         )
 
     def _answer(self, check: Spec, quiz: viser.GuiDropdownHandle) -> None:
