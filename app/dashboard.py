@@ -15,6 +15,7 @@ from collections.abc import Callable
 import viser
 
 from app.catalog import UnknownNodeError, lookup
+from app.catalog import names as catalog_names
 from app.exercises.editor_server import EditorHub
 from app.exercises.grader import Grader
 from app.exercises.model import load_exercises
@@ -96,6 +97,7 @@ class Dashboard:
         self.rosout = RosoutLog(runtime.node)
         self._stop = threading.Event()
         self.start_requests = StartRequests()  # Start clicks the stage shows at once
+        self._catalog_names = frozenset(catalog_names())
         self.graph = GraphSnapshot()
         self._panels: list[Panel] = self._build_gui()
         self._ui_thread = threading.Thread(target=self._ui_loop, name="ui-refresh", daemon=True)
@@ -133,6 +135,7 @@ class Dashboard:
             self._rates.client(),
             self.page_links,
             starting=self._starting_nodes,
+            program_output=self._program_output,
         )
         stage.follow_window(self.server)
         # The current step's title, buttons, checks and Back/Next: above the tools, so they
@@ -214,6 +217,19 @@ class Dashboard:
             except UnknownNodeError:  # a learner's own program: drawn once it joins
                 pass
         return found
+
+    def _program_output(self) -> tuple[str, list[str]]:
+        """The learner's most recently started program (not a catalog node): its name and
+        state, and its last lines of output."""
+        own = [
+            status
+            for name, status in self.supervisor.statuses().items()
+            if name not in self._catalog_names
+        ]
+        if not own:
+            return "", []
+        latest = max(own, key=lambda status: status.started_at or 0.0)
+        return f"{latest.name} · {latest.describe()}", self.supervisor.output(latest.name, 40)
 
     def _exercise_marks(self, lesson_id: str) -> str:
         """The outline's exercise column: ✓ for each exercise passed, ○ for each open."""

@@ -11,6 +11,7 @@ STAGES: dict[str, str] = {
     "graph": "Live ROS graph",
     "turtlesim": "Turtlesim",
     "scene": "3D scene",
-    "code": "Code",
+    "tf": "TF tree",
+    "code": "Code and its output",
 }
 DEFAULT_STAGE = "graph"  # a unit that names none: units 1-11 are about the graph

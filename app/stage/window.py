@@ -32,6 +32,8 @@ from app.stage.graph_view import (
     stage_svg,
 )
 from app.stage.pulses import CallWatch, Pulse, caller_of
+from app.stage.tf_stage import TfStage
+from app.stage.turtlesim_stage import TurtlesimStage
 from app.ui import MarkdownView, assign
 from app.ui.loop import UiLoop
 from app.ui.page_links import SINK, SINK_FRAME, PageLinks
@@ -60,9 +62,11 @@ window.addEventListener('pagehide', () => parent.__stageWidthOff && parent.__sta
 report();
 """
 RATE_CHANGE = 0.15  # a rate must move this much (share) before the dots are re-timed
-_TURTLESIM_NOTE = (
-    "### Turtlesim\nTurtlesim's window is in the **Turtlesim** tab of the panel on the "
-    "right: start `turtlesim_node` there and drive with the arrow keys."
+_IN_WINDOW = ("graph", "turtlesim", "tf")  # stages drawn in the stage window
+OUTPUT_LINES = 40
+NO_OUTPUT = (
+    "_Nothing has run yet._ **Run my node** (Learn › Exercise) runs your code; what it "
+    "prints and logs shows here."
 )
 
 
@@ -82,9 +86,13 @@ class Stage:
         rates: SharedRatesClient | None = None,
         links: PageLinks | None = None,
         starting: Callable[[], list[str]] = lambda: [],
+        program_output: Callable[[], tuple[str, list[str]]] = lambda: ("", []),
     ) -> None:
         """``starting()``: nodes whose process was just started and that the ROS graph does
-        not list yet (drawn at once, marked 'starting…', so a click on Start shows)."""
+        not list yet (drawn at once, marked 'starting…', so a click on Start shows).
+        ``program_output()``: the learner's latest program (its state) and its last lines,
+        shown under the code."""
+        self._program_output = program_output
         self._node = node
         self._starting = starting
         self._links = links
@@ -137,7 +145,13 @@ class Stage:
                 self._inspector = MarkdownView(
                     gui, "_Click a box in the graph to see what it offers and uses._"
                 )
-            self._note = MarkdownView(gui, _TURTLESIM_NOTE, visible=False)
+            self.turtlesim = TurtlesimStage(gui, ui, node, links)
+            self.tf = TfStage(gui, node)
+        # Under the code: what the learner's program printed (the exercise's output).
+        self._output_window = gui.add_panel()
+        self._output_window.dock_below(code_window)
+        with self._output_window.add_tab("Output of my node", viser.Icon.TERMINAL_2):
+            self._output = MarkdownView(gui, NO_OUTPUT)
         self.show(DEFAULT_STAGE)
 
     def follow_window(self, server: viser.ViserServer) -> None:
@@ -164,11 +178,14 @@ class Stage:
         if abs(wanted - self.width) >= REFIT_PX or not self._fitted:
             self._fitted = True
             self.width = wanted
-            self._window.set_width(wanted)
-            self._code_window.set_width(wanted)
+            self._set_widths()
             # Wider stage, more boxes a row (boxes already placed stay where they are).
             self._places.per_row = max(PER_ROW, (wanted - 40) // STEP_X)
             self._last_picture = 0.0
+
+    def _set_widths(self) -> None:
+        for window in (self._window, self._code_window, self._output_window):
+            window.set_width(self.width)
 
     def show(self, stage: str) -> None:
         """Put ``stage`` on (an unknown name is ignored: lessons are validated at load)."""
@@ -176,16 +193,26 @@ class Stage:
             return
         self.current = stage
         assign(self._selector, STAGES[stage])
-        self._window.visible = stage in ("graph", "turtlesim")
+        self._window.visible = stage in _IN_WINDOW
         self._graph_box.visible = stage == "graph"
-        self._note.handle.visible = stage == "turtlesim"
+        self.turtlesim.set_active(stage == "turtlesim")
+        self.tf.set_active(stage == "tf")
         self._code_window.visible = stage == "code"
+        self._output_window.visible = stage == "code"
+        if stage == "code" and self._fitted:
+            self._set_widths()  # the column the code and its output share
         self._last_picture = 0.0  # draw at once
         if stage != "graph":
             self._rates.watch({})  # no subscriptions for a picture nobody sees
             self._calls.watch({}, {})
 
     def refresh(self, graph: GraphSnapshot) -> None:
+        if self.current == "turtlesim":
+            self.turtlesim.refresh(graph)
+        elif self.current == "tf":
+            self.tf.refresh()
+        elif self.current == "code":
+            self._output.show(_output_text(*self._program_output()))
         if self.current != "graph":
             return
         now = time.monotonic()
@@ -322,6 +349,8 @@ class Stage:
     def close(self) -> None:
         self._rates.close()
         self._calls.close()
+        self.turtlesim.close()
+        self.tf.close()
 
 
 def _calls_to_watch(
@@ -340,3 +369,10 @@ def _calls_to_watch(
                 if name in shown:
                     out.setdefault(name, kind)
     return services, actions
+
+
+def _output_text(program: str, lines: list[str]) -> str:
+    if not program:
+        return NO_OUTPUT
+    body = "\n".join(lines[-OUTPUT_LINES:]) or "(no output yet)"
+    return f"**{program}**\n```\n{body}\n```"

@@ -4,7 +4,8 @@ An accessibility checker (axe-core, in tests/browser/test_accessibility.py)
 found, in viser's own widgets: white text on mid blue, green, red and gray
 buttons (contrast 2.3-3.6, WCAG asks 4.5), gray labels on white (3.3) and
 message text on dark gray (3.5), and icon-only buttons without a name (a
-message's close button, the viewer's settings button). The dashboard sends
+message's close button, the viewer's settings button), and images without alt
+text (viser's image widget shows a label, not an alt). The dashboard sends
 this once: darker button colours and labels in both colour schemes (CSS
 variables of Mantine, viser's UI kit), and a page script that names the
 unnamed buttons as they appear.
@@ -41,6 +42,13 @@ const fix = () => {
     if (button.innerText.trim()) continue;
     const name = nameOf(button);
     if (name) button.setAttribute('aria-label', name);
+  }
+  // viser's image widget (turtlesim's window, camera images) has a label but no alt text.
+  for (const img of doc.querySelectorAll('img:not([alt])')) {
+    const box = img.parentElement && img.parentElement.parentElement;
+    const label = box && box.firstElementChild && box.firstElementChild.tagName === 'P'
+      ? box.firstElementChild.innerText.trim() : '';
+    img.setAttribute('alt', label ? `${label} (live picture)` : 'live picture');
   }
 };
 if (parent.__classroomNamer) parent.__classroomNamer.disconnect();

@@ -32,10 +32,18 @@ def _node_names(node) -> list[str]:
 
 def _on_stage(page: Page) -> list[str]:
     """Which stages the page shows, read from what is visible ([] is the 3D scene)."""
-    graph = page.locator("svg.stage-graph").filter(visible=True).count() > 0
-    code = page.get_by_role("tab", name="Code of this lesson").filter(visible=True).count() > 0
-    turtle = page.get_by_text("Turtlesim's window is in the").filter(visible=True).count() > 0
-    return [name for name, on in (("graph", graph), ("code", code), ("turtlesim", turtle)) if on]
+
+    def shown(locator) -> bool:
+        return locator.filter(visible=True).count() > 0
+
+    seen = {
+        "graph": shown(page.locator("svg.stage-graph")),
+        "code": shown(page.get_by_role("tab", name="Code of this lesson"))
+        and shown(page.get_by_role("tab", name="Output of my node")),
+        "turtlesim": shown(page.get_by_text("Arrow keys drive turtle1 while this window")),
+        "tf": shown(page.locator("div.stage-tf")),
+    }
+    return [name for name, on in seen.items() if on]
 
 
 def _wait_stage(page: Page, wanted: str, timeout: float = 5.0) -> None:

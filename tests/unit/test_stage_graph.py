@@ -48,8 +48,8 @@ def test_a_unit_without_stage_gets_the_default_and_a_step_can_override(tmp_path)
 def test_an_unknown_stage_is_a_clear_error(tmp_path):
     with pytest.raises(LessonError, match=r"unknown stage 'movie' \(stages: graph, turtlesim"):
         load_lesson(_copy(tmp_path, 'stage = "movie"\n'))
-    with pytest.raises(LessonError, match=r"steps\[0\]: unknown stage 'tf'"):
-        load_lesson(_copy(tmp_path / "b", 'stage = "graph"\n', 'stage = "tf"\n'))
+    with pytest.raises(LessonError, match=r"steps\[0\]: unknown stage 'film'"):
+        load_lesson(_copy(tmp_path / "b", 'stage = "graph"\n', 'stage = "film"\n'))
     with pytest.raises(LessonError, match="field 'stage' must be str"):
         load_lesson(_copy(tmp_path / "c", "stage = 3\n"))
 
