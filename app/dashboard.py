@@ -11,6 +11,7 @@ import os
 import threading
 import time
 from collections.abc import Callable
+from typing import cast
 
 import viser
 
@@ -99,6 +100,7 @@ class Dashboard:
         self.start_requests = StartRequests()  # Start clicks the stage shows at once
         self._catalog_names = frozenset(catalog_names())
         self.graph = GraphSnapshot()
+        self._tools: dict[str, Panel] = {}
         self._panels: list[Panel] = self._build_gui()
         self._ui_thread = threading.Thread(target=self._ui_loop, name="ui-refresh", daemon=True)
 
@@ -125,6 +127,7 @@ class Dashboard:
         side_window = gui.add_panel()
         side_window.dock_left()
         side_window.set_width(560)
+        opener = TabOpener(gui, {name: [GROUP_OF[name], name] for name in TAB_NAMES})
         # The stage: what the current step is about (the live graph, ...), chosen by the lesson.
         self._rates = SharedRates(node)  # the stage and the Graph tab measure a topic once
         stage = Stage(
@@ -136,12 +139,13 @@ class Dashboard:
             self.page_links,
             starting=self._starting_nodes,
             program_output=self._program_output,
+            inspect=self._inspect,
+            open_tool=opener.open,
         )
         stage.follow_window(self.server)
         # The current step's title, buttons, checks and Back/Next: above the tools, so they
         # stay in view whichever tool is open (the step's text is in Learn › Lessons).
         step_card = gui.add_folder("This step")
-        opener = TabOpener(gui, {name: [GROUP_OF[name], name] for name in TAB_NAMES})
         builders: dict[str, Callable[[], Panel]] = {
             "Lessons": lambda: LessonsPanel(
                 gui,
@@ -193,6 +197,7 @@ class Dashboard:
                     with tools.add_tab(name, _ICONS[name]):
                         built[name] = builders[name]()
         panels = [built[name] for name in TAB_NAMES]
+        self._tools = built
         # A lesson's `console` buttons type their command into the Console tab.
         console = next(p for p in panels if isinstance(p, ConsolePanel))
         self.lessons.console = console.run_for_lesson
@@ -217,6 +222,20 @@ class Dashboard:
             except UnknownNodeError:  # a learner's own program: drawn once it joins
                 pass
         return found
+
+    def _inspect(self, kind: str, name: str, type_text: str) -> None:
+        """A box clicked on the stage: the tools that show more of it pick it (UI thread)."""
+        tools = self._tools
+        if kind == "topic":
+            cast(TopicsPanel, tools["Topics"]).preselect(name)
+            cast(EchoPanel, tools["Echo"]).show_topic(name, type_text)
+        elif kind == "node":
+            cast(ParametersPanel, tools["Parameters"]).preselect(name)
+            cast(NodesPanel, tools["Nodes"]).preselect(name)
+        elif kind == "service":
+            cast(ServicesPanel, tools["Services"]).preselect(name)
+        elif kind == "action":
+            cast(ActionsPanel, tools["Actions"]).preselect(name)
 
     def _program_output(self) -> tuple[str, list[str]]:
         """The learner's most recently started program (not a catalog node): its name and

@@ -143,6 +143,12 @@ class NodesPanel:
 
     # -- UI thread -------------------------------------------------------------
 
+    def preselect(self, node_name: str) -> None:
+        """Pick the catalog entry that makes ROS node ``node_name`` (a stage click)."""
+        entry = next((e for e in ENTRIES if e.node_name == node_name), None)
+        if entry is not None:
+            assign(self._selector, entry.name)
+
     def _valid_selection(self) -> None:
         """Dropdown values come from the browser: anything outside the catalog is reset."""
         if self._selector.value not in _ENTRY_NAMES:

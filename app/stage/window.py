@@ -63,6 +63,13 @@ report();
 """
 RATE_CHANGE = 0.15  # a rate must move this much (share) before the dots are re-timed
 _IN_WINDOW = ("graph", "turtlesim", "tf")  # stages drawn in the stage window
+# A clicked box's tools (set to it already): (tool, button label).
+_TOOLS_FOR: dict[str, tuple[tuple[str, str], ...]] = {
+    "topic": (("Echo", "Echo {name}"), ("Topics", "Rate, plot and publish {name} in Topics")),
+    "node": (("Parameters", "Parameters of {name}"), ("Nodes", "{name} in Run › Nodes")),
+    "service": (("Services", "Call {name} in Services"),),
+    "action": (("Actions", "Send a goal to {name} in Actions"),),
+}
 OUTPUT_LINES = 40
 NO_OUTPUT = (
     "_Nothing has run yet._ **Run my node** (Learn › Exercise) runs your code; what it "
@@ -87,12 +94,17 @@ class Stage:
         links: PageLinks | None = None,
         starting: Callable[[], list[str]] = lambda: [],
         program_output: Callable[[], tuple[str, list[str]]] = lambda: ("", []),
+        inspect: Callable[[str, str, str], None] = lambda _kind, _name, _type: None,
+        open_tool: Callable[[str], None] = lambda _tool: None,
     ) -> None:
         """``starting()``: nodes whose process was just started and that the ROS graph does
         not list yet (drawn at once, marked 'starting…', so a click on Start shows).
         ``program_output()``: the learner's latest program (its state) and its last lines,
-        shown under the code."""
+        shown under the code. ``inspect(kind, name, type)``: a box was clicked (the tools
+        preselect it); ``open_tool(name)`` brings a tool's tab into view."""
         self._program_output = program_output
+        self._inspect = inspect
+        self._open_tool = open_tool
         self._node = node
         self._starting = starting
         self._links = links
@@ -145,6 +157,13 @@ class Stage:
                 self._inspector = MarkdownView(
                     gui, "_Click a box in the graph to see what it offers and uses._"
                 )
+                # The tools that show more of the clicked box (already set to it).
+                self._tool_buttons = [
+                    gui.add_button("", icon=viser.Icon.EXTERNAL_LINK, visible=False)
+                    for _ in range(2)
+                ]
+                for i, button in enumerate(self._tool_buttons):
+                    button.on_click(ui.callback(self._open_inspected_tool, i))
             self.turtlesim = TurtlesimStage(gui, ui, node, links)
             self.tf = TfStage(gui, node)
         # Under the code: what the learner's program printed (the exercise's output).
@@ -285,9 +304,34 @@ class Stage:
         return f'<a href="{href}" target="{SINK}"><title>{html.escape(title)}</title>{content}</a>'
 
     def _pick(self, index: int) -> None:
-        if 0 <= index < len(self._picked):
-            self._inspected = self._picked[index].key
-            self._last_picture = 0.0  # answer at once
+        if not 0 <= index < len(self._picked):
+            return
+        vertex = self._picked[index]
+        self._inspected = vertex.key
+        self._last_picture = 0.0  # answer at once
+        self._inspect(vertex.kind, vertex.name, self._full_type(vertex))
+        tools = _TOOLS_FOR.get(vertex.kind, ())
+        for i, button in enumerate(self._tool_buttons):
+            if i < len(tools):
+                button.label = tools[i][1].format(name=vertex.name)
+            button.visible = i < len(tools)
+
+    def _full_type(self, vertex: Vertex) -> str:
+        """A topic's, service's or action's full type name ('' for a node)."""
+        for e in self._endpoints:
+            for table in (
+                e.publishes, e.subscribes, e.servers, e.clients, e.action_servers,
+                e.action_clients,
+            ):  # fmt: skip
+                if vertex.name in table and vertex.kind != "node":
+                    return table[vertex.name]
+        return ""
+
+    def _open_inspected_tool(self, index: int) -> None:
+        kind = self._inspected.partition(":")[0]
+        tools = _TOOLS_FOR.get(kind, ())
+        if index < len(tools):
+            self._open_tool(tools[index][0])
 
     def _inspection(self, labels: dict[str, str]) -> str:
         """What the clicked box offers and uses, as `ros2 node info` / `topic info` say."""
@@ -327,13 +371,11 @@ class Stage:
                 + (f" · {rate}" if rate else "")
                 + f"\n- publishers: {', '.join(users['pub']) or 'none'}"
                 + f"\n- subscribers: {', '.join(users['sub']) or 'none'}"
-                + "\n\nSee its messages in the **Echo** tab, its rate in **Topics**."
             )
         return (
             f"**{kind.capitalize()} `{name}`**"
             + f"\n- served by: {', '.join(users['serve']) or 'none'}"
             + f"\n- used by: {', '.join(users['use']) or 'none'}"
-            + f"\n\nCall it from the **{'Actions' if kind == 'action' else 'Services'}** tab."
         )
 
     def _steady_rate(self, topic: str) -> float:

@@ -3,6 +3,7 @@ can pick another, and the live graph grows and shows messages moving on /chatter
 
 from __future__ import annotations
 
+import re
 import time
 
 import pytest
@@ -10,7 +11,14 @@ from playwright.sync_api import Page, expect
 
 from app.lessons.schema import load_course
 from app.stage import STAGES
-from tests.browser.helpers import choose, open_tab, out_of_view, start_node, step_controls
+from tests.browser.helpers import (
+    choose,
+    expect_text,
+    open_tab,
+    out_of_view,
+    start_node,
+    step_controls,
+)
 from tests.conftest import ARTIFACTS
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -232,4 +240,35 @@ def test_a_service_call_and_an_action_goal_travel_as_pulses(browser, dashboard):
         expect(page.get_by_text("Status: SUCCEEDED").filter(visible=True)).to_be_visible()
     finally:
         page.screenshot(path=str(ARTIFACTS / "stage-pulses.png"))
+        page.context.close()
+
+
+def test_a_click_on_a_box_sets_the_tools_to_it(browser, dashboard):
+    """A topic clicked on stage is echoed and followed in Topics; a node's parameters show."""
+    page = _open(browser, dashboard, SIZES[0])
+    try:
+        choose(page, "On stage", STAGES["graph"])
+        start_node(page, "parameters_node")
+        greeting = page.locator('svg.stage-graph g.sg-vertex[data-name="/greeting"] a')
+        expect(greeting).to_be_visible(timeout=20_000)
+        greeting.click()
+        page.get_by_role("button", name="Echo /greeting", exact=True).click()
+        expect(page.get_by_role("tab", name="Echo", exact=True)).to_have_attribute(
+            "aria-selected", "true"
+        )
+        expect_text(page, "ros2 topic echo /greeting")
+        expect_text(page, re.compile(r"\] data: '"), timeout=20_000)  # its messages
+        page.get_by_role("button", name="Rate, plot and publish /greeting in Topics").click()
+        topic = page.get_by_label("Topic", exact=True).filter(visible=True)
+        expect(topic).to_have_value("/greeting")
+        page.locator('svg.stage-graph g.sg-vertex[data-name="/parameters_node"] a').click()
+        page.get_by_role("button", name="Parameters of /parameters_node", exact=True).click()
+        expect(page.get_by_role("tab", name="Parameters", exact=True)).to_have_attribute(
+            "aria-selected", "true"
+        )
+        expect(page.get_by_label("Node", exact=True).filter(visible=True)).to_have_value(
+            "/parameters_node"
+        )
+    finally:
+        page.screenshot(path=str(ARTIFACTS / "stage-inspect.png"))
         page.context.close()
