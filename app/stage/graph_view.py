@@ -46,6 +46,11 @@ class StablePlaces:
         self.per_row = per_row
         self._at: dict[str, tuple[float, float]] = {}
 
+    def forget(self, key: str) -> None:
+        """Let ``key`` take a new place once (a node drawn 'starting…' before its edges were
+        known: once they are, it joins its group)."""
+        self._at.pop(key, None)
+
     def place(self, vertices: list[Vertex], edges: list[Edge]) -> list[Placed]:
         fresh = layout(vertices, edges, self.per_row)
         taken: list[tuple[float, float]] = []
@@ -76,10 +81,18 @@ def _overlaps(at: tuple[float, float], taken: list[tuple[float, float]]) -> bool
 def _free_cell(
     wish: tuple[float, float], taken: list[tuple[float, float]], per_row: int
 ) -> tuple[float, float]:
-    """``wish`` if free, else the first free grid cell from its row down."""
+    """``wish`` if free; else the nearest free place in its row (half a box at a time, left
+    or right: a second subscriber goes beside the first, not under it); else the first
+    free grid cell from the next row down."""
     if not _overlaps(wish, taken):
         return wish
-    row = max(0, round((wish[1] - MARGIN) / STEP_Y))
+    left, right = float(MARGIN), MARGIN + (per_row - 1) * STEP_X
+    for k in range(1, 2 * per_row + 1):
+        for sign in (1, -1):
+            x = wish[0] + sign * k * STEP_X / 2
+            if left - 1 <= x <= right + 1 and not _overlaps((x, wish[1]), taken):
+                return (x, wish[1])
+    row = max(0, round((wish[1] - MARGIN) / STEP_Y)) + 1
     while True:
         y = MARGIN + row * STEP_Y
         for column in range(per_row):

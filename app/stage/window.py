@@ -123,6 +123,7 @@ class Stage:
         # Calls and goals as pulses: an event wakes the UI loop, which draws it at once.
         self._calls = CallWatch(node, on_event=lambda: ui.post(lambda: None))
         self._drawn_pulses: set[tuple[str, str, float]] = set()
+        self._alone: set[str] = set()  # node boxes drawn without an edge
         self._callers: dict[tuple[str, str], str] = {}
         self._shown_rates: dict[str, float] = {}
         self._last_picture = 0.0
@@ -257,6 +258,12 @@ class Stage:
         labels = {topic: rate_text(rate) for topic, rate in rates.items()}
         vertices, edges = graph_picture(endpoints, labels, show_quiet=quiet)
         vertices += [Vertex("node", name, STARTING) for name in starting]
+        # A node drawn alone (starting, or its endpoints not discovered yet) joins its
+        # group's place once its first edge is known; every other box stays put.
+        linked = {key for e in edges for key in (e.source, e.target)}
+        for key in self._alone & linked:
+            self._places.forget(key)
+        self._alone = {f"node:{v.name}" for v in vertices if v.kind == "node"} - linked
         placed = self._places.place(vertices, edges)
         self._picked = [p.vertex for p in placed]
         self._endpoints = endpoints
