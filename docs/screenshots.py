@@ -207,7 +207,7 @@ def exercise_graded(page: Page) -> None:
     wrong = (exercise.path / "mistakes" / "adds.py").read_text(encoding="utf-8")
     _tool(page, "Exercise")
     _choose(page, "Exercise", f"{exercise.unit:02d} · {exercise.title}")
-    _choose(page, "On stage", "Code and its output")
+    _choose(page, "On stage", "Code")
     page.get_by_role("tab", name="Your code").click()
     editor = page.frame_locator(f"iframe[src*='slug={exercise.slug}']")
     editor.locator(".ace_content").click()

@@ -12,6 +12,6 @@ STAGES: dict[str, str] = {
     "turtlesim": "Turtlesim",
     "scene": "3D scene",
     "tf": "TF tree",
-    "code": "Code and its output",
+    "code": "Code",  # the lesson's or the learner's, with its output under it
 }
 DEFAULT_STAGE = "graph"  # a unit that names none: units 1-11 are about the graph
