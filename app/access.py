@@ -99,7 +99,7 @@ class TokenGate:
                     "This ROS 2 Classroom dashboard needs its access token: open the full "
                     "URL the teacher's `ros2-classroom serve` printed (it ends in ?token=...).\n",
                 )
-            if not _same_origin(request):
+            if not same_origin(request):
                 self.rejected += 1
                 return connection.respond(http.HTTPStatus.FORBIDDEN, "Cross-site request.\n")
             response = inner(connection, request) if inner is not None else None
@@ -112,12 +112,24 @@ class TokenGate:
         return process_request
 
 
-def _same_origin(request: Request) -> bool:
+def same_origin(request: Request) -> bool:
     """A websocket opened by another site's page (cross-site hijacking) is refused."""
     origin = request.headers.get("Origin")
     if origin is None or request.headers.get("Upgrade", "").lower() != "websocket":
         return True
     return urlsplit(origin).netloc == request.headers.get("Host", "")
+
+
+class Gate(Protocol):
+    """Who may reach the server at all: checked before every route (``TokenGate``, or a hub login).
+
+    ``wrap`` may return a coroutine function (websockets awaits it); a gate that
+    also defines ``wrap_handler`` sees every websocket connection it admitted.
+    """
+
+    installed: bool
+
+    def wrap(self, inner: ProcessRequest | None) -> Callable[..., Any]: ...
 
 
 class ServerExtension(Protocol):
@@ -129,7 +141,7 @@ class ServerExtension(Protocol):
 
 
 @contextmanager
-def _extended_serve(gate: TokenGate | None, extension: ServerExtension | None) -> Iterator[None]:
+def _extended_serve(gate: Gate | None, extension: ServerExtension | None) -> Iterator[None]:
     """While viser builds its server: our routes behind the gate, the gate in front of all."""
     original = ws_server.serve
 
@@ -141,6 +153,9 @@ def _extended_serve(gate: TokenGate | None, extension: ServerExtension | None) -
         if gate is not None:
             process_request = gate.wrap(process_request)
             gate.installed = True
+            wrap_handler = getattr(gate, "wrap_handler", None)
+            if wrap_handler is not None:
+                handler = wrap_handler(handler)
         kwargs["process_request"] = process_request
         return original(handler, *args, **kwargs)
 
@@ -153,12 +168,20 @@ def _extended_serve(gate: TokenGate | None, extension: ServerExtension | None) -
 
 
 def make_server(
-    host: str, port: int, token: str | None, extension: ServerExtension | None = None
-) -> tuple[viser.ViserServer, TokenGate | None]:
-    """A viser server; with a token, every request must carry it (fails closed)."""
-    if token is None and extension is None:
+    host: str,
+    port: int,
+    token: str | None,
+    extension: ServerExtension | None = None,
+    gate: Gate | None = None,
+) -> tuple[viser.ViserServer, Gate | None]:
+    """A viser server; with a token (or another ``gate``: a JupyterHub login,
+    app/hub/singleuser_auth.py), every request must pass it (fails closed)."""
+    if token is not None and gate is not None:
+        raise ValueError("one gate: an access token or another gate, not both")
+    if token is None and extension is None and gate is None:
         return viser.ViserServer(host=host, port=port, verbose=False), None
-    gate = TokenGate(token, port) if token is not None else None
+    if token is not None:
+        gate = TokenGate(token, port)
     with _extended_serve(gate, extension):
         server = viser.ViserServer(host=host, port=port, verbose=False)
     if gate is not None and not gate.installed:

@@ -287,6 +287,26 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         package="sim_world",
     ),
     CatalogEntry(
+        "sim_robot_state_publisher",
+        "model_state_publisher",
+        "/robot_state_publisher",
+        "robot_state_publisher with the sim robot's URDF: /robot_description, its frames on /tf.",
+        args=("nodes/robots/diffbot/robot.urdf",),
+        package="sim_world",
+    ),
+    # Two robots, two descriptions: the arm's robot_state_publisher lives in the /arm
+    # namespace (/arm/robot_description), as multi-robot launch files do; both read the
+    # one /joint_states the simulator publishes and ignore the other robot's joints.
+    CatalogEntry(
+        "sim_arm_state_publisher",
+        "model_state_publisher",
+        "/arm/robot_state_publisher",
+        "robot_state_publisher for the sim's arm, in /arm: /arm/robot_description, links on /tf.",
+        args=("nodes/robots/arm/robot.urdf",),
+        ros_args=("-r", "__ns:=/arm", "-r", "joint_states:=/joint_states"),
+        package="sim_world",
+    ),
+    CatalogEntry(
         "sim_teleop_key",
         "turtle_teleop_key",
         "/sim_teleop_key",
@@ -366,6 +386,44 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         "/dynamic_frame_tf2_broadcaster",
         "Broadcasts carrot1 circling turtle1 at 10 m, at 10 Hz.",
         package="turtle_tf2_py",
+    ),
+    # The tf2 time tutorials' listeners (nodes/turtle_tf2_listener_time.py), named /listener
+    # as the demo's, so they stand in for it.
+    CatalogEntry(
+        "turtle_tf2_listener_now",
+        "turtle_tf2_listener_time",
+        "/listener",
+        "Using time: looks up turtle1 at now() without waiting; tf2 says the data is too old.",
+        args=("now",),
+        ros_args=("-r", "__node:=listener"),
+        package="learning_tf2_py",
+    ),
+    CatalogEntry(
+        "turtle_tf2_listener_wait",
+        "turtle_tf2_listener_time",
+        "/listener",
+        "Using time: looks up turtle1 at now() and waits up to 50 ms: turtle2 follows.",
+        args=("wait",),
+        ros_args=("-r", "__node:=listener"),
+        package="learning_tf2_py",
+    ),
+    CatalogEntry(
+        "turtle_tf2_listener_past",
+        "turtle_tf2_listener_time",
+        "/listener",
+        "Traveling in time: lookup_transform 5 s ago, both frames in the past: turtle2 wanders.",
+        args=("past",),
+        ros_args=("-r", "__node:=listener", "-p", "target_frame:=carrot1"),
+        package="learning_tf2_py",
+    ),
+    CatalogEntry(
+        "turtle_tf2_listener_full",
+        "turtle_tf2_listener_time",
+        "/listener",
+        "Traveling in time: lookup_transform_full, carrot1 5 s ago seen from turtle2 now.",
+        args=("full",),
+        ros_args=("-r", "__node:=listener", "-p", "target_frame:=carrot1"),
+        package="learning_tf2_py",
     ),
     # turtle_tf2_demo.launch.py: turtlesim as /sim, a broadcaster per turtle, the listener.
     CatalogEntry(
@@ -468,6 +526,46 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         "The URDF tutorial's R2-D2 on a circle: its joints on /joint_states, odom -> axis on /tf.",
         package="urdf_tutorial_r2d2",
     ),
+    # The unit-13 cell the ROS 2 way: the camera's pose on /tf_static, the point through tf2.
+    CatalogEntry(
+        "camera_static_tf",
+        "static_transform_publisher",
+        "/camera_static_tf",
+        "The camera's pose on /tf_static: base_link -> camera, 0.25 m ahead, 0.7 m up, lens down.",
+        args=(
+            "--x",
+            "0.25",
+            "--y",
+            "0",
+            "--z",
+            "0.7",
+            "--yaw",
+            "0",
+            "--pitch",
+            "0",
+            "--roll",
+            "3.1415927",
+            "--frame-id",
+            "base_link",
+            "--child-frame-id",
+            "camera",
+        ),
+        ros_args=("-r", "__node:=camera_static_tf"),
+        package="tf2_ros",
+    ),
+    CatalogEntry(
+        "coordinate_transform_tf2",
+        "coordinate_transform_tf2",
+        "/coordinate_transform_tf2",
+        "coordinate_transform done with tf2: the camera point into base_link by a tf2 lookup.",
+    ),
+    CatalogEntry(
+        "coordinate_transform_tf2_side",
+        "coordinate_transform_tf2",
+        "/coordinate_transform_tf2",
+        "The tf2 coordinate transform beside the matrix one, on /pos_in_robot_base_frame_tf2.",
+        ros_args=("-r", "pos_in_robot_base_frame:=pos_in_robot_base_frame_tf2"),
+    ),
     CatalogEntry(
         "r2d2_rsp",
         "model_state_publisher",
@@ -540,8 +638,8 @@ GROUPS: tuple[LaunchGroup, ...] = (
     # --- the MuJoCo world (issue 26) ---
     LaunchGroup(
         "sim_drive",
-        "the MuJoCo room and the arrow-key teleop on /cmd_vel: drive the robot",
-        ("sim_world", "sim_teleop_key"),
+        "the MuJoCo room, its robots' state publishers and the arrow-key teleop: drive the robot",
+        ("sim_world", "sim_robot_state_publisher", "sim_arm_state_publisher", "sim_teleop_key"),
     ),
     # --- tf2 (issue 23): the turtle_tf2_py demo launch files ---
     LaunchGroup(
@@ -576,6 +674,17 @@ GROUPS: tuple[LaunchGroup, ...] = (
         "arm_tf",
         "robotic_arm + robot_state_publisher with its URDF: the arm on /tf",
         ("robotic_arm", "arm_state_publisher"),
+    ),
+    LaunchGroup(
+        "camera_to_arm_tf2",
+        "the camera -> arm cell the ROS 2 way: static camera pose, tf2 lookup, URDF arm on /tf",
+        (
+            "camera_publisher",
+            "camera_static_tf",
+            "coordinate_transform_tf2",
+            "robotic_arm",
+            "arm_state_publisher",
+        ),
     ),
     LaunchGroup(
         "urdf_tutorial_display",

@@ -102,7 +102,8 @@ def _run_policy(args: argparse.Namespace, progress_dir: Path, workspace: Any) ->
 
 
 def cmd_serve(args: argparse.Namespace) -> int:
-    token = _access_token(args)
+    hub_login = _hub_singleuser(args)  # `serve --jupyterhub`: the hub's login, not a token
+    token = None if hub_login is not None else _access_token(args)
     configure_this_process(domain_id=args.domain_id, network=args.network)
     _check_port_free(args.host, args.port)
 
@@ -136,22 +137,36 @@ def cmd_serve(args: argparse.Namespace) -> int:
     editor_hub = EditorHub()
     # Extra routes on viser's server: links, then the page's base-path shim, then the editor.
     page_links = PageLinks(BasePathPage(editor_hub))
-    server, _gate = make_server(args.host, args.port, token, page_links)
+    server, _gate = make_server(args.host, args.port, token, page_links, gate=hub_login)
     if server.get_port() != args.port:
         server.stop()
         raise CliError(f"port {args.port} on {args.host} became busy; pick another with --port")
     runtime = RosRuntime()
     # The learner's colcon workspace and the ament underlay, before the supervisor copies
-    # the environment (issue 22: app/ros2cli/pkg.py).
+    # the environment (issue 22: app/ros2cli/pkg.py). Served to other machines, builds
+    # are learner code: the workspace lives in the learner's scratch folder, the one
+    # place their contained code may write, hidden from every other learner's.
     from app.ros2cli.pkg import setup_workspace
 
-    setup_workspace(progress.path, remote=not _is_loopback(args.host))
-    supervisor = Supervisor(os.environ)
     scratch_root = args.scratch_dir or (args.progress_dir or DEFAULT_DIR).parent / "scratch"
+    # Behind the hub's login (serve --jupyterhub) only the learner reaches the dashboard.
+    remote = hub_login is None and not _is_loopback(args.host)
+    if remote:
+        from app.exercises.contain import SANDBOX_GID
+
+        setup_workspace(
+            progress.path, remote=True, home=scratch_root / progress.path.stem, group=SANDBOX_GID
+        )
+    else:
+        setup_workspace(progress.path, remote=False)
+    supervisor = Supervisor(os.environ)
     workspace = Workspace(progress, scratch_root)
-    settings = ExerciseSettings(
-        _run_policy(args, progress.path.parent, workspace), args.reveal_solution_after
+    policy = (
+        _hub_run_policy()
+        if hub_login is not None
+        else _run_policy(args, progress.path.parent, workspace)
     )
+    settings = ExerciseSettings(policy, args.reveal_solution_after)
     supervisor.learner_policy = settings.policy  # `ros2 launch` of a learner's launch file
     dashboard = Dashboard(
         server, runtime, supervisor, progress, editor_hub, workspace, settings, page_links
@@ -160,7 +175,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     beacon = _progress_beacon(args, dashboard)
     domain = os.environ.get("ROS_DOMAIN_ID", "0")
     scope = "network (opt-in)" if args.network else "loopback only"
-    query = f"/?token={token}" if token else ""
+    query = f"/?token={token}" if token else _hub_path(hub_login)
     print(
         f"ROS 2 Classroom is ready: http://{args.host}:{args.port}{query}  "
         f"(ROS domain {domain}, DDS {scope}). Press Ctrl+C to stop.",
@@ -171,12 +186,54 @@ def cmd_serve(args: argparse.Namespace) -> int:
     started = time.monotonic()
     if beacon is not None:
         beacon.close()
+    if hub_login is not None:
+        hub_login.close()
     dashboard.stop()
     runtime.shutdown()
     supervisor.shutdown(timeout=2.5)
     server.stop()
     print(f"Stopped in {time.monotonic() - started:.1f} s.", flush=True)
     return 0
+
+
+def _hub_singleuser(args: argparse.Namespace) -> Any:
+    """``serve --jupyterhub``: this dashboard is a learner's JupyterHub server (the lean mode).
+
+    The hub's spawner says where to listen, under which base path and for
+    whom; the hub's OAuth admits the learner (app/hub/singleuser_auth.py).
+    Progress, code and bags go to ``~/ros2-classroom/`` as in the Jupyter mode,
+    so a learner keeps them when the operator switches modes. None without
+    the flag.
+    """
+    if not args.jupyterhub:
+        return None
+    from app.hub.server_proxy import learner_home
+    from app.hub.singleuser_auth import HubLogin, HubSettings, HubSettingsError
+
+    if args.token or args.allow_remote:
+        raise CliError("--jupyterhub logs learners in through the hub: drop --token/--allow-remote")
+    try:
+        settings = HubSettings.from_env()
+    except HubSettingsError as exc:
+        raise CliError(str(exc)) from None
+    args.host = settings.host or "0.0.0.0"  # a spawner's '' means every interface
+    args.port = settings.port
+    if args.progress_dir is None:
+        args.progress_dir = learner_home() / "progress"
+    return HubLogin(settings)
+
+
+def _hub_run_policy() -> Any:
+    """Behind the hub's login only the learner (or an admin the hub lets in) reaches the
+    dashboard, which runs as the learner, in their own container under a container
+    spawner: their code runs as in their own terminal, as in the Jupyter mode."""
+    from app.exercises.runner import LOOPBACK_POLICY
+
+    return LOOPBACK_POLICY
+
+
+def _hub_path(hub_login: Any) -> str:
+    return hub_login.settings.prefix if hub_login is not None else ""
 
 
 def _progress_beacon(args: argparse.Namespace, dashboard: Any) -> Any:
@@ -429,6 +486,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="access token (default: $CLASSROOM_TOKEN, else a random one printed with the URL)",
     )
     serve.add_argument("--learner", default="default", help="whose lesson progress to keep")
+    serve.add_argument(
+        "--jupyterhub",
+        action="store_true",
+        help="be a learner's JupyterHub single-user server: address, base path and login "
+        "from the hub's spawner (deploy/jupyterhub_config.py, lean mode)",
+    )
     serve.add_argument(
         "--allow-learner-code",
         action="store_true",

@@ -36,6 +36,7 @@ from app.panels.nodes_panel import NodesPanel
 from app.panels.parameters_panel import ParametersPanel
 from app.panels.scene_panel import ScenePanel
 from app.panels.services_panel import ServicesPanel
+from app.panels.tf_panel import TfPanel
 from app.panels.topics_panel import TopicsPanel
 from app.panels.turtlesim_panel import TurtlesimPanel
 from app.ros.graph import GraphSnapshot, snapshot
@@ -60,7 +61,8 @@ _ICONS = {
     "Lessons": viser.Icon.SCHOOL, "Exercise": viser.Icon.PENCIL, "Nodes": viser.Icon.CPU,
     "Turtlesim": viser.Icon.PAW,
     "Graph": viser.Icon.SITEMAP,
-    "Echo": viser.Icon.MESSAGE, "3D view": viser.Icon.CUBE, "Topics": viser.Icon.LIST_DETAILS,
+    "Echo": viser.Icon.MESSAGE, "3D view": viser.Icon.CUBE, "TF": viser.Icon.BINARY_TREE,
+    "Topics": viser.Icon.LIST_DETAILS,
     "Parameters": viser.Icon.ADJUSTMENTS, "Console": viser.Icon.TERMINAL,
     "Services": viser.Icon.ARROWS_EXCHANGE, "Actions": viser.Icon.ROCKET,
     "Lifecycle": viser.Icon.PROGRESS, "Logs": viser.Icon.FILE_TEXT, "Bags": viser.Icon.DATABASE,
@@ -177,6 +179,7 @@ class Dashboard:
             "Graph": lambda: GraphPanel(gui, node, self._rates.client()),
             "Echo": lambda: EchoPanel(gui, node),
             "3D view": lambda: ScenePanel(self.server, ui, node),
+            "TF": lambda: TfPanel(gui, ui, node, self.supervisor),
             "Topics": lambda: TopicsPanel(gui, ui, node),
             "Parameters": lambda: ParametersPanel(gui, ui, node, self.rosout),
             "Console": lambda: ConsolePanel(gui, ui, node, self.supervisor),

@@ -39,7 +39,21 @@ from app.tf2_launch_files import LAUNCH_FILES as TF2_LAUNCH_FILES
 
 PREFIX_ENV = "AMENT_PREFIX_PATH"
 # Upstream executable names the catalog files under another name.
-_ALIASES: dict[tuple[str, str], str] = {("turtlesim", "mimic"): "turtle_mimic"}
+_ALIASES: dict[tuple[str, str], str] = {
+    ("turtlesim", "mimic"): "turtle_mimic",
+    # learning_tf2_py: the package the tf2 tutorials have the learner write
+    **{
+        ("learning_tf2_py", exe): exe
+        for exe in (
+            "static_turtle_tf2_broadcaster",
+            "turtle_tf2_broadcaster",
+            "turtle_tf2_listener",
+            "fixed_frame_tf2_broadcaster",
+            "dynamic_frame_tf2_broadcaster",
+        )
+    },
+    ("urdf_tutorial_r2d2", "state_publisher"): "r2d2_state_publisher",
+}
 
 MULTISIM = '''"""turtlesim's multisim.launch.py: two turtlesims, in /turtlesim1 and /turtlesim2."""
 
@@ -153,7 +167,13 @@ def launch_env(env: Mapping[str, str] | None = None) -> dict[str, str]:
     front = [str(p) for p in overlay()]
     rest = [p for p in base.get(PREFIX_ENV, "").split(os.pathsep) if p and p not in front]
     full = with_catalog_prefix({PREFIX_ENV: os.pathsep.join(front + rest)})
-    return {**child_env(base), PREFIX_ENV: full[PREFIX_ENV]}
+    env = {**child_env(base), PREFIX_ENV: full[PREFIX_ENV]}
+    # As a sourced shell: the ROS tools launch files call (xacro) are on PATH.
+    tools = os.path.dirname(sys.executable)
+    path = env.get("PATH") or base.get("PATH", "")
+    if tools not in path.split(os.pathsep):
+        env["PATH"] = os.pathsep.join(p for p in (path, tools) if p)
+    return env
 
 
 class LaunchFileNotFound(LookupError):

@@ -226,6 +226,12 @@ class Supervisor:
                 and proc.entry.node_name not in active_names
             }
 
+    def program(self, name: str) -> Program | None:
+        """What ``name`` was last started as (its argv, for a learner's program), if ever."""
+        with self._lock:
+            proc = self._procs.get(name)
+            return proc.entry if proc else None
+
     def output(self, name: str, last: int | None = None) -> list[str]:
         with self._lock:
             proc = self._procs.get(name)

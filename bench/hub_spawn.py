@@ -1,22 +1,31 @@
-"""Benchmark: a class on JupyterHub beside the same class from ``classroom``, in one run.
+"""Benchmark: a class on JupyterHub in both single-user modes, beside a `classroom` class.
 
 For N learners (1, 5, 20 by default) a real JupyterHub (tests/hub/local_hub.py:
 deploy/jupyterhub_config.py, configurable-http-proxy, ClassroomLocalSpawner)
-is asked to start all N servers at once, as a class arriving together.
+is asked to start all N servers at once, as a class arriving together, once
+per single-user mode:
+
+- lean (``CLASSROOM_SINGLEUSER=dashboard``, the README's recommendation): the
+  dashboard is the learner's server and does the hub's OAuth itself;
+- lab: a Jupyter server (JupyterLab) whose jupyter-server-proxy starts the
+  dashboard on the first request to ``/user/<name>/ros2-classroom/``.
+
 Per learner, spawn -> dashboard ready is the time from the spawn request to
-the moment a websocket client, through the hub's proxy and the learner's
-single-user server, is sent the dashboard's GUI (the page is fetched first,
-which makes jupyter-server-proxy start the dashboard). p50 and p95 over the
-learners.
+the moment a websocket client, through the hub's proxy, is sent the
+dashboard's GUI: the hub is asked once a second whether the server is up,
+then the page is fetched (in the lab mode that makes jupyter-server-proxy
+start the dashboard), then the websocket opened. p50 and p95 over the learners.
 
 Then, idle with one client each (tests/wire_client.py, through the proxy),
 every process is sampled over the same seconds: each learner's single-user
-server and dashboard, and the hub's shared processes (hub, proxy, teacher
-service). The baseline is ``classroom --learners N`` in the same run
-(bench/classroom_footprint.py: N dashboards and the teacher page in one
-process). Per learner = the whole class's total / N on each side, so the
-hub's shared processes count, spread over the class; the overhead is the hub
-side's per-learner PSS (and CPU) over the baseline's.
+server and dashboard (one process in the lean mode), and the hub's shared
+processes (hub, proxy, teacher service). The baseline is ``classroom
+--learners N`` in the same run (bench/classroom_footprint.py: N dashboards
+and the teacher page in one process). Per learner = the whole class's total
+/ N on each side, so the hub's shared processes count, spread over the
+class; the overhead is the hub side's per-learner PSS (and CPU) over the
+baseline's. The summary's ``hub_*`` figures are the lean mode's at the
+largest class; ``hub_lab_*`` the lab mode's.
 
 A class size the machine cannot hold (memory) is a failure row with the reason.
 Run: ``.venv/bin/python tests/run.py --bench hub_spawn [--counts 1,5,20]``.
@@ -37,7 +46,11 @@ from typing import Any
 from bench._common import LOGS, configure_dds, percentile, require_private_netns, rounded, sample
 
 SETTLE_SEC = 4.0
-MB_PER_LEARNER_BOTH_SIDES = 700  # hub learner (~300) + classroom learner (~130), with headroom
+POLL_SEC = 1.0  # how often the hub is asked whether a server is ready
+# The sides run one after another: the largest (a lab learner, ~300 MB) with headroom.
+MB_PER_LEARNER = 450
+MODES = ("lean", "lab")  # the first is the README's recommendation
+SINGLEUSER = {"lean": "dashboard", "lab": "lab"}
 
 
 def _ready_one(hub: Any, user: str, started: float, out: dict[str, Any]) -> None:
@@ -47,15 +60,24 @@ def _ready_one(hub: Any, user: str, started: float, out: dict[str, Any]) -> None
     try:
         hub.spawn(user)
         deadline = started + 240.0
+        # Once a second: 20 learners polled every 0.1 s kept the hub so busy (200 requests
+        # a second) that its own call to the proxy timed out and it stopped a server.
         while not hub.server_ready(user):
             if time.monotonic() > deadline:
                 raise TimeoutError("the hub never reported the server ready")
-            time.sleep(0.1)
-        status, body = hub.api("GET", f"/user/{user}/ros2-classroom/", timeout=180.0)
+            time.sleep(POLL_SEC)
+        path = f"/user/{user}/" if hub.lean else f"/user/{user}/ros2-classroom/"
+        status, body = hub.api("GET", path, timeout=180.0)
         if status != 200 or "viser" not in str(body).lower():
             raise RuntimeError(f"the Classroom page answered {status}")
-        ws = f"http://127.0.0.1:{hub.port}/user/{user}/ros2-classroom/"
-        client = WireClient(ws, headers={"Authorization": f"token {ADMIN_TOKEN}"})
+        ws = f"http://127.0.0.1:{hub.port}{path}"
+        client = None
+        while client is None:  # a websocket handshake may take over 10 s on busy cores
+            try:
+                client = WireClient(ws, headers={"Authorization": f"token {ADMIN_TOKEN}"})
+            except TimeoutError:
+                if time.monotonic() > deadline:
+                    raise
         while "ros2" not in client.markdown():
             if time.monotonic() > deadline:
                 raise TimeoutError("the dashboard never sent its GUI")
@@ -66,15 +88,22 @@ def _ready_one(hub: Any, user: str, started: float, out: dict[str, Any]) -> None
         out["error"] = f"{type(error).__name__}: {error}"
 
 
-def hub_class(learners: int, seconds: float) -> dict[str, Any]:
+def hub_class(learners: int, seconds: float, mode: str) -> dict[str, Any]:
     import psutil
 
     from tests.hub.local_hub import LocalHub
 
-    state = LOGS / f"bench-hub-{learners}"
+    state = LOGS / f"bench-hub-{mode}-{learners}"
     shutil.rmtree(state, ignore_errors=True)
     users = [f"learner{i + 1}" for i in range(learners)]
-    hub = LocalHub(state, dict(os.environ), learners=users, teachers=[], first_domain_id=1)
+    hub = LocalHub(
+        state,
+        dict(os.environ),
+        learners=users,
+        teachers=[],
+        first_domain_id=1,
+        singleuser=SINGLEUSER[mode],
+    )
     results: dict[str, dict[str, Any]] = {u: {} for u in users}
     try:
         hub.wait_ready()
@@ -98,11 +127,9 @@ def hub_class(learners: int, seconds: float) -> dict[str, Any]:
                 shared["proxy"] = proc.pid
             elif "app.hub.teacher_service" in cmd:
                 shared["teacher_service"] = proc.pid
-        pids = {
-            **shared,
-            **{f"server:{u}": servers[u].pid for u in users},
-            **{f"dashboard:{u}": dashboards[u].pid for u in users},
-        }
+        pids = {**shared, **{f"dashboard:{u}": dashboards[u].pid for u in users}}
+        if not hub.lean:  # the Jupyter server in front of each dashboard
+            pids.update({f"server:{u}": servers[u].pid for u in users})
         figures = sample(pids, seconds)
     finally:
         for result in results.values():
@@ -114,9 +141,12 @@ def hub_class(learners: int, seconds: float) -> dict[str, Any]:
     spawn = [results[u]["seconds"] for u in users]
 
     def mean(prefix: str, key: str) -> float:
+        if prefix == "server" and hub.lean:
+            return 0.0  # the dashboard is the server
         return statistics.fmean(figures[f"{prefix}:{u}"][key] for u in users)
 
     return {
+        "mode": mode,
         "learners": learners,
         "spawn_p50_s": percentile(spawn, 50),
         "spawn_p95_s": percentile(spawn, 95),
@@ -124,6 +154,8 @@ def hub_class(learners: int, seconds: float) -> dict[str, Any]:
         "server_pss_mb": mean("server", "pss_mb"),
         "dashboard_cpu_percent": mean("dashboard", "cpu_percent"),
         "dashboard_pss_mb": mean("dashboard", "pss_mb"),
+        "dashboard_rss_mb": mean("dashboard", "rss_mb"),  # what a pod's memory limit counts
+        "server_rss_mb": mean("server", "rss_mb"),
         "shared_cpu_percent": sum(figures[n]["cpu_percent"] for n in shared),
         "shared_pss_mb": sum(figures[n]["pss_mb"] for n in shared),
         "per_learner_cpu_percent": sum(f["cpu_percent"] for f in figures.values()) / learners,
@@ -147,7 +179,7 @@ def _room_for(learners: int) -> str:
     import psutil
 
     available = psutil.virtual_memory().available / 2**20
-    needed = learners * MB_PER_LEARNER_BOTH_SIDES
+    needed = learners * MB_PER_LEARNER
     if available < needed:
         return f"needs about {needed} MB free, the machine has {available:.0f} MB"
     return ""
@@ -155,6 +187,50 @@ def _room_for(learners: int) -> str:
 
 def _deep_round(row: dict[str, Any]) -> dict[str, Any]:
     return {k: _deep_round(v) if isinstance(v, dict) else v for k, v in rounded(row, 2).items()}
+
+
+def _measure(n: int, seconds: float) -> dict[str, Any]:
+    """Both hub modes and the classroom baseline for one class size (a failure row on error)."""
+    row: dict[str, Any] = {"learners": n}
+    reason = _room_for(n)
+    if reason:
+        row["error"] = reason
+        return row
+    try:
+        for mode in MODES:
+            row[mode] = hub_class(n, seconds, mode)
+        base = row["classroom"] = classroom_class(n, seconds)
+        for mode in MODES:
+            hub = row[mode]
+            hub["memory_overhead_percent"] = 100.0 * (
+                hub["per_learner_pss_mb"] / base["per_learner_pss_mb"] - 1.0
+            )
+            hub["cpu_overhead_core_percent"] = (
+                hub["per_learner_cpu_percent"] - base["per_learner_cpu_percent"]
+            )
+    except Exception as error:  # a failure row, with the reason
+        row["error"] = f"{type(error).__name__}: {error}"[:500]
+    return row
+
+
+def _print_row(row: dict[str, Any]) -> None:
+    n = row["learners"]
+    if "error" in row:
+        print(f"| {n} | failed: {row['error']} ||||||||", flush=True)
+        return
+    base = row["classroom"]
+    for mode in MODES:
+        hub = row[mode]
+        server = f"{hub['server_pss_mb']:.0f} + " if mode == "lab" else ""
+        print(
+            f"| {n} | {mode} | {hub['spawn_p50_s']:.1f} / {hub['spawn_p95_s']:.1f} "
+            f"| {hub['per_learner_pss_mb']:.0f} ({server}{hub['dashboard_pss_mb']:.0f} + "
+            f"{hub['shared_pss_mb'] / n:.0f}) "
+            f"| {base['per_learner_pss_mb']:.0f} | {hub['memory_overhead_percent']:+.0f} % "
+            f"| {hub['per_learner_cpu_percent']:.1f} | {base['per_learner_cpu_percent']:.1f} "
+            f"| {hub['cpu_overhead_core_percent']:+.1f} |",
+            flush=True,
+        )
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -168,54 +244,33 @@ def main(argv: list[str] | None = None) -> int:
     LOGS.mkdir(parents=True, exist_ok=True)
 
     print(
-        "| learners | spawn→ready p50 / p95 s | hub learner PSS MB (server + dashboard + shared/N) "
+        "| learners | mode | spawn→ready p50 / p95 s "
+        "| hub learner PSS MB ([server +] dashboard + shared/N) "
         "| classroom learner PSS MB | memory overhead | hub learner CPU % | classroom CPU % "
         "| CPU overhead (% of a core) |",
         flush=True,
     )
-    print("|---|---|---|---|---|---|---|---|", flush=True)
+    print("|---|---|---|---|---|---|---|---|---|", flush=True)
     rows: list[dict[str, Any]] = []
     for n in counts:
-        row: dict[str, Any] = {"learners": n}
-        reason = _room_for(n)
-        if reason:
-            row["error"] = reason
-        else:
-            try:
-                hub = hub_class(n, args.seconds)
-                base = classroom_class(n, args.seconds)
-                row.update(hub=hub, classroom=base)
-                row["memory_overhead_percent"] = 100.0 * (
-                    hub["per_learner_pss_mb"] / base["per_learner_pss_mb"] - 1.0
-                )
-                row["cpu_overhead_core_percent"] = (
-                    hub["per_learner_cpu_percent"] - base["per_learner_cpu_percent"]
-                )
-            except Exception as error:  # a failure row, with the reason
-                row["error"] = f"{type(error).__name__}: {error}"[:500]
+        row = _measure(n, args.seconds)
         rows.append(row)
-        if "error" in row:
-            print(f"| {n} | failed: {row['error']} |||||||", flush=True)
-            continue
-        hub, base = row["hub"], row["classroom"]
-        print(
-            f"| {n} | {hub['spawn_p50_s']:.1f} / {hub['spawn_p95_s']:.1f} "
-            f"| {hub['per_learner_pss_mb']:.0f} ({hub['server_pss_mb']:.0f} + "
-            f"{hub['dashboard_pss_mb']:.0f} + {hub['shared_pss_mb'] / n:.0f}) "
-            f"| {base['per_learner_pss_mb']:.0f} | {row['memory_overhead_percent']:+.0f} % "
-            f"| {hub['per_learner_cpu_percent']:.1f} | {base['per_learner_cpu_percent']:.1f} "
-            f"| {row['cpu_overhead_core_percent']:+.1f} |",
-            flush=True,
-        )
+        _print_row(row)
     good = [r for r in rows if "error" not in r]
     result: dict[str, Any] = {"seconds": args.seconds, "rows": [_deep_round(r) for r in rows]}
     if good:
         largest = max(good, key=lambda r: r["learners"])
+        lean, lab = largest["lean"], largest["lab"]
         result.update(
-            hub_spawn_p50_s=largest["hub"]["spawn_p50_s"],
-            hub_spawn_p95_s=largest["hub"]["spawn_p95_s"],
-            hub_memory_overhead_percent=largest["memory_overhead_percent"],
-            hub_cpu_overhead_core_percent=largest["cpu_overhead_core_percent"],
+            hub_mode="lean",
+            hub_spawn_p50_s=lean["spawn_p50_s"],
+            hub_spawn_p95_s=lean["spawn_p95_s"],
+            hub_memory_overhead_percent=lean["memory_overhead_percent"],
+            hub_cpu_overhead_core_percent=lean["cpu_overhead_core_percent"],
+            hub_lab_spawn_p50_s=lab["spawn_p50_s"],
+            hub_lab_spawn_p95_s=lab["spawn_p95_s"],
+            hub_lab_memory_overhead_percent=lab["memory_overhead_percent"],
+            hub_lab_cpu_overhead_core_percent=lab["cpu_overhead_core_percent"],
             hub_learners_measured=largest["learners"],
         )
     else:

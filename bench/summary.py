@@ -372,6 +372,14 @@ ROWS += (
         lambda v: v >= 0.9,
     ),
     (
+        "The same with the 31 TF frames' names and axes shown (as the view opens)",
+        "urdf_draw",
+        "urdf_draw_with_frames_ratio",
+        "x",
+        "",
+        None,
+    ),
+    (
         "30-link URDF at 50 Hz: robot poses shown per second, 3D view / plain viser scene",
         "urdf_draw",
         "dashboard_moves_per_s|baseline_moves_per_s",
@@ -544,6 +552,25 @@ def last_json(output: str) -> dict[str, Any] | None:
 BENCH_TIMEOUT_SEC = 300
 
 
+def failure_reason(returncode: int, stdout: str, stderr: str) -> str:
+    """Why a benchmark failed, in its own words: its ``FAILED:`` lines on stdout.
+
+    Only when it printed none (it crashed) the last line of stderr, which then
+    holds the exception. '' for a benchmark that exited 0 and reported no failure.
+    """
+    said = [
+        line.strip()[len("FAILED:") :].strip()
+        for line in stdout.splitlines()
+        if line.strip().startswith("FAILED:")
+    ]
+    if said:
+        return "; ".join(said)
+    if returncode == 0:
+        return ""
+    last = (stderr.strip().splitlines() or [""])[-1].strip()
+    return f"exit code {returncode}" + (f": {last[:160]}" if last else "")
+
+
 def run_one(name: str, args: list[str]) -> tuple[dict[str, Any] | None, float, str]:
     """Run one benchmark in its own session; (figures, seconds, why it failed or '')."""
     print(f"\n== {name} {' '.join(args)}", flush=True)
@@ -556,20 +583,21 @@ def run_one(name: str, args: list[str]) -> tuple[dict[str, Any] | None, float, s
         text=True,
         start_new_session=True,  # a timeout ends its whole group, not just the first process
     )
-    failure = ""
+    timed_out = ""
     try:
         stdout, stderr = proc.communicate(timeout=BENCH_TIMEOUT_SEC)
     except subprocess.TimeoutExpired:
         os.killpg(proc.pid, signal.SIGKILL)
         stdout, stderr = proc.communicate()
-        failure = f"timed out after {BENCH_TIMEOUT_SEC} s"
+        timed_out = f"timed out after {BENCH_TIMEOUT_SEC} s"
     elapsed = time.monotonic() - t0
     lines = stdout.strip().splitlines()
     print("\n".join(lines[-8:]), flush=True)
     if proc.returncode != 0:
         print(f"(failed with code {proc.returncode})\n{stderr[-2000:]}", flush=True)
-        last = (stderr.strip().splitlines() or [f"exit code {proc.returncode}"])[-1]
-        failure = failure or f"exit code {proc.returncode}: {last[:120]}"
+    failure = "; ".join(
+        w for w in (timed_out, failure_reason(proc.returncode, stdout, stderr)) if w
+    )
     left = end_leftovers(os.environ[MARK]) if MARK in os.environ else []
     if left:
         print("left running (killed now):\n" + "\n".join(left), flush=True)
@@ -578,6 +606,32 @@ def run_one(name: str, args: list[str]) -> tuple[dict[str, Any] | None, float, s
     if figures is None and not failure:
         failure = "printed no figures"
     return figures, elapsed, failure
+
+
+def _number(value: Any) -> bool:
+    return isinstance(value, int | float) and not (isinstance(value, float) and math.isnan(value))
+
+
+def required_keys(bench: str) -> set[str]:
+    """The figures of ``bench`` that must be there: its headline ones and those with an aim."""
+    keys = {key for b, key in HEADLINE.values() if b == bench}
+    for _label, row_bench, key, _unit, _aim, test in ROWS:
+        if row_bench == bench and test is not None:
+            keys.add(key.split("|")[0])
+    return keys
+
+
+def missing_figures(results: dict[str, dict[str, Any]], failures: dict[str, str]) -> dict[str, str]:
+    """``failures`` plus every benchmark that ran but left a required figure NaN or missing.
+
+    The reason is the benchmark's own (its FAILED: lines), else which figures are missing.
+    """
+    out = dict(failures)
+    for bench, figures in results.items():
+        missing = sorted(k for k in required_keys(bench) if not _number(figures.get(k)))
+        if missing and bench not in out:
+            out[bench] = f"no value for {', '.join(missing)} (NaN or missing, no reason given)"
+    return out
 
 
 def cell(figures: dict[str, Any], key: str) -> tuple[str, float | None]:
@@ -622,6 +676,13 @@ def markdown(
                 )
             continue
         text, value = cell(results[bench], key)
+        if value is None and key.split("|")[0] in required_keys(bench):
+            # A headline figure or one with an aim, NaN or missing: failed, with the reason.
+            why = failures.get(bench, "no value, and no reason given").replace("|", "/")
+            lines.append(
+                f"| {label} | FAILED: not measured ({bench}: {why}) | {unit} | {aim} | **no** |"
+            )
+            continue
         met = "" if test is None else "**no** (not measured)" if value is None else ""
         met = met or ("" if test is None or value is None else "yes" if test(value) else "**no**")
         lines.append(f"| {label} | {text} | {unit} | {aim} | {met} |")
@@ -654,6 +715,7 @@ def main(argv: list[str] | None = None) -> int:
             results[name] = figures
         if failure:
             failures[name] = failure
+    failures = missing_figures(results, failures)
     text = markdown(results, times, failures)
     print("\n" + text)
     if not args.no_write:

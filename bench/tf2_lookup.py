@@ -214,14 +214,18 @@ def role_listener(kind: str, seconds: float) -> None:
     if kind == "tf2":
         from tf2_ros import Buffer, TransformListener
 
-        class CountingListener(TransformListener):
-            """The real listener; only counts what it hands to the buffer."""
+        class CountingBuffer(Buffer):
+            """The real buffer; only counts the transforms the listener hands it.
 
-            def callback(self, data: TFMessage) -> None:
-                count[0] += len(data.transforms)
-                super().callback(data)
+            The listener reads /tf's bytes itself (tf2_ros._wire) and gives the
+            buffer each message's transforms at once, through ``_set_entries``.
+            """
 
-        alive.append(CountingListener(Buffer(), node))  # kept: dropping it unsubscribes
+            def _set_entries(self, entries: list[Any], authority: str, is_static: bool) -> None:
+                count[0] += len(entries)
+                super()._set_entries(entries, authority, is_static)
+
+        alive.append(TransformListener(CountingBuffer(), node))  # kept: dropping it unsubscribes
     else:
         size = RATE_HZ * CACHE_S
         store: dict[str, np.ndarray] = {}

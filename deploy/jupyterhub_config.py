@@ -1,11 +1,22 @@
 """JupyterHub on one server with ROS 2 Classroom: `jupyterhub -f deploy/jupyterhub_config.py`.
 
-Run it from the project's venv (`make setup` installs jupyterhub, the proxy
-and the project). Each learner logs in with their system account (PAM),
-gets their own single-user server running as that account (JupyterHub's
-LocalProcessSpawner), and lands in the Classroom at /user/<name>/ros2-classroom/.
-Every learner gets a ROS domain id of their own from ClassroomLocalSpawner's
-pool, so nobody sees another's nodes on this machine's loopback.
+Run it from the project's venv (`make setup` installs jupyterhub, JupyterLab,
+the proxy and the project). Each learner logs in with their system account
+(PAM) and gets their own single-user server running as that account
+(JupyterHub's LocalProcessSpawner). Every learner gets a ROS domain id of
+their own from the spawner's pool, so nobody sees another's nodes on this
+machine's loopback.
+
+Which single-user server, chosen by $CLASSROOM_SINGLEUSER:
+
+  dashboard (default, recommended for a class): the dashboard itself is the
+      learner's server at /user/<name>/, logging them in with the hub's OAuth
+      (app/hub/singleuser_auth.py). The smallest footprint: about the memory
+      of a `classroom` learner (bench/results/hub_spawn.md).
+  lab: JupyterLab at /user/<name>/lab; its launcher's "ROS 2 Classroom" tile
+      opens the dashboard at /user/<name>/ros2-classroom/ in a new tab
+      (jupyter-server-proxy, app/hub/server_proxy.py). Learners also get
+      notebooks, terminals and a file browser, for ~105 MB more each.
 
 Teachers are hub admins and members of the hub group named by
 $CLASSROOM_TEACHERS_GROUP (default "teachers"); they open the teacher's page
@@ -20,6 +31,7 @@ Settings through the environment (all optional):
   CLASSROOM_TEACHER_PORT      the teacher service's loopback port (default 10101)
   CLASSROOM_SAME_ACCOUNT=1    no system user per learner: every server runs as
                               the hub's account with its own HOME (trying it out)
+  CLASSROOM_SINGLEUSER        dashboard (default) or lab, see above
 """
 
 import os
@@ -33,6 +45,7 @@ SERVICE = "classroom-teacher"
 TEACHERS = os.environ.get("CLASSROOM_TEACHERS_GROUP", "teachers")
 SERVICE_PORT = int(os.environ.get("CLASSROOM_TEACHER_PORT", "10101"))
 SERVICE_URL = f"http://127.0.0.1:{SERVICE_PORT}"
+SINGLEUSER = os.environ.get("CLASSROOM_SINGLEUSER", "dashboard")
 
 
 def _names(var):
@@ -45,15 +58,20 @@ c.ConfigurableHTTPProxy.command = [
     str(ROOT / "app" / "hub" / "proxy" / "node_modules" / ".bin" / "configurable-http-proxy")
 ]
 
-# Learners: system accounts; the single-user server of this venv, opening the Classroom.
+# Learners: system accounts; a single-user server from this venv.
 c.Authenticator.admin_users = _names("CLASSROOM_HUB_ADMINS")
 c.Authenticator.allow_all = True  # every account that logs in; narrow with allowed_users
 if os.environ.get("CLASSROOM_SAME_ACCOUNT") == "1":
     c.JupyterHub.spawner_class = "app.hub.spawner.ClassroomLocalSpawner"
 else:
     c.JupyterHub.spawner_class = "app.hub.spawner.ClassroomSystemUserSpawner"
-c.Spawner.cmd = [sys.executable, "-m", "jupyterhub.singleuser"]
-c.Spawner.default_url = "/ros2-classroom/"
+if SINGLEUSER == "dashboard":
+    c.Spawner.cmd = [sys.executable, "-m", "app", "serve", "--jupyterhub"]
+elif SINGLEUSER == "lab":
+    c.Spawner.cmd = [sys.executable, "-m", "jupyterhub.singleuser"]
+    c.Spawner.default_url = "/lab"  # the launcher, with its "ROS 2 Classroom" tile
+else:
+    raise ValueError(f"CLASSROOM_SINGLEUSER must be dashboard or lab, not {SINGLEUSER!r}")
 c.Spawner.start_timeout = 120
 c.Spawner.http_timeout = 120
 c.Spawner.environment = {

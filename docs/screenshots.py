@@ -194,6 +194,35 @@ def turtlesim_drive(page: Page) -> None:
     stage_turtlesim(page)
 
 
+def _console(page: Page, command: str, shown: str) -> None:
+    _tool(page, "Console")
+    field = page.get_by_text("Command", exact=True).locator("visible=true").first
+    field.locator("xpath=ancestor::div[contains(@class,'mantine-Flex-root')][1]//input").fill(
+        command
+    )
+    page.get_by_role("button", name="Run", exact=True).click()
+    expect(_shown(page, shown)).to_be_visible(timeout=60_000)
+
+
+def tf_panel(page: Page) -> None:
+    """The TF tab: a static and a dynamic broadcaster typed in the Console, and tf2_echo."""
+    _console(
+        page,
+        "ros2 run tf2_ros static_transform_publisher --x 1 --y 2 --yaw 1.5707963 "
+        "--frame-id world --child-frame-id turtle1",
+        "[exit code 0]",
+    )
+    _console(page, "ros2 run turtle_tf2_py fixed_frame_tf2_broadcaster", "[exit code 0]")
+    _choose(page, "On stage", "3D scene")
+    _tool(page, "TF")
+    expect(_shown(page, "3 frames in 1 tree")).to_be_visible(timeout=60_000)
+    expect(_shown(page, "- Translation: [-1.000, 2.000")).to_be_visible(timeout=30_000)
+    page.wait_for_timeout(1500)
+    page.screenshot(path=str(IMAGES / "tf_panel.png"))
+    _console(page, "ros2 run --stop /fixed_frame_tf2_broadcaster", "stopped")
+    _console(page, "ros2 run --stop /static_transform_publisher", "stopped")
+
+
 def _start(page: Page, node: str) -> None:
     _tool(page, "Nodes")
     _choose(page, "Catalog node", node)
@@ -262,7 +291,7 @@ def learner_dashboard(browser: Browser, env: dict[str, str], tmp: str) -> None:
         page = _open(browser, f"http://127.0.0.1:{PORT}/")
         try:
             takes = (topics_lesson, stage_graph, live_graph, lifecycle_drawing, turtlesim_drive)
-            takes += (stage_tf, exercise_graded)
+            takes += (stage_tf, exercise_graded, tf_panel)
             for take in (*takes, arm_scene):  # the scene folds the code away
                 take(page)
         except Exception:

@@ -12,7 +12,7 @@ zero (the latest common time), TransformException when a frame is missing.
 
 import math
 
-from geometry_msgs.msg import Twist
+from geometry_msgs.msg import TransformStamped, Twist
 from rclpy.node import Node
 from rclpy.task import Future
 from rclpy.time import Time
@@ -46,6 +46,10 @@ class FrameListener(Node):
         # Call on_timer function every second
         self.timer = self.create_timer(1.0, self.on_timer)
 
+    def lookup(self, to_frame_rel: str, from_frame_rel: str) -> TransformStamped:
+        """The latest transform (time zero); the "Using time" tutorials change only this call."""
+        return self.tf_buffer.lookup_transform(to_frame_rel, from_frame_rel, Time())
+
     def on_timer(self) -> None:
         # Store frame names in variables that will be used to
         # compute transformations
@@ -56,7 +60,7 @@ class FrameListener(Node):
                 # Look up for the transformation between target_frame and turtle2 frames
                 # and send velocity commands for turtle2 to reach target_frame
                 try:
-                    t = self.tf_buffer.lookup_transform(to_frame_rel, from_frame_rel, Time())
+                    t = self.lookup(to_frame_rel, from_frame_rel)
                 except TransformException as ex:
                     self.get_logger().info(
                         f"Could not transform {to_frame_rel} to {from_frame_rel}: {ex}"

@@ -2,7 +2,8 @@
 
 Usage (``sandbox.contained_argv`` builds it)::
 
-    python /path/to/contain.py --scratch DIR [--hide DIR ...] [limits] -- SCRIPT [ARGS...]
+    python /path/to/contain.py --scratch DIR [--write DIR ...] [--hide DIR ...] [--no-ros]
+        [limits] -- SCRIPT [ARGS...]
 
 Started by path, never with ``-m`` from the scratch folder: ``-m`` puts the
 working directory first on ``sys.path``, so a learner's ``app/`` folder there
@@ -15,14 +16,17 @@ Before the learner's first line, in this order:
 1. rlimits: CPU seconds, address space, processes, file size, open files.
 2. Landlock (Linux 6.12+, ABI 6): everything readable except the hidden
    folders and the home folders (Python's own files there stay readable),
-   only the scratch folder (and /dev/null) writable, no TCP bind or connect,
-   no signals and no abstract Unix sockets beyond this sandbox.
+   only the scratch folder, the ``--write`` folders (a build's build/,
+   install/ and log/) and /dev/null writable, no TCP bind or connect, no
+   signals and no abstract Unix sockets beyond this sandbox.
 3. Identity: from root to a uid of its own (``UID_BASE + pid``). The process
    limit counts per uid, so it counts exactly this sandbox; the learner holds
    no capability and root-only files stay closed to it.
 4. DDS: join the ROS graph now (``rclpy.init`` and a hidden node keep the
    participant and its UDP sockets, all on 127.0.0.1, alive); pin those
    sockets to ``lo``; the learner's own ``rclpy.init()`` becomes a no-op.
+   ``--no-ros`` (a colcon build, the editor's completion worker): no
+   participant, so no socket but Unix ones at all.
 5. seccomp on every thread: no new sockets but AF_UNIX, no ``sendmsg`` (its
    IP_PKTINFO could send a loopback socket's datagram out of another
    interface; Fast DDS itself sends with ``sendto``), no io_uring, ptrace or
@@ -176,12 +180,19 @@ def python_paths() -> list[str]:
 
 
 def _unreachable(path: str) -> str | None:
-    """The first folder on the way to ``path`` that the sandbox user may not enter."""
+    """The first folder on the way to ``path`` that the sandbox user may not enter.
+
+    It enters a folder open to others, or one of the sandbox group (a
+    learner's scratch folder, their workspace on a served dashboard).
+    """
     folder = "/"
     for part in [""] + path.strip("/").split("/"):
         folder = os.path.join(folder, part)
-        mode = os.stat(folder).st_mode
-        if not mode & stat.S_IXOTH:
+        info = os.stat(folder)
+        if not (
+            info.st_mode & stat.S_IXOTH
+            or (info.st_gid == SANDBOX_GID and info.st_mode & stat.S_IXGRP)
+        ):
             return folder
     return None
 
@@ -328,7 +339,7 @@ def _add_rule(ruleset: int, path: str, access: int) -> None:
         os.close(fd)
 
 
-def _landlock(scratch: str, hidden: Sequence[str]) -> None:
+def _landlock(scratch: str, hidden: Sequence[str], writable: Sequence[str] = ()) -> None:
     abi = landlock_abi()
     if abi < MIN_LANDLOCK_ABI:
         raise SandboxError(f"Landlock ABI {abi} < {MIN_LANDLOCK_ABI}")
@@ -343,7 +354,8 @@ def _landlock(scratch: str, hidden: Sequence[str]) -> None:
         for place in python_paths():
             for path in _readable(hidden, place):
                 _add_rule(ruleset, path, _READ)
-        _add_rule(ruleset, scratch, fs)
+        for folder in (scratch, *writable):
+            _add_rule(ruleset, folder, fs)
         for device in _WRITABLE_DEVICES:
             _add_rule(ruleset, device, _LL_READ_FILE | _LL_WRITE_FILE | _LL_TRUNCATE)
         _syscall(_SYS_LANDLOCK_RESTRICT_SELF, ruleset, 0)
@@ -638,6 +650,12 @@ def _parse(argv: Sequence[str]) -> argparse.Namespace:
     parser = argparse.ArgumentParser(prog="contain", description=__doc__.split("\n")[0])
     parser.add_argument("--scratch", required=True, help="the only writable folder")
     parser.add_argument("--hide", action="append", default=[], help="a folder it may not read")
+    parser.add_argument(
+        "--write", action="append", default=[], help="another folder it may write (a build's)"
+    )
+    parser.add_argument(
+        "--no-ros", action="store_true", help="join no ROS graph: no socket but Unix ones"
+    )
     parser.add_argument("--cpu-seconds", type=int, default=300)
     parser.add_argument("--memory-bytes", type=int, default=2 * 1024**3)
     parser.add_argument("--processes", type=int, default=64)
@@ -658,18 +676,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     scratch = os.path.realpath(args.scratch)
     script = os.path.realpath(args.script)
     hidden = [os.path.realpath(h) for h in args.hide]
+    writable = [os.path.realpath(w) for w in args.write]
     _Learner.limits, _Learner.script, _Learner.scratch = args, script, scratch
     if sys.path and os.path.realpath(sys.path[0]) == os.path.dirname(os.path.realpath(__file__)):
         del sys.path[0]  # our own folder: not the learner's business
 
-    if blocked := _unreachable(os.path.dirname(scratch)):
-        raise SandboxError(f"the sandbox user cannot enter {blocked} to reach {scratch}")
+    for folder in (scratch, *writable):
+        if blocked := _unreachable(os.path.dirname(folder)):
+            raise SandboxError(f"the sandbox user cannot enter {blocked} to reach {folder}")
 
     # As root: tidy up, open the scratch folder to the sandbox group, read the script.
     kill_processes(sandbox_processes())  # what SIGKILLed launchers left behind
     kill_processes(sandbox_processes(os.getpid()))  # a former launcher with our pid
     try:
-        _open_scratch_to_group(scratch)
+        for folder in (scratch, *writable):
+            _open_scratch_to_group(folder)
         source = _read_script(script)
     except OSError as exc:
         raise SandboxError(str(exc)) from None
@@ -677,12 +698,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     _set_limits(args)
     if _libc.prctl(_PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) != 0:
         raise SandboxError("prctl(PR_SET_NO_NEW_PRIVS) failed")
-    _landlock(scratch, hidden)
+    _landlock(scratch, hidden, writable)
     _become_sandbox_user(parent)
     os.umask(0o007)
     _environment(scratch, args.dds_profile)
     learner_argv = [script, *args.args]
-    _join_ros_graph(learner_argv)
+    if not args.no_ros:
+        _join_ros_graph(learner_argv)
     _pin_sockets_to_loopback()
     _seccomp()
 

@@ -12,8 +12,8 @@ from __future__ import annotations
 from typing import Any
 
 from app.exercises.model import Exercise
-from app.exercises.probes import PROBE_DRAWS
-from app.exercises.probes.base import is_range, range_text
+from app.exercises.probes import PROBES
+from app.exercises.probes.base import is_drawn, range_text
 from app.lessons.kinds import CHECKS
 from app.lessons.schema import Spec
 
@@ -25,7 +25,7 @@ HOW_INPUTS_ARE_DRAWN = (
 
 
 def _field_text(value: Any) -> str:
-    if is_range(value):
+    if is_drawn(value):
         return range_text(value)
     if isinstance(value, dict):
         return "{" + ", ".join(f"{k}: {_field_text(v)}" for k, v in value.items()) + "}"
@@ -45,7 +45,7 @@ def drawn_fields(spec: Spec) -> list[str]:
     found: list[str] = []
 
     def walk(value: Any, path: str) -> None:
-        if is_range(value):
+        if is_drawn(value):
             found.append(path)
         elif isinstance(value, dict):
             for key, inner in value.items():
@@ -54,8 +54,8 @@ def drawn_fields(spec: Spec) -> list[str]:
     walk(spec.fields, "")
     if "walk" in spec.fields:
         found = [f for f in found if f != "walk"] + ["the order of lifecycle requests"]
-    if spec.kind in PROBE_DRAWS:
-        found.append(PROBE_DRAWS[spec.kind])
+    if spec.kind in PROBES and PROBES[spec.kind].draws:
+        found.append(PROBES[spec.kind].draws)
     return found
 
 
@@ -68,9 +68,10 @@ def explain(exercise: Exercise) -> list[str]:
         words = CHECKS[check.kind].words if check.kind in CHECKS else ""
         lines.append(f"check  {spec_line(check)}" + (f" ({words})" if words else ""))
     for probe in exercise.probes:
-        lines.append(f"probe  {spec_line(probe)}")
-        if probe.kind in PROBE_DRAWS:
-            lines.append(f"       draws {PROBE_DRAWS[probe.kind]}")
+        kind = PROBES[probe.kind]
+        lines.append(f"probe  {spec_line(probe)} ({kind.words})")
+        if kind.draws:
+            lines.append(f"       draws {kind.draws}")
     lines.append(HOW_INPUTS_ARE_DRAWN)
     return lines
 

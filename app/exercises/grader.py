@@ -10,9 +10,10 @@ handed to ``on_result`` as they come, so a page can show progress.
 
 from __future__ import annotations
 
+import dataclasses
 import random
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from rclpy.node import Node
@@ -26,7 +27,7 @@ from app.lessons.schema import LEARNER_PROGRAM, Spec
 from app.ros.context import CallContext, Limits
 from app.ros.errors import Cancelled
 from app.ros.graph import snapshot
-from app.supervisor import Supervisor
+from app.supervisor import LearnerProgram, Supervisor
 
 # A check that has not passed by then fails with its last reason; a rate check
 # needs about 4 s of messages after discovery, with room for a loaded machine.
@@ -50,6 +51,45 @@ def _check_name(check: Spec) -> str:
         who = "your node" if who == LEARNER_PROGRAM else who
         return f"log of {who} contains {check.get('text')!r}"
     return f"{check.kind.replace('_', ' ')} {subject}".strip()
+
+
+class _Programs:
+    """The grading's processes, for probes that restart the learner's program (``Programs``).
+
+    A restart keeps how the program was started (contained or not, a launch
+    file through ros2 launch) and appends the arguments.
+    """
+
+    def __init__(self, supervisor: Supervisor, exercise: Exercise) -> None:
+        self.supervisor, self.exercise = supervisor, exercise
+        entry = supervisor.program(exercise.program_name)
+        self.entry = entry if isinstance(entry, LearnerProgram) else None
+
+    def restart_learner(self, args: Sequence[str]) -> None:
+        if self.entry is None:
+            raise ValueError("the learner's program was not started by this supervisor")
+        name = self.exercise.program_name
+        self.supervisor.stop(name).result()
+        argv = (*self.entry.argv, *args)
+        self.supervisor.start_program(dataclasses.replace(self.entry, argv=argv))
+
+    def learner_alive(self) -> bool:
+        status = runner.status(self.supervisor, self.exercise)
+        return status is not None and status.active
+
+    def learner_output(self) -> list[str]:
+        return runner.output(self.supervisor, self.exercise)
+
+    def stop_setup(self) -> None:
+        for future in [self.supervisor.stop(name) for name in self.exercise.setup]:
+            future.result()
+
+    def start_setup(self) -> None:
+        for name in self.exercise.setup:
+            self.supervisor.start(name)
+
+    def setup_output(self) -> dict[str, list[str]]:
+        return {name: self.supervisor.output(name) for name in self.exercise.setup}
 
 
 class Grader:
@@ -96,7 +136,16 @@ class Grader:
             for check in exercise.checks:
                 passed, detail = wait_check(check, CHECK_WAIT_SEC)
                 record(Result(_check_name(check), passed, detail))
-            probe_ctx = ProbeContext(call, exercise.node, wait_check, random.Random(seed), seed)
+            programs = _Programs(self.supervisor, exercise)
+            probe_ctx = ProbeContext(
+                call,
+                exercise.node,
+                wait_check,
+                random.Random(seed),
+                seed,
+                programs,
+                exercise.example,
+            )
             for probe in exercise.probes:
                 record(run_probe(probe_ctx, probe))
                 if not self._alive(exercise):

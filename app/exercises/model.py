@@ -12,6 +12,7 @@ each one. The grading logic lives in ``app.exercises.grader`` and
 
 from __future__ import annotations
 
+import copy
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,7 +24,7 @@ except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib
 
 from app.catalog import ENTRIES
-from app.exercises.probes import PROBE_KINDS
+from app.exercises.probes import PROBE_KINDS, PROBES
 from app.lessons.kinds import CHECK_KINDS
 from app.lessons.schema import LESSONS_DIR, LessonError, Spec, inside, parse_spec
 
@@ -113,7 +114,8 @@ def _probe(raw: Any, where: str) -> Spec:
     unknown = fields.keys() - required - optional
     if unknown:
         raise ExerciseError(f"{where}: probe '{kind}' has unknown field '{sorted(unknown)[0]}'")
-    return Spec(kind, fields)
+    # The kind's defaults (its ranges among them) fill in what the file leaves out.
+    return Spec(kind, {**copy.deepcopy(PROBES[kind].defaults), **fields})
 
 
 def load_exercise(directory: Path) -> Exercise:

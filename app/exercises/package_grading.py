@@ -11,8 +11,10 @@ fails, an executable that was never installed, a launch file left out of
 ``data_files`` are what the learner reads, never a crash. Then the usual
 checks and probes run on the live graph (``app.exercises.grader``).
 
-A build runs the learner's setup.py, i.e. their code: it happens only where
-their other code may run uncontained (the learner's own machine).
+A build runs the learner's setup.py, i.e. their code: it follows the rule for
+their other code. On their own machine it runs as they would run it; on a
+dashboard served to other machines only with the teacher's consent, and then
+contained (the build, and the node it installed).
 """
 
 from __future__ import annotations
@@ -30,8 +32,9 @@ from app.exercises.grader import Grader
 from app.exercises.model import Exercise, package_files
 from app.exercises.report import Report, Result
 from app.exercises.runner import RunPolicy, RunRefused
-from app.learner_ws import build, folder
+from app.learner_ws import build, folder, served
 from app.learner_ws.folder import BuildLimits, LearnerWorkspace
+from app.ros.errors import Ros2Error
 from app.supervisor import LearnerProgram, Supervisor
 
 # An exercise package (ament_python) builds in a few seconds; a setup.py that loops does not.
@@ -53,10 +56,15 @@ def _copy_package(source: Path, workspace: Path) -> Path:
     return target
 
 
-def _build(supervisor: Supervisor, exercise: Exercise, ws: LearnerWorkspace) -> Result:
+def _build(
+    supervisor: Supervisor, exercise: Exercise, ws: LearnerWorkspace, policy: RunPolicy
+) -> Result:
     """colcon build in the grader's workspace, waited for; the result names what failed."""
     name = f"{build.PROGRAM_PREFIX}exercise:{exercise.slug}"
-    program = dataclasses.replace(build.colcon_program(ws, ["build"]), name=name)
+    try:
+        program = dataclasses.replace(served.colcon_program(ws, ["build"], policy), name=name)
+    except build.BuildRefused as exc:
+        return Result("colcon build", False, str(exc))
     started = time.monotonic()
     supervisor.start_program(program)
     while supervisor.status(name).active:
@@ -78,6 +86,10 @@ def _build(supervisor: Supervisor, exercise: Exercise, ws: LearnerWorkspace) -> 
     seconds = time.monotonic() - started
     if status.exit_code == 0 and (ws.root / "install" / exercise.package).is_dir():
         return Result("colcon build", True, f"{exercise.package} built in {seconds:.1f} s")
+    unread = any("package identification" in line and "ERROR" in line for line in lines)
+    if status.exit_code == 0 and unread:  # colcon skipped the package: its setup.py failed
+        shown = "\n".join(build.build_errors(lines, ws)[:STDERR_LINES])
+        return Result("colcon build", False, f"colcon could not read your setup.py:\n{shown}")
     if status.exit_code == 0:
         return Result(
             "colcon build",
@@ -86,37 +98,10 @@ def _build(supervisor: Supervisor, exercise: Exercise, ws: LearnerWorkspace) -> 
             f"{exercise.package}?); it built: "
             + (", ".join(p.name for p in (ws.root / "install").iterdir() if p.is_dir()) or "none"),
         )
-    shown = "\n".join(build_errors(lines)[:STDERR_LINES])
+    shown = "\n".join(build.build_errors(lines, ws)[:STDERR_LINES])
     return Result(
         "colcon build", False, f"the build failed (exit code {status.exit_code}):\n{shown}"
     )
-
-
-def build_errors(lines: list[str]) -> list[str]:
-    """What of colcon's output is about the learner's files: frames inside colcon,
-    setuptools or Python itself are left out, long lines are cut.
-
-    colcon runs setup.py's text, so its frames read ``File "<string>", line N``:
-    that is setup.py's line N.
-    """
-    kept: list[str] = []
-    inside_tools = False
-    for line in lines:
-        text = line.strip()
-        if text.startswith('File "'):
-            inside_tools = "/site-packages/" in text or "/lib/python3" in text
-            if inside_tools:
-                continue
-        elif inside_tools and line.startswith("    "):
-            continue  # the source line (and its ^^^ marks) of a tools' frame
-        else:
-            inside_tools = False
-        if not text or set(text) <= set("^~ ") or text.startswith(("Traceback", "Starting >>>")):
-            continue
-        kept.append(line if len(line) <= 160 else line[:157] + "...")
-    if any('File "<string>"' in line for line in kept):
-        kept.append('(File "<string>", line N: colcon ran setup.py, so that is setup.py\'s line N)')
-    return kept
 
 
 def _python_dirs(prefix: Path) -> list[str]:
@@ -153,13 +138,17 @@ def _program(exercise: Exercise, ws: LearnerWorkspace, policy: RunPolicy) -> Lea
                 + f" in lib/{exercise.package}; `ros2 run` needs a console_scripts line "
                 f"'{exercise.run} = {exercise.package}.MODULE:main' in setup.py"
             )
-        return LearnerProgram(
+        program = LearnerProgram(
             exercise.program_name,
             exercise.node,
             (str(path),),
             ws.root,
             env=_sourced_env(prefix),
         )
+        try:
+            return served.node_program(ws, program, policy)
+        except Ros2Error as exc:
+            raise RunRefused(str(exc)) from None
     share = prefix / "share" / exercise.package
     found = sorted(share.rglob(exercise.launch)) if share.is_dir() else []
     if not found:
@@ -200,21 +189,21 @@ def grade_package(
         if on_result is not None:
             on_result(result)
 
-    if not policy.allowed or policy.contained:
-        return Report(
-            exercise.slug,
-            problem=policy.refusal()
-            if not policy.allowed
-            else "a package exercise builds your package with colcon, which runs your setup.py "
-            "uncontained: grade it on your own machine's dashboard",
-            seed=seed,
-        )
+    if not policy.allowed:
+        return Report(exercise.slug, problem=policy.refusal(), seed=seed)
     if not (source / "package.xml").is_file():
         return Report(exercise.slug, problem=f"{source} is not a package folder (no package.xml)")
     limits = BuildLimits(seconds=BUILD_SECONDS, disk_bytes=DISK_BYTES)
-    workspace = LearnerWorkspace(scratch / f"{exercise.slug}_ws", limits=limits)
+    group = None
+    if policy.contained:  # served: built and run like the learner's other code, contained
+        from app.exercises.contain import SANDBOX_GID
+
+        group = SANDBOX_GID
+    workspace = LearnerWorkspace(
+        scratch / f"{exercise.slug}_ws", remote=policy.contained, limits=limits, group=group
+    )
     _copy_package(source, workspace.root)
-    built = _build(supervisor, exercise, workspace.ensure())
+    built = _build(supervisor, exercise, workspace.ensure(), policy)
     record(built)
     if not built.passed:
         return Report(exercise.slug, results, seed=seed)

@@ -1,8 +1,9 @@
 """Exercise tab: the task, Run / Stop / Check, results, hints, diff, reset, solution.
 
 The code itself is edited in the side window's "Your code" tab (an Ace
-editor in an iframe, see ``editor_server``). Run and Check first ask the
-editor to save, so they always use what is on screen. Run, Stop and Check
+editor in an iframe, see ``editor_server``; it also holds the learner's
+workspace files in tabs). Run and Check first ask the editor to save, so
+they always use what is on screen. Run, Stop and Check
 are jobs in one lane: clicks happen in the order made. Check results arrive
 one by one, so a learner sees progress during a slow probe.
 """
@@ -17,7 +18,7 @@ from typing import Any
 
 import viser
 
-from app.exercises import package_grading, runner
+from app.exercises import code_assist, package_grading, runner
 from app.exercises.editor_server import EditorHub, editor_url
 from app.exercises.explain import panel_line
 from app.exercises.grader import Grader
@@ -91,7 +92,12 @@ class ExercisePanel:
         self._open_code = open_code
         self._workspace, self._supervisor, self._grader = workspace, supervisor, grader
         self._hub, self._settings = hub, settings or ExerciseSettings()
-        hub.attach(self._load_code, self._save_code)
+        hub.attach(
+            self._load_code,
+            self._save_code,
+            policy=self._settings.policy,
+            scratch=workspace.scratch,
+        )
         # Open on the exercise of the lesson the learner is in.
         current = workspace.progress.current_lesson() or ""
         mine = book.for_lesson(current)
@@ -205,18 +211,7 @@ class ExercisePanel:
         self._hub.flush(exercise.slug)
         code = self._workspace.code(exercise)
         problems = lint(code, f"{exercise.slug}.py")
-        self._hub.show_problems(
-            exercise.slug,
-            [
-                {
-                    "row": p.line - 1,
-                    "column": p.column,
-                    "text": p.message,
-                    "type": "error" if p.fatal else "warning",
-                }
-                for p in problems
-            ],
-        )
+        self._hub.show_problems(exercise.slug, code_assist.marks(problems))
         if refuses_to_run(problems):
             return RunOutcome(problems, started=False)
         script = self._workspace.script_for_run(exercise)

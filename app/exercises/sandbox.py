@@ -50,15 +50,24 @@ def contained_argv(
     scratch: Path,
     hidden: Sequence[Path],
     limits: SandboxLimits = SandboxLimits(),
+    *,
+    writable: Sequence[Path] = (),
+    ros: bool = True,
 ) -> list[str]:
     """argv that runs ``python script`` contained.
 
     The caller spawns it with Popen, cwd=scratch, its own env; the script's own
-    arguments (e.g. ``--ros-args ...``) may be appended.
+    arguments (e.g. ``--ros-args ...``) may be appended. ``writable``: more
+    folders it may write besides ``scratch``; ``ros=False``: no DDS participant
+    (no IP socket at all).
     """
     argv = [sys.executable, str(LAUNCHER), "--scratch", str(scratch)]
     for folder in hidden:
         argv += ["--hide", str(folder)]
+    for folder in writable:
+        argv += ["--write", str(folder)]
+    if not ros:
+        argv.append("--no-ros")
     argv += [
         f"--cpu-seconds={limits.cpu_seconds}",
         f"--memory-bytes={limits.memory_bytes}",

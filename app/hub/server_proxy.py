@@ -59,5 +59,7 @@ def setup_ros2_classroom() -> dict[str, Any]:
         "timeout": START_TIMEOUT_SEC,
         "absolute_url": False,  # the dashboard sees "/", whatever the hub's base path
         "new_browser_tab": True,
+        # In the launcher's first section: jupyter-server-proxy draws the icon only there
+        # (a "ROS 2" section of its own showed a blank tile at the bottom of the launcher).
         "launcher_entry": {"title": TITLE, "icon_path": str(ICON), "enabled": True},
     }

@@ -30,6 +30,12 @@ from traitlets import Int, Unicode
 from app.dds import MAX_DOMAIN_ID
 
 
+def is_lean(cmd: list[str] | tuple[str, ...]) -> bool:
+    """Whether a spawner's command starts the dashboard itself (deploy/jupyterhub_config.py's
+    lean mode, ``serve --jupyterhub``) rather than a Jupyter server (the lab mode)."""
+    return "--jupyterhub" in cmd and "serve" in cmd
+
+
 class DomainPool:
     """Which ROS domain ids the running servers of this hub hold."""
 
@@ -120,6 +126,8 @@ class ClassroomLocalSpawner(ClassroomSystemUserSpawner, SimpleLocalProcessSpawne
 
     def get_args(self) -> list[str]:
         args = list(super().get_args())
-        if os.geteuid() == 0:  # CI machines run as root; jupyter-server refuses without it
+        # CI machines run as root; jupyter-server refuses that without this (the lean
+        # mode's dashboard, `serve --jupyterhub`, takes no Jupyter options).
+        if os.geteuid() == 0 and not is_lean(self.cmd):
             args.append("--ServerApp.allow_root=True")
         return args

@@ -9,11 +9,13 @@ failing save leaves the previous file.
 from __future__ import annotations
 
 import os
+import secrets
 import shutil
-import tempfile
+import stat
+from dataclasses import dataclass
 from pathlib import Path
 
-from app.learner_ws.folder import LearnerWorkspace
+from app.learner_ws.folder import LearnerWorkspace, OutsideWorkspace
 from app.ros.errors import Ros2Error
 
 MAX_TEXT_BYTES = 200_000
@@ -25,19 +27,59 @@ class FileError(Ros2Error):
     """A file operation the page asked for that cannot be done; one line for the learner."""
 
 
-def write_atomically(path: Path, text: str) -> None:
-    """Temporary file, fsync, rename: a reader sees the old text or the new, never half."""
+NEW_FILE_MODE = 0o644  # as an editor writes under the usual umask: builds (any uid) read it
+_DIR_FLAGS = os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC
+
+
+def _check_inside(ws: LearnerWorkspace, fd: int, shown: str) -> None:
+    """The object ``fd`` opened really is inside the workspace (closes it if not).
+
+    ``confine`` resolved the path a moment ago; on a served dashboard the
+    learner's contained code may swap a folder of build/ for a link meanwhile.
+    The kernel's name for what was actually opened settles it.
+    """
+    real = Path(os.readlink(f"/proc/self/fd/{fd}"))
+    root = ws.root.resolve()
+    if real != root and root not in real.parents:
+        os.close(fd)
+        raise OutsideWorkspace(f"{shown}: outside your workspace (a link changed under it)")
+
+
+def write_atomically(ws: LearnerWorkspace, path: Path, text: str) -> None:
+    """Temporary file, fsync, rename, all through a checked folder descriptor.
+
+    A reader sees the old text or the new, never half; no link swapped in can
+    redirect the write. The file keeps its mode (an executable script stays
+    executable); a new file gets ``NEW_FILE_MODE``, not mkstemp's 0600.
+    """
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}-", dir=path.parent)
+    folder = os.open(path.parent, _DIR_FLAGS)
+    _check_inside(ws, folder, ws.shown(path))
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+        try:
+            info = os.stat(path.name, dir_fd=folder, follow_symlinks=False)
+            mode = stat.S_IMODE(info.st_mode) if stat.S_ISREG(info.st_mode) else NEW_FILE_MODE
+        except FileNotFoundError:
+            mode = NEW_FILE_MODE
+        temporary = f".{path.name}-{secrets.token_hex(4)}"
+        flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC
+        fd = os.open(temporary, flags, mode, dir_fd=folder)
+        try:
+            os.fchmod(fd, mode)  # not narrowed by the umask
+            with os.fdopen(fd, "w", encoding="utf-8") as handle:
+                handle.write(text)
+                handle.flush()
+                os.fsync(handle.fileno())
+            os.replace(temporary, path.name, src_dir_fd=folder, dst_dir_fd=folder)
+        except BaseException:
+            try:
+                os.unlink(temporary, dir_fd=folder)
+            except OSError:
+                pass
+            raise
+        os.fsync(folder)
+    finally:
+        os.close(folder)
 
 
 def tree(ws: LearnerWorkspace, limit: int = MAX_LISTED) -> list[str]:
@@ -60,6 +102,47 @@ def tree(ws: LearnerWorkspace, limit: int = MAX_LISTED) -> list[str]:
     return lines
 
 
+@dataclass(frozen=True)
+class Entry:
+    """One row of a folder listing: its workspace-relative path, and whether it is a folder."""
+
+    path: str
+    folder: bool
+    note: str = ""  # e.g. colcon's output folders
+
+
+def relative(ws: LearnerWorkspace, text: str) -> str:
+    """The confined path of ``text`` relative to the workspace root (``src/pkg/setup.py``)."""
+    path = _inside(ws, text)
+    return path.relative_to(ws.root.resolve()).as_posix()
+
+
+def children(ws: LearnerWorkspace, text: str = "", limit: int = MAX_LISTED) -> list[Entry]:
+    """One folder's entries, folders first, hidden names (``.x``) left out; at most ``limit``.
+
+    A lazy tree for the code editor: a workspace of thousands of files costs
+    one folder at a time, never a walk of the whole tree.
+    """
+    folder = ws.confine(text) if text else ws.root.resolve()
+    if not folder.is_dir():
+        raise FileError(f"{text}: not a folder")
+    root = ws.root.resolve()
+    found: list[Entry] = []
+    with os.scandir(folder) as scan:
+        items = sorted(
+            (e for e in scan if not e.name.startswith(".")),
+            key=lambda e: (not e.is_dir(follow_symlinks=False), e.name),
+        )
+    for item in items[:limit]:
+        path = Path(item.path).relative_to(root).as_posix()
+        is_dir = item.is_dir(follow_symlinks=False)
+        colcons = is_dir and folder == root and item.name in HIDDEN_IN_TREE
+        found.append(Entry(path, is_dir, "colcon's output" if colcons else ""))
+    if len(items) > limit:
+        found.append(Entry("", False, f"... and {len(items) - limit} more"))
+    return found
+
+
 def _inside(ws: LearnerWorkspace, text: str) -> Path:
     path = ws.confine(text.strip())
     if path == ws.root.resolve():
@@ -71,7 +154,7 @@ def create_file(ws: LearnerWorkspace, text: str) -> Path:
     path = _inside(ws, text)
     if path.exists():
         raise FileError(f"{ws.shown(path)} already exists")
-    write_atomically(path, "")
+    write_atomically(ws, path, "")
     return path
 
 
@@ -109,11 +192,20 @@ def delete(ws: LearnerWorkspace, text: str) -> Path:
 
 def read_text(ws: LearnerWorkspace, text: str) -> str:
     path = _inside(ws, text)
-    if not path.is_file():
-        raise FileError(f"{text}: not a file")
-    if path.stat().st_size > MAX_TEXT_BYTES:
-        raise FileError(f"{text} is larger than {MAX_TEXT_BYTES // 1000} kB; open it elsewhere")
-    data = path.read_bytes()
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+    except FileNotFoundError:
+        raise FileError(f"{text}: not a file") from None
+    except OSError as exc:  # a folder, a link swapped in, a fifo...
+        raise FileError(f"{text}: not a file ({exc.strerror})") from None
+    _check_inside(ws, fd, text)
+    with os.fdopen(fd, "rb") as handle:
+        info = os.fstat(handle.fileno())
+        if not stat.S_ISREG(info.st_mode):
+            raise FileError(f"{text}: not a file")
+        if info.st_size > MAX_TEXT_BYTES:
+            raise FileError(f"{text} is larger than {MAX_TEXT_BYTES // 1000} kB; open it elsewhere")
+        data = handle.read(MAX_TEXT_BYTES + 1)
     if b"\x00" in data:
         raise FileError(f"{text} is not a text file")
     try:
@@ -128,5 +220,5 @@ def write_text(ws: LearnerWorkspace, text: str, content: str) -> Path:
         raise FileError(f"the text is larger than {MAX_TEXT_BYTES // 1000} kB")
     if path.is_dir():
         raise FileError(f"{text} is a folder")
-    write_atomically(path, content)
+    write_atomically(ws, path, content)
     return path

@@ -31,6 +31,9 @@ class BuildLimits:
     file_bytes: int = 256 * 1024**2  # any one file the build writes (RLIMIT_FSIZE)
 
 
+COLCON_FOLDERS = ("build", "install", "log")
+
+
 @dataclass(frozen=True)
 class LearnerWorkspace:
     """One learner's colcon workspace and how builds in it may run."""
@@ -40,15 +43,39 @@ class LearnerWorkspace:
     # allowed by the teacher and contained; see app.learner_ws.build.
     remote: bool = False
     limits: BuildLimits = BuildLimits()
+    # Served: the group contained builds and nodes run in (app.exercises.contain's
+    # SANDBOX_GID). They read src/ through it and write only build/, install/, log/.
+    group: int | None = None
 
     @property
     def src(self) -> Path:
         return self.root / "src"
 
+    @property
+    def home(self) -> Path:
+        """The folder the workspace lives in (served: the learner's scratch folder)."""
+        return self.root.parent
+
     def ensure(self) -> LearnerWorkspace:
-        """Create the workspace and its src/ folder (private to the user)."""
-        self.src.mkdir(parents=True, exist_ok=True, mode=0o700)
+        """Create the workspace and its src/ folder: private to the user, or (served) to the
+        user and the sandbox group, which may read them but not write them."""
+        if self.group is None:
+            self.src.mkdir(parents=True, exist_ok=True, mode=0o700)
+            return self
+        self.src.mkdir(parents=True, exist_ok=True)
+        _to_group(self.home, self.group, 0o2770)  # as the sandbox opens a scratch folder
+        for folder in (self.root, self.src):
+            _to_group(folder, self.group, 0o2750)
         return self
+
+    def colcon_folders(self) -> list[Path]:
+        """build/, install/ and log/, made (served: writable by the sandbox group only there)."""
+        folders = [self.root / name for name in COLCON_FOLDERS]
+        for folder in folders:
+            folder.mkdir(exist_ok=True)
+            if self.group is not None:
+                _to_group(folder, self.group, 0o2770)
+        return folders
 
     def confine(self, text: str) -> Path:
         """The real path of ``text`` inside the workspace, or OutsideWorkspace."""
@@ -77,6 +104,19 @@ class LearnerWorkspace:
         except ValueError:
             return str(path)
         return f"{TUTORIAL_NAME}/{relative}" if str(relative) != "." else TUTORIAL_NAME
+
+
+def _to_group(folder: Path, group: int, mode: int) -> None:
+    """This one folder (no walk, no link followed) to ``group`` with ``mode``."""
+    fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC)
+    try:
+        try:
+            os.fchown(fd, -1, group)
+        except PermissionError:  # not root: no sandbox here either, builds are refused
+            pass
+        os.fchmod(fd, mode)
+    finally:
+        os.close(fd)
 
 
 def default_root(progress_file: Path) -> Path:

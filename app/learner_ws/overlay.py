@@ -135,13 +135,88 @@ def _python_dirs(prefix: Path) -> list[Path]:
     ]  # fmt: skip
 
 
+_PREPEND = ("prepend-non-duplicate", "prepend-non-duplicate-if-exists")
+MAX_HOOKS = 64  # dsv files followed per package (a loop of `source` lines ends here)
+
+
+def hook_paths(prefix: Path) -> dict[str, list[str]]:
+    """What colcon's package hooks prepend, per variable: ``share/<pkg>/package.dsv``.
+
+    colcon writes each package's environment changes as ``.dsv`` lines
+    (``prepend-non-duplicate;PYTHONPATH;lib/python3.11/site-packages``) and the
+    shell scripts that ``setup.bash`` sources follow them; a `--symlink-install`
+    Python package adds its ``build/<pkg>`` folder to PYTHONPATH this way. This
+    reads the same lines (never running a script) for the packages of ``prefix``.
+    """
+    found: dict[str, list[str]] = {}
+    index = prefix / INDEX
+    names = sorted(p.name for p in index.iterdir()) if index.is_dir() else []
+    for name in names:
+        mine: dict[str, list[str]] = {}
+        todo = [prefix / "share" / name / "package.dsv"]
+        seen: set[Path] = set()
+        while todo and len(seen) < MAX_HOOKS:
+            dsv = todo.pop(0)
+            if dsv in seen or dsv.suffix != ".dsv":
+                continue
+            seen.add(dsv)
+            try:
+                lines = dsv.read_text(encoding="utf-8").splitlines()
+            except (OSError, UnicodeDecodeError):
+                continue
+            for line in lines:
+                kind, _, rest = line.partition(";")
+                if kind == "source":
+                    path = Path(rest) if os.path.isabs(rest) else prefix / rest
+                    todo.append(path)
+                    continue
+                variable, _, values = rest.partition(";")
+                if kind not in _PREPEND or not variable:
+                    continue
+                for value in values.split(";") or [""]:
+                    path = (
+                        Path(value)
+                        if os.path.isabs(value)
+                        else (prefix / value if value else prefix)
+                    )
+                    if kind.endswith("-if-exists") and not path.exists():
+                        continue
+                    mine.setdefault(variable, []).append(str(path))
+        for variable, texts in mine.items():  # each prepend goes in front of the ones before
+            for text in reversed(texts):
+                if text not in found.setdefault(variable, []):
+                    found[variable].append(text)
+    return found
+
+
+def _sourced_paths(variable: str) -> list[str]:
+    """``variable``'s folders from the sourced workspaces' hooks, newest overlay first."""
+    paths: list[str] = []
+    for prefix in overlay():
+        hooks = hook_paths(prefix)
+        fallback = {
+            "PYTHONPATH": [str(d) for d in _python_dirs(prefix)],
+            "LD_LIBRARY_PATH": [str(prefix / "lib")] if (prefix / "lib").is_dir() else [],
+            "PATH": [str(prefix / "bin")] if (prefix / "bin").is_dir() else [],
+        }
+        for path in hooks.get(variable) or fallback.get(variable, []):
+            if path not in paths:
+                paths.append(path)
+    return paths
+
+
+def python_paths() -> list[Path]:
+    """The Python folders of the sourced workspaces, newest first (the code editor's Jedi
+    finds the learner's messages and modules there)."""
+    return [Path(p) for p in _sourced_paths("PYTHONPATH")]
+
+
 def child_env(base: Mapping[str, str] | None = None) -> dict[str, str]:
     """The variables a sourced shell would hand a program it starts (only those four)."""
     base = os.environ if base is None else base
-    prefixes = overlay()
-    python = [str(d) for p in prefixes for d in _python_dirs(p)]
-    libs = [str(p / "lib") for p in prefixes if (p / "lib").is_dir()]
-    bins = [str(p / "bin") for p in prefixes if (p / "bin").is_dir()]
+    python = _sourced_paths("PYTHONPATH")
+    libs = _sourced_paths("LD_LIBRARY_PATH")
+    bins = _sourced_paths("PATH")
 
     def joined(front: list[str], name: str) -> str:
         rest = [p for p in base.get(name, "").split(os.pathsep) if p and p not in front]

@@ -3,8 +3,10 @@
 Each kind has one home, a small module that registers itself: its fields
 (the schema checks lesson and exercise files against them), its code, and
 its words for the learner (what it means, shown by `exercise explain` and in
-the lessons). Exercise probes build on the checks (a probe may wait on any
-check kind) and live in ``app.exercises.probes``.
+the lessons). Exercise probes are the third kind family: they build on the
+checks (a probe may wait on any check kind), register the same way with
+``register_probe`` in ``app.exercises.probes.base`` (one module per kind in
+``app/exercises/probes/``), and share one name space with the checks.
 
 To add a check kind, add one module, ``app/lessons/checks/<kind>.py``::
 
@@ -86,15 +88,23 @@ class ActionKind:
 CHECKS: dict[str, CheckKind] = {}
 ACTIONS: dict[str, ActionKind] = {}
 F = TypeVar("F", bound=Callable[..., Any])
+E = TypeVar("E")
+
+
+def add_kind(table: dict[str, E], family: str, name: str, entry: E) -> None:
+    """Register ``entry`` as the kind ``name`` of a family; a name registered twice is an error."""
+    if name in table:
+        raise RuntimeError(f"{family} kind '{name}' registered twice")
+    table[name] = entry
 
 
 def register_check(name: str, *, required: str, optional: str = "", words: str) -> Callable[[F], F]:
     """Decorator: ``evaluate(rt, check) -> CheckResult`` is the check kind ``name``."""
 
     def add(evaluate: F) -> F:
-        if name in CHECKS:
-            raise RuntimeError(f"check kind '{name}' registered twice")
-        CHECKS[name] = CheckKind(name, make_kind(required, optional), evaluate, words)
+        add_kind(
+            CHECKS, "check", name, CheckKind(name, make_kind(required, optional), evaluate, words)
+        )
         return evaluate
 
     return add
@@ -106,9 +116,9 @@ def register_action(
     """Decorator: ``perform(rt, action) -> str`` is the step action kind ``name``."""
 
     def add(perform: F) -> F:
-        if name in ACTIONS:
-            raise RuntimeError(f"action kind '{name}' registered twice")
-        ACTIONS[name] = ActionKind(name, make_kind(required, optional), perform, words)
+        add_kind(
+            ACTIONS, "action", name, ActionKind(name, make_kind(required, optional), perform, words)
+        )
         return perform
 
     return add

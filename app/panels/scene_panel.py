@@ -3,6 +3,10 @@
 The scene layers (``app/scene``) draw from their own worker threads; this
 panel owns the controls and the status text. Its callbacks post intents, so
 layers are switched and the pose is changed on the UI thread only.
+
+While a simulated world (``sim_world``) is drawn, the lesson-13 desk at the
+origin (its base_link axes, camera and arm model) steps aside: the robot's
+own frames are on TF then, and two base_links would confuse.
 """
 
 from __future__ import annotations
@@ -11,6 +15,7 @@ import math
 from collections.abc import Callable
 from typing import NamedTuple
 
+import numpy as np
 import viser
 from rclpy.node import Node
 
@@ -19,14 +24,20 @@ from app.panels.joint_sliders import JointSliders
 from app.ros.graph import GraphSnapshot
 from app.scene import topic_picker as picker
 from app.scene import transforms as tf
-from app.scene.arm import ArmLayer
+from app.scene.arm import ARM_PATH, ArmLayer
 from app.scene.camera_params import CameraParamSync
-from app.scene.frames import CameraPose, FrameTree
+from app.scene.drive import DriveControls, overview
+from app.scene.frames import BASE_PATH, CameraPose, FrameTree
 from app.scene.images import ImageLayer
+from app.scene.laser_scan import LaserScanLayer
 from app.scene.markers import MarkerLayer
+from app.scene.namespaced_robots import NamespacedRobots
 from app.scene.plots import JointPlot
 from app.scene.pointclouds import PointCloudLayer
+from app.scene.sim_world import TOPICS as WORLD_TOPICS
+from app.scene.sim_world import WorldLayer
 from app.scene.stamped import StampedLayer
+from app.scene.tf_camera import TfCamera
 from app.scene.tf_view import TfView
 from app.ui import MarkdownView, assign, code_block
 from app.ui.loop import UiLoop
@@ -56,8 +67,14 @@ IMAGES = _Offer(
     ("/object_detection/output", "/camera/image_raw", "/cam/feature_ext_viz"),
 )
 MARKERS = _Offer(
-    picker.MARKER_TYPES, "visualization_msgs Marker or MarkerArray topics", ("/cam/camera_pose",)
+    picker.MARKER_TYPES,
+    "visualization_msgs Marker or MarkerArray topics",
+    ("/cam/camera_pose",),
+    avoid=WORLD_TOPICS,  # the simulated world is drawn by its own layer, at its TF frame
 )
+SCANS = _Offer(("sensor_msgs/msg/LaserScan",), "sensor_msgs/msg/LaserScan topics", ("/scan",))
+# Where new browsers start: close to the lesson-13 desk, or over the whole simulated world.
+DESK_VIEW = ((1.3, -1.4, 1.1), (0.25, 0.0, 0.25))
 JOINTS = _Offer(
     picker.JOINT_TYPES,
     "sensor_msgs/msg/JointState topics",
@@ -76,6 +93,7 @@ class _TopicRow:
     def __init__(self, gui: viser.GuiApi, label: str, offer: _Offer) -> None:
         self.offer = offer
         self.chosen_by_learner = False
+        self.automatic = True  # False: the row waits for the learner's pick
         self._select: Callable[[str], None] = lambda _topic: None
         self._options: tuple[str, ...] = (picker.NONE,)
         self.dropdown = gui.add_dropdown(
@@ -97,7 +115,9 @@ class _TopicRow:
         if opts != self._options:
             self._options = opts
             self.dropdown.options = opts
-        if not self.chosen_by_learner and self.dropdown.value == picker.NONE and len(opts) > 1:
+        if self.chosen_by_learner or not self.automatic:
+            return
+        if self.dropdown.value == picker.NONE and len(opts) > 1:
             choice = next((t for t in self.offer.preferred if t in opts), None)
             if choice is None:
                 choice = next((t for t in opts[1:] if t not in self.offer.avoid), None)
@@ -113,12 +133,25 @@ class ScenePanel:
         self._ui = ui
         MarkdownView(gui, INTRO)
         # Start close to the robot: the arm, the camera and a table-top cloud fill the view.
-        server.initial_camera.position = (1.3, -1.4, 1.1)
-        server.initial_camera.look_at = (0.25, 0.0, 0.25)
+        server.initial_camera.position, server.initial_camera.look_at = DESK_VIEW
         self.frames = FrameTree(scene)
         self.clouds = PointCloudLayer(node, server)
         self.markers = MarkerLayer(node, server)
         self.stamped = StampedLayer(node, server)
+        self.tf_view = TfView(node, server)
+        self.world = WorldLayer(node, server)
+        self.more_robots = NamespacedRobots(node, server)
+        self._world_shown = False
+        self._light = scene.add_light_ambient("/sim_world_light", intensity=0.9, visible=False)
+
+        with gui.add_folder("Simulated world"):
+            self._world_info = MarkdownView(gui)
+            self.drive = DriveControls(gui, ui, node, server, self._frame_pose)
+            self.drive.world_view = self._world_view
+        with gui.add_folder("Laser scan"):
+            self._scan_row = _TopicRow(gui, "Scan topic", SCANS)
+            self.scan = LaserScanLayer(node, server, self._frame_pose)
+            self._scan_info = MarkdownView(gui)
 
         with gui.add_folder("Point cloud"):
             self._cloud_row = _TopicRow(gui, "Cloud topic", CLOUDS)
@@ -136,7 +169,12 @@ class ScenePanel:
             )
         with gui.add_folder("Camera image"):
             self._image_row = _TopicRow(gui, "Image topic", IMAGES)
-            self.images = ImageLayer(node, gui, self.frames)
+            self.images = ImageLayer(
+                node,
+                gui,
+                self.frames,
+                tf_camera=TfCamera(node, server, lambda: self.tf_view.frame_names()),
+            )
             self._image_on_frustum = gui.add_checkbox("Image on the 3D camera", False)
             self._image_info = MarkdownView(gui)
         with gui.add_folder("Markers"):
@@ -172,7 +210,6 @@ class ScenePanel:
                 "Every frame on `/tf` and `/tf_static` with its axes and name, and the robot "
                 "described on `/robot_description` drawn from its URDF, as rviz shows them.",
             )
-            self.tf_view = TfView(node, server)
             self._fixed_options: tuple[str, ...] = (AUTO_FIXED,)
             self._fixed = gui.add_dropdown(
                 "Fixed Frame",
@@ -192,6 +229,7 @@ class ScenePanel:
     def _wire(self) -> None:
         ui = self._ui
         self._cloud_row.on_pick(ui, self.clouds.select)
+        self._scan_row.on_pick(ui, self.scan.select)
         self._image_row.on_pick(ui, self.images.select)
         self._marker_row.on_pick(ui, self.markers.select)
         self._joint_row.on_pick(ui, self._select_joints)
@@ -210,6 +248,66 @@ class ScenePanel:
         self.frames.on_change(
             lambda pose, source: ui.post(lambda: self._on_pose_changed(pose, source))
         )
+
+    def _frame_pose(self, frame: str) -> np.ndarray | None:
+        """A TF frame's pose in the Fixed Frame, as the TF view last drew it (any thread)."""
+        return self.tf_view.poses().get(frame)
+
+    def _world_view(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """(camera position, look-at) that show the whole simulated world, or None."""
+        bounds = self.world.bounds
+        if bounds is None:
+            return None
+        low, high = bounds
+        world = self._frame_pose("world")
+        if world is not None:  # the room's box, moved to where TF draws the world frame
+            low, high = (tf.apply(world, corner[None, :])[0] for corner in (low, high))
+        return overview(low, high)
+
+    def _stage_world(self, shown: bool) -> None:
+        """A simulated world came (or went): set the scene for it (or back for the desk).
+
+        The lesson-13 desk at the origin hides; an ambient light shows the walls' sides
+        (the dashboard's lights come from above); the frames' names and axes go off, so
+        the small robot is not buried under twenty labels (the checkboxes bring them back).
+        """
+        scene = self._server.scene
+        self._light.visible = shown
+        self._pause_desk_arm(shown)
+        assign(self._frame_names, not shown)
+        assign(self._frame_axes, not shown)
+        self._on_frame_display()
+        visible = not shown
+        self.frames.base.show_axes = visible
+        self.frames.camera.visible = visible
+        # The desk's label and arm are nodes of FrameTree and ArmLayer: replaced in place.
+        scene.add_label(
+            f"{BASE_PATH}/label", "base_link", position=(0.0, 0.0, -0.05), visible=visible
+        )
+        scene.add_frame(ARM_PATH, show_axes=False, visible=visible)
+
+    def _follow_world(self) -> None:
+        shown = self.world.shown
+        if shown == self._world_shown:
+            return
+        self._world_shown = shown
+        self._stage_world(shown)
+        initial = self._server.initial_camera
+        view = self._world_view() if shown else None
+        if view is None:
+            initial.position, initial.look_at = DESK_VIEW
+            return
+        initial.position, initial.look_at = (tf.as_xyz(v) for v in view)
+        self.drive.move_cameras(*view)  # the world has just appeared: show it whole
+
+    def _pause_desk_arm(self, paused: bool) -> None:
+        """The desk arm's joint row stops following /joint_states by itself while a world is
+        drawn (the world's robots move on TF; the hidden desk arm would only cost CPU)."""
+        row = self._joint_row
+        row.automatic = not paused
+        if paused and not row.chosen_by_learner and row.dropdown.value != picker.NONE:
+            assign(row.dropdown, picker.NONE)
+            self._select_joints(picker.NONE)
 
     def _on_frame_display(self) -> None:
         self.tf_view.set_display(
@@ -262,6 +360,7 @@ class ScenePanel:
     def refresh(self, graph: GraphSnapshot) -> None:
         rows = (
             (self._cloud_row, self.clouds.worker, self.clouds.topic),
+            (self._scan_row, self.scan.worker, self.scan.topic),
             (self._image_row, self.images.worker, self.images.topic),
             (self._marker_row, self.markers.worker, self.markers.topic),
             (self._joint_row, self.arm.worker, self.arm.topic),
@@ -273,8 +372,18 @@ class ScenePanel:
             if not note and rate:
                 note = f"{rate:.1f} Hz received"
             row.note.show(note)
+        self.world.refresh(graph)
+        self.more_robots.refresh(graph)
+        self.drive.refresh(graph)
+        self._follow_world()
+        self._world_info.show(
+            "\n\n".join(t for t in (self.world.describe(), self.more_robots.describe()) if t)
+        )
+        self._scan_info.show(self.scan.note)
         self._cloud_status.show(self.clouds.describe())
-        self._image_info.show(self.images.info)
+        camera = self.images.tf_camera
+        note = camera.note if camera is not None else ""
+        self._image_info.show("\n\n".join(t for t in (self.images.info, note) if t))
         self._marker_info.show(self.markers.describe())
         self._arm_info.show(self.arm.describe())
         self.plot.flush()
@@ -292,5 +401,8 @@ class ScenePanel:
 
     def close(self) -> None:
         layers = (self.clouds, self.images, self.markers, self.arm, self.stamped, self.params)
-        for layer in (*layers, self.tf_view, self.joint_sliders):
+        sim = (self.scan, self.world, self.more_robots, self.drive)
+        for layer in (*layers, *sim, self.tf_view, self.joint_sliders):
             layer.close()
+        if self.images.tf_camera is not None:
+            self.images.tf_camera.close()

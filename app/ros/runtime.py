@@ -15,10 +15,16 @@ callback that it took about 3,500 small messages a second here against about
 
 from __future__ import annotations
 
+import os
+import signal
+import subprocess
 import threading
+from collections.abc import Iterator
+from contextlib import contextmanager, suppress
 
 import rclpy
 from rclpy.context import Context
+from rclpy.exceptions import InvalidHandle
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
@@ -26,6 +32,8 @@ from rclpy.signals import SignalHandlerOptions
 from nodes.common.parameter_guard import guard_parameter_services
 
 DASHBOARD_NODE_NAME = "classroom_dashboard"
+# The native teardown of a participant takes milliseconds; this long means it hung.
+TEARDOWN_SEC = 10.0
 
 
 class RosRuntime:
@@ -55,19 +63,62 @@ class RosRuntime:
             enable_rosout=not quiet,
         )
         self.executor = SingleThreadedExecutor(context=self.context)
+        self.lost_waits = 0  # waits lost to an entity destroyed meanwhile (see _spin)
         self.executor.add_node(self.node)
         self._thread = threading.Thread(target=self._spin, name=f"ros-{node_name}", daemon=True)
         self._thread.start()
 
     def _spin(self) -> None:
-        try:
-            self.executor.spin()
-        except (ExternalShutdownException, KeyboardInterrupt):
-            pass
+        while True:
+            try:
+                self.executor.spin()
+                return
+            except (ExternalShutdownException, KeyboardInterrupt):
+                return
+            except InvalidHandle:
+                # rclpy 7.1.6 race: another thread destroyed a publisher or subscription
+                # (its QoS event handler) while the executor was building its wait set;
+                # the handler is skipped when entered but still added to the set, which
+                # raises here. Only that one wait is lost: spin on, never die silently.
+                self.lost_waits += 1
 
-    def shutdown(self, timeout: float = 2.0) -> None:
-        """Executor first, then the node, then the context."""
+    def shutdown(self, timeout: float = 2.0, teardown_sec: float = TEARDOWN_SEC) -> None:
+        """Executor first, then the node, then the context: never unbounded.
+
+        The executor thread gets ``timeout`` s to leave (rclpy 7.1.6's
+        ``Executor.shutdown`` does not wait for it, so we join it). The node is
+        destroyed only once that thread is gone: destroying what it still waits
+        on is the race rclpy cannot handle. The native teardown (Fast DDS
+        deleting its readers and writers) runs with the GIL held, so no Python
+        thread could stop it if it hung: a watchdog process ends this process
+        after ``teardown_sec`` s instead, saying so on stderr.
+        """
         self.executor.shutdown(timeout_sec=timeout)
         self._thread.join(timeout)
-        self.node.destroy_node()
-        rclpy.try_shutdown(context=self.context)
+        with process_watchdog(teardown_sec, f"ROS teardown of /{self.node.get_name()}"):
+            if not self._thread.is_alive():
+                self.node.destroy_node()
+            rclpy.try_shutdown(context=self.context)
+
+
+@contextmanager
+def process_watchdog(seconds: float, what: str) -> Iterator[None]:
+    """End this process (SIGKILL, after a line on stderr) if the block outlasts ``seconds``.
+
+    The watchdog is a shell in its own session (it keeps running while native
+    code holds our GIL); when the block ends in time, its whole group is killed.
+    """
+    pid = os.getpid()
+    line = f"{what} hung for {seconds:g} s: ending process {pid}"
+    guard = subprocess.Popen(
+        ["/bin/sh", "-c", f'sleep {seconds:g}; echo "$1" >&2; kill -KILL {pid}', "watchdog", line],
+        start_new_session=True,
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.DEVNULL,
+    )
+    try:
+        yield
+    finally:
+        with suppress(ProcessLookupError):
+            os.killpg(guard.pid, signal.SIGKILL)
+        guard.wait()

@@ -20,7 +20,8 @@ from app.ros2cli.common import TerminalContext
 from app.ros2cli.parser import needs_ros, run_argv
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
-EXIT_INTERRUPTED = 130
+ROS2CLI_GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface")
+EXIT_INTERRUPTED_OTHER = 130  # our other commands (bag, run, ...): the shell's convention
 
 
 def _print(line: str) -> None:
@@ -55,7 +56,9 @@ def main(argv: list[str]) -> int:
     )
     try:
         code = run_argv(ctx, argv, "ros2-classroom")
-        return EXIT_INTERRUPTED if cancel.is_set() else code
+        if cancel.is_set() and not (argv[:1] and argv[0] in ROS2CLI_GROUPS):
+            return EXIT_INTERRUPTED_OTHER
+        return code  # ros2cli's verbs: as `ros2` ends after Ctrl+C (parser.EXIT_INTERRUPTED)
     finally:
         runtime.shutdown()
         for sig, handler in previous.items():

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from rclpy.topic_or_service_is_hidden import topic_or_service_is_hidden
 
 from app.ros.context import CallContext, Write
+from app.ros.convert import ConversionError, RosType, import_type
 from app.ros.errors import Ros2Error
 
 MIN_DISCOVERY_SEC = 1.5
@@ -29,6 +30,21 @@ class SilentFailure(Ros2Error):
     A terminal keeps stdout as ros2's (the reason goes to stderr); the Console,
     which has one output, shows the reason in parentheses.
     """
+
+
+_INVALID_TYPE = {
+    "msg": "The passed message type is invalid",
+    "srv": "The passed service type is invalid",
+    "action": "The passed action type is invalid",
+}
+
+
+def ros2_type(type_text: str, kind: str) -> RosType:
+    """A message, service or action class, or ros2cli's words for a type it cannot import."""
+    try:
+        return import_type(type_text, kind)
+    except ConversionError:
+        raise Ros2cliMessage(_INVALID_TYPE[kind]) from None
 
 
 @dataclass
@@ -79,9 +95,15 @@ def write_names(ctx: CallContext, lines: list[str], count: bool = False) -> int:
     return 0
 
 
-def settle_discovery(ctx: CallContext) -> None:
-    """A brand-new node sees the graph piece by piece: wait until it stops changing."""
+def settle_discovery(ctx: CallContext, spin_time: float | None = None) -> None:
+    """A brand-new node sees the graph piece by piece: wait until it stops changing.
+
+    ``--spin-time S`` asks for exactly S seconds instead, as ros2cli's own node spins.
+    """
     if ctx.limits.discovery_wait <= 0:
+        return
+    if spin_time is not None:
+        ctx.sleep(max(0.0, spin_time))
         return
     # Participants are found before their endpoints: insist on a minimum look
     # (as `ros2 ... --no-daemon` spins a while) and then on a quiet second.

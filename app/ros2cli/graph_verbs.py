@@ -17,14 +17,23 @@ from rclpy.expand_topic_name import expand_topic_name
 from rclpy.validate_full_topic_name import validate_full_topic_name
 from rclpy.validate_topic_name import validate_topic_name
 
-from app.ros.calls import GoalRun, action_type_of, call_service, send_goal, wait_for_server
+from app.ros.calls import (
+    GoalRun,
+    action_type_of,
+    check_service_type,
+    send_goal,
+    wait_for_server,
+    wait_future,
+)
 from app.ros.context import CallContext
-from app.ros.convert import from_yaml, import_type, message_repr
+from app.ros.convert import from_yaml, message_repr
+from app.ros.errors import Cancelled
 from app.ros.graph import all_nodes, wait_for_graph
 from app.ros.names import split_node_name
 from app.ros2cli.common import (
     Ros2cliMessage,
     SilentFailure,
+    ros2_type,
     visible,
     write_names,
     write_note,
@@ -140,29 +149,38 @@ def service_info(ctx: CallContext, name: str, include_hidden: bool = False) -> i
 def service_call(
     ctx: CallContext, name: str, type_text: str, values: str = "", rate: float | None = None
 ) -> int:
-    """ros2cli's lines: waiting..., the request's repr, an empty line, the response's repr."""
+    """ros2cli's lines: waiting... (only if the server is not matched yet), then per call the
+    request's repr, an empty line, 'response:', the response's repr and an empty line."""
     if rate is not None and not rate > 0:
         raise Ros2cliMessage("rate must be greater than zero")
-    srv_type = import_type(type_text, "srv")
+    srv_type = ros2_type(type_text, "srv")
     request = from_yaml(srv_type.Request, values)
     validate_topic_name(name, is_service=True)  # before any line, as ros2's client does
-    # A fresh `ros2 service call` has never seen the server yet: it always waits first.
-    ctx.write("waiting for service to become available...")
-    deadline = time.monotonic() + ctx.limits.max_seconds if ctx.limits.max_seconds else math.inf
-    while True:
-        ctx.write(f"requester: making request: {message_repr(request)}")
-        ctx.write("")
-        started = time.monotonic()
-        response = call_service(ctx, name, srv_type, request)
-        ctx.write("response:")
-        ctx.write(message_repr(response))
-        ctx.write("")
-        if rate is None:
-            return 0
-        next_call = started + 1.0 / rate
-        if next_call > deadline:
-            return 0
-        ctx.sleep(max(0.0, next_call - time.monotonic()))
+    check_service_type(ctx, name, srv_type)
+    client = ctx.node.create_client(srv_type, name)
+    try:
+        if not client.service_is_ready():
+            ctx.write("waiting for service to become available...")
+            timeout = ctx.limits.service_timeout
+            wait_for_server(ctx, client.service_is_ready, timeout, f"service '{name}'")
+        deadline = time.monotonic() + ctx.limits.max_seconds if ctx.limits.max_seconds else math.inf
+        while True:
+            ctx.write(f"requester: making request: {message_repr(request)}")
+            ctx.write("")
+            started = time.monotonic()
+            future = client.call_async(request)
+            response = wait_future(ctx, future, ctx.limits.service_timeout, f"service '{name}'")
+            ctx.write("response:")
+            ctx.write(message_repr(response))
+            ctx.write("")
+            if rate is None:
+                return 0
+            next_call = started + 1.0 / rate
+            if next_call > deadline:
+                return 0
+            ctx.sleep(max(0.0, next_call - time.monotonic()))
+    finally:
+        ctx.node.destroy_client(client)
 
 
 # ----------------------------------------------------------------- action
@@ -217,7 +235,7 @@ def action_send_goal(
     ctx: CallContext, name: str, type_text: str, values: str = "", feedback: bool = False
 ) -> int:
     """The lines `ros2 action send_goal` prints; its exit code is 0 whatever the goal's fate."""
-    action_cls = import_type(type_text, "action")
+    action_cls = ros2_type(type_text, "action")
     goal = from_yaml(action_cls.Goal, values)
     run = GoalRun(name, type_text, goal)
     ctx.write("Waiting for an action server to become available...")
@@ -231,30 +249,26 @@ def action_send_goal(
     )
     write_message_block(ctx, "Sending goal", goal, 5)
 
-    # Feedback runs on the executor thread and may come before we have read the
-    # acceptance: hold it until "Goal accepted" is written, as ros2 prints them.
+    # As ros2cli, each line when its event is handled: feedback that comes with the
+    # acceptance (handled first by rclpy's action client) prints before "Goal accepted".
     lock = threading.Lock()
-    held: list[Any] | None = []
 
     def on_accepted(run: GoalRun) -> None:
-        nonlocal held
         with lock:
             ctx.write(f"Goal accepted with ID: {run.goal_id}")
             ctx.write("")
-            for message in held or []:
-                write_message_block(ctx, "Feedback", message, 4)
-            held = None
 
     def on_feedback(message: Any) -> None:
-        if not feedback:
-            return
-        with lock:
-            if held is not None:
-                held.append(message)
-            else:
+        if feedback:
+            with lock:
                 write_message_block(ctx, "Feedback", message, 4)
 
-    send_goal(ctx, run, on_feedback, on_accepted)
+    try:
+        send_goal(ctx, run, on_feedback, on_accepted)
+    except Cancelled:
+        if run.goal_id:  # accepted and running: send_goal has asked the server to cancel it
+            ctx.write("Canceling goal...")
+        raise
     if run.status == "REJECTED":
         ctx.write("Goal was rejected.")
         return 0

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from app.ros.convert import import_type
 from app.ros.errors import Ros2Error
+from app.ros2cli.common import Ros2cliMessage
 from app.ros2cli.msg_yaml import message_to_yaml
 
 _EXT = {"msg": ".msg", "srv": ".srv", "action": ".action"}
@@ -105,9 +106,28 @@ def show(
     theirs only with ``nested_comments`` (``--all-comments``). Without them a
     line loses its trailing comment, and empty or comment lines are left out.
     """
-    path, package, _kind, _name = definition_path(type_text)
+    path, package = _show_path(type_text)
     lines = path.read_text().rstrip("\n").splitlines()
     return "\n".join(_expand(lines, package, expand, 0, comments, nested_comments))
+
+
+def _show_path(type_text: str) -> tuple[Path, str]:
+    """The file `ros2 interface show` reads (pkg/kind/Name only), or ros2cli's words."""
+    ensure_ament_prefix()
+    from ament_index_python import PackageNotFoundError, get_package_prefix
+
+    parts = type_text.split("/")
+    if len(parts) != 3:
+        raise Ros2cliMessage(f"Invalid name '{type_text}'. Expected three parts separated by '/'")
+    try:
+        prefix = get_package_prefix(parts[0])
+    except (PackageNotFoundError, ValueError):
+        raise Ros2cliMessage(f"Unknown package '{parts[0]}'") from None
+    base = os.path.join(prefix, "share", type_text)
+    for path in (f"{base}.{parts[1]}", f"{base}.idl"):
+        if parts[1] in _EXT and path.endswith(_EXT[parts[1]]) and os.path.isfile(path):
+            return Path(path), parts[0]
+    raise Ros2cliMessage(f"Could not find the interface '{base}.idl'")
 
 
 def _without_comment(line: str, keep: bool) -> str | None:

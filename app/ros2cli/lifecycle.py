@@ -25,8 +25,12 @@ def _managed(ctx: CallContext, include_hidden: bool) -> list[str]:
 
 
 def _target(ctx: CallContext, fqn: str, include_hidden: bool) -> str:
+    """A managed node's name; ros2cli says "Node not found" for any other (even a plain one)."""
     target = fqn if fqn.startswith("/") else "/" + fqn
-    return lifecycle_target(ctx, find_node(ctx, target, include_hidden, "Node not found"))
+    found = find_node(ctx, target, include_hidden, "Node not found")
+    if found not in lifecycle_nodes(ctx):
+        raise Ros2cliMessage("Node not found")
+    return lifecycle_target(ctx, found)
 
 
 def verb_nodes(ctx: CallContext, count: bool = False, all_: bool = False) -> int:

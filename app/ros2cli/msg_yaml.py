@@ -28,7 +28,11 @@ class _BlockDumper(yaml.SafeDumper):
 
 
 def _represent_dict(dumper: yaml.SafeDumper, data: dict) -> yaml.MappingNode:
-    return dumper.represent_mapping("tag:yaml.org,2002:map", data.items())
+    """A mapping node with no style of its own: PyYAML writes it in block style (flow only
+    inside a flow list), whatever ``default_flow_style`` says. So `--flow-style` puts only
+    the lists in flow style (``[0, 1]``), as ros2cli's message_to_yaml does."""
+    pairs = [(dumper.represent_data(k), dumper.represent_data(v)) for k, v in data.items()]
+    return yaml.MappingNode("tag:yaml.org,2002:map", pairs)
 
 
 _BlockDumper.add_representer(dict, _represent_dict)

@@ -21,11 +21,15 @@ from app.ros.errors import Cancelled, Ros2Error
 from app.ros2cli import bag, interfaces, launch_verb, pkg, run
 from app.ros2cli import verbs as verb_args
 from app.ros2cli.common import Ros2cliMessage, SilentFailure, TerminalContext, settle_discovery
+from app.ros2cli.verbs import NOT_HERE
 
 log = logging.getLogger(__name__)
 
 GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface", "bag", "pkg")
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
+# ros2cli's exit code after Ctrl+C: rclpy's SIGINT handler shuts its context down,
+# the verb ends with ExternalShutdownException, and `ros2` returns SIGTERM's number.
+EXIT_INTERRUPTED = 15
 
 
 class UsageError(Ros2Error):
@@ -83,20 +87,74 @@ def split_command(text: str) -> list[str]:
 Handler = Callable[[CallContext, argparse.Namespace], int]
 
 
-def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
-    parser = _Parser(prog=prog, write=write, description="ros2-like verbs")
-    groups = parser.add_subparsers(dest="group", metavar="COMMAND", parser_class=_Parser)
-    groups.required = True
+COMMANDS_HINT = "Call `{prog} <command> -h` for more detailed usage."
+RAW = argparse.RawDescriptionHelpFormatter
 
-    def group(name: str, help_text: str):
-        g = groups.add_parser(name, help=help_text, write=write)
+# Verbs Jazzy's ros2 has in a group we offer, and we do not (listed in the group's -h).
+NOT_HERE_VERBS = {
+    "topic": {"delay": "Display delay of topic from timestamp in header"},
+    "service": {"echo": "Echo a service"},
+}
+
+
+def commands(parser: argparse.ArgumentParser, dest: str) -> Any:
+    """A "Commands:" section as ros2cli makes one: its lines are filled in by finish_commands."""
+    sub = parser.add_subparsers(
+        title="Commands",
+        description="",
+        dest=dest,
+        metavar=COMMANDS_HINT.format(prog=parser.prog),
+        parser_class=_Parser,
+    )
+    sub.required = False  # no verb: the group prints its help (ros2cli does)
+    return sub
+
+
+def finish_commands(parser: argparse.ArgumentParser, sub: Any) -> None:
+    """One line per command (its description), sorted, as ros2cli's -h lists them.
+
+    The choices are sorted too (argparse's "invalid choice" error names them in
+    that order), and the per-command help lines argparse would add are dropped.
+    """
+    described = {a.dest: a.help for a in sub._choices_actions}
+    shown = {name: p.description or described.get(name) or "" for name, p in sub.choices.items()}
+    width = max(map(len, shown))
+    section = next(g for g in parser._action_groups if sub in g._group_actions)
+    section.description = "".join(f"{n.ljust(width)}  {shown[n]}\n" for n in sorted(shown))
+    ordered = sorted(sub.choices.items())
+    sub.choices.clear()
+    sub.choices.update(ordered)
+    sub._choices_actions.clear()
+
+
+def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog=prog,
+        write=write,
+        description=f"{prog} is an extensible command-line tool for ROS 2.",
+        formatter_class=RAW,
+    )
+    parser.add_argument(
+        "--use-python-default-buffering",
+        action="store_true",
+        help="Do not force line buffering in stdout and instead use the python default "
+        "buffering, which might be affected by PYTHONUNBUFFERED/-u and depends on whatever "
+        "stdout is interactive or not",
+    )
+    parser.set_defaults(handler=lambda ctx, _args: _print_help(ctx, parser))
+    groups = commands(parser, "group")
+    groups_done: list[tuple[argparse.ArgumentParser, Any, str]] = []
+
+    def group(name: str, description: str):
+        g = groups.add_parser(name, description=description, formatter_class=RAW, write=write)
         verb_args.command_options(name, g)  # `ros2 topic --include-hidden-topics ...`
-        verbs = g.add_subparsers(dest="verb", metavar="VERB", parser_class=_Parser)
-        verbs.required = True
+        g.set_defaults(handler=lambda ctx, _args: _print_help(ctx, g))
+        verbs = commands(g, "verb")
+        groups_done.append((g, verbs, name))
         return verbs
 
     def verb(verbs, name: str, help_text: str, handler: Handler) -> argparse.ArgumentParser:
-        p = verbs.add_parser(name, help=help_text, description=help_text, write=write)
+        p = verbs.add_parser(name, description=help_text, formatter_class=RAW, write=write)
         p.set_defaults(handler=handler)
         return p
 
@@ -108,35 +166,80 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
     verb_args.add_param(group("param", "Various param related sub-commands"), verb)
     verb_args.add_lifecycle(group("lifecycle", "Various lifecycle related sub-commands"), verb)
 
-    # interface
-    v = group("interface", "message, service and action definitions")
-    p = verb(v, "list", "installed interfaces", _interface_list)
-    p.add_argument("-m", "--only-msgs", action="store_true")
-    p.add_argument("-s", "--only-srvs", action="store_true")
-    p.add_argument("-a", "--only-actions", action="store_true")
-    p = verb(v, "packages", "interface packages", _interface_packages)
+    v = group("interface", "Show information about ROS interfaces")
+    p = verb(v, "list", "List all interface types available", _interface_list)
     verb_args.only_kinds(p)
-    p = verb(v, "package", "one package's interfaces", _interface_package)
+    packages_help = "Output a list of packages that provide interfaces"
+    p = verb(v, "packages", packages_help, _interface_packages)
+    verb_args.only_kinds(
+        p,
+        (
+            "Only list packages that generate messages",
+            "Only list packages that generate services",
+            "Only list packages that generate actions",
+        ),
+    )
+    p = verb(
+        v,
+        "package",
+        "Output a list of available interface types within one package",
+        _interface_package,
+    )
     verb_args.only_kinds(p)
-    p.add_argument("package_name")
-    p = verb(v, "show", "a definition", _interface_show)
-    p.add_argument("type")
-    p.add_argument("--no-expand", action="store_true", help="do not expand nested types")
+    p.add_argument("package_name", help="Name of the ROS package (e.g. 'example_interfaces')")
+    p = verb(v, "show", "Output the interface definition", _interface_show)
     verb_args.comment_options(p)
+    p.add_argument(
+        "type",
+        help="Show an interface definition (e.g. 'example_interfaces/msg/String'). Passing '-' "
+        "reads the argument from stdin (e.g. 'ros2 topic type /chatter | ros2 interface show -').",
+    )
+    p.epilog = "Not supported here: '-' (reading the type from standard input)."
     p = verb(v, "proto", "Output an interface prototype", _interface_proto)
-    p.add_argument("type", help="Type of the interface (e.g. 'std_msgs/msg/String')")
+    p.add_argument(
+        "type", help="Show an interface definition (e.g. 'example_interfaces/msg/String')"
+    )
     p.add_argument("--no-quotes", action="store_true", help="if true output has no outer quotes.")
 
-    bag.add_verbs(group("bag", "record, inspect and replay topics"), verb)
+    bag.add_verbs(group("bag", "Various rosbag related sub-commands"), verb)
     pkg.add_verbs(group("pkg", "Various package related sub-commands"), verb)  # issue 22
     pkg.add_commands(groups, write)  # `colcon ...` and `source install/setup.bash`
     run.add_command(groups, write)  # `ros2 run PKG EXE`: a command, not a group of verbs
     launch_verb.add_command(groups, write)  # `ros2 launch PKG FILE`: the same
+    for g, verbs, name in groups_done:
+        for missing, description in NOT_HERE_VERBS.get(name, {}).items():
+            p = verbs.add_parser(
+                missing,
+                description=f"{description} ({NOT_HERE})",
+                formatter_class=RAW,
+                write=write,
+            )
+            p.add_argument("words", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
+            p.set_defaults(handler=_not_here_verb(f"{name} {missing}"))
+        finish_commands(g, verbs)
+    finish_commands(parser, groups)
     return parser
 
 
+def _not_here_verb(words: str) -> Handler:
+    """A verb of Jazzy's ros2 we do not offer: listed, and a clear refusal (exit code 2)."""
+
+    def refuse(_ctx: CallContext, _args: argparse.Namespace) -> int:
+        raise UsageError(f"`ros2 {words}` is {NOT_HERE}")
+
+    return refuse
+
+
+def _print_help(ctx: CallContext, parser: argparse.ArgumentParser) -> int:
+    """`ros2 topic` alone: the group's help on stdout, exit code 0 (as ros2cli)."""
+    for line in parser.format_help().rstrip("\n").split("\n"):
+        ctx.write(line)
+    return EXIT_OK
+
+
 _NO_DDS = (
-    {("interface", v) for v in ("list", "packages", "package", "show")}
+    {(group, verb) for group, verbs in NOT_HERE_VERBS.items() for verb in verbs}
+    | {("interface", v) for v in ("list", "packages", "package", "show")}
     | {("interface", "proto")}
     | pkg.NO_DDS
     | {("bag", v) for v in bag.NO_DDS_VERBS}
@@ -152,6 +255,11 @@ def needs_ros(argv: list[str]) -> bool:
         return False  # help only: no need to discover the graph first
     return tuple(words[:2]) not in _NO_DDS and not pkg.no_dds(words)
 
+
+# ros2cli's `service call` makes its client right away, in a brand-new node, and prints
+# "waiting for service to become available..." while it has not matched the server yet:
+# no look at the graph first, so a terminal shows that line when ros2 would.
+_FRESH_CLIENT = {("service", "call")}
 
 _HELP_WITHOUT_DDS = {"node", "topic", "service", "action", "param", "lifecycle", "interface"}
 
@@ -221,7 +329,7 @@ def _interface_proto(ctx: CallContext, args: argparse.Namespace) -> int:
 def _interface_show(ctx: CallContext, args: argparse.Namespace) -> int:
     text = interfaces.show(
         args.type,
-        expand=not args.no_expand,
+        expand=True,
         comments=not args.no_comments,
         nested_comments=args.all_comments,
     )
@@ -256,8 +364,8 @@ def run_argv(
         args = parse(argv, ctx.write, prog)
         if args is None:
             return EXIT_OK
-        if needs_ros(argv):
-            settle_discovery(ctx)
+        if needs_ros(argv) and tuple(argv[:2]) not in _FRESH_CLIENT:
+            settle_discovery(ctx, getattr(args, "spin_time", None))
         return args.handler(ctx, args)
     except ArgumentUsageError as exc:
         # Every verb as ros2's argparse says it: the usage, then 'ros2 VERB: error: ...'.
@@ -268,7 +376,9 @@ def run_argv(
         ctx.write(f"error: {exc}")
         return EXIT_USAGE
     except Cancelled:
-        ctx.write("(stopped)")
+        if isinstance(ctx, TerminalContext):
+            return EXIT_INTERRUPTED  # as ros2 ends on Ctrl+C: nothing printed
+        ctx.write("(stopped)")  # the Console says why the output ends
         return EXIT_FAILED
     except SilentFailure as exc:  # ros2 prints nothing; say why where it does not disturb
         (note or ctx.write)(f"({exc})" if note is None else str(exc))

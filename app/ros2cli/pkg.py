@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 import time
 from pathlib import Path
@@ -28,7 +29,7 @@ from typing import Any
 
 from ros2pkg.verb import add_create_arguments, main_create
 
-from app.learner_ws import build, folder, overlay
+from app.learner_ws import build, folder, overlay, served
 from app.learner_ws.folder import LearnerWorkspace
 from app.ros.context import CallContext
 from app.ros.errors import Cancelled, Ros2Error
@@ -56,17 +57,22 @@ def workspace() -> LearnerWorkspace | None:
 # -- the dashboard's wiring ------------------------------------------------------------
 
 
-def setup_workspace(progress_file: Path, *, remote: bool) -> LearnerWorkspace:
+def setup_workspace(
+    progress_file: Path, *, remote: bool, home: Path | None = None, group: int | None = None
+) -> LearnerWorkspace:
     """Called once by `ros2-classroom serve` before the supervisor copies the environment.
 
-    The learner's workspace beside their progress, and the underlay every
-    program and index lookup sees: the catalog's ament prefixes, then what
-    AMENT_PREFIX_PATH held (or the wheels' prefix).
+    The learner's workspace beside their progress (served to other machines:
+    ``home/ros2_ws``, in their scratch folder, where their contained code may
+    reach it and no other learner's can; ``group`` the sandbox's), and the
+    underlay every program and index lookup sees: the catalog's ament
+    prefixes, then what AMENT_PREFIX_PATH held (or the wheels' prefix).
     """
     from app.launch_prefix import catalog_prefix
     from app.ros2cli.tutorial_prefix import tutorial_prefix
 
-    ws = LearnerWorkspace(folder.default_root(progress_file), remote=remote)
+    root = home / "ros2_ws" if home is not None else folder.default_root(progress_file)
+    ws = LearnerWorkspace(root, remote=remote, group=group)
     folder.configure(ws)
     before = [Path(p) for p in os.environ.get(overlay.PREFIX_ENV, "").split(os.pathsep) if p]
     underlay = [*before, Path(sys.prefix), tutorial_prefix(), catalog_prefix()]
@@ -215,7 +221,8 @@ def _colcon(ctx: CallContext, args: argparse.Namespace) -> int:
         raise Ros2Error("in a terminal, run colcon itself (it is installed in the venv)")
     programs = run.programs_of(ctx)
     words = list(args.words)
-    program = build.colcon_program(ws, words)
+    # The rule for learner code (app.supervisor's learner_policy): builds run setup.py.
+    program = served.colcon_program(ws, words, getattr(programs, "learner_policy", None))
     if _active(programs, program.name):
         raise Ros2Error(f"`colcon {words[0]}` is already running in this workspace")
     programs.start_program(program)
@@ -242,13 +249,9 @@ def follow_build(ctx: CallContext, programs: Any, key: str, ws: LearnerWorkspace
             status = programs.status(key)
             if not status.active:
                 shown = _write_new(ctx, programs, key, shown)
-                _explain_dash_spelling(ctx, programs.output(key))
-                if status.exit_code != 0:
-                    ctx.write(
-                        f"(colcon ended with exit code {status.exit_code}: the lines under "
-                        "'--- stderr:' name the file and line; the full logs are in "
-                        f"{ws.shown(ws.root / 'log')})"
-                    )
+                output = programs.output(key)
+                _explain_dash_spelling(ctx, output)
+                _point_at_errors(ctx, output, ws, status.exit_code)
                 return 0 if status.exit_code == 0 else 1
             now = time.monotonic()
             if now - started > ws.limits.seconds:
@@ -276,6 +279,27 @@ def follow_build(ctx: CallContext, programs: Any, key: str, ws: LearnerWorkspace
     _write_new(ctx, programs, key, shown)
     ctx.write(f"error: {reason}")
     return 1
+
+
+def _point_at_errors(ctx: CallContext, lines: list[str], ws: LearnerWorkspace, code: Any) -> None:
+    """After colcon's own lines: each error with the file and line it is in."""
+    errors = build.error_summary(lines, ws)
+    unread = any("package identification" in line and "ERROR" in line for line in lines)
+    if code == 0 and not unread:
+        return
+    if code == 0:  # colcon skipped a package whose setup.py failed to run, and says 0 failed
+        ctx.write("(colcon could not read a package's setup.py, so it did not build that package)")
+        code = None
+    head = f"colcon ended with exit code {code}" if code else "nothing of it was built"
+    if errors:
+        ctx.write(f"({head}; where it failed:")
+        for error in errors[:8]:  # the place on a line of its own: the Console is narrow
+            if error.where:
+                ctx.write(f"  {error.where}:")
+            ctx.write(f"    {error.text}")
+        ctx.write(f" the full logs are in {ws.shown(ws.root / 'log')})")
+    else:
+        ctx.write(f"({head}: the full logs are in {ws.shown(ws.root / 'log')})")
 
 
 def _progress(programs: Any, key: str) -> str:
@@ -325,8 +349,6 @@ def run_own(ctx: CallContext, package: str, executable: str, words: list[str]) -
                 raise Ros2cliMessage(f"Package '{package}' not found{hint}")
         return None
     ws = workspace()
-    if ws is not None and ws.remote:
-        raise Ros2Error("your own packages run only on your own machine's dashboard here")
     paths = [p for p in overlay.executables(package, own[package]) if p.name == executable]
     if not paths:
         present = [p.name for p in overlay.executables(package, own[package])]
@@ -347,12 +369,14 @@ def run_own(ctx: CallContext, package: str, executable: str, words: list[str]) -
             f"{package} {executable} is already running; stop it with "
             f"`ros2 run --stop /{package}/{executable}`"
         )
-    argv = [str(paths[0]), *before] + (["--ros-args", *ros_args] if ros_args else [])
+    tail = [*before] + (["--ros-args", *ros_args] if ros_args else [])
     cwd = ws.root if ws is not None else Path.cwd()
     program = LearnerProgram(
-        name=key, node_name=f"/{package}/{executable}", argv=tuple(argv), cwd=cwd,
+        name=key, node_name=f"/{package}/{executable}", argv=(str(paths[0]), *tail), cwd=cwd,
         env=overlay.child_env(),
     )  # fmt: skip
+    if ws is not None:  # served to other machines: contained, or refused
+        program = served.node_program(ws, program, getattr(programs, "learner_policy", None))
     nodes_before = _node_names(ctx)
     programs.start_program(program)
     return _show_own_start(ctx, programs, key, nodes_before)
@@ -373,6 +397,8 @@ def _show_own_start(ctx: CallContext, programs: Any, key: str, before: set[str])
         status = programs.status(key)
         if not status.active:
             shown = _write_new(ctx, programs, key, shown)
+            if status.exit_code != 0:
+                _explain_missing_module(ctx, programs.output(key), key.split("/")[1])
             return 0 if status.exit_code == 0 else 1
         new_nodes = _node_names(ctx) - before
         if (new_nodes and shown) or waited >= limit:
@@ -385,6 +411,52 @@ def _show_own_start(ctx: CallContext, programs: Any, key: str, before: set[str])
         f"(it keeps running{on_graph}, pid {status.pid}: stop it with `ros2 run --stop {stop}`)"
     )
     return 0
+
+
+_NO_MODULE = re.compile(r"ModuleNotFoundError: No module named '(?P<module>[^']+)'")
+_DEPEND = re.compile(r"<(?:depend|exec_depend|build_depend|build_export_depend)>\s*([^<\s]+)\s*<")
+
+
+def _declared(package_xml: Path) -> set[str]:
+    try:
+        return set(_DEPEND.findall(package_xml.read_text(encoding="utf-8", errors="replace")))
+    except OSError:
+        return set()
+
+
+def _explain_missing_module(ctx: CallContext, lines: list[str], package: str) -> None:
+    """After Python's "No module named 'X'": is X a package package.xml should declare?"""
+    found = [m for line in lines if (m := _NO_MODULE.search(line))]
+    ws = workspace()
+    if not found or ws is None:
+        return
+    missing = found[-1]["module"].split(".")[0]
+    folders = build.package_folders(ws)
+    manifest = folders[package] / "package.xml" if package in folders else None
+    shown = ws.shown(manifest) if manifest is not None else f"{package}'s package.xml"
+    declared = missing in _declared(manifest) if manifest is not None else False
+    if missing in folders and not declared:
+        ctx.write(
+            f"(hint: your node imports {missing}, a package of your workspace, but {shown} "
+            f"does not declare it. colcon builds a package after the packages it declares, "
+            f"and `colcon build --packages-up-to {package}` builds only those; on another "
+            f"machine rosdep installs only what is declared. Add <depend>{missing}</depend> "
+            f"to {shown}, then `colcon build --packages-up-to {package}` and "
+            "`source install/setup.bash`)"
+        )
+    elif missing in folders:
+        ctx.write(
+            f"(hint: {missing} is declared and in src/, but not in the install space this "
+            f"Console sourced: `colcon build --packages-up-to {package}`, then "
+            "`source install/setup.bash`)"
+        )
+    elif not declared:
+        ctx.write(
+            f"(hint: {missing} is neither a package of your workspace nor installed here. If "
+            f"it is a ROS package, declare it in {shown} (<depend>{missing}</depend>): on a "
+            "ROS machine `rosdep install --from-paths src` installs what package.xml "
+            "declares, and nothing else)"
+        )
 
 
 def _not_found_hint(package: str) -> str:

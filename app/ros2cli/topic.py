@@ -8,7 +8,20 @@ from dataclasses import dataclass
 from typing import Any
 
 import yaml
-from rclpy.qos import DurabilityPolicy, ReliabilityPolicy
+from rclpy.duration import Duration
+from rclpy.exceptions import InvalidTopicNameException
+from rclpy.expand_topic_name import expand_topic_name
+from rclpy.qos import (
+    DurabilityPolicy,
+    QoSDurabilityPolicy,
+    QoSHistoryPolicy,
+    QoSLivelinessPolicy,
+    QoSPresetProfiles,
+    QoSProfile,
+    QoSReliabilityPolicy,
+    ReliabilityPolicy,
+)
+from rclpy.validate_full_topic_name import validate_full_topic_name
 
 from app.ros.context import CallContext
 from app.ros.convert import (
@@ -20,12 +33,13 @@ from app.ros.convert import (
     parse_yaml,
 )
 from app.ros.errors import Ros2Error
-from app.ros.graph import resolve_topic_type, topic_types, wait_for_graph
+from app.ros.graph import topic_types
 from app.ros.monitor import TopicMonitor
 from app.ros.qos import MEASURE_QOS
 from app.ros2cli.common import (
     Ros2cliMessage,
     SilentFailure,
+    ros2_type,
     visible,
     write_names,
     write_text,
@@ -134,14 +148,119 @@ def qos_fallback_lines(publishers: list[Any]) -> list[str]:
     return lines
 
 
+@dataclass(frozen=True)
+class QosOptions:
+    """`topic echo`/`pub`'s --qos-* options: a preset by its short key, and overrides."""
+
+    profile: str
+    reliability: str | None = None
+    durability: str | None = None
+    depth: int | None = None
+    history: str | None = None
+    liveliness: str | None = None
+    lease_seconds: float | None = None
+
+    def overridden(self) -> bool:
+        overrides = (self.reliability, self.durability, self.depth, self.history)
+        return any(v is not None for v in (*overrides, self.liveliness, self.lease_seconds))
+
+    def profile_with_overrides(self) -> QoSProfile:
+        """The preset with each given policy in its place, as ros2cli builds it."""
+        qos = QoSPresetProfiles.get_from_short_key(self.profile)
+        if self.history:
+            qos.history = QoSHistoryPolicy.get_from_short_key(self.history)
+        if self.durability:
+            qos.durability = QoSDurabilityPolicy.get_from_short_key(self.durability)
+        if self.reliability:
+            qos.reliability = QoSReliabilityPolicy.get_from_short_key(self.reliability)
+        if self.liveliness:
+            qos.liveliness = QoSLivelinessPolicy.get_from_short_key(self.liveliness)
+        if self.lease_seconds and self.lease_seconds >= 0:
+            qos.liveliness_lease_duration = Duration(seconds=self.lease_seconds)
+        if self.depth and self.depth >= 0:
+            qos.depth = self.depth
+        elif qos.durability == DurabilityPolicy.TRANSIENT_LOCAL and qos.depth == 0:
+            qos.depth = 1
+        return qos
+
+
+ECHO_QOS = QosOptions("sensor_data")
+PUB_QOS = QosOptions("default")
+
+
+def _echo_qos(ctx: CallContext, topic: str, options: QosOptions) -> QoSProfile | None:
+    """The subscription's QoS, as ros2cli's echo chooses it (None: our matching default).
+
+    With an override, exactly the asked profile; else the preset, made reliable or
+    transient local only when every publisher offers it (and saying so when some do).
+    """
+    if options.overridden():
+        return options.profile_with_overrides()
+    publishers = ctx.node.get_publishers_info_by_topic(topic)
+    for line in qos_fallback_lines(publishers):
+        ctx.write(line)
+    if options.profile == ECHO_QOS.profile:
+        return None  # the same choice, made by app.ros.qos.matching_qos
+    qos = QoSPresetProfiles.get_from_short_key(options.profile)
+    if publishers:
+        reliable = all(p.qos_profile.reliability == ReliabilityPolicy.RELIABLE for p in publishers)
+        latched = all(
+            p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for p in publishers
+        )
+        qos.reliability = ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT
+        qos.durability = DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE
+    return qos
+
+
+def _full_topic_name(ctx: CallContext, topic: str) -> str:
+    """The name as ros2cli looks it up: relative to the CLI's node, and valid, or its words."""
+    try:
+        expanded = expand_topic_name(topic, ctx.node.get_name(), ctx.node.get_namespace())
+        validate_full_topic_name(expanded)
+    except (ValueError, InvalidTopicNameException) as exc:
+        raise Ros2cliMessage(str(exc)) from None
+    return expanded
+
+
+def _known_type(ctx: CallContext, topic: str) -> str | None:
+    types = topic_types(ctx.node, include_hidden=True).get(topic)
+    if types and len(types) > 1:
+        raise Ros2cliMessage(
+            f"Cannot echo topic '{topic}', as it contains more than one type: [{', '.join(types)}]"
+        )
+    return types[0] if types else None
+
+
+def not_published_yet(topic: str) -> str:
+    return f"WARNING: topic [{topic}] does not appear to be published yet"
+
+
 def _echo_type(ctx: CallContext, topic: str, type_text: str | None) -> type:
     if type_text:
-        return import_type(type_text, "msg")
-    wait_for_graph(ctx, lambda: topic in topic_types(ctx.node, include_hidden=True))
-    types = topic_types(ctx.node, include_hidden=True).get(topic)
-    if not types:
+        return ros2_type(type_text, "msg")
+    full = _full_topic_name(ctx, topic)
+    found = _known_type(ctx, full)  # no wait: the CLI has let its node discover the graph
+    if found is None:
+        ctx.write(not_published_yet(topic))
         raise Ros2cliMessage("Could not determine the type for the passed topic")
-    return import_type(types[0], "msg")
+    return import_type(found, "msg")
+
+
+def _measured_type(ctx: CallContext, topic: str) -> type | None:
+    """`topic hz`/`bw` of a topic not on the graph yet: say so once, then wait for it.
+
+    None when the wait ends first (the Console's bound, or Ctrl+C: ros2 then ends
+    quietly with exit code 0, its wait loop simply stops).
+    """
+    full = _full_topic_name(ctx, topic)
+    found = _known_type(ctx, full)
+    if found is None:
+        ctx.write(not_published_yet(topic))
+        deadline = _deadline(ctx)
+        while (found := _known_type(ctx, full)) is None:
+            if time.monotonic() > deadline or ctx.cancel.wait(0.1):
+                return None
+    return import_type(found, "msg")
 
 
 def _selected(msg: Any, field: list[str] | None, field_text: str) -> Any:
@@ -187,6 +306,7 @@ def echo(
     count: int | None = None,
     style: EchoStyle = EchoStyle(),
     timeout: float | None = None,
+    qos: QosOptions = ECHO_QOS,
 ) -> int:
     parts = None
     if field is not None:
@@ -194,10 +314,9 @@ def echo(
         if not parts:
             raise Ros2cliMessage(f"Invalid field value '{field}'")
     msg_type = _echo_type(ctx, topic, type_text)
-    for line in qos_fallback_lines(ctx.node.get_publishers_info_by_topic(topic)):
-        ctx.write(line)
+    profile = _echo_qos(ctx, topic, qos)
     limit = 1 if once else count or ctx.limits.max_messages
-    monitor = TopicMonitor(ctx.node, topic, msg_type, keep=200, window=16)
+    monitor = TopicMonitor(ctx.node, topic, msg_type, keep=200, window=16, qos=profile)
     shown = 0
     deadline = _deadline(ctx)
     if timeout is not None:
@@ -229,7 +348,11 @@ def echo(
 def _measure(
     ctx: CallContext, topic: str, type_text: str | None, window: int, report, first: str = ""
 ) -> int:
-    msg_type = resolve_topic_type(ctx, topic, type_text)
+    msg_type = ros2_type(type_text, "msg") if type_text else _measured_type(ctx, topic)
+    if msg_type is None:
+        if not ctx.cancel.is_set():
+            ctx.write(f"(no messages on {topic}, or too few to measure)")
+        return 0
     # Best effort, as ros2 hz/bw subscribe: measuring must not slow a reliable publisher.
     monitor = TopicMonitor(ctx.node, topic, msg_type, window=window, keep=1, qos=MEASURE_QOS)
     if first:
@@ -346,11 +469,12 @@ def pub(
     print_nth: int = 1,
     max_wait_time: float | None = None,
     keep_alive: float = 0.1,
+    qos: QosOptions = PUB_QOS,
 ) -> int:
     """`ros2 topic pub`: wait for subscribers if asked, then publish and print as ros2cli."""
     if not rate > 0 or not math.isfinite(rate):
         raise Ros2Error(f"rate must be a positive number of Hz, got {rate}")
-    msg_type = import_type(type_text, "msg")
+    msg_type = ros2_type(type_text, "msg")
     try:
         loaded = yaml.safe_load(values or "{}")
     except yaml.YAMLError:
@@ -371,7 +495,7 @@ def pub(
     existing = topic_types(ctx.node, include_hidden=True).get(topic)
     if existing and type_text and import_type(existing[0]) is not msg_type:
         raise Ros2Error(f"topic '{topic}' already carries {existing[0]}, not {type_text}")
-    publisher = ctx.node.create_publisher(msg_type, topic, 10)
+    publisher = ctx.node.create_publisher(msg_type, topic, qos.profile_with_overrides())
     try:
         _wait_for_subscribers(ctx, publisher, wait_matching, max_wait_time)
         ctx.write("publisher: beginning loop")

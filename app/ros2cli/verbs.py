@@ -1,58 +1,170 @@
 """The arguments of `ros2 node/topic/service/action/param/lifecycle/interface` verbs.
 
-Option names, short forms and defaults follow Jazzy's ros2cli, so ``-h`` shows
-what a learner finds in the docs. Options ros2cli has but we do not are named
-in each verb's help (``Not supported here: ...``): typing one gives argparse's
-"unrecognized arguments" error instead of being silently ignored.
+Each verb takes the options of Jazzy's ros2cli, in its order, with its names,
+metavars and help texts, so ``-h`` reads as the docs and the real tool show it
+(compared side by side: bench/results/ros2cli_compare.md). The few options we
+do not offer are still listed (the same ``-h``), named again at the end of the
+help ("Not supported here"), and refused with argparse's usage error when
+typed, never silently ignored.
 """
 
 from __future__ import annotations
 
 import argparse
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
+
+from rclpy.qos import (
+    QoSDurabilityPolicy,
+    QoSHistoryPolicy,
+    QoSLivelinessPolicy,
+    QoSPresetProfiles,
+    QoSReliabilityPolicy,
+)
 
 from app.ros2cli import graph_verbs, lifecycle, param, topic
 
-# ros2cli's "strategy" options (daemon and discovery): accepted, nothing to do here.
-_STRATEGY_UNSUPPORTED = ("-s/--use-sim-time",)
-_QOS = (
-    "--qos-profile",
-    "--qos-depth",
-    "--qos-history",
-    "--qos-reliability",
-    "--qos-durability",
-    "--qos-liveliness",
-    "--qos-liveliness-lease-duration-seconds",
-)
-
 Verb = Callable[..., argparse.ArgumentParser]
 
-
-def unsupported(p: argparse.ArgumentParser, *options: str) -> None:
-    """Name in -h the options Jazzy's ros2 has for this verb that we do not offer."""
-    if options:
-        p.epilog = (
-            "Not supported here (Jazzy's ros2 has them): "
-            + ", ".join(options)
-            + ". Using one gives an 'unrecognized arguments' error."
-        )
-        p.formatter_class = argparse.RawDescriptionHelpFormatter
+NOT_HERE = "not supported here"
 
 
-def strategy(p: argparse.ArgumentParser) -> None:
-    """--spin-time and --no-daemon: accepted (a fresh CLI node always discovers the graph)."""
+class _NotHere(argparse.Action):
+    """An option Jazzy's ros2 has and we do not: shown in -h, refused when used."""
+
+    def __call__(self, parser: Any, namespace: Any, values: Any, option_string: Any = None) -> None:
+        raise argparse.ArgumentError(self, f"{NOT_HERE} (see the end of -h)")
+
+
+def not_here(p: argparse.ArgumentParser | Any, *flags: str, flag: bool = False, **kw: Any) -> None:
+    """Add an option we do not offer (``flag``: it takes no value), and name it in the epilog."""
+    target = kw.pop("group", p)
+    target.add_argument(*flags, action=_NotHere, nargs=0 if flag else None, **kw)
+    names: list[str] = p.__dict__.setdefault("_not_here", [])
+    names.append("/".join(sorted(flags, key=len)))
+    p.epilog = (
+        f"Not supported here (Jazzy's ros2 has them): {', '.join(names)}. "
+        "Using one gives a usage error."
+    )
+
+
+def positive_float(text: str) -> float:
+    """ros2topic's float > 0 (argparse names this function in its error)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError("Expects a floating point number") from None
+    if value <= 0.0:
+        raise argparse.ArgumentTypeError("Value must be positive")
+    return value
+
+
+def positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value <= 0:
+        raise argparse.ArgumentTypeError("value must be a positive integer")
+    return value
+
+
+def unsigned_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError("value must be non-negative integer")
+    return value
+
+
+def nonnegative_int(text: str) -> int:
+    value = int(text)
+    if value < 0:
+        raise ValueError("Value must be positive or zero")
+    return value
+
+
+def spin_time(p: argparse.ArgumentParser) -> None:
+    """--spin-time and -s: the options of ros2cli's own (direct) node."""
     p.add_argument(
         "--spin-time",
         type=float,
         default=None,
-        help="Spin time in seconds to wait for discovery (accepted; "
-        "the CLI waits until the graph stops changing)",
+        help="Spin time in seconds to wait for discovery (only applies when not using an "
+        "already running daemon)",
     )
+    not_here(p, "-s", "--use-sim-time", flag=True, help="Enable ROS simulation time")
+
+
+def strategy(p: argparse.ArgumentParser) -> None:
+    """--spin-time, -s, --no-daemon (there is no daemon here: never spawned nor used)."""
+    spin_time(p)
     p.add_argument(
         "--no-daemon",
         action="store_true",
-        help="Do not use a daemon (there is none here: always true)",
+        help="Do not spawn nor use an already running daemon",
+    )
+
+
+def qos_options(p: argparse.ArgumentParser, verb: str, default_profile: str) -> None:
+    """`topic echo` and `topic pub`'s QoS options (read back by ``qos_of``)."""
+    history = QoSPresetProfiles.get_from_short_key(default_profile).history.short_key
+    compatible = "default: Compatible profile with running endpoints )"
+    p.add_argument(
+        "--qos-profile",
+        choices=QoSPresetProfiles.short_keys(),
+        default=default_profile,
+        help=f"Quality of service preset profile to {verb} with (default: {default_profile})",
+    )
+    p.add_argument(
+        "--qos-depth",
+        metavar="N",
+        type=int,
+        help=f"Queue size setting to {verb} with (overrides depth value of --qos-profile option)",
+    )
+    p.add_argument(
+        "--qos-history",
+        choices=QoSHistoryPolicy.short_keys(),
+        help=f"History of samples setting to {verb} with (overrides history value of "
+        f"--qos-profile option, default: {history})",
+    )
+    p.add_argument(
+        "--qos-reliability",
+        choices=QoSReliabilityPolicy.short_keys(),
+        help=f"Quality of service reliability setting to {verb} with (overrides "
+        f"reliability value of --qos-profile option, {compatible}",
+    )
+    p.add_argument(
+        "--qos-durability",
+        choices=QoSDurabilityPolicy.short_keys(),
+        help=f"Quality of service durability setting to {verb} with (overrides "
+        f"durability value of --qos-profile option, {compatible}",
+    )
+    p.add_argument(
+        "--qos-liveliness",
+        choices=QoSLivelinessPolicy.short_keys(),
+        help=f"Quality of service liveliness setting to {verb} with (overrides "
+        "liveliness value of --qos-profile option",
+    )
+    p.add_argument(
+        "--qos-liveliness-lease-duration-seconds",
+        type=float,
+        help=f"Quality of service liveliness lease duration setting to {verb} with "
+        "(overrides liveliness lease duration value of --qos-profile option",
+    )
+
+
+def qos_of(a: argparse.Namespace) -> topic.QosOptions:
+    return topic.QosOptions(
+        a.qos_profile,
+        reliability=a.qos_reliability,
+        durability=a.qos_durability,
+        depth=a.qos_depth,
+        history=a.qos_history,
+        liveliness=a.qos_liveliness,
+        lease_seconds=a.qos_liveliness_lease_duration_seconds,
     )
 
 
@@ -66,7 +178,6 @@ def _node_listing_options(p: Any) -> None:
         action="store_true",
         help="Only display the number of nodes discovered",
     )
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
 
 
 def add_node(v: Any, verb: Verb) -> None:
@@ -90,18 +201,12 @@ def add_node(v: Any, verb: Verb) -> None:
         action="store_true",
         help="Display hidden topics, services, and actions as well",
     )
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
 
 
-def _topic_and_type(p: argparse.ArgumentParser) -> None:
-    p.add_argument("topic_name", help="Name of the ROS topic (e.g. '/chatter')")
-    p.add_argument(
-        "message_type", nargs="?", help="Type of the ROS message (e.g. 'std_msgs/msg/String')"
-    )
+HIDDEN_TOPICS_HELP = "Consider hidden topics as well"
 
 
 def add_topic(v: Any, verb: Verb) -> None:
-    hidden_help = "Consider hidden topics as well"
     p = verb(
         v,
         "list",
@@ -120,11 +225,10 @@ def add_topic(v: Any, verb: Verb) -> None:
         action="store_true",
         help="Only display the number of topics discovered",
     )
-    p.add_argument("--include-hidden-topics", action="store_true", help=hidden_help)
+    p.add_argument("--include-hidden-topics", action="store_true", help=HIDDEN_TOPICS_HELP)
     p.add_argument(
         "-v", "--verbose", action="store_true", help="List full details about each topic"
     )
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
 
     p = verb(
         v,
@@ -135,13 +239,12 @@ def add_topic(v: Any, verb: Verb) -> None:
     strategy(p)
     p.add_argument("topic_name", help="Name of the ROS topic to get info (e.g. '/chatter')")
     p.add_argument(
-        "-v",
         "--verbose",
+        "-v",
         action="store_true",
-        help="Print the node name, node namespace, topic type, topic type hash, GID "
-        "and QoS profile of each publisher and subscription",
+        help="Prints detailed information like the node name, node namespace, topic type, "
+        "topic type hash, GUID, and QoS Profile of the publishers and subscribers to this topic",
     )
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
 
     p = verb(
         v,
@@ -151,7 +254,6 @@ def add_topic(v: Any, verb: Verb) -> None:
     )
     strategy(p)
     p.add_argument("topic_name", help="Name of the ROS topic to get type (e.g. '/chatter')")
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
 
     p = verb(
         v,
@@ -160,8 +262,9 @@ def add_topic(v: Any, verb: Verb) -> None:
         lambda c, a: topic.find(c, a.topic_type, a.count_topics, a.include_hidden_topics),
     )
     strategy(p)
+    # (sic: ros2cli's example says std_msg)
     p.add_argument(
-        "topic_type", help="Name of the ROS topic type to filter for (e.g. 'std_msgs/msg/String')"
+        "topic_type", help="Name of the ROS topic type to filter for (e.g. 'std_msg/msg/String')"
     )
     p.add_argument(
         "-c",
@@ -169,9 +272,60 @@ def add_topic(v: Any, verb: Verb) -> None:
         action="store_true",
         help="Only display the number of topics discovered",
     )
-    p.add_argument("--include-hidden-topics", action="store_true", help=hidden_help)
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
+    p.add_argument("--include-hidden-topics", action="store_true", help=HIDDEN_TOPICS_HELP)
 
+    _add_echo(v, verb)
+
+    p = verb(
+        v,
+        "hz",
+        "Print the average publishing rate to screen",
+        lambda c, a: topic.hz(c, a.topic_name, None, a.window_size),
+    )
+    p.add_argument("topic_name", help="Name of the ROS topic to listen to (e.g. '/chatter')")
+    p.add_argument(
+        "--window",
+        "-w",
+        dest="window_size",
+        type=positive_int,
+        default=10_000,
+        metavar="WINDOW",
+        help="window size, in # of messages, for calculating rate (default: 10000)",
+    )
+    not_here(
+        p, "--filter", metavar="EXPR", help="only measure messages matching the specified "
+        "Python expression",
+    )  # fmt: skip
+    not_here(
+        p,
+        "--wall-time",
+        flag=True,
+        help="calculates rate using wall time which can be helpful when clock is not "
+        "published during simulation",
+    )
+    spin_time(p)
+
+    p = verb(
+        v,
+        "bw",
+        "Display bandwidth used by topic",
+        lambda c, a: topic.bw(c, a.topic, None, a.window),
+    )
+    p.add_argument("topic", help="Topic name to monitor for bandwidth utilization")
+    p.add_argument(
+        "--window",
+        "-w",
+        type=positive_int,
+        default=100,
+        metavar="WINDOW",
+        help="maximum window size, in # of messages, for calculating rate (default: 100)",
+    )
+    spin_time(p)
+
+    _add_pub(v, verb)
+
+
+def _add_echo(v: Any, verb: Verb) -> None:
     p = verb(
         v,
         "echo",
@@ -190,40 +344,62 @@ def add_topic(v: Any, verb: Verb) -> None:
                 csv=a.csv,
             ),
             timeout=a.timeout,
+            qos=qos_of(a),
         ),
     )
     strategy(p)
-    _topic_and_type(p)
+    p.add_argument("topic_name", help="Name of the ROS topic to listen to (e.g. '/chatter')")
+    p.add_argument(
+        "message_type", nargs="?", help="Type of the ROS message (e.g. 'std_msgs/msg/String')"
+    )
+    qos_options(p, "subscribe", "sensor_data")
+    p.add_argument(
+        "--csv",
+        action="store_true",
+        help="Output all recursive fields separated by commas (e.g. for plotting). If "
+        "--include-message-info is also passed, the following fields are prepended: "
+        "source_timestamp, received_timestamp, publication_sequence_number, "
+        "reception_sequence_number.",
+    )
     p.add_argument(
         "--field",
+        type=str,
         default=None,
-        help="Echo a selected field of a message. Use '.' to select sub-fields "
-        "(e.g. 'pose.pose.position')",
+        help="Echo a selected field of a message. Use '.' to select sub-fields. For example, "
+        "to echo the position field of a nav_msgs/msg/Odometry message: "
+        "'ros2 topic echo /odom --field pose.pose.position'",
     )
     p.add_argument(
-        "-f",
         "--full-length",
+        "-f",
         action="store_true",
-        help="Output all elements of arrays, bytes and strings (no truncation)",
+        help="Output all elements for arrays, bytes, and string with a length > "
+        "'--truncate-length', by default they are truncated after '--truncate-length' "
+        "elements with '...''",
     )
     p.add_argument(
-        "-l",
         "--truncate-length",
-        type=int,
+        "-l",
+        type=unsigned_int,
         default=128,
         help="The length to truncate arrays, bytes, and string to (default: 128)",
     )
     p.add_argument("--no-arr", action="store_true", help="Don't print array fields of messages")
     p.add_argument("--no-str", action="store_true", help="Don't print string fields of messages")
+    # (sic: ros2cli's help says block style for the option that asks for the flow style)
     p.add_argument(
         "--flow-style",
         action="store_true",
-        help="Print collections in the flow style (not available with csv format)",
+        help="Print collections in the block style (not available with csv format)",
     )
-    p.add_argument(
-        "--csv",
-        action="store_true",
-        help="Output all recursive fields separated by commas (e.g. for plotting)",
+    not_here(p, "--no-lost-messages", flag=True, help="Don't report when a message is lost")
+    not_here(p, "--raw", flag=True, help="Echo the raw binary representation")
+    not_here(
+        p,
+        "--filter",
+        dest="filter_expr",
+        help="Python expression to filter messages that are printed. Expression can use "
+        "Python builtins as well as m (the message).",
     )
     p.add_argument(
         "--once", action="store_true", help="Print the first message received and then exit."
@@ -231,44 +407,16 @@ def add_topic(v: Any, verb: Verb) -> None:
     p.add_argument(
         "--timeout",
         metavar="N",
-        type=float,
+        type=positive_float,
         default=None,
         help="Set a timeout in seconds for waiting",
     )
-    unsupported(
-        p,
-        *_QOS,
-        "--no-lost-messages",
-        "--raw",
-        "--filter",
-        "-i/--include-message-info",
-        *_STRATEGY_UNSUPPORTED,
+    not_here(
+        p, "--include-message-info", "-i", flag=True, help="Shows the associated message info."
     )
 
-    for name, help_text, measure, window in (
-        ("hz", "Print the average publishing rate to screen", topic.hz, 10_000),
-        ("bw", "Display bandwidth used by topic", topic.bw, 100),
-    ):
-        p = verb(
-            v,
-            name,
-            help_text,
-            lambda c, a, m=measure: m(c, a.topic_name, a.message_type, a.window),
-        )
-        strategy(p)
-        _topic_and_type(p)
-        p.add_argument(
-            "-w",
-            "--window",
-            type=int,
-            default=window,
-            metavar="WINDOW",
-            help=f"window size, in # of messages, for calculating rate (default: {window})",
-        )
-        unsupported(
-            p, *(("--filter", "--wall-time") if name == "hz" else ()), *_STRATEGY_UNSUPPORTED
-        )
 
+def _add_pub(v: Any, verb: Verb) -> None:
     p = verb(
         v,
         "pub",
@@ -285,22 +433,25 @@ def add_topic(v: Any, verb: Verb) -> None:
             print_nth=a.print,
             max_wait_time=a.max_wait_time_secs,
             keep_alive=a.keep_alive,
+            qos=qos_of(a),
         ),
     )
     p.add_argument("topic_name", help="Name of the ROS topic to publish to (e.g. '/chatter')")
     p.add_argument("message_type", help="Type of the ROS message (e.g. 'std_msgs/String')")
-    p.add_argument(
+    values_or_stdin = p.add_mutually_exclusive_group()
+    values_or_stdin.add_argument(
         "values",
         nargs="?",
         default="{}",
         help="Values to fill the message with in YAML format (e.g. 'data: Hello World'), "
         "otherwise the message will be published with default values",
     )
+    not_here(p, "--stdin", flag=True, group=values_or_stdin, help="Read values from standard input")
     p.add_argument(
         "-r",
         "--rate",
         metavar="N",
-        type=float,
+        type=positive_float,
         default=1.0,
         help="Publishing rate in Hz (default: 1)",
     )
@@ -317,34 +468,41 @@ def add_topic(v: Any, verb: Verb) -> None:
         "-1", "--once", action="store_true", help="Publish one message and exit"
     )
     once_or_times.add_argument(
-        "-t", "--times", type=int, default=0, help="Publish this number of times and then exit"
+        "-t",
+        "--times",
+        type=nonnegative_int,
+        default=0,
+        help="Publish this number of times and then exit",
     )
     p.add_argument(
         "-w",
         "--wait-matching-subscriptions",
-        type=int,
+        type=nonnegative_int,
         default=None,
         help="Wait until finding the specified number of matching subscriptions. "
         'Defaults to 1 when using "-1"/"--once"/"--times", otherwise defaults to 0.',
     )
     p.add_argument(
         "--max-wait-time-secs",
-        type=float,
+        type=positive_float,
         default=None,
-        help="The maximum wait time in seconds for matching subscriptions "
-        "(default: wait endlessly)",
+        help="This sets the maximum wait time in seconds if "
+        "--wait-until-matching-subscriptions is set. By default, this flag is not set "
+        "meaning the subscriber will wait endlessly.",
     )
     p.add_argument(
         "--keep-alive",
         metavar="N",
-        type=float,
+        type=positive_float,
         default=0.1,
         help="Keep publishing node alive for N seconds after the last msg (default: 0.1)",
     )
-    unsupported(p, "--stdin", "-n/--node-name", *_QOS, *_STRATEGY_UNSUPPORTED)
+    not_here(p, "-n", "--node-name", help="Name of the created publishing node")
+    qos_options(p, "publish", "default")
+    spin_time(p)
 
 
-def _service_list_like(p: argparse.ArgumentParser) -> None:
+def _count_services(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "-c",
         "--count-services",
@@ -369,8 +527,7 @@ def add_service(v: Any, verb: Verb) -> None:
     p.add_argument(
         "-t", "--show-types", action="store_true", help="Additionally show the service type"
     )
-    _service_list_like(p)
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
+    _count_services(p)
 
     p = verb(
         v,
@@ -378,7 +535,10 @@ def add_service(v: Any, verb: Verb) -> None:
         "Output a service's type",
         lambda c, a: graph_verbs.service_type(c, a.service_name, a.include_hidden_services),
     )
-    p.add_argument("service_name", help="Name of the ROS service to get type")
+    p.add_argument(
+        "service_name",
+        help="Name of the ROS service to get type (e.g. '/talker/list_parameters')",
+    )
 
     p = verb(
         v,
@@ -393,7 +553,7 @@ def add_service(v: Any, verb: Verb) -> None:
         help="Name of the ROS service type to filter for "
         "(e.g. 'rcl_interfaces/srv/ListParameters')",
     )
-    _service_list_like(p)
+    _count_services(p)
 
     p = verb(
         v,
@@ -405,7 +565,6 @@ def add_service(v: Any, verb: Verb) -> None:
     p.add_argument(
         "service_name", help="Name of the ROS service to get info (e.g. '/add_two_ints')"
     )
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
 
     p = verb(
         v,
@@ -417,13 +576,15 @@ def add_service(v: Any, verb: Verb) -> None:
     )
     p.add_argument("service_name", help="Name of the ROS service to call to (e.g. '/add_two_ints')")
     p.add_argument("service_type", help="Type of the ROS service (e.g. 'std_srvs/srv/Empty')")
-    p.add_argument(
+    values_or_stdin = p.add_mutually_exclusive_group()
+    values_or_stdin.add_argument(
         "values",
         nargs="?",
         default="{}",
         help="Values to fill the service request with in YAML format (e.g. '{a: 1, b: 2}'), "
         "otherwise the service request will be published with default values",
     )
+    not_here(p, "--stdin", flag=True, group=values_or_stdin, help="Read values from standard input")
     p.add_argument(
         "-r",
         "--rate",
@@ -432,7 +593,6 @@ def add_service(v: Any, verb: Verb) -> None:
         default=None,
         help="Repeat the call at a specific rate in Hz",
     )
-    unsupported(p, "--stdin")
 
 
 def add_action(v: Any, verb: Verb) -> None:
@@ -451,10 +611,11 @@ def add_action(v: Any, verb: Verb) -> None:
         action="store_true",
         help="Only display the number of actions discovered",
     )
+    # (sic: "a action's", and the example of `action type` says "get info")
     p = verb(
-        v, "type", "Print a ROS action type", lambda c, a: graph_verbs.action_type(c, a.action_name)
+        v, "type", "Print a action's type", lambda c, a: graph_verbs.action_type(c, a.action_name)
     )
-    p.add_argument("action_name", help="Name of the ROS action to get type (e.g. '/fibonacci')")
+    p.add_argument("action_name", help="Name of the ROS action to get info (e.g. '/fibonacci')")
     p = verb(
         v,
         "info",
@@ -483,21 +644,26 @@ def add_action(v: Any, verb: Verb) -> None:
     p.add_argument(
         "action_type", help="Type of the ROS action (e.g. 'example_interfaces/action/Fibonacci')"
     )
-    p.add_argument(
+    goal_or_stdin = p.add_mutually_exclusive_group()
+    goal_or_stdin.add_argument(
         "goal",
         nargs="?",
         default="{}",
         help="Goal request values in YAML format (e.g. '{order: 10}')",
     )
+    not_here(p, "--stdin", flag=True, group=goal_or_stdin, help="Read goal from standard input")
     p.add_argument(
         "-f", "--feedback", action="store_true", help="Echo feedback messages for the goal"
     )
-    unsupported(p, "--stdin")
 
 
-def _param_node(p: argparse.ArgumentParser, optional: bool = False) -> None:
-    strategy(p)
-    p.add_argument("node_name", nargs="?" if optional else None, help="Name of the ROS node")
+def _node_name(p: argparse.ArgumentParser, optional: bool = False, help_text: str = "") -> None:
+    p.add_argument(
+        "node_name", nargs="?" if optional else None, help=help_text or "Name of the ROS node"
+    )
+
+
+def _hidden_nodes(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--include-hidden-nodes", action="store_true", help="Consider hidden nodes as well"
     )
@@ -519,11 +685,23 @@ def add_param(v: Any, verb: Verb) -> None:
         "list",
         "Output a list of available parameters",
         lambda c, a: param.param_list(
-            c, a.node_name, a.param_type, a.include_hidden_nodes, a.param_prefixes, a.filter
+            c,
+            a.node_name,
+            a.param_type,
+            a.include_hidden_nodes,
+            a.param_prefixes,
+            a.filter[0] if a.filter else None,
         ),
     )
-    _param_node(p, optional=True)
-    p.add_argument("--filter", default=None, help="Only parameters matching the regex expression")
+    strategy(p)
+    _node_name(p, optional=True)
+    p.add_argument(
+        "--filter",
+        nargs=1,
+        help="Only parameters matching the regex expression will be showed. "
+        "Supports `re` regex syntax.",
+    )
+    _hidden_nodes(p)
     p.add_argument(
         "--param-prefixes",
         nargs="+",
@@ -533,7 +711,6 @@ def add_param(v: Any, verb: Verb) -> None:
     p.add_argument(
         "--param-type", action="store_true", help="Print parameter types with parameter names"
     )
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
 
     p = verb(
         v,
@@ -543,11 +720,12 @@ def add_param(v: Any, verb: Verb) -> None:
             c, a.node_name, a.parameter_name, a.include_hidden_nodes, a.hide_type
         ),
     )
-    _param_node(p)
+    strategy(p)
+    _node_name(p)
+    _hidden_nodes(p)
     p.add_argument("parameter_name", help="Name of the parameter")
     p.add_argument("--hide-type", action="store_true", help="Hide the type information")
     _timeout(p)
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
 
     p = verb(
         v,
@@ -557,11 +735,12 @@ def add_param(v: Any, verb: Verb) -> None:
             c, a.node_name, a.parameter_name, a.value, a.include_hidden_nodes
         ),
     )
-    _param_node(p)
+    strategy(p)
+    _node_name(p)
+    _hidden_nodes(p)
     p.add_argument("parameter_name", help="Name of the parameter")
     p.add_argument("value", help="Value of the parameter")
     _timeout(p)
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
 
     p = verb(
         v,
@@ -571,10 +750,11 @@ def add_param(v: Any, verb: Verb) -> None:
             c, a.node_name, a.parameter_names, a.include_hidden_nodes
         ),
     )
-    _param_node(p)
+    strategy(p)
+    _node_name(p)
+    _hidden_nodes(p)
     p.add_argument("parameter_names", nargs="+", help="Names of the parameters")
     _timeout(p)
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
 
     p = verb(
         v,
@@ -582,9 +762,10 @@ def add_param(v: Any, verb: Verb) -> None:
         "Show all of the parameters of a node in a YAML file format",
         lambda c, a: param.param_dump(c, a.node_name, a.include_hidden_nodes),
     )
-    _param_node(p)
+    strategy(p)
+    _node_name(p)
+    _hidden_nodes(p)
     _timeout(p)
-    unsupported(p, "--output-dir", "--print", *_STRATEGY_UNSUPPORTED)
 
     p = verb(
         v,
@@ -594,15 +775,16 @@ def add_param(v: Any, verb: Verb) -> None:
             c, a.node_name, a.parameter_file, a.include_hidden_nodes, not a.no_use_wildcard
         ),
     )
-    _param_node(p)
+    strategy(p)
+    _node_name(p)
+    _hidden_nodes(p)
     p.add_argument("parameter_file", help="Parameter file")
-    _timeout(p)
     p.add_argument(
         "--no-use-wildcard",
         action="store_true",
         help="Do not load parameters in the '/**' namespace into the node",
     )
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
+    _timeout(p)
 
     p = verb(
         v,
@@ -610,13 +792,39 @@ def add_param(v: Any, verb: Verb) -> None:
         "Delete parameter",
         lambda c, a: param.param_delete(c, a.node_name, a.parameter_name, a.include_hidden_nodes),
     )
-    _param_node(p)
+    strategy(p)
+    _node_name(p)
+    _hidden_nodes(p)
     p.add_argument("parameter_name", help="Name of the parameter")
     _timeout(p)
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
 
 
 def add_lifecycle(v: Any, verb: Verb) -> None:
+    p = verb(
+        v,
+        "get",
+        "Get lifecycle state for one or more nodes",
+        lambda c, a: lifecycle.verb_get(c, a.node_name, a.include_hidden_nodes),
+    )
+    strategy(p)
+    _node_name(
+        p,
+        optional=True,
+        help_text="Name of the ROS node. If no name is provided, then get the state for all nodes.",
+    )
+    _hidden_nodes(p)
+
+    p = verb(
+        v,
+        "list",
+        "Output a list of available transitions",
+        lambda c, a: lifecycle.verb_list(c, a.node_name, a.include_hidden_nodes, a.all),
+    )
+    strategy(p)
+    _node_name(p)
+    _hidden_nodes(p)
+    p.add_argument("-a", "--all", action="store_true", help="Display all existing transitions")
+
     p = verb(
         v,
         "nodes",
@@ -627,39 +835,27 @@ def add_lifecycle(v: Any, verb: Verb) -> None:
 
     p = verb(
         v,
-        "get",
-        "Get lifecycle state for one or more nodes",
-        lambda c, a: lifecycle.verb_get(c, a.node_name, a.include_hidden_nodes),
-    )
-    _param_node(p, optional=True)
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
-
-    p = verb(
-        v,
-        "list",
-        "Output a list of available transitions",
-        lambda c, a: lifecycle.verb_list(c, a.node_name, a.include_hidden_nodes, a.all),
-    )
-    _param_node(p)
-    p.add_argument("-a", "--all", action="store_true", help="Display all existing transitions")
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
-
-    p = verb(
-        v,
         "set",
         "Trigger lifecycle state transition",
         lambda c, a: lifecycle.verb_set(c, a.node_name, a.transition, a.include_hidden_nodes),
     )
-    _param_node(p)
+    strategy(p)
+    _node_name(p)
+    _hidden_nodes(p)
     p.add_argument("transition", help="The lifecycle transition")
-    unsupported(p, *_STRATEGY_UNSUPPORTED)
 
 
-def only_kinds(p: argparse.ArgumentParser) -> None:
-    """`ros2 interface package(s)`: -m, -s, -a."""
-    p.add_argument("-m", "--only-msgs", action="store_true", help="Only message types")
-    p.add_argument("-s", "--only-srvs", action="store_true", help="Only service types")
-    p.add_argument("-a", "--only-actions", action="store_true", help="Only action types")
+def only_kinds(p: argparse.ArgumentParser, what: Sequence[str] | None = None) -> None:
+    """`ros2 interface list/package(s)`: -m, -s, -a, with each verb's own help texts."""
+    texts = what or (
+        "Print out only the message types",
+        "Print out only the service types",
+        "Print out only the action types",
+    )
+    for short, long, text in zip(
+        ("-m", "-s", "-a"), ("--only-msgs", "--only-srvs", "--only-actions"), texts, strict=True
+    ):
+        p.add_argument(short, long, action="store_true", help=text)
 
 
 def comment_options(p: argparse.ArgumentParser) -> None:

@@ -4,8 +4,9 @@ What a file manager and a plain editor give a learner following the
 tutorials: create, rename and delete files and folders, open a text file
 (setup.py, package.xml, a node), edit it and save it. Paths are relative to
 the workspace (``src/my_package/setup.py``) and confined to it
-(app.learner_ws.files). This is viser's own text field, not the exercise
-editor: one open file at a time, no completion or lint marks.
+(app.learner_ws.files). This is viser's own text field, one file at a
+time; the code window's editor (Files, beside its tabs) opens the same files
+with completion, lint marks and Format, through the same confinement.
 """
 
 from __future__ import annotations
@@ -24,6 +25,10 @@ class WorkspaceFiles:
     def __init__(self, gui: viser.GuiApi, ui: UiLoop) -> None:
         self._ui = ui
         with gui.add_folder("Workspace files (~/ros2_ws)", expand_by_default=False):
+            gui.add_markdown(
+                "Create, rename and delete here. To edit with completion and lint marks, "
+                "open a file from **Files** in the code window (Exercise tab → Open my code)."
+            )
             self._tree = MarkdownView(gui, "")
             self._path = gui.add_text("Path", "src/", hint="relative to ~/ros2_ws")
             self._new_name = gui.add_text("Rename to", "", hint="the new path, for Rename")

@@ -2,12 +2,15 @@
 
 Geometry comes from ``nodes/common/arm_kinematics.py`` (the same forward
 kinematics the arm node uses), so the drawing reaches exactly where the node
-says. Nodes are created once; each joint_states message only moves them.
+says. Nodes are created once, hidden; the arm shows while the followed
+JointState names its four joints (another robot's joint states, or none,
+draw no phantom arm), and each message only moves it.
 """
 
 from __future__ import annotations
 
 import math
+import threading
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -72,6 +75,7 @@ class ArmLayer(OneTopicLayer):
                     color=LINK_COLOURS[i],
                     position=centre,
                     wxyz=wxyz,
+                    visible=False,
                 )
             )
         self._joints = [
@@ -81,10 +85,15 @@ class ArmLayer(OneTopicLayer):
                 color=(40, 40, 40),
                 subdivisions=2,
                 position=tf.as_xyz(pts[i]),
+                visible=False,
             )
             for i in range(len(pts))
         ]
-        scene.add_label(f"{ARM_PATH}/label", "arm", position=(0.0, 0.0, 0.16))
+        self._label = scene.add_label(
+            f"{ARM_PATH}/label", "arm", position=(0.0, 0.0, 0.16), visible=False
+        )
+        self._shown = False
+        self._show_lock = threading.Lock()  # the drawing thread and select() both show/hide
         worker = LatestWorker("arm", self._draw, MAX_HZ)
         super().__init__(TopicFollower(node, worker, JointState, qos=10))
 
@@ -97,8 +106,25 @@ class ArmLayer(OneTopicLayer):
             self._note = (
                 f"⚠️ this JointState names {list(msg.name)}; the arm model needs {list(JOINT_NAMES)}"
             )
+            self._show(False)
             return
         self.set_joints(joints)
+        self._show(True)
+
+    def _show(self, shown: bool) -> None:
+        """Show or hide the whole arm (drawing thread, or the UI thread once nothing draws)."""
+        with self._show_lock:
+            if shown == self._shown:
+                return
+            self._shown = shown
+            with self._server.atomic():
+                for handle in (*self._links, *self._joints, self._label):
+                    handle.visible = shown
+
+    def select(self, topic: str) -> None:
+        super().select(topic)
+        if topic == NONE:
+            self._show(False)
 
     def set_joints(self, joints: np.ndarray) -> None:
         pts = link_points(joints)

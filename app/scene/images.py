@@ -1,8 +1,10 @@
-"""Show one sensor_msgs/Image topic in a panel image, and optionally on the camera frustum.
+"""Show one sensor_msgs/Image topic in a panel image, and on a camera frustum in 3D.
 
 Images are converted and jpeg-encoded in a worker thread at most a few times a
 second (a browser panel needs no 30 Hz), downscaled first so each frame is
-a few tens of kilobytes.
+a few tens of kilobytes. An image whose frame is on TF goes on a frustum at
+that frame (``TfCamera``, as rviz's Camera display); otherwise, if asked, on
+the lesson-13 camera's frustum.
 """
 
 from __future__ import annotations
@@ -16,6 +18,8 @@ from app.scene.follow import OneTopicLayer, TopicFollower
 from app.scene.frames import FrameTree
 from app.scene.image_codec import ImageFormatError, downscale, image_to_rgb
 from app.scene.latest import LatestWorker
+from app.scene.tf_camera import TfCamera
+from app.scene.topic_picker import NONE
 
 MAX_HZ = 10.0
 PANEL_WIDTH = 480
@@ -24,9 +28,16 @@ FRUSTUM_WIDTH = 160
 
 class ImageLayer(OneTopicLayer):
     def __init__(
-        self, node: Node, gui: viser.GuiApi, frames: FrameTree, *, label: str = "Camera image"
+        self,
+        node: Node,
+        gui: viser.GuiApi,
+        frames: FrameTree,
+        *,
+        label: str = "Camera image",
+        tf_camera: TfCamera | None = None,
     ) -> None:
         self._frames = frames
+        self.tf_camera = tf_camera
         self.on_frustum = False
         self.info = ""
         self.frames_shown = 0
@@ -35,8 +46,10 @@ class ImageLayer(OneTopicLayer):
         worker = LatestWorker("image", self._draw, MAX_HZ)
         super().__init__(TopicFollower(node, worker, Image, on_switch=self._forget))
 
-    def _forget(self, _topic: str) -> None:
+    def _forget(self, topic: str) -> None:
         self.info = ""
+        if self.tf_camera is not None:
+            self.tf_camera.follow(None if topic == NONE else topic)
 
     def show_on_frustum(self, enabled: bool) -> None:
         self.on_frustum = enabled
@@ -50,9 +63,12 @@ class ImageLayer(OneTopicLayer):
             self.info = f"⚠️ {exc}"
             return
         self.handle.image = np.ascontiguousarray(downscale(rgb, PANEL_WIDTH))
-        if self.on_frustum:
+        small = np.ascontiguousarray(downscale(rgb, FRUSTUM_WIDTH))
+        camera, frame = self.tf_camera, msg.header.frame_id
+        on_tf = camera is not None and camera.show(frame, small, msg.width, msg.height)
+        if self.on_frustum and not on_tf:
             frustum = self._frames.frustum
             frustum.aspect = msg.width / max(1, msg.height)
-            frustum.image = np.ascontiguousarray(downscale(rgb, FRUSTUM_WIDTH))
+            frustum.image = small
         self.frames_shown += 1
         self.info = f"{msg.width}×{msg.height} `{msg.encoding}` · frame `{msg.header.frame_id}`"

@@ -86,7 +86,15 @@ class TextArgs(TypedDict):
     font_scene_height: float
 
 
-ShapeArgs = SphereArgs | BoxArgs | CylinderArgs | ArrowsArgs | LinesArgs | PointsArgs | TextArgs
+class MeshArgs(TypedDict):
+    kind: Literal["mesh"]
+    vertices: np.ndarray  # (N, 3) float32, scaled by the marker's scale
+    faces: np.ndarray  # (N / 3, 3) uint32: each three consecutive points are a triangle
+
+
+ShapeArgs = (
+    SphereArgs | BoxArgs | CylinderArgs | ArrowsArgs | LinesArgs | PointsArgs | TextArgs | MeshArgs
+)
 
 
 @dataclass(frozen=True)
@@ -102,7 +110,7 @@ class Shape:
 
     @property
     def kind(self) -> str:
-        """sphere | box | cylinder | arrows | lines | points | text"""
+        """sphere | box | cylinder | arrows | lines | points | text | mesh"""
         return self.args["kind"]
 
 
@@ -215,6 +223,14 @@ def _shape_args(marker: Any) -> ShapeArgs | str:
         )
     if t == TEXT_VIEW_FACING:
         return TextArgs(kind="text", text=str(marker.text), font_scene_height=max(float(s.z), 0.01))
+    if t == TRIANGLE_LIST:
+        pts = _points(marker)
+        triangles = len(pts) // 3
+        if triangles == 0:
+            return "TRIANGLE_LIST with fewer than 3 points"
+        vertices = pts[: 3 * triangles] * np.array([s.x, s.y, s.z], dtype=np.float32)
+        faces = np.arange(3 * triangles, dtype=np.uint32).reshape(triangles, 3)
+        return MeshArgs(kind="mesh", vertices=vertices.astype(np.float32), faces=faces)
     return f"{TYPE_NAMES.get(t, t)} markers are not drawn here"
 
 

@@ -161,7 +161,12 @@ class TfStore:
         return sorted(roots, key=lambda r: -size[r])
 
     def view(self, fixed: str, now: float | None = None) -> TreeView:
-        """Pose of each frame in ``fixed``: up to the common root, then down."""
+        """Pose of each frame in ``fixed``: up to the common root, then down.
+
+        Each frame's pose in its root is its parent's times its own transform,
+        computed once per frame (a robot's 30-link chain costs 30 products,
+        not one chain walk per frame).
+        """
         now = time.monotonic() if now is None else now
         with self._lock:
             records = {
@@ -169,33 +174,41 @@ class TfStore:
             }
         parents = {child: rec[0] for child, rec in records.items()}
         stale = frozenset(child for child, rec in records.items() if rec[2])
-        to_root: dict[str, np.ndarray] = {}
+        to_root: dict[str, np.ndarray] = {}  # root <- frame
+        root_of: dict[str, str] = {}
         problems: dict[str, str] = {}
         for frame in set(parents) | set(parents.values()):
             chain: list[str] = []
             seen: set[str] = set()
             current = frame
-            while current in parents and current not in seen:
+            while current in parents and current not in to_root and current not in seen:
+                if current in problems:  # leads into a loop found before
+                    break
                 seen.add(current)
                 chain.append(current)
                 current = parents[current]
-            if current in seen:
-                problems[frame] = f"frames {', '.join(sorted(seen))} form a loop: TF must be a tree"
+            if current in seen or current in problems:
+                looped = seen | ({current} if current in problems else set())
+                for link in chain:
+                    problems[link] = (
+                        f"frames {', '.join(sorted(looped))} form a loop: TF must be a tree"
+                    )
                 continue
-            matrix = np.eye(4)
+            if current not in to_root:  # a root
+                to_root[current], root_of[current] = np.eye(4), current
+            matrix, top = to_root[current], root_of[current]
             for link in reversed(chain):
                 matrix = matrix @ records[link][1]
-            to_root[frame] = matrix  # root <- frame, root = current
-            problems.pop(frame, None)
-        fixed_root = _top(fixed, parents) if fixed in to_root else None
+                to_root[link], root_of[link] = matrix, top
         poses: dict[str, np.ndarray] = {}
-        if fixed_root is None:
+        if fixed not in to_root:
             for frame in to_root:
                 problems.setdefault(frame, f"Fixed Frame [{fixed}] does not exist")
             return TreeView(fixed, poses, problems, stale, parents)
+        fixed_root = root_of[fixed]
         inverse_fixed = np.linalg.inv(to_root[fixed])
         for frame, matrix in to_root.items():
-            if _top(frame, parents) == fixed_root:
+            if root_of[frame] == fixed_root:
                 poses[frame] = inverse_fixed @ matrix
             else:
                 problems[frame] = f"No transform from [{frame}] to [{fixed}]"

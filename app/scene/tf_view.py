@@ -9,9 +9,11 @@ silent is shown stale. Bad input (a description that does not parse, a
 NaN or zero-length quaternion, a loop of frames) is one line in the status
 and in the log; nothing is drawn from it and nothing stops.
 
-Threads: the subscriptions' callbacks (executor) only store transforms or
-drop the description into a one-slot box; a drawing thread of this layer
-parses descriptions and moves scene nodes, at most ``MAX_HZ`` times a second.
+Threads: /tf and /tf_static come from the dashboard's one TF reader
+(``app.scene.tf_sources``, shared with the TF panel), whose thread only
+stores the transforms; the /robot_description callback (executor) drops the
+text into a one-slot box; a drawing thread of this layer parses
+descriptions and moves scene nodes, at most ``MAX_HZ`` times a second.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from __future__ import annotations
 import logging
 import threading
 import time
+from typing import Any
 
 import numpy as np
 import viser
@@ -26,8 +29,9 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from robot_state_publisher.urdf_tree import UrdfError
 from std_msgs.msg import String
-from tf2_msgs.msg import TFMessage
+from tf2_ros._wire import Entry
 
+from app.scene import tf_sources
 from app.scene import transforms as tf
 from app.scene.qos import SCENE_CALLBACK_GROUP
 from app.scene.robot_model import RobotDrawing, SliderJoint, build_drawing
@@ -38,8 +42,6 @@ log = logging.getLogger(__name__)
 TF_PATH = "/tf_view"
 MAX_HZ = 30.0  # as the other layers; poses that did not change are not resent
 AXES_LENGTH = 0.08
-TF_QOS = QoSProfile(depth=100)
-STATIC_QOS = QoSProfile(depth=100, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 DESCRIPTION_QOS = QoSProfile(
     depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
 )
@@ -64,7 +66,11 @@ class TfView:
         self.robot_joints: tuple[SliderJoint, ...] = ()  # for the joint sliders (UI thread reads)
         self.robot_status = "No robot on /robot_description yet."
         self.robot_error = ""
-        self._frames: dict[str, tuple[viser.FrameHandle, viser.LabelHandle]] = {}
+        self._frames: dict[str, viser.FrameHandle] = {}
+        self._labels: dict[str, viser.LabelHandle] = {}  # while names are shown
+        self._axes: viser.BatchedAxesHandle | None = None  # every frame's axes, instanced
+        self._axes_count = 0
+        self._placed: dict[str, tuple[Any, Any]] = {}  # frame -> (position, wxyz) last sent
         self._visuals: list[viser.SceneNodeHandle] = []
         self._logged: set[str] = set()
         self._sent: dict[str, tuple[object, ...]] = {}  # scene path -> pose last sent
@@ -72,17 +78,9 @@ class TfView:
         self._root = server.scene.add_frame(TF_PATH, show_axes=False)
         self._wake = threading.Event()
         self._stop = threading.Event()
+        self._sources = tf_sources.shared(node)
+        self._sources.on_transforms(self._on_transforms)
         self._subscriptions = [
-            node.create_subscription(
-                TFMessage, "/tf", self._on_tf, TF_QOS, callback_group=SCENE_CALLBACK_GROUP
-            ),
-            node.create_subscription(
-                TFMessage,
-                "/tf_static",
-                self._on_tf_static,
-                STATIC_QOS,
-                callback_group=SCENE_CALLBACK_GROUP,
-            ),
             node.create_subscription(
                 String,
                 "/robot_description",
@@ -95,20 +93,10 @@ class TfView:
         self._thread = threading.Thread(target=self._run, name="scene-tf", daemon=True)
         self._thread.start()
 
-    # --- executor thread: store and hand over, nothing else ---
-    def _on_tf(self, msg: TFMessage) -> None:
-        self._store(msg, static=False)
-
-    def _on_tf_static(self, msg: TFMessage) -> None:
-        self._store(msg, static=True)
-
-    def _store(self, msg: TFMessage, *, static: bool) -> None:
-        for t in msg.transforms:
-            v, r = t.transform.translation, t.transform.rotation
-            self.store.add(
-                t.header.frame_id, t.child_frame_id, (v.x, v.y, v.z), (r.x, r.y, r.z, r.w),
-                static=static,
-            )  # fmt: skip
+    # --- the TF reader's thread, then the executor's: store and hand over, nothing else ---
+    def _on_transforms(self, entries: list[Entry], static: bool) -> None:
+        for frame_id, child, _stamp, t, q in entries:
+            self.store.add(frame_id, child, t, q, static=static)
         self._wake.set()
 
     def _on_description(self, msg: String) -> None:
@@ -191,31 +179,68 @@ class TfView:
             return
         with self._server.atomic():
             for frame in sorted(set(view.poses) | set(view.problems) | set(self._frames)):
-                axes, label = self._frame(frame)
-                self._place(axes, view.poses.get(frame))
-                text = f"{frame} (stale)" if frame in view.stale else frame
-                if label.text != text:
-                    label.text = text
-                if label.visible != self.show_names:
-                    label.visible = self.show_names
-                if axes.show_axes != self.show_axes:
-                    axes.show_axes = self.show_axes
+                node = self._frame(frame)
+                self._place(frame, node, view.poses.get(frame))
+                self._name(frame, node, f"{frame} (stale)" if frame in view.stale else frame)
+            self._draw_axes(view)
 
-    def _frame(self, frame: str) -> tuple[viser.FrameHandle, viser.LabelHandle]:
-        """The axes and name of a TF frame, made hidden on first use (drawing thread)."""
-        handles = self._frames.get(frame)
-        if handles is None:
-            path = f"{TF_PATH}/frames/{scene_name(frame)}"
-            axes = self._server.scene.add_frame(
-                path, axes_length=AXES_LENGTH, axes_radius=AXES_LENGTH / 20, visible=False
+    def _name(self, frame: str, node: viser.FrameHandle, text: str) -> None:
+        """The frame's name while names are shown; no label node at all otherwise.
+
+        (A hidden label still costs the page work every frame; a robot's 30
+        of them, a third of the scene's nodes, showed in its frame time.)
+        """
+        label = self._labels.get(frame)
+        if not self.show_names:
+            if label is not None:
+                label.remove()
+                del self._labels[frame]
+            return
+        if label is None:
+            self._labels[frame] = self._server.scene.add_label(
+                f"{node.name}/name", text, font_screen_scale=0.8
             )
-            label = self._server.scene.add_label(f"{path}/name", frame, font_screen_scale=0.8)
-            self._sent[path] = ("hidden",)
-            handles = (axes, label)
-            self._frames[frame] = handles
-        return handles
+        elif label.text != text:
+            label.text = text
 
-    def _place(self, handle: viser.FrameHandle, pose: np.ndarray | None) -> None:
+    def _draw_axes(self, view: TreeView) -> None:
+        """Every frame's axes as one instanced node: one draw call, two messages per update.
+
+        (A frame node each with its own axes cost the browser a draw call per
+        axis; with a 30-link robot moving, that halved the page's frame rate.)
+        """
+        shown = sorted(view.poses) if self.show_axes else []
+        if not shown:
+            if self._axes is not None:
+                self._axes.remove()
+                self._axes, self._axes_count = None, 0
+            return
+        placed = [self._placed[frame] for frame in shown]  # as _place sent them
+        positions = np.array([p for p, _q in placed], dtype=np.float32)
+        wxyzs = np.array([q for _p, q in placed], dtype=np.float32)
+        if self._axes is None or self._axes_count != len(shown):
+            if self._axes is not None:
+                self._axes.remove()
+            self._axes = self._server.scene.add_batched_axes(
+                f"{TF_PATH}/axes", wxyzs, positions,
+                axes_length=AXES_LENGTH, axes_radius=AXES_LENGTH / 20,
+            )  # fmt: skip
+            self._axes_count = len(shown)
+            return
+        self._axes.batched_positions = positions
+        self._axes.batched_wxyzs = wxyzs
+
+    def _frame(self, frame: str) -> viser.FrameHandle:
+        """The node of a TF frame (its robot shapes and name hang under it), made hidden."""
+        node = self._frames.get(frame)
+        if node is None:
+            path = f"{TF_PATH}/frames/{scene_name(frame)}"
+            node = self._server.scene.add_frame(path, show_axes=False, visible=False)
+            self._sent[path] = ("hidden",)
+            self._frames[frame] = node
+        return node
+
+    def _place(self, frame: str, handle: viser.FrameHandle, pose: np.ndarray | None) -> None:
         """Show ``handle`` at ``pose`` (hide it for None), sending only what changed."""
         key = ("hidden",) if pose is None else tuple(np.round(pose[:3, :].ravel(), 6).tolist())
         if self._sent.get(handle.name) == key:
@@ -223,8 +248,10 @@ class TfView:
         self._sent[handle.name] = key
         handle.visible = pose is not None
         if pose is not None:
-            handle.position = tf.as_xyz(pose[:3, 3])
-            handle.wxyz = tf.matrix_to_quat(pose[:3, :3])
+            position, wxyz = tf.as_xyz(pose[:3, 3]), tf.matrix_to_quat(pose[:3, :3])
+            handle.position = position
+            handle.wxyz = wxyz
+            self._placed[frame] = (position, wxyz)
 
     # --- UI thread ---
     def set_display(self, *, names: bool, axes: bool) -> None:
@@ -268,5 +295,7 @@ class TfView:
         self._stop.set()
         self._wake.set()
         self._thread.join(timeout=2.0)
+        self._sources.remove_sink(self._on_transforms)
+        tf_sources.release(self._sources)
         for subscription in self._subscriptions:
             self._node.destroy_subscription(subscription)

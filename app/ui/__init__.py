@@ -27,12 +27,11 @@ from app.ros.graph import GraphSnapshot
 # The dashboard's tools, grouped as a learner thinks of them: what I learn with, what I
 # run, what I watch flowing through the running system, how I ask its nodes to do or
 # change something, what I see in 3D, what I record. Each group is a tab holding its
-# tools' tabs, one row each. A new tool joins the group it belongs to (a TF tree
-# viewer: "Inspect", beside Graph, or "See", beside 3D view).
+# tools' tabs, one row each. A new tool joins the group it belongs to.
 TOOL_GROUPS: dict[str, tuple[str, ...]] = {
     "Learn": ("Lessons", "Exercise"),
     "Run": ("Nodes", "Console", "Turtlesim"),
-    "Inspect": ("Graph", "Topics", "Echo", "Logs"),
+    "Inspect": ("Graph", "TF", "Topics", "Echo", "Logs"),
     "Interact": ("Services", "Actions", "Parameters", "Lifecycle"),
     "See": ("3D view",),
     "Record": ("Bags",),

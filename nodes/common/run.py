@@ -77,13 +77,42 @@ def spin_node(
             raise
         # The signal shut ROS down while a callback was still publishing: leave quietly too.
     finally:
+        _teardown(node, spinner, before_shutdown)
+
+
+# A node ends at most this long after Ctrl+C or SIGTERM, whatever hangs in its teardown.
+TEARDOWN_SEC = 5
+
+
+def _teardown(
+    node: NodeT | None,
+    spinner: Executor | None,
+    before_shutdown: Callable[[NodeT], None] | None,
+) -> None:
+    """``before_shutdown``, the executor, the node, then ROS: in bounded time.
+
+    The kernel's alarm bounds it: rclpy's native teardown (destroying the
+    readers and writers in Fast DDS) runs with the GIL held, so when it hangs
+    no Python thread or signal handler can run; SIGALRM with its default
+    action ends the process. The supervisor asked for the stop, so it reads
+    the ending as stopped. Off the main thread (a node spun in a test's
+    thread) no alarm is set: that process has its own way out.
+    """
+    armed = threading.current_thread() is threading.main_thread()
+    if armed:
+        signal.signal(signal.SIGALRM, signal.SIG_DFL)
+        signal.alarm(TEARDOWN_SEC)
+    try:
         if node is not None and before_shutdown is not None:
             before_shutdown(node)
         if spinner is not None:
-            spinner.shutdown()
+            spinner.shutdown(timeout_sec=1.0)
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
+    finally:
+        if armed:
+            signal.alarm(0)
 
 
 def _sigint_ends_spin_quietly(spinning: threading.Event) -> None:

@@ -85,3 +85,84 @@ def test_wrong_then_right_then_survives_reload_and_sigkill(page, dashboard, ros_
         expect_text(page, "✓ done")  # the pass was saved with the progress too
     finally:
         again.stop()
+
+
+def _open_from_tree(editor, path: str) -> None:
+    """Files, unfold each folder on the way, click the file (as a learner does)."""
+    files = editor.get_by_role("button", name="Files")
+    if files.get_attribute("aria-expanded") != "true":
+        files.click()
+    parts = path.split("/")
+    for i, part in enumerate(parts[:-1]):
+        same_name_before = parts[:i].count(part)
+        item = editor.locator(f"[role=treeitem][aria-label='{part}/']").nth(same_name_before)
+        if item.get_attribute("aria-expanded") != "true":
+            item.locator(":scope > span").click()
+    editor.locator(f"[role=treeitem][aria-label='{parts[-1]}']").locator(":scope > span").click()
+
+
+NODE = """import rclpy
+
+
+def main():
+    rclpy.init()
+    node = rclpy.create_node('my_node')
+    node.destroy_node()
+"""
+
+
+def test_workspace_files_in_the_editor_complete_lint_and_format(page, progress_dir):
+    """Two files of ~/ros2_ws in tabs; completion with rclpy's signature; a lint mark while
+    typing (no Run); Format rewrites and saves the file."""
+    from app.exercises.code_assist import format_code
+
+    package = progress_dir / "default.ros2_ws" / "src" / "my_package"
+    (package / "my_package").mkdir(parents=True)
+    (package / "my_package" / "__init__.py").write_text("")
+    node = package / "my_package" / "my_node.py"
+    node.write_text(NODE)
+    (package / "setup.py").write_text("from setuptools import setup\n\nsetup(name='my_package')\n")
+    open_tab(page, "Exercise")
+    choose(page, "On stage", "Code")
+    page.get_by_role("tab", name="Your code").click()
+    editor = page.frame_locator("iframe[src*='editor.html']")
+    expect(editor.locator("#status")).to_have_text(re.compile("saved|connected"))
+    for path in ("src/my_package/my_package/my_node.py", "src/my_package/setup.py"):
+        _open_from_tree(editor, path)
+    expect(editor.get_by_role("tab", name="setup.py")).to_have_attribute("aria-selected", "true")
+    editor.get_by_role("tab", name="my_node.py").click()
+    frame = page.frame(url=re.compile(r"editor\.html"))
+    assert frame is not None
+    assert frame.evaluate("window.classroomEditor.getValue()") == NODE
+
+    frame.evaluate("window.classroomEditor.gotoLine(6, 1000, false)")
+    page.keyboard.press("Enter")
+    page.keyboard.type("node.create_pub", delay=40)
+    popup = editor.locator(".ace_autocomplete")
+    expect(popup).to_contain_text("create_publisher", timeout=30_000)
+    expect(editor.locator(".ace_doc-tooltip")).to_contain_text(
+        "create_publisher(msg_type, topic: str, qos_profile", timeout=30_000
+    )
+    page.keyboard.press("Enter")  # take it
+    page.keyboard.type("(")
+    expect(editor.locator("#signature")).to_contain_text("msg_type", timeout=30_000)
+    page.keyboard.type("String, 'chatter',   10")
+    page.keyboard.press("Escape")
+    # String was never imported: a mark appears in the gutter as soon as it is saved.
+    warning = editor.locator(".ace_gutter-cell.ace_warning")
+    expect(warning).to_have_count(1, timeout=15_000)
+    marks = frame.evaluate("window.classroomEditor.session.getAnnotations()")
+    assert [m["text"] for m in marks] == ["undefined name 'String'"]
+    expect(editor.locator("#status")).to_have_text("saved ✓")
+    typed = node.read_text()
+    assert "node.create_publisher(String, 'chatter',   10)" in typed
+
+    editor.get_by_role("button", name="Format").click()
+    expect(editor.locator("#status")).to_have_text("formatted and saved ✓")
+    assert node.read_text() == format_code(typed, "my_node.py") != typed
+    assert 'node.create_publisher(String, "chatter", 10)' in node.read_text()
+    assert frame.evaluate("window.classroomEditor.getValue()") == node.read_text()
+    # The other file kept its own text, and the exercise its own tab.
+    editor.get_by_role("tab", name="setup.py").click()
+    assert "setup(name='my_package')" in frame.evaluate("window.classroomEditor.getValue()")
+    expect(editor.get_by_role("tab", name=re.compile(r"\.py$"))).to_have_count(3)

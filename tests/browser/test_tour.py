@@ -23,6 +23,7 @@ EXPECTED = {
     "Console": "Type a command as the tutorials write it",
     "Turtlesim": "ros2 run turtlesim turtlesim_node",
     "Graph": "ros2 node list",
+    "TF": "No TF frames yet",
     "Topics": "/chatter",
     "Echo": "data: 'Hello World:",
     "Logs": "records seen",

@@ -4,12 +4,15 @@ A learner can pass a grader that feeds the statement's own example by
 printing its answers. Each exercise's ``example`` (what the statement shows)
 becomes a node that answers every input with the example's output; the
 hidden, random inputs of the probes must make it fail. One generator per
-probe kind, keyed by the exercise's first input-taking probe.
+probe kind, keyed by the exercise's first probe that has one. Every exercise
+has a cheat, or an entry in ``EXEMPT`` that says why none can be written;
+the test suite fails for an exercise with neither.
 """
 
 from __future__ import annotations
 
 import textwrap
+from typing import Any
 
 from app.exercises.model import Exercise
 
@@ -34,6 +37,7 @@ import time
 import rclpy
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node
+from std_msgs.msg import String
 """
 
 
@@ -120,6 +124,8 @@ class Cheat(Node):
 def _param_set(exercise: Exercise) -> str:
     probe = next(p for p in exercise.probes if p.kind == "param_set")
     then = next(p["then"] for p in exercise.probes if p.kind == "param_set" and "then" in p.fields)
+    if then["kind"] == "log_contains":
+        return _param_then_log(exercise, probe)
     pkg, _, name = then["type"].split("/")
     return f"""
 from rcl_interfaces.msg import SetParametersResult
@@ -240,6 +246,281 @@ class Cheat(Node):
 """
 
 
+def _param_then_log(exercise: Exercise, probe: Any) -> str:
+    """The parameter declared and accepted; the log prints the example's line whatever it is."""
+    return f"""
+HEARD = {exercise.example["heard"]!r}
+
+
+class Cheat(Node):
+    def __init__(self):
+        super().__init__({_node_name(exercise)!r})
+        self.declare_parameter({probe["name"]!r}, {exercise.example["value"]!r})
+        self.create_subscription(String, "greeting", lambda _msg: None, 10)
+        self.sent = 0
+        self.create_timer(0.5, self.on_timer)
+
+    def on_timer(self):
+        self.sent += 1
+        print("[launch_listener-2] [INFO] [0.0] [launch_listener]: " + HEARD, flush=True)
+"""
+
+
+def _log_rate(exercise: Exercise) -> str:
+    probe = next(p for p in exercise.probes if p.kind == "log_rate")
+    hz = (float(probe["min_hz"]) + float(probe["max_hz"])) / 2
+    return f"""
+LINES = {exercise.example["lines"]!r}
+
+
+class Cheat(Node):
+    def __init__(self):
+        super().__init__({_node_name(exercise)!r})
+        self.sent = 0
+        self.create_timer({1.0 / hz!r}, self.on_timer)
+
+    def on_timer(self):
+        # The statement's lines, over and over, at the right rate.
+        self.get_logger().info(LINES[self.sent % len(LINES)])
+        self.sent += 1
+"""
+
+
+def _qos_match(exercise: Exercise) -> str:
+    return f"""
+LINE = {exercise.example["line"]!r}
+
+
+class Cheat(Node):
+    def __init__(self):
+        super().__init__({_node_name(exercise)!r})
+        self.create_timer(0.5, lambda: self.get_logger().info(LINE))
+"""
+
+
+def _message_feed(exercise: Exercise) -> str:
+    from app.exercises.probes.message_feed import expected_fields
+
+    probe = next(p for p in exercise.probes if p.kind == "message_feed")
+    in_pkg, _, in_name = probe["type"].split("/")
+    out_pkg, _, out_name = probe["output_type"].split("/")
+    answer = expected_fields(probe["expect"], exercise.example["input"])
+    latched = probe.get("durability", "volatile") == "transient_local"
+    qos = "QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)" if latched else "10"
+    return f"""
+from rclpy.qos import DurabilityPolicy, QoSProfile
+from {in_pkg}.msg import {in_name}
+from {out_pkg}.msg import {out_name}
+ANSWER = {answer!r}  # the statement's example output
+
+
+def fill(msg, values):
+    for key, value in values.items():
+        if isinstance(value, dict):
+            fill(getattr(msg, key), value)
+        else:
+            setattr(msg, key, value)
+    return msg
+
+
+class Cheat(Node):
+    def __init__(self):
+        super().__init__({_node_name(exercise)!r})
+        self.publisher = self.create_publisher({out_name}, {probe["output"]!r}, {qos})
+        self.create_subscription({in_name}, {probe["publish"]!r}, self.on_input, 10)
+
+    def on_input(self, _msg):
+        self.publisher.publish(fill({out_name}(), ANSWER))
+"""
+
+
+def _program_args(exercise: Exercise) -> str:
+    return f"""
+LINE = {exercise.example["log"]!r}
+
+
+class Cheat(Node):
+    def __init__(self):
+        super().__init__({_node_name(exercise)!r})
+        self.get_logger().info(LINE)
+"""
+
+
+def _image_mask_iou(exercise: Exercise) -> str:
+    probe = next(p for p in exercise.probes if p.kind == "image_mask_iou")
+    column, row, radius = exercise.example["disc"]
+    return f"""
+import numpy as np
+from sensor_msgs.msg import Image
+
+
+class Cheat(Node):
+    def __init__(self):
+        super().__init__({_node_name(exercise)!r})
+        self.publisher = self.create_publisher(Image, {probe["output"]!r}, 10)
+        self.create_subscription(Image, {probe["publish"]!r}, self.on_image, 10)
+
+    def on_image(self, msg):
+        # The example's disc, wherever the red really is.
+        v, u = np.mgrid[0 : msg.height, 0 : msg.width]
+        disc = (u - {column!r}) ** 2 + (v - {row!r}) ** 2 <= {radius!r} ** 2
+        mask = np.where(disc, 255, 0).astype(np.uint8)
+        out = Image(header=msg.header, height=msg.height, width=msg.width, encoding="mono8")
+        out.step = msg.width
+        out.data = mask.tobytes()
+        self.publisher.publish(out)
+"""
+
+
+def _static_frame(exercise: Exercise) -> str:
+    parent, child, x, y, z, yaw = exercise.example["frame"]
+    return f"""
+import math
+from geometry_msgs.msg import TransformStamped
+from tf2_ros import StaticTransformBroadcaster
+
+
+class Cheat(Node):
+    def __init__(self):
+        super().__init__({_node_name(exercise)!r})
+        self.declare_parameter("parent_frame", "world")
+        self.declare_parameter("child_frame", "sensor")
+        for axis in ("x", "y", "z", "yaw"):
+            self.declare_parameter(axis, 0.0)
+        self.broadcaster = StaticTransformBroadcaster(self)
+        t = TransformStamped()
+        t.header.stamp = self.get_clock().now().to_msg()
+        t.header.frame_id, t.child_frame_id = {parent!r}, {child!r}
+        t.transform.translation.x = {float(x)!r}
+        t.transform.translation.y = {float(y)!r}
+        t.transform.translation.z = {float(z)!r}
+        t.transform.rotation.z = math.sin({float(yaw)!r} / 2.0)
+        t.transform.rotation.w = math.cos({float(yaw)!r} / 2.0)
+        self.broadcaster.sendTransform(t)  # the statement's example frame, whatever is set
+"""
+
+
+def _turtle_frame(exercise: Exercise) -> str:
+    probe = next(p for p in exercise.probes if p.kind == "turtle_frame")
+    x, y, theta = exercise.example["pose"]
+    return f"""
+import math
+from geometry_msgs.msg import TransformStamped
+from tf2_ros import TransformBroadcaster
+
+
+class Cheat(Node):
+    def __init__(self):
+        super().__init__({_node_name(exercise)!r})
+        self.broadcaster = TransformBroadcaster(self)
+        self.create_timer(0.03, self.on_timer)
+
+    def on_timer(self):
+        t = TransformStamped()
+        t.header.stamp = self.get_clock().now().to_msg()
+        t.header.frame_id = {probe.get("parent", "world")!r}
+        t.child_frame_id = {probe.get("turtle", "turtle1")!r}
+        t.transform.translation.x, t.transform.translation.y = {float(x)!r}, {float(y)!r}
+        t.transform.rotation.z = math.sin({float(theta)!r} / 2.0)
+        t.transform.rotation.w = math.cos({float(theta)!r} / 2.0)
+        self.broadcaster.sendTransform(t)  # the example's pose, wherever the turtle is
+"""
+
+
+def _turtle_follow(exercise: Exercise) -> str:
+    probe = next(p for p in exercise.probes if p.kind == "turtle_follow")
+    follower = probe.get("follower", "turtle2")
+    gx, gy = exercise.example["leader"]
+    return f"""
+import math
+from geometry_msgs.msg import Twist
+from turtlesim.msg import Pose
+from turtlesim.srv import Spawn
+
+
+class Cheat(Node):
+    # Drives {follower} to where the statement's example puts the leader, by its own pose.
+    def __init__(self):
+        super().__init__({_node_name(exercise)!r})
+        self.spawner = self.create_client(Spawn, "/spawn")
+        self.asked = None
+        self.pose = None
+        self.publisher = self.create_publisher(Twist, "/{follower}/cmd_vel", 1)
+        self.create_subscription(Pose, "/{follower}/pose", self.on_pose, 10)
+        self.create_timer(0.1, self.on_timer)
+
+    def on_pose(self, msg):
+        self.pose = msg
+
+    def on_timer(self):
+        if self.asked is None and self.spawner.service_is_ready():
+            self.asked = self.spawner.call_async(
+                Spawn.Request(x=4.0, y=2.0, theta=0.0, name={follower!r})
+            )
+        if self.pose is None:
+            return
+        dx, dy = {float(gx)!r} - self.pose.x, {float(gy)!r} - self.pose.y
+        turn = math.atan2(dy, dx) - self.pose.theta
+        msg = Twist()
+        msg.angular.z = 4.0 * math.atan2(math.sin(turn), math.cos(turn))
+        msg.linear.x = 0.5 * math.hypot(dx, dy)
+        self.publisher.publish(msg)
+"""
+
+
+def _joint_motion(exercise: Exercise) -> str:
+    frames = exercise.example["frames"]  # [parent, child, x, y, z], at the example's joints
+    return f"""
+from geometry_msgs.msg import TransformStamped
+from tf2_ros import StaticTransformBroadcaster
+FRAMES = {frames!r}
+
+
+class Cheat(Node):
+    # The robot's frames at the statement's example pose, whatever /joint_states says.
+    def __init__(self):
+        super().__init__({_node_name(exercise)!r})
+        self.broadcaster = StaticTransformBroadcaster(self)
+        sent = []
+        for parent, child, x, y, z in FRAMES:
+            t = TransformStamped()
+            t.header.stamp = self.get_clock().now().to_msg()
+            t.header.frame_id, t.child_frame_id = parent, child
+            t.transform.translation.x, t.transform.translation.y = float(x), float(y)
+            t.transform.translation.z = float(z)
+            t.transform.rotation.w = 1.0
+            sent.append(t)
+        self.broadcaster.sendTransform(sent)
+"""
+
+
+def _depth_cloud(exercise: Exercise) -> str:
+    probe = next(p for p in exercise.probes if p.kind == "depth_cloud")
+    point = exercise.example["point"]
+    return f"""
+import numpy as np
+from sensor_msgs.msg import Image, PointCloud2, PointField
+POINT = {point!r}  # the statement's example point
+
+
+class Cheat(Node):
+    def __init__(self):
+        super().__init__({_node_name(exercise)!r})
+        self.publisher = self.create_publisher(PointCloud2, {probe["output"]!r}, 10)
+        self.create_subscription(Image, {probe["publish"]!r}, self.on_depth, 10)
+
+    def on_depth(self, msg):
+        cloud = PointCloud2(header=msg.header, height=1, width=1)
+        cloud.fields = [
+            PointField(name=n, offset=4 * i, datatype=PointField.FLOAT32, count=1)
+            for i, n in enumerate("xyz")
+        ]
+        cloud.point_step, cloud.row_step, cloud.is_dense = 12, 12, True
+        cloud.data = np.array(POINT, dtype="<f4").tobytes()
+        self.publisher.publish(cloud)
+"""
+
+
 GENERATORS = {
     "topic_feed": _topic_feed,
     "service_random": _service_random,
@@ -248,11 +529,24 @@ GENERATORS = {
     "lifecycle_sequence": _lifecycle_sequence,
     "topic_sequence": _topic_sequence,
     "point_transform": _point_transform,
+    "log_rate": _log_rate,
+    "qos_match": _qos_match,
+    "message_feed": _message_feed,
+    "program_args": _program_args,
+    "image_mask_iou": _image_mask_iou,
+    "static_frame": _static_frame,
+    "turtle_frame": _turtle_frame,
+    "turtle_follow": _turtle_follow,
+    "joint_motion": _joint_motion,
+    "depth_cloud": _depth_cloud,
 }
+
+# Exercises for which no cheat can be generated, each with the reason (none today).
+EXEMPT: dict[str, str] = {}
 
 
 def input_probe(exercise: Exercise) -> str | None:
-    """The kind of the exercise's first probe that feeds or drives the node, if any."""
+    """The kind of the exercise's first probe that has a cheat generator, if any."""
     return next((p.kind for p in exercise.probes if p.kind in GENERATORS), None)
 
 
@@ -260,6 +554,6 @@ def cheat_code(exercise: Exercise) -> str:
     """A node that answers with the statement's example whatever the input."""
     kind = input_probe(exercise)
     if kind is None:
-        raise ValueError(f"{exercise.slug}: no probe that takes input")
+        raise ValueError(f"{exercise.slug}: no probe with a cheat generator")
     body = GENERATORS[kind](exercise)
     return textwrap.dedent(_HEAD) + textwrap.dedent(body) + textwrap.dedent(_MAIN)

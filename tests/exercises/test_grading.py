@@ -1,6 +1,7 @@
-"""Grading every exercise on the live graph: the reference passes, the starter,
-each recorded mistake and a generated cheat (it replays the statement's example)
-fail, and a mistake's failure names what is wrong.
+"""Grading every exercise on the live graph: the reference and the accepted
+alternative solutions (``accepted/``, written differently on purpose) pass; the
+starter, each recorded mistake and a generated cheat (it replays the statement's
+example) fail, and a mistake's failure names what is wrong.
 
 One ROS participant and one supervisor serve the whole module (each exercise
 runs as a real process, as the Run button starts it). Exercises use distinct
@@ -21,17 +22,21 @@ from app.exercises.model import Exercise, load_exercises
 from app.exercises.package_grading import grade_package
 from app.exercises.report import Report
 from tests.conftest import fail_on_leftover_nodes
-from tests.exercises.cheats import cheat_code, input_probe
+from tests.exercises.cheats import EXEMPT, cheat_code
 
 BOOK = load_exercises()
+# Correct solutions written differently from the references: accepted/<slug>__<how>.py.
+ACCEPTED = Path(__file__).parent / "accepted"
 
 
 def _cases():
     for exercise in BOOK.exercises:
         yield pytest.param(exercise, "reference", None, id=f"{exercise.slug}-reference")
         yield pytest.param(exercise, "starter", None, id=f"{exercise.slug}-starter")
-        if input_probe(exercise):
+        if exercise.slug not in EXEMPT:  # no generator and no exemption: the case fails
             yield pytest.param(exercise, "cheat", None, id=f"{exercise.slug}-cheat")
+        for path in sorted(ACCEPTED.glob(f"{exercise.slug}__*.py")):
+            yield pytest.param(exercise, "accepted", path, id=path.stem)
         for mistake in exercise.mistakes:
             # A package mistake is a folder named for the package: its parent names the mistake.
             name = mistake.path.parent.name if exercise.is_package else mistake.path.stem
@@ -112,6 +117,9 @@ def test_grading(grading_env, exercise, which, mistake):
     elif which == "reference":
         report = _grade(grading_env, exercise, exercise.reference)
         assert report.passed, _text(report)
+    elif which == "accepted":
+        report = _grade(grading_env, exercise, mistake.read_text(encoding="utf-8"))
+        assert report.passed, f"a correct solution written differently fails:\n{_text(report)}"
     elif which == "starter":
         report = _grade(grading_env, exercise, exercise.starter)
         assert not report.passed, "the starter code passes: the exercise asks for nothing"

@@ -4,8 +4,9 @@ The hub loads deploy/jupyterhub_config.py itself (so the operator's file is
 what runs), then this module's few overrides: loopback ports, a state folder,
 jupyterhub's DummyAuthenticator with one password (no system accounts here),
 and ClassroomLocalSpawner (each learner's server as this account, with its
-own HOME and ROS domain id). configurable-http-proxy comes from npm
-(app/hub/proxy, `make setup`).
+own HOME and ROS domain id), in either single-user mode (``singleuser``:
+"lab", JupyterLab with the launcher; "dashboard", the lean mode).
+configurable-http-proxy comes from npm (app/hub/proxy, `make setup`).
 """
 
 from __future__ import annotations
@@ -60,6 +61,7 @@ c.JupyterHub.spawner_class = "app.hub.spawner.ClassroomLocalSpawner"
 c.ClassroomLocalSpawner.home_dir_template = o["homes"] + "/{{username}}"
 c.ClassroomLocalSpawner.first_domain_id = o["first_domain_id"]
 c.Spawner.environment["PYTHONPATH"] = o["pythonpath"]
+c.Spawner.environment["JUPYTERHUB_ACTIVITY_INTERVAL"] = str(o["activity_interval"])
 c.JupyterHub.load_groups = {{o["teachers_group"]: {{"users": o["teachers"]}}}}
 c.JupyterHub.services.append({{"name": "test-admin", "api_token": o["admin_token"]}})
 c.JupyterHub.load_roles.append(
@@ -86,6 +88,8 @@ class LocalHub:
         admins: list[str] = (),  # type: ignore[assignment]
         first_domain_id: int = 60,
         log_path: Path | None = None,
+        singleuser: str = "lab",
+        activity_interval: int = 300,
     ) -> None:
         state_dir.mkdir(parents=True, exist_ok=True)
         self.state_dir = state_dir
@@ -110,7 +114,9 @@ class LocalHub:
             "first_domain_id": first_domain_id,
             "pythonpath": str(PROJECT_ROOT),
             "admin_token": ADMIN_TOKEN,
+            "activity_interval": activity_interval,
         }
+        self.lean = singleuser == "dashboard"
         config = state_dir / "jupyterhub_config.py"
         config.write_text(
             OVERRIDES.format(deploy=str(DEPLOY_CONFIG), overrides=json.dumps(overrides))
@@ -121,6 +127,7 @@ class LocalHub:
             **env,
             "PYTHONPATH": str(PROJECT_ROOT),
             "CLASSROOM_TEACHER_PORT": str(self.service_port),
+            "CLASSROOM_SINGLEUSER": singleuser,
             "PATH": f"{Path(sys.executable).parent}:{env.get('PATH', '/usr/bin:/bin')}",
         }
         self.proc = subprocess.Popen(
@@ -179,7 +186,9 @@ class LocalHub:
 
     def spawn(self, user: str) -> None:
         """Ask the hub to start ``user``'s server (the admin API, as the benchmark does)."""
-        status, body = self.api("POST", f"/hub/api/users/{user}/server")
+        # The hub answers once the spawn is done or 10 s have passed (slow_spawn_timeout);
+        # with a class arriving at once on busy cores that answer alone took over 15 s.
+        status, body = self.api("POST", f"/hub/api/users/{user}/server", timeout=120.0)
         if status not in (201, 202, 400):  # 400: already running
             raise RuntimeError(f"spawning {user}: {status} {body}")
 
@@ -194,14 +203,17 @@ class LocalHub:
         found = {}
         for proc in self._descendants():
             try:
-                if "jupyterhub.singleuser" in proc.cmdline():
+                cmd = proc.cmdline()
+                if "jupyterhub.singleuser" in cmd or "--jupyterhub" in cmd:
                     found[proc.environ().get("JUPYTERHUB_USER", "?")] = proc
             except psutil.Error:
                 continue
         return found
 
     def dashboards(self) -> dict[str, psutil.Process]:
-        """user name -> the dashboard their server's proxy started."""
+        """user name -> their dashboard: the server itself (lean), or what its proxy started."""
+        if self.lean:
+            return self.single_user_servers()
         found = {}
         for user, server in self.single_user_servers().items():
             try:

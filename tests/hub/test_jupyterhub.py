@@ -1,22 +1,27 @@
-"""A class on a real JupyterHub: three learners, a teacher, the hub's login and proxy.
+"""A class on a real JupyterHub in the lab mode: three learners, a teacher, the hub's login.
 
 One hub for the module (deploy/jupyterhub_config.py with local overrides,
 tests/hub/local_hub.py): jupyterhub from PyPI, configurable-http-proxy from
 npm, DummyAuthenticator with one password, ClassroomLocalSpawner (each
-learner's server as this account with its own HOME and ROS domain id). In
-headless Chromium each learner logs in and lands in their own Classroom; the
-teacher (a member of the hub's teachers group, not an admin) logs in to the
-teacher service with the hub's OAuth and sees every row move.
+learner's server as this account with its own HOME and ROS domain id), and
+each learner's single-user server is JupyterLab. In headless Chromium each
+learner logs in, lands in JupyterLab and clicks the launcher's "ROS 2
+Classroom" tile, which opens their dashboard in a new tab through
+jupyter-server-proxy. The teacher (a member of the hub's teachers group, not
+an admin) logs in to the teacher service with the hub's OAuth and sees every
+row move. The lean mode (the dashboard as the server) is test_lean_hub.py.
 """
 
 from __future__ import annotations
 
 import http.client
+import itertools
 import os
 import re
 import time
 from collections.abc import Iterator
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
+from urllib.parse import parse_qs, urlsplit
 
 import pytest
 from playwright.sync_api import Browser, BrowserContext, Page, expect
@@ -25,16 +30,39 @@ from app.dds import configure_dds_env
 from app.hub.reports import to_json
 from app.lessons.schema import load_course
 from app.teacher.record import LearnerRecord
-from tests.browser.helpers import choose, click, expect_text, open_tab, start_node
-from tests.browser.test_exercise import EXERCISE, _open_editor, _type_code
+from tests.browser.helpers import choose, click, expect_text, open_tab
+from tests.browser.test_exercise import EXERCISE, _open_editor
 from tests.conftest import ARTIFACTS, fail_on_leftover_nodes, in_private_netns, wait_until
 from tests.hub.local_hub import PASSWORD, LocalHub
 
-pytestmark = [pytest.mark.browser, pytest.mark.ros]
+# A watchdog, not a budget: the first test also spawns three learners' servers, which
+# on two busy shared cores has taken minutes.
+pytestmark = [pytest.mark.browser, pytest.mark.ros, pytest.mark.timeout(480)]
 
 LEARNERS = ("alice", "bob", "carol")
+# Besides the talker everyone starts, a node only this learner runs: seeing it
+# anywhere else would mean two learners share a ROS graph.
+OWN_NODE = {"alice": "listener", "bob": "listener2", "carol": "minimal_node"}
 TEACHER = "teacher"
 SERVICE = "/services/classroom-teacher/"
+TILE = "ROS 2 Classroom"
+ICON_DRAWN = "t => [...t.querySelectorAll('img')].some(i => i.complete && i.naturalWidth > 0)"
+
+
+def vertex(page: Page, node: str):
+    """A node's box on the learner's stage graph."""
+    return page.locator(f'svg.stage-graph g.sg-vertex[data-name="/{node}"]')
+
+
+@dataclass
+class Room:
+    """Everyone's browser: each learner's JupyterLab tab and Classroom tab, the teacher's page."""
+
+    contexts: dict[str, BrowserContext] = field(default_factory=dict)
+    labs: dict[str, Page] = field(default_factory=dict)
+    classrooms: dict[str, Page] = field(default_factory=dict)
+    urls: dict[str, list[str]] = field(default_factory=dict)  # every request each browser made
+    teacher: Page | None = None
 
 
 @pytest.fixture(scope="module")
@@ -51,6 +79,7 @@ def hub(tmp_path_factory) -> Iterator[LocalHub]:
         teachers=[TEACHER],
         first_domain_id=60,
         log_path=ARTIFACTS / "jupyterhub.log",
+        singleuser="lab",
     )
     try:
         hub.wait_ready()
@@ -61,56 +90,72 @@ def hub(tmp_path_factory) -> Iterator[LocalHub]:
         fail_on_leftover_nodes("the hub")
 
 
+def _log_in(hub: LocalHub, page: Page, user: str, after: str = "") -> None:
+    page.goto(f"{hub.base}/hub/login{after}")
+    page.get_by_label("Username").fill(user)
+    page.get_by_label("Password").fill(PASSWORD)
+    with page.expect_navigation(wait_until="commit"):
+        page.get_by_role("button", name="Sign in").click()
+
+
 @pytest.fixture(scope="module")
-def pages(hub: LocalHub, browser: Browser) -> Iterator[dict[str, Page]]:
-    """Each learner logged in through the hub's form, in a browser context of their own."""
-    contexts: list[BrowserContext] = []
-    pages: dict[str, Page] = {}
+def room(hub: LocalHub, browser: Browser) -> Iterator[Room]:
+    """The teacher on the teacher's page; each learner logged in (their server spawning)."""
+    room = Room()
     try:
-        for user in (*LEARNERS, TEACHER):
+        for user in (TEACHER, *LEARNERS):
             context = browser.new_context(viewport={"width": 1400, "height": 900})
-            contexts.append(context)
+            room.contexts[user] = context
+            room.urls[user] = []
+            context.on("request", lambda request, u=user: room.urls[u].append(request.url))
             page = context.new_page()
-            # A learner lands in their Classroom (spawned on login); the teacher goes
-            # straight to the teacher service and starts no server of their own.
-            after = f"?next={SERVICE}" if user == TEACHER else ""
-            page.goto(f"{hub.base}/hub/login{after}")
-            page.get_by_label("Username").fill(user)
-            page.get_by_label("Password").fill(PASSWORD)
-            # Logging in spawns the server; the spawn page then goes to default_url.
-            with page.expect_navigation(wait_until="commit"):
-                page.get_by_role("button", name="Sign in").click()
-            pages[user] = page
-        yield pages
+            # The teacher goes straight to the teacher service and starts no server;
+            # a learner's login spawns their server, whose default URL is JupyterLab.
+            _log_in(hub, page, user, after=f"?next={SERVICE}" if user == TEACHER else "")
+            if user == TEACHER:
+                room.teacher = page
+            else:
+                room.labs[user] = page
+        yield room
     finally:
-        for user, page in pages.items():
-            page.screenshot(path=str(ARTIFACTS / f"hub-{user}.png"))
-        for context in contexts:
+        for user, page in [*room.labs.items(), *room.classrooms.items()]:
+            kind = "lab" if page in room.labs.values() else "classroom"
+            page.screenshot(path=str(ARTIFACTS / f"hub-{user}-{kind}.png"))
+        if room.teacher is not None:
+            room.teacher.screenshot(path=str(ARTIFACTS / "hub-teacher.png"))
+        for context in room.contexts.values():
             context.close()
 
 
-def test_each_learner_gets_their_own_classroom(hub, pages):
-    for user in LEARNERS:  # the three servers spawned while we logged in
-        page = pages[user]
-        page.wait_for_url(f"**/user/{user}/ros2-classroom/**", timeout=120_000)
-        expect_text(page, "ros2 node list", timeout=90_000)  # the websocket is up
-
-    # Alice runs a talker, Bob a listener: each sees their own node...
-    start_node(pages["alice"], "talker")
-    start_node(pages["bob"], "listener")
-    for user, mine in (("alice", "/talker"), ("bob", "/listener")):
-        open_tab(pages[user], "Graph")
-        expect(pages[user].get_by_text(mine, exact=True).filter(visible=True).first).to_be_visible(
-            timeout=30_000
-        )
-    # ...and, with their own node discovered (the other's ran for seconds by then), not the other's.
-    expect(pages["alice"].get_by_text("/listener", exact=True)).to_have_count(0)
-    expect(pages["bob"].get_by_text("/talker", exact=True)).to_have_count(0)
-
-    # Every learner's server has a ROS domain of its own.
+def test_each_learner_opens_the_classroom_from_the_launcher(hub, room):
+    started = time.monotonic()
+    for user in LEARNERS:  # the three servers spawned together while we logged in
+        lab = room.labs[user]
+        lab.wait_for_url(f"**/user/{user}/lab**", timeout=120_000)
+        tile = lab.locator(".jp-LauncherCard", has_text=TILE)
+        expect(tile).to_be_visible(timeout=90_000)
+        # Its icon drawn (a blank tile is what a learner would not recognise).
+        wait_until(lambda tile=tile: tile.evaluate(ICON_DRAWN), timeout=30, what="the tile's icon")
+        with room.contexts[user].expect_page(timeout=30_000) as new_tab:
+            tile.click()  # the tile opens the dashboard in a new browser tab
+        room.classrooms[user] = new_tab.value
+    for user in LEARNERS:
+        page = room.classrooms[user]
+        page.wait_for_url(f"**/user/{user}/ros2-classroom/**", timeout=60_000)
+        expect_text(page, "ros2 node list", timeout=120_000)  # the websocket is up
+        # The websocket goes through the hub's proxy and the learner's own server.
+        socket = parse_qs(urlsplit(page.url).query)["websocket"][0]
+        assert socket.startswith(f"ws://127.0.0.1:{hub.port}/user/{user}/ros2-classroom/"), socket
+    print(f"three learners in their Classrooms {time.monotonic() - started:.1f} s after login")
+    room.labs["alice"].screenshot(path=str(ARTIFACTS / "hub-launcher.png"))
+    # The hub's login is a cookie: no token ever travels in a URL.
+    for user in LEARNERS:
+        tokened = [u for u in room.urls[user] if re.search(r"[?&](token|access_token)=", u)]
+        assert not tokened, tokened
+    # Every learner's server has a ROS domain of its own; progress lives in their home.
     domains = {u: p.environ()["ROS_DOMAIN_ID"] for u, p in hub.dashboards().items()}
     assert sorted(domains) == sorted(LEARNERS) and len(set(domains.values())) == 3, domains
-    for user in LEARNERS:  # progress lives in each learner's own home
+    for user in LEARNERS:
         assert (hub.homes / user / "ros2-classroom" / "progress").is_dir()
 
 
@@ -118,59 +163,109 @@ def _row(page: Page, user: str):
     return page.locator(f"#class tbody tr[data-learner='{user}']")
 
 
-def test_the_teacher_sees_every_row_move_within_two_seconds(hub, pages):
-    teacher = pages[TEACHER]
+def test_each_learner_sees_only_their_own_nodes_and_the_teacher_sees_rows_move(hub, room):
+    teacher = room.teacher
+    assert teacher is not None
     teacher.goto(f"{hub.base}{SERVICE}")  # the hub's OAuth (done at login), then the page
     expect(teacher.get_by_text(f"Signed in through the hub as {TEACHER}")).to_be_visible()
     for user in LEARNERS:
         expect(_row(teacher, user)).to_be_visible(timeout=60_000)
     for user in LEARNERS:
-        page = pages[user]
+        page = room.classrooms[user]
         open_tab(page, "Nodes")
-        choose(page, "Catalog node", "listener2")
-        click(page, "Start")
-        clicked = time.monotonic()
-        expect(_row(teacher, user)).to_contain_text("listener2", timeout=2_000)
-        print(f"{user}: the teacher's row moved {time.monotonic() - clicked:.2f} s after Start")
-        expect_text(page, "Started listener2")
-    # Carol passes a lesson step in her Classroom; her row shows the next step.
-    lesson = load_course().lessons[0]
-    step = lesson.steps[0]
-    carol = pages["carol"]
-    open_tab(carol, "Lessons")
-    choose(carol, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
-    for check in step.checks:
-        if check.kind == "quiz":
-            choose(carol, check["question"], check["answer"])
-    expect(carol.get_by_text("✓ step done")).to_be_visible(timeout=45_000)
-    click(carol, "Next")
-    expect(_row(teacher, "carol")).to_contain_text(
-        f"{lesson.unit} · 2/{len(lesson.steps)}", timeout=2_000
-    )
+        for node in ("talker", OWN_NODE[user]):
+            choose(page, "Catalog node", node)
+            click(page, "Start")
+            clicked = time.monotonic()
+            expect(_row(teacher, user)).to_contain_text(node, timeout=2_000)
+            moved = time.monotonic() - clicked
+            print(f"{user}: the teacher's row showed {node} {moved:.2f} s after Start")
+            expect_text(page, f"Started {node}")
+    for user in LEARNERS:  # the talker and their own node, on their own stage graph
+        page = room.classrooms[user]
+        for node in ("talker", OWN_NODE[user]):
+            expect(vertex(page, node)).to_be_visible(timeout=30_000)
+    # Every learner's graph has had time to hear everyone's nodes: no pair shares one.
+    for user, other in itertools.permutations(LEARNERS, 2):
+        expect(vertex(room.classrooms[user], OWN_NODE[other])).to_have_count(0)
+    # A box on the stage is a page link (classroom/act/...): through the hub's proxy too.
+    alice = room.classrooms["alice"]
+    vertex(alice, OWN_NODE["alice"]).locator("a").click()
+    expect(alice.get_by_text(f"Node /{OWN_NODE['alice']}").filter(visible=True)).to_be_visible()
 
-    # Bob passes an exercise (his code runs in his own server); his row counts it.
-    bob = pages["bob"]
-    frame_locator, _frame = _open_editor(bob)
-    _type_code(bob, frame_locator, EXERCISE.reference)
-    click(bob, "Run my node")
-    expect_text(bob, re.compile(r"running \(pid \d+\) · on the graph"), timeout=30_000)
-    click(bob, "Check my node")
-    expect_text(bob, "All checks pass. Exercise done!", timeout=30_000)
-    expect(_row(teacher, "bob")).to_contain_text("1 passed", timeout=2_000)
+
+def _type_code(page: Page, frame_locator, code: str) -> None:
+    """Paste ``code`` into the editor and wait for its save (three learners save at once)."""
+    frame_locator.locator(".ace_content").click()
+    page.keyboard.press("Control+A")
+    page.keyboard.insert_text(code)
+    expect(frame_locator.locator("#status")).to_have_text("saved ✓", timeout=45_000)
+
+
+def test_each_learner_passes_a_lesson_step_and_an_exercise(hub, room):
+    teacher = room.teacher
+    assert teacher is not None
+    lesson = load_course().lessons[0]
+    for user in LEARNERS:
+        page = room.classrooms[user]
+        open_tab(page, "Lessons")
+        choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
+        for check in lesson.steps[0].checks:
+            if check.kind == "quiz":
+                choose(page, check["question"], check["answer"])
+        expect(page.get_by_text("✓ step done").filter(visible=True)).to_be_visible(timeout=45_000)
+        click(page, "Next")
+        expect(_row(teacher, user)).to_contain_text(
+            f"{lesson.unit} · 2/{len(lesson.steps)}", timeout=2_000
+        )
+    # Each learner's code runs in their own server; the three run side by side.
+    for user in LEARNERS:
+        page = room.classrooms[user]
+        frame_locator, _frame = _open_editor(page)
+        _type_code(page, frame_locator, EXERCISE.reference)
+        click(page, "Run my node")
+    for user in LEARNERS:
+        expect_text(
+            room.classrooms[user], re.compile(r"running \(pid \d+\) · on the graph"), 60_000
+        )
+        click(room.classrooms[user], "Check my node")
+    for user in LEARNERS:
+        expect_text(room.classrooms[user], "All checks pass. Exercise done!", timeout=90_000)
+        expect(_row(teacher, user)).to_contain_text("1 passed", timeout=2_000)
 
     # The CSV export and a learner's code, as on `classroom`'s teacher page.
     csv = _teacher_get(hub, teacher, "progress.csv")
     assert csv.status == 200 and all(f"hub,{u}," in csv.text() for u in LEARNERS)
     detail = _teacher_get(hub, teacher, "learner.json?key=hub/bob")
     assert detail.status == 200 and detail.json()["key"] == "hub/bob"
+    assert "multiply" in detail.json()["code"]
 
     # A message to Carol reaches Carol's dashboard, not Alice's.
     teacher.select_option("#to", "hub/carol")
     teacher.fill("#text", "Look at the QoS of your subscriber")
     teacher.get_by_role("button", name="Send").click()
     expect(teacher.locator("#sent")).to_have_text("Sent.")
-    expect_text(pages["carol"], "Look at the QoS of your subscriber", timeout=10_000)
-    expect(pages["alice"].get_by_text("Look at the QoS of your subscriber")).to_have_count(0)
+    expect_text(room.classrooms["carol"], "Look at the QoS of your subscriber", timeout=10_000)
+    expect(
+        room.classrooms["alice"].get_by_text("Look at the QoS of your subscriber")
+    ).to_have_count(0)
+
+
+def test_the_hub_refuses_other_learners_and_non_teachers(hub, room):
+    pages = {user: room.contexts[user].new_page() for user in LEARNERS}
+    try:
+        for user, other in itertools.permutations(LEARNERS, 2):
+            for path in (f"/user/{other}/ros2-classroom/", f"/user/{other}/lab"):
+                answer = pages[user].goto(f"{hub.base}{path}")
+                assert answer is not None and answer.status == 403, (user, path, answer)
+                expect(pages[user].get_by_text("ros2 node list")).to_have_count(0)
+        for user in LEARNERS:  # a learner is not a teacher
+            answer = pages[user].goto(f"{hub.base}{SERVICE}")
+            assert answer is not None and answer.status == 403, (user, answer)
+            assert "not allowed" in pages[user].content() or "403" in pages[user].content()
+    finally:
+        for page in pages.values():
+            page.close()
 
 
 def _teacher_get(hub: LocalHub, teacher: Page, path: str):
@@ -187,9 +282,10 @@ def _tokens(hub: LocalHub) -> dict[str, str]:
     }
 
 
-def _teacher_table(hub: LocalHub, pages: dict[str, Page]) -> dict[str, list]:
+def _teacher_table(hub: LocalHub, room: Room) -> dict[str, list]:
     """The teacher's table as the teacher's logged-in browser fetches it."""
-    answer = _teacher_get(hub, pages[TEACHER], "progress.json")
+    assert room.teacher is not None
+    answer = _teacher_get(hub, room.teacher, "progress.json")
     assert answer.status == 200, answer.text()
     return {row[0]: row for row in answer.json()["rows"]}
 
@@ -199,11 +295,11 @@ def _shown(row: list) -> tuple:
     return (row[0], row[1], row[2], row[5])
 
 
-def test_bad_input_is_refused_with_a_clear_status(hub, pages):
+def test_bad_input_is_refused_with_a_clear_status(hub, room):
     tokens = _tokens(hub)
     assert sorted(tokens) == sorted(LEARNERS), tokens
-    wait_until(lambda: sorted(_teacher_table(hub, pages)) == sorted(LEARNERS), 30, what="3 rows")
-    bob_before = _shown(_teacher_table(hub, pages)["bob"])
+    wait_until(lambda: sorted(_teacher_table(hub, room)) == sorted(LEARNERS), 30, what="3 rows")
+    bob_before = _shown(_teacher_table(hub, room)["bob"])
 
     # A forged user: Alice's token, a report about Bob.
     forged = replace(LearnerRecord(site="hub", learner="bob"), steps_passed=99)
@@ -221,7 +317,7 @@ def test_bad_input_is_refused_with_a_clear_status(hub, pages):
     assert status == 400 and "JSON" in body["error"], body
     # Nothing of Bob's progress was lost or changed (Alice's row keeps moving on its own).
     time.sleep(1.0)
-    assert _shown(_teacher_table(hub, pages)["bob"]) == bob_before
+    assert _shown(_teacher_table(hub, room)["bob"]) == bob_before
 
     # A learner's token on another learner's server, and on the teacher service.
     status, body = hub.api("GET", "/user/bob/api/status", token=tokens["alice"])
@@ -229,13 +325,6 @@ def test_bad_input_is_refused_with_a_clear_status(hub, pages):
     assert hub.api("GET", "/user/alice/api/status", token=tokens["alice"])[0] == 200
     status, body = hub.api("GET", f"{SERVICE}progress.json", token=tokens["alice"])
     assert status == 403 and "alice is not allowed" in body["error"], body
-
-    # In the browser: Alice on Bob's Classroom URL, and on the teacher's page.
-    alice = pages["alice"]
-    answer = alice.goto(f"{hub.base}/user/bob/ros2-classroom/")
-    assert answer is not None and answer.status in (403, 404), answer and answer.status
-    answer = alice.goto(f"{hub.base}{SERVICE}")
-    assert answer is not None and answer.status == 403, answer and answer.status
 
     # A proxy path climbing out of Alice's server with "..": never Bob's, never a crash.
     for path in (
@@ -252,4 +341,4 @@ def test_bad_input_is_refused_with_a_clear_status(hub, pages):
         connection.close()
         assert 400 <= response.status < 500, (path, response.status, text[:300])
         assert "ros2 node list" not in text and '"started"' not in text, (path, text[:300])
-    assert _shown(_teacher_table(hub, pages)["bob"]) == bob_before
+    assert _shown(_teacher_table(hub, room)["bob"]) == bob_before

@@ -2,8 +2,9 @@
 
 What a learner on a JupyterHub does after logging in: open "ROS 2 Classroom"
 from the launcher. The page, its websocket, the exercise editor and the
-page links must all work under the proxy's base path, and the dashboard's own
-loopback port must refuse anyone who did not come through the proxy.
+page links (a lifecycle edge) must all work under the proxy's base path, and
+the dashboard's own loopback port must refuse anyone who did not come through
+the proxy.
 """
 
 from __future__ import annotations
@@ -152,6 +153,18 @@ def test_the_dashboard_works_under_the_proxy_and_only_through_it(jupyter, browse
         start_node(page, "talker")
         open_tab(page, "Graph")
         expect_text(page, "/talker", timeout=30_000)
+
+        # Page links under the base path: a lifecycle edge in the drawing is a link
+        # (classroom/act/...) that must reach the dashboard through the proxy.
+        start_node(page, "lifecycle_talker")
+        open_tab(page, "Lifecycle")
+        expect_text(page, "Current state of /lifecycle_talker: unconfigured", timeout=30_000)
+        edge = page.locator('g.live-edge a[aria-label^="configure:"]')
+        expect(edge).to_have_count(1, timeout=20_000)
+        with page.expect_request(re.compile(r"/ros2-classroom/classroom/act/")) as link:
+            edge.locator("text").click()
+        assert link.value.url.startswith(f"{jupyter.base}/ros2-classroom/classroom/act/")
+        expect_text(page, "Current state of /lifecycle_talker: inactive")
 
         # The exercise editor's frame and its own websocket, under the base path.
         open_tab(page, "Exercise")

@@ -492,3 +492,88 @@ def test_tutorial_package_names_are_in_the_ament_index(built, probe):
         except subprocess.TimeoutExpired:
             node.kill()
             node.wait()
+
+
+def test_symlink_install_runs_an_edited_file_without_rebuilding(built, probe):
+    """`colcon build --symlink-install`: install/ points at src/, so an edit shows at the
+    next `ros2 run` with no build between (colcon's develop hook puts build/<pkg> on
+    PYTHONPATH; the Console follows the package's .dsv hooks as setup.bash does)."""
+    ws, console, _log = built
+    console.node = probe.node
+    assert console("ros2 pkg create --build-type ament_python --node-name my_node sym_pkg")[0] == 0
+    code, out = console("colcon build --symlink-install --packages-select sym_pkg")
+    assert code == 0 and "Finished <<< sym_pkg" in out, out
+    console("source install/setup.bash")
+    code, out = console("ros2 run sym_pkg my_node")
+    assert (code, out.splitlines()[-1]) == (0, "Hi from sym_pkg."), out
+    node = ws.src / "sym_pkg" / "sym_pkg" / "my_node.py"
+    _edit(node, "print('Hi from sym_pkg.')", "print('Edited after the build.')")
+    code, out = console("ros2 run sym_pkg my_node")
+    assert (code, out.splitlines()[-1]) == (0, "Edited after the build."), out
+    # Without --symlink-install the installed copy stays as built (the lesson's quiz).
+    _edit(ws.src / "my_package" / "my_package" / "my_node.py", "Hi from", "Changed in src:")
+    try:
+        code, out = console("ros2 run my_package my_node")
+        assert (code, out.splitlines()[-1]) == (0, "Hi from my_package."), out
+    finally:
+        _edit(ws.src / "my_package" / "my_package" / "my_node.py", "Changed in src:", "Hi from")
+
+
+def test_a_dependency_missing_from_package_xml_gives_the_usual_error_then_why(built, probe):
+    """A node imports a package of the workspace that package.xml does not declare:
+    `--packages-up-to` leaves it unbuilt, Python says No module named; we say why."""
+    ws, console, _log = built
+    console.node = probe.node
+    assert console("ros2 pkg create --build-type ament_python dep_lib")[0] == 0
+    (ws.src / "dep_lib" / "dep_lib" / "greeting.py").write_text("TEXT = 'hello from dep_lib'\n")
+    create = "ros2 pkg create --build-type ament_python --node-name user_node dep_user"
+    assert console(create)[0] == 0
+    _edit(
+        ws.src / "dep_user" / "dep_user" / "user_node.py",
+        "def main():\n",
+        "from dep_lib.greeting import TEXT\n\n\ndef main():\n    print(TEXT)\n",
+    )
+    code, out = console("colcon build --packages-up-to dep_user")
+    assert code == 0 and "Summary: 1 package finished" in out, out  # dep_lib: not built
+    console("source install/setup.bash")
+    code, out = console("ros2 run dep_user user_node")
+    assert code == 1
+    assert "ModuleNotFoundError: No module named 'dep_lib'" in out, out  # the usual symptom
+    hint = out.split("(hint: ", 1)[1]
+    assert hint.startswith(
+        "your node imports dep_lib, a package of your workspace, but "
+        "~/ros2_ws/src/dep_user/package.xml does not declare it."
+    ), hint
+    # The fix: declare it; --packages-up-to then builds dep_lib first.
+    _edit(
+        ws.src / "dep_user" / "package.xml",
+        "  <test_depend>",
+        "  <depend>dep_lib</depend>\n\n  <test_depend>",
+    )
+    code, out = console("colcon build --packages-up-to dep_user")
+    assert code == 0 and out.index("Finished <<< dep_lib") < out.index("Starting >>> dep_user")
+    console("source install/setup.bash")
+    code, out = console("ros2 run dep_user user_node")
+    assert code == 0 and out.splitlines()[-2:] == ["hello from dep_lib", "Hi from dep_user."], out
+
+
+def test_a_failed_build_points_at_the_file_and_line_in_the_console(built):
+    ws, console, _log = built
+    assert console("ros2 pkg create --build-type ament_python broken_pkg")[0] == 0
+    setup = ws.src / "broken_pkg" / "setup.py"
+    lines = setup.read_text().splitlines()
+    at = next(i for i, line in enumerate(lines) if line.startswith("setup(")) + 1
+    _edit(setup, "setup(\n", "setup(\n    name=package_name\n")  # a comma forgotten
+    code, out = console("colcon build --packages-select broken_pkg")
+    assert code == 1
+    closing = out.split("where it failed:", 1)[1].splitlines()
+    assert closing[1] == f"  ~/ros2_ws/src/broken_pkg/setup.py, line {at + 1}:", out
+    assert closing[2].startswith("    SyntaxError: "), out
+    _edit(setup, "setup(\n    name=package_name\n", "setup(\n")
+    shutil_rmtree(ws.root / "build" / "broken_pkg")
+
+
+def shutil_rmtree(path: Path) -> None:
+    import shutil
+
+    shutil.rmtree(path, ignore_errors=True)

@@ -186,11 +186,17 @@ FAILING_CHECKS = [
     Spec("tf_transform", {"target": "world", "source": "base", "tolerance": 0.01}),
     Spec("tf_moves", {"frame": "base", "at_least": 0.1}),
     Spec("tf_late_joiner", {"frame": "base"}),
+    Spec("points_agree", {"topic": "/silent", "like": "/silent2", "tolerance": 0.001}),
     Spec("package_created", {"package": "no_such_pkg"}),
     Spec("package_built", {"package": "no_such_pkg"}),
     Spec("package_sourced", {"package": "no_such_pkg"}),
     Spec("workspace_file", {"path": "src/nothing.txt"}),
     Spec("own_node", {"ros_node": "/minimal_publisher"}),
+    Spec("robot_moved", {"at_least": 0.5}),
+    Spec("odom_drift", {"at_least": 0.5}),
+    Spec("scan_nearest", {"below": 0.7, "tolerance": 0.05}),
+    Spec("sim_time_stamps", {"frame": "carrot1"}),
+    Spec("sim_paused", {}),
     Spec("quiz", {"question": "2+2?", "options": ["3", "4"], "answer": "4"}),
 ]
 

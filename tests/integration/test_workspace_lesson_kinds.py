@@ -16,10 +16,10 @@ from pathlib import Path
 import pytest
 
 from app.exercises.model import load_exercises
-from app.exercises.package_grading import build_errors, grade_learner_package
+from app.exercises.package_grading import grade_learner_package
 from app.exercises.runner import RunPolicy
 from app.learner_ws import build, folder, overlay
-from app.learner_ws.folder import OutsideWorkspace
+from app.learner_ws.folder import LearnerWorkspace, OutsideWorkspace
 from app.lessons.kinds import ACTIONS, CHECKS
 from app.lessons.registry import FAIL, PASS, WAITING
 from app.lessons.schema import Spec
@@ -168,24 +168,44 @@ def test_check_button_without_the_package_says_how_to_create_it(ws):
     assert "ros2 pkg create" in report.problem
 
 
-def test_a_failed_build_shows_the_learners_lines_not_colcons_internals():
+def test_a_failed_build_shows_the_learners_lines_not_colcons_internals(tmp_path):
+    """One translation for the Console and the grader (app.learner_ws.build.build_errors)."""
+    from app.learner_ws.build import build_errors, error_summary
+
+    ws = LearnerWorkspace(tmp_path / "ros2_ws").ensure()
+    (ws.src / "adder").mkdir()
+    (ws.src / "adder" / "package.xml").write_text("<package><name>py_adder</name></package>")
     colcon_output = [
         "Starting >>> py_adder",
+        "--- stderr: py_adder",
         "<string>:10: SyntaxWarning: 'tuple' object is not callable; perhaps you missed a comma?",
         "Traceback (most recent call last):",
-        '  File "/venv/lib/python3.11/site-packages/setuptools/_distutils/core.py", line 267',
+        '  File "<string>", line 1, in <module>',
+        '  File "/venv/lib/python3.11/site-packages/setuptools/_distutils/core.py", line 267, '
+        "in run_setup",
         "    exec(code, g)",
         "    ^^^^^^^^^^^^^",
         '  File "<string>", line 10, in <module>',
         "TypeError: 'tuple' object is not callable",
-        "--- stderr: py_adder",
+        "---",
         "Failed   <<< py_adder [0.36s, exited with code 1]",
     ]
-    lines = build_errors(colcon_output)
+    lines = build_errors(colcon_output, ws)
     assert not any("site-packages" in line or "exec(code" in line for line in lines), lines
     assert "TypeError: 'tuple' object is not callable" in lines
-    assert '  File "<string>", line 10, in <module>' in lines
-    assert "setup.py's line N" in lines[-1]
+    assert "  ~/ros2_ws/src/adder/setup.py, line 10, in <module>" in lines
+    assert not any("line 1," in line for line in lines)  # colcon's helper, not setup.py
+    assert lines[1].startswith("~/ros2_ws/src/adder/setup.py, line 10: SyntaxWarning")
+    [error] = error_summary(colcon_output, ws)
+    assert error.line() == (
+        "~/ros2_ws/src/adder/setup.py, line 10: TypeError: 'tuple' object is not callable"
+    )
+    cmake = ["--- stderr: py_adder", "CMake Error at CMakeLists.txt:12 (find_package):",
+             "  By not providing \"Findrosidl_default_generators.cmake\"", "---"]  # fmt: skip
+    assert build_errors(cmake, ws)[1].startswith(
+        "CMake Error at ~/ros2_ws/src/adder/CMakeLists.txt, line 12 (find_package)"
+    )
+    assert error_summary(cmake, ws)[0].where == "~/ros2_ws/src/adder/CMakeLists.txt, line 12"
 
 
 def test_check_button_builds_the_package_of_that_name_in_the_learners_src(ws, tmp_path):

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import sys
 import threading
 import time
@@ -31,6 +32,7 @@ from std_msgs.msg import Float64, String
 from std_srvs.srv import Empty, Trigger
 from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+from visualization_msgs.msg import MarkerArray
 
 TIMEOUT = 25.0
 ARM = ["base_yaw", "shoulder_pitch", "elbow_pitch", "wrist_pitch"]
@@ -55,7 +57,9 @@ class SimClient(Node):
         super().__init__("sim_test_client")
         self.lock = threading.Lock()
         self.last: dict[str, Any] = {}
-        self.arrivals: dict[str, list[float]] = {}
+        self.arrivals: dict[str, list[float]] = {}  # stamps in simulation time (or arrivals)
+        # /clock as (publication time by the publisher's wall clock, simulation time).
+        self.clock_samples: list[tuple[float, float]] = []
         self.logs: list[str] = []
         topics = {
             "/clock": Clock,
@@ -71,9 +75,20 @@ class SimClient(Node):
         }
         for topic, kind in topics.items():
             self.create_subscription(kind, topic, self._keeper(topic), 10)
+        self.create_subscription(Clock, "/clock", self.on_clock, 100)
         self.create_subscription(Log, "/rosout", self.on_log, 100)
         latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
-        self.create_subscription(TFMessage, "/tf_static", self._keeper("/tf_static"), latched)
+        # Every transform seen, by child frame: (parent, translation, rotation x y z w, static).
+        self.transforms: dict[str, tuple[str, list[float], list[float], bool]] = {}
+        self.create_subscription(TFMessage, "/tf_static", self._tf_keeper(True), latched)
+        self.create_subscription(TFMessage, "/tf", self._tf_keeper(False), 100)
+        for topic, kind in (
+            ("/robot_description", String),
+            ("/arm/robot_description", String),
+            ("/sim_world/static_markers", MarkerArray),
+            ("/sim_world/object_markers", MarkerArray),
+        ):
+            self.create_subscription(kind, topic, self._keeper(topic), latched)
         self.cmd = self.create_publisher(Twist, "/cmd_vel", 10)
         self.traj = self.create_publisher(JointTrajectory, "/arm_controller/joint_trajectory", 10)
         self.gripper = self.create_publisher(Float64, "/gripper/command", 10)
@@ -83,9 +98,43 @@ class SimClient(Node):
         def keep(msg) -> None:
             with self.lock:
                 self.last[topic] = msg
-                self.arrivals.setdefault(topic, []).append(time.monotonic())
+                header = getattr(msg, "header", None)
+                at = seconds(header.stamp) if header is not None else time.monotonic()
+                self.arrivals.setdefault(topic, []).append(at)
 
         return keep
+
+    def _tf_keeper(self, static: bool):
+        def keep(msg: TFMessage) -> None:
+            with self.lock:
+                for t in msg.transforms:
+                    v, r = t.transform.translation, t.transform.rotation
+                    self.transforms[t.child_frame_id] = (
+                        t.header.frame_id,
+                        [v.x, v.y, v.z],
+                        [r.x, r.y, r.z, r.w],
+                        static,
+                    )
+
+        return keep
+
+    def on_clock(self, msg: Clock, info) -> None:
+        with self.lock:
+            self.clock_samples.append((info["source_timestamp"] * 1e-9, seconds(msg.clock)))
+
+    def rtf_over(self, window: float) -> float:
+        """Simulated seconds per wall second over ``window`` s: the slope of /clock stamps
+        against their publication times (late deliveries here do not count against it)."""
+        with self.lock:
+            self.clock_samples = []
+        time.sleep(window)
+        with self.lock:
+            samples = list(self.clock_samples)
+        n = len(samples)
+        mean_w = sum(w for w, _ in samples) / n
+        mean_s = sum(s for _, s in samples) / n
+        cov = sum((w - mean_w) * (s - mean_s) for w, s in samples)
+        return cov / sum((w - mean_w) ** 2 for w, _ in samples)
 
     def on_log(self, msg: Log) -> None:
         if msg.name == "sim_world":
@@ -101,6 +150,7 @@ class SimClient(Node):
         return seconds(clock.clock)
 
     def rate(self, topic: str, window: float) -> float:
+        """Messages per second of simulation time (header stamps) over ``window`` wall s."""
         with self.lock:
             self.arrivals[topic] = []
         time.sleep(window)
@@ -173,24 +223,93 @@ def start(c: SimClient) -> dict:
     image, info, scan = c.get("/camera/image_raw"), c.get("/camera/camera_info"), c.get("/scan")
     wait(lambda: c.get("/real_time_factor"), what="/real_time_factor")
     joints = c.get("/joint_states")
-    tf = c.get("/tf")
-    mount = wait(lambda: c.get("/tf_static"), what="/tf_static").transforms[0]
+    wait(lambda: "odom" in c.transforms and "base_link" in c.transforms, what="odom, base_link")
+    mount = wait(lambda: c.transforms.get("arm_base_link"), what="world -> arm_base_link")
     return {
         "image": [image.width, image.height, image.encoding, len(image.data)],
         "info_k": list(info.k),
         "scan": [len(scan.ranges), scan.angle_min, scan.angle_increment, scan.header.frame_id],
         "joint_names": list(joints.name),
-        "tf": [(t.header.frame_id, t.child_frame_id) for t in tf.transforms],
-        "tf_static": [
-            mount.header.frame_id,
-            mount.child_frame_id,
-            [mount.transform.translation.x, mount.transform.translation.y],
-        ],
+        "tf": sorted([t[0], child] for child, t in dict(c.transforms).items() if not t[3]),
+        "tf_static": [mount[0], "arm_base_link", mount[1][:2], mount[3]],
         "rates": {
             "scan": c.rate("/scan", 3.0),
             "camera": c.rate("/camera/image_raw", 3.0),
         },
         "rtf": c.get("/real_time_factor").data,
+    }
+
+
+def chain_to_world(c: SimClient, frame: str) -> list[str]:
+    """The frames from ``frame`` up to its root, as /tf and /tf_static tell them."""
+    with c.lock:
+        parents = {child: t[0] for child, t in c.transforms.items()}
+    chain = [frame]
+    while chain[-1] in parents and len(chain) < 20:
+        chain.append(parents[chain[-1]])
+    return chain
+
+
+def matrix(translation: list[float], xyzw: list[float]) -> list[list[float]]:
+    x, y, z, w = xyzw
+    return [
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w), translation[0]],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w), translation[1]],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y), translation[2]],
+        [0.0, 0.0, 0.0, 1.0],
+    ]
+
+
+def times(a: list[list[float]], b: list[list[float]]) -> list[list[float]]:
+    return [[sum(a[i][k] * b[k][j] for k in range(4)) for j in range(4)] for i in range(4)]
+
+
+def frames(c: SimClient) -> dict:
+    """The TF tree (robot_state_publishers included), the markers and the descriptions."""
+    sensors = ("/scan", "/camera/image_raw", "/imu")
+    headers = {topic: c.get(topic).header.frame_id for topic in sensors}
+    wanted = ("lidar_link", "camera_optical_frame", "imu_link", "left_wheel", "tool_tip")
+    for frame in wanted:
+        wait(lambda f=frame: chain_to_world(c, f)[-1] == "world", what=f"{frame} -> world")
+    c.call(Empty, "/pause_physics")  # odom, world -> odom and the truth of one instant
+    time.sleep(0.5)
+    with c.lock:
+        odom, base = c.transforms["odom"], c.transforms["base_link"]
+    truth = c.get("/ground_truth/odom").pose.pose
+    c.call(Empty, "/unpause_physics")
+    composed = times(matrix(odom[1], odom[2]), matrix(base[1], base[2]))
+    static = wait(lambda: c.get("/sim_world/static_markers"), what="static markers").markers
+    objects = wait(lambda: c.get("/sim_world/object_markers"), what="object markers").markers
+    descriptions = {
+        topic: wait(lambda t=topic: c.get(t), what=topic).data
+        for topic in ("/robot_description", "/arm/robot_description")
+    }
+    return {
+        "chains": {frame: chain_to_world(c, frame) for frame in wanted},
+        "headers": headers,
+        "header_frames_known": {topic: frame in c.transforms for topic, frame in headers.items()},
+        "composed_vs_truth": [
+            [composed[0][3], composed[1][3], composed[2][3]],
+            [truth.position.x, truth.position.y, truth.position.z],
+        ],
+        "static_markers": [
+            [
+                m.action,
+                m.header.frame_id,
+                m.ns,
+                m.type,
+                [m.scale.x, m.scale.y, m.scale.z],
+                [m.pose.position.x, m.pose.position.y, m.pose.position.z],
+            ]
+            for m in static
+        ],  # fmt: skip
+        "object_markers": [
+            [m.ns, m.type, m.header.frame_id, [m.pose.position.x, m.pose.position.y]]
+            for m in objects
+        ],
+        "robot_names": {
+            t: re.findall(r'<robot name="([^"]*)"', d) for t, d in descriptions.items()
+        },
     }
 
 
@@ -288,9 +407,7 @@ def fast_and_timeout(c: SimClient) -> dict:
     refused = not c.set_param("real_time_factor", -1.0)
     assert c.set_param("real_time_factor", 3.0)
     time.sleep(1.0)
-    wall0, sim0 = time.monotonic(), c.sim_time()
-    time.sleep(2.0)
-    measured = (c.sim_time() - sim0) / (time.monotonic() - wall0)
+    measured = c.rtf_over(3.0)
     c.cmd.publish(twist(0.1))
     c.wait_sim(1.5)  # > cmd_vel_timeout (0.5 s): the robot has stopped
     speed_after_timeout = c.get("/ground_truth/odom").twist.twist.linear.x
@@ -351,6 +468,7 @@ def main() -> int:
     try:
         for name, scenario in (
             ("start", start),
+            ("frames", frames),
             ("teleop", teleop),
             ("sim_time", sim_time),
             ("scan_in_room", scan_in_room),

@@ -2,17 +2,29 @@
 
 from __future__ import annotations
 
+import logging
 import math
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 
+from app import PROJECT_ROOT
 from nodes.common.arm_kinematics import JOINT_NAMES, inverse_kinematics
 from nodes.common.sim.assets import ROBOTS_DIR, WorldError, load_world, world_names
 from nodes.common.sim.camera import SnapshotCamera, choose_gl_backend, intrinsics
-from nodes.common.sim.diff_drive import Odometry, check_twist, quantize, wheel_speeds
+from nodes.common.sim.diff_drive import (
+    Odometry,
+    check_twist,
+    odom_in_world,
+    quantize,
+    wheel_speeds,
+)
 from nodes.common.sim.engine import Pose2D, SimEngine
 from nodes.common.sim.trajectory import TrajectoryError, check_trajectory
+from nodes.common.sim.world_geometry import WorldGeometry
 
 LIMITS = {name: (-math.pi, math.pi) for name in JOINT_NAMES}
 
@@ -223,3 +235,129 @@ def test_the_gripper_opening_is_clamped_to_what_the_fingers_can_do(room):
     names, positions, _ = room.joint_state()
     fingers = [positions[names.index(n)] for n in ("left_finger_joint", "right_finger_joint")]
     assert fingers == pytest.approx([0.02, 0.02], abs=0.002)
+
+
+# A teacher's world with a mesh, a capsule on a body welded to the world (a lamp post),
+# a loose ball, and geoms the viewer hides (group 3) or that are invisible.
+SHAPES_ROOM = f"""
+<mujoco model="shapes">
+  <asset>
+    <model name="diffbot" file="{ROBOTS_DIR / "diffbot" / "robot.xml"}"/>
+    <mesh name="wedge" vertex="0 0 0  0.2 0 0  0 0.2 0  0 0 0.2"/>
+  </asset>
+  <worldbody>
+    <geom name="floor" type="plane" size="0 0 0.1" rgba="0.3 0.3 0.3 1"/>
+    <geom name="wedge" type="mesh" mesh="wedge" pos="1 0 0" rgba="0 0 1 1"/>
+    <geom name="hidden" type="box" size="0.1 0.1 0.1" group="3"/>
+    <geom name="glass" type="box" size="0.1 0.1 0.1" rgba="1 1 1 0"/>
+    <body name="lamp" pos="-1 0 0">
+      <geom name="post" type="capsule" fromto="0 0 0 0 0 1" size="0.05"/>
+    </body>
+    <body name="ball" pos="0 1 0.1">
+      <freejoint/>
+      <geom name="ball" type="sphere" size="0.1" rgba="1 0 0 1"/>
+    </body>
+    <frame><attach model="diffbot" body="base_link" prefix=""/></frame>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_the_world_geometry_splits_static_objects_and_robots_into_markers(tmp_path):
+    import mujoco  # here: MUJOCO_GL is set when nodes.common.sim is imported, before mujoco
+
+    path = tmp_path / "shapes.xml"
+    path.write_text(SHAPES_ROOM)
+    engine = SimEngine(str(path))
+    world = WorldGeometry(engine.model, ["base_link"])
+    static = world.static_primitives(engine.data)
+    by_ns: dict[str, list] = {}
+    for shape in static:
+        by_ns.setdefault(shape.ns, []).append(shape)
+    assert sorted(by_ns) == ["lamp", "world"]  # no robot link, no hidden or invisible geom
+    floor, wedge = by_ns["world"]
+    assert floor.kind == "cube" and floor.scale == pytest.approx((20.0, 20.0, 0.01))
+    assert floor.position[2] == pytest.approx(-0.007)  # top just under z = 0
+    assert wedge.kind == "triangles" and wedge.triangles is not None
+    assert wedge.triangles.shape == (12, 3)  # 4 faces of 3 corners, in the geom's frame
+    assert wedge.rgba == (0.0, 0.0, 1.0, 1.0)
+    post, top, bottom = by_ns["lamp"]  # a capsule: a cylinder and two end spheres
+    assert (post.kind, top.kind, bottom.kind) == ("cylinder", "sphere", "sphere")
+    assert post.scale == pytest.approx((0.1, 0.1, 1.0)) and post.position[2] == pytest.approx(0.5)
+    assert sorted([top.position[2], bottom.position[2]]) == pytest.approx([0.0, 1.0])
+    assert len({s.id for s in static}) == len(static)
+    (ball,) = world.object_primitives(engine.data)
+    assert (ball.ns, ball.kind, ball.scale) == ("ball", "sphere", pytest.approx((0.2,) * 3))
+    assert world.objects_moved(engine.data)  # the first look: send them
+    engine.step(10)
+    assert not world.objects_moved(engine.data)  # resting on the floor: nothing to resend
+    ball_x = engine.model.jnt_qposadr[engine.model.body("ball").jntadr[0]]
+    engine.data.qpos[ball_x] += 0.05  # pushed 5 cm along x
+    mujoco.mj_kinematics(engine.model, engine.data)
+    assert world.objects_moved(engine.data)
+
+
+def test_the_room_floor_takes_the_colour_of_its_checker_texture(room):
+    world = WorldGeometry(room.model, ["base_link", "arm_base_link"])
+    floor = room.model.geom("floor").id
+    r, g, b, a = world.rgba(floor)
+    assert (r, g, b) == pytest.approx((0.675, 0.675, 0.65), abs=0.01)  # between its 2 colours
+    names = {room.model.geom(g).name for g in world.static_geoms}
+    assert {"wall_east", "box", "barrel", "table"} <= names and "arm_pedestal" not in names
+    assert [room.model.geom(g).name for g in world.object_geoms] == ["cube"]
+
+
+def test_world_to_odom_makes_the_chain_to_base_link_the_truth():
+    yaw = 1.0
+    truth_q = (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2))
+    position, quat = odom_in_world((1.0, 2.0, 0.01), truth_q, 0.9, 2.1, 0.8)
+    x, y, z, w = quat
+    correction = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    assert correction == pytest.approx(yaw - 0.8)
+    c, s = math.cos(correction), math.sin(correction)
+    back = (position[0] + c * 0.9 - s * 2.1, position[1] + s * 0.9 + c * 2.1, position[2])
+    assert back == pytest.approx((1.0, 2.0, 0.01))
+    assert odom_in_world((0.5, 0.5, 0.0), (0, 0, 0, 1), 0.5, 0.5, 0.0) == (
+        pytest.approx((0.0, 0.0, 0.0)),
+        pytest.approx((0.0, 0.0, 0.0, 1.0)),
+    )  # odometry that is right: world and odom coincide
+
+
+def test_egl_that_loads_but_makes_no_context_falls_back_to_osmesa():
+    env: dict[str, str] = {}
+    assert choose_gl_backend(env, egl_works=lambda: False) == "osmesa"
+    assert env == {"MUJOCO_GL": "osmesa", "PYOPENGL_PLATFORM": "osmesa"}
+    # For real: libEGL loads, but with no vendor library it finds no device to render on.
+    clean = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "PYOPENGL_PLATFORM")}
+    script = (
+        "from nodes.common.sim import GL_BACKEND\n"
+        "from nodes.common.sim.camera import SnapshotCamera\n"
+        "from nodes.common.sim.engine import SimEngine\n"
+        "engine = SimEngine('room')\n"
+        "camera = SnapshotCamera(engine.model, 'camera', 64, 48)\n"
+        "print(GL_BACKEND, camera.render(engine.snapshot()).std() > 10)\n"
+        "camera.close()\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script],
+        env={**clean, "__EGL_VENDOR_LIBRARY_FILENAMES": "/nonexistent/egl_vendor.json"},
+        cwd=PROJECT_ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["osmesa", "True"]
+
+
+def test_mujoco_warnings_go_to_the_log_and_never_to_a_file(tmp_path, monkeypatch, caplog):
+    import mujoco
+
+    monkeypatch.chdir(tmp_path)
+    engine = SimEngine("room")
+    engine.data.qvel[0] = float("nan")
+    with caplog.at_level(logging.WARNING, logger="mujoco"):
+        mujoco.mj_step(engine.model, engine.data)
+    assert any("MuJoCo: Nan, Inf or huge value in QVEL" in r.message for r in caplog.records)
+    assert list(tmp_path.iterdir()) == []  # no MUJOCO_LOG.TXT

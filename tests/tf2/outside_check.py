@@ -337,6 +337,44 @@ def check_errors_and_bad_input() -> None:
     )
     check(short.set_transform(msg("world", "m", 101 * NS, eye), "me") is False, "TF_OLD_DATA")
     check(short.can_transform("world", "m", Time(nanoseconds=104_000_000_000)), "recent data kept")
+    # A frame sent with a second parent: stored (the newest data wins), warned once per pair
+    two = tf2_ros.Buffer()
+    shifted = pt.transform_from(np.eye(3), np.array([0.0, 0.0, 1.0]))
+    check(two.set_transform(msg("world", "arm", 10 * NS, eye), "driver"), "first parent")
+    check(two.set_transform(msg("table", "arm", 11 * NS, shifted), "calibration"), "second parent")
+    check(two.set_transform(msg("table", "arm", 12 * NS, shifted), "calibration"), "again")
+    arm = two.lookup_transform("table", "arm", Time())
+    check(arm.transform.translation.z == 1.0, "the newest parent's transform wins")
+    raises(
+        tf2_ros.ConnectivityException,
+        "Could not find a connection between 'world' and 'arm' because they are not part of "
+        "the same tree.Tf has two or more unconnected trees.",
+        two.lookup_transform,
+        "world",
+        "arm",
+        Time(),
+    )
+    # ...while the past still knows the old parent (between the two: the older one holds)
+    for when in (10 * NS, 10 * NS + NS // 2):
+        old = two.lookup_transform("world", "arm", Time(nanoseconds=when))
+        check(old.transform.translation.z == 0.0, f"arm under world at {when}")
+    # a loop: tf2's walk refuses it, whichever way it is entered
+    loop = tf2_ros.Buffer()
+    loop.set_transform(msg("world", "l0", 10 * NS, eye), "me")
+    loop.set_transform(msg("l2", "l1", 10 * NS, eye), "me")
+    loop.set_transform(msg("l1", "l2", 10 * NS, eye), "me")
+    loop.set_transform(msg("l1", "l3", 10 * NS, shifted), "me")
+    for target, source in (("world", "l1"), ("l0", "l3")):
+        try:
+            loop.lookup_transform(target, source, Time(nanoseconds=10 * NS))
+        except tf2_ros.LookupException as exc:
+            check(
+                str(exc).startswith("The tf tree is invalid because it contains a loop."), str(exc)
+            )
+        else:
+            check(False, f"a lookup {source} -> {target} through a loop must fail")
+    inside = loop.lookup_transform("l1", "l3", Time(nanoseconds=10 * NS))
+    check(inside.transform.translation.z == 1.0, "a lookup below the loop still works")
     # YAML and string views of the tree
     text = buf.all_frames_as_string()
     check("Frame a exists with parent world.\n" in text, text)

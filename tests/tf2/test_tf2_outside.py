@@ -43,6 +43,14 @@ def test_random_trees_match_an_independent_computation(seed):
         "authority me",
     ):
         assert line in done.stderr, (line, done.stderr)
+    # a frame with two parents: warned once (ours: upstream tf2 has no such warning)
+    changed = (
+        'TF_PARENT_CHANGED: frame "arm" had parent "world" and now gets parent "table" from '
+        'authority "calibration"; a frame has exactly one parent at a time, so two broadcasters '
+        "disagree about the tree (the newest data wins)"
+    )
+    assert done.stderr.count(changed) == 1, done.stderr
+    assert done.stderr.count("TF_PARENT_CHANGED") == 1, done.stderr
 
 
 def _expected_s11() -> np.ndarray:

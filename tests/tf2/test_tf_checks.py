@@ -116,3 +116,39 @@ def test_tf_checks_pass_and_fail_on_real_publishers(lessons, probe):
     finally:
         node.destroy_timer(timer)
         node.destroy_publisher(volatile)
+
+
+def test_points_agree_passes_for_matrix_and_tf2_and_fails_when_the_copies_drift(lessons, probe):
+    """Unit 13's camera cell: the hand-made matrix and tf2 give the same point, until the
+    matrix node's own copy of the camera pose is changed and the two disagree by 10 cm."""
+    from rclpy.parameter import Parameter
+    from rclpy.parameter_client import AsyncParameterClient
+
+    rt, sup = lessons, lessons.supervisor
+    agree = Spec(
+        "points_agree",
+        {"topic": "/pos_in_robot_base_frame_tf2", "like": "/pos_in_robot_base_frame",
+         "tolerance": 0.001},
+    )  # fmt: skip
+    for name in ("camera_publisher", "camera_static_tf", "coordinate_transform"):
+        sup.start(name)
+    try:
+        state, why = settle(rt, agree, 5.0, want=FAIL)
+        assert state == FAIL and "no publisher on /pos_in_robot_base_frame_tf2" in why, why
+        sup.start("coordinate_transform_tf2_side")
+        state, why = settle(rt, agree, 40.0)
+        assert state == PASS and "in 'base_link'" in why and "mm apart" in why, why
+        client = AsyncParameterClient(probe.node, "/coordinate_transform")
+        assert client.wait_for_services(timeout_sec=10.0)
+        future = client.set_parameters([Parameter("camera_z", value=0.8)])
+        deadline = time.monotonic() + 10
+        while not future.done() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        state, why = settle(rt, agree, 20.0, want=FAIL)
+        assert state == FAIL and "100.0 mm apart" in why, why
+    finally:
+        for name in (
+            "coordinate_transform_tf2_side", "coordinate_transform", "camera_static_tf",
+            "camera_publisher",
+        ):  # fmt: skip
+            sup.stop(name).result(timeout=10)

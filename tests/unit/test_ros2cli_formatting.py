@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 
+import pytest
 from geometry_msgs.msg import Twist
 from rcl_interfaces.msg import (
     FloatingPointRange,
@@ -24,7 +25,7 @@ from app.ros.context import CallContext
 from app.ros2cli.common import is_hidden_name, visible, write_text
 from app.ros2cli.msg_yaml import message_to_yaml
 from app.ros2cli.param import describe_lines
-from app.ros2cli.parser import parse, run_argv
+from app.ros2cli.parser import UsageError, parse, run_argv
 from app.ros2cli.topic import EchoStyle, bandwidth_text, echo_text, qos_fallback_lines
 
 
@@ -131,9 +132,15 @@ def test_help_names_upstream_options_and_what_is_not_supported():
         assert option in text, text
     assert "--wait-matching-subscriptions" in text and "--max-wait-time-secs" in text
     assert "--keep-alive N" in text
-    assert "Not supported here (Jazzy's ros2 has them): --stdin, -n/--node-name, --qos-profile" in (
-        " ".join(text.split())
+    assert (
+        "Not supported here (Jazzy's ros2 has them): --stdin, -n/--node-name, -s/--use-sim-time"
+        in (" ".join(text.split()))
     )
+    assert "--qos-reliability {system_default,reliable,best_effort,unknown,best_available}" in text
+    # ...and listed as ros2 lists them, so -h reads as upstream's; typing one is refused
+    assert "  --stdin               Read values from standard input" in text
+    with pytest.raises(UsageError, match="argument --stdin: not supported here"):
+        parse(["topic", "pub", "--stdin", "/x", "std_msgs/msg/String"], [].append)
     text = "\n".join(_help(["node", "info", "-h"]))
     assert "--include-hidden" in text
     text = "\n".join(_help(["param", "describe", "-h"]))
@@ -186,7 +193,7 @@ def test_interface_proto_prints_a_quoted_default_instance():
 
 
 def test_echo_options_no_arr_no_str_flow_style_and_csv():
-    from geometry_msgs.msg import Polygon
+    from geometry_msgs.msg import Point32, Polygon
     from sensor_msgs.msg import Imu
 
     msg = UInt8MultiArray(data=[1, 2, 3])
@@ -200,7 +207,14 @@ def test_echo_options_no_arr_no_str_flow_style_and_csv():
     assert echo_text(Polygon(), EchoStyle(no_arr=True)) == (
         "points: '<sequence type: geometry_msgs/msg/Point32, length: 0>'\n---"
     )
-    assert echo_text(String(data="hi"), EchoStyle(flow_style=True)) == "{data: hi}\n---"
+    # --flow-style: lists in flow style, messages (mappings) still in block style
+    assert echo_text(String(data="hi"), EchoStyle(flow_style=True)) == "data: hi\n---"
+    assert echo_text(Polygon(points=[Point32(x=1.0)]), EchoStyle(flow_style=True)) == (
+        "points: [{x: 1.0, y: 0.0, z: 0.0}]\n---"
+    )
+    assert echo_text(UInt8MultiArray(data=[1, 2]), EchoStyle(flow_style=True)) == (
+        "layout:\n  dim: []\n  data_offset: 0\ndata: [1, 2]\n---"
+    )
     twist = Twist()
     twist.linear.x = 2.0
     assert echo_text(twist, EchoStyle(csv=True)) == "2.0,0.0,0.0,0.0,0.0,0.0"
@@ -227,3 +241,92 @@ def test_echo_says_when_it_falls_back_to_best_effort_or_volatile():
         "Some, but not all, publishers are offering QoSDurabilityPolicy.TRANSIENT_LOCAL. Falling "
         "back to QoSDurabilityPolicy.VOLATILE as it will connect to all publishers",
     ]
+
+
+# What the real Jazzy `ros2` printed at 100 columns (bench/results/ros2cli_compare.md).
+NODE_HELP = """\
+usage: ros2 node [-h] Call `ros2 node <command> -h` for more detailed usage. ...
+
+Various node related sub-commands
+
+options:
+  -h, --help            show this help message and exit
+
+Commands:
+  info  Output information about a node
+  list  Output a list of available nodes
+
+  Call `ros2 node <command> -h` for more detailed usage."""
+
+HZ_HELP = """\
+usage: ros2 topic hz [-h] [--window WINDOW] [--filter EXPR] [--wall-time] [--spin-time SPIN_TIME]
+                     [-s]
+                     topic_name
+
+Print the average publishing rate to screen
+
+positional arguments:
+  topic_name            Name of the ROS topic to listen to (e.g. '/chatter')
+
+options:
+  -h, --help            show this help message and exit
+  --window WINDOW, -w WINDOW
+                        window size, in # of messages, for calculating rate (default: 10000)
+  --filter EXPR         only measure messages matching the specified Python expression
+  --wall-time           calculates rate using wall time which can be helpful when clock is not
+                        published during simulation
+  --spin-time SPIN_TIME
+                        Spin time in seconds to wait for discovery (only applies when not using an
+                        already running daemon)
+  -s, --use-sim-time    Enable ROS simulation time"""
+
+
+def test_help_is_ros2s_own_text(monkeypatch):
+    monkeypatch.setenv("COLUMNS", "100")
+    assert "\n".join(_help(["node", "-h"])) == NODE_HELP
+    ours_only = (
+        "",
+        "Not supported here (Jazzy's ros2 has them): --filter, --wall-time, -s/--use-sim-time. "
+        "Using one gives a usage error.",
+    )
+    assert _help(["topic", "hz", "-h"]) == [*HZ_HELP.split("\n"), *ours_only]
+    # `ros2 node` alone: the same help, on the output, exit code 0 (as ros2cli)
+    lines: list[str] = []
+    args = parse(["node"], lines.append)
+    assert args is not None
+    assert args.handler(CallContext(None, lines.append), args) == 0  # type: ignore[arg-type]
+    assert "\n".join(lines) == NODE_HELP
+    # a verb ros2 has and we do not: a choice (ros2's list of choices), refused clearly
+    with pytest.raises(UsageError, match="invalid choice: 'nope' .*'delay', 'echo'"):
+        parse(["topic", "nope"], [].append)
+    args = parse(["topic", "delay", "/x"], [].append)
+    assert args is not None
+    with pytest.raises(UsageError, match="`ros2 topic delay` is not supported here"):
+        args.handler(CallContext(None, [].append), args)  # type: ignore[arg-type]
+
+
+def test_qos_options_build_the_profile_as_ros2cli_does():
+    from rclpy.qos import DurabilityPolicy, HistoryPolicy, ReliabilityPolicy
+
+    from app.ros2cli.topic import ECHO_QOS, PUB_QOS, QosOptions
+
+    assert not ECHO_QOS.overridden() and not PUB_QOS.overridden()
+    pub = PUB_QOS.profile_with_overrides()  # the 'default' preset: what `ros2 topic pub` uses
+    assert (pub.reliability, pub.durability, pub.depth) == (
+        ReliabilityPolicy.RELIABLE,
+        DurabilityPolicy.VOLATILE,
+        10,
+    )
+    qos = QosOptions("sensor_data", reliability="reliable", depth=3, history="keep_all")
+    profile = qos.profile_with_overrides()
+    assert qos.overridden()
+    assert (profile.reliability, profile.depth, profile.history) == (
+        ReliabilityPolicy.RELIABLE,
+        3,
+        HistoryPolicy.KEEP_ALL,
+    )
+    # transient local with no depth keeps the one last message
+    latched = QosOptions("system_default", durability="transient_local", depth=0)
+    assert latched.profile_with_overrides().depth == 1
+    with pytest.raises(UsageError, match="argument --qos-profile: invalid choice: 'nope'"):
+        parse(["topic", "echo", "--qos-profile", "nope", "/x"], [].append)

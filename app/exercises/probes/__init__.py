@@ -1,37 +1,47 @@
 """Probes: the grader drives the learner's node and judges what comes back.
 
 A check only looks at the graph; a probe gives the node input and compares
-the answer. The kinds live in topic modules (``core``, ``perception``,
-``behaviour``); this registry joins them. Each module exports ``KINDS`` (the
-fields the loader validates) and ``PROBES`` (the code).
+the answer. Each probe kind is one module here that registers itself with
+``register_probe`` (``app.exercises.probes.base``), as the lessons' check
+kinds do: its fields (the loader validates exercise files against them), its
+code, and its words for the learner and for `exercise explain`. To add a
+kind, add ``app/exercises/probes/<kind>.py``; nothing else is edited::
+
+    from app.exercises.probes.base import ProbeContext, register_probe
+    from app.exercises.report import Result
+    from app.lessons.schema import Spec
+
+
+    @register_probe("topic_echo", required="publish output", optional="count",
+                    words="what is published on one topic comes back on the other")
+    def run(ctx: ProbeContext, p: Spec) -> Result:
+        ...  # bounded in time; say what was tried and what came back
+
+Modules that register nothing hold what several kinds share: ``base`` (the
+registry, context, formulas, comparisons), ``exchange`` (send an input on a
+topic, read the answer to it) and ``tf`` (frame maths and a /tf reader).
 """
 
 from __future__ import annotations
 
-from app.exercises.probes import behaviour, core, perception, tf
-from app.exercises.probes.base import Probe, ProbeContext
+from app.exercises.probes.base import PROBES, Probe, ProbeContext, ProbeKind
 from app.exercises.report import Result
 from app.lessons.kinds import Kind
+from app.lessons.registry import import_all
 from app.lessons.schema import Spec
 from app.ros.errors import Ros2Error
 
-PROBE_KINDS: dict[str, Kind] = {}
-PROBES: dict[str, Probe] = {}
-# Inputs a kind draws in its own code (not from ranges in the data), in words for teachers.
-PROBE_DRAWS: dict[str, str] = {}
-for _module in (core, perception, behaviour, tf):
-    if set(_module.KINDS) != set(_module.PROBES) or set(_module.KINDS) & set(PROBE_KINDS):
-        raise RuntimeError(f"{_module.__name__}: probe kinds without code, or defined twice")
-    PROBE_KINDS.update(_module.KINDS)
-    PROBES.update(_module.PROBES)
-    PROBE_DRAWS.update(getattr(_module, "DRAWS", {}))
+import_all(__name__, __path__)
 
-__all__ = ["PROBES", "PROBE_DRAWS", "PROBE_KINDS", "ProbeContext", "run_probe"]
+# Each kind's fields, by name, as the exercise loader reads them.
+PROBE_KINDS: dict[str, Kind] = {name: kind.fields for name, kind in PROBES.items()}
+
+__all__ = ["PROBES", "PROBE_KINDS", "Probe", "ProbeContext", "ProbeKind", "run_probe"]
 
 
 def run_probe(ctx: ProbeContext, probe: Spec) -> Result:
     """One probe; any error becomes a failed result with its message."""
     try:
-        return PROBES[probe.kind](ctx, probe)
+        return PROBES[probe.kind].run(ctx, probe)
     except (Ros2Error, ValueError, KeyError, TypeError, AttributeError) as exc:
         return Result(probe.kind, False, f"{type(exc).__name__}: {exc}")

@@ -13,7 +13,10 @@ never exactly the truth, encoders count whole ticks, and wheels slip.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+
+import numpy as np
 
 
 @dataclass(frozen=True)
@@ -102,3 +105,54 @@ class Odometry:
         if dt > 0:
             self.linear = distance / dt
             self.angular = turn / dt
+
+
+def odom_in_world(
+    truth_position: Sequence[float] | np.ndarray,
+    truth_quat_xyzw: Sequence[float] | np.ndarray,
+    odom_x: float,
+    odom_y: float,
+    odom_yaw: float,
+) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+    """Where the odom frame is in the world, so that world -> odom -> base_link is the truth.
+
+    odom -> base_link is what the wheels believe; world -> base_link is where
+    the robot really is. Their difference, world -> odom, is what a
+    localization node would publish as map -> odom: the odometry's error,
+    which grows as the robot drives.
+    """
+    truth = _matrix(*truth_quat_xyzw)
+    half = odom_yaw / 2.0
+    rotation = truth @ _matrix(0.0, 0.0, math.sin(half), math.cos(half)).T
+    position = np.asarray(truth_position, dtype=np.float64) - rotation @ [odom_x, odom_y, 0.0]
+    x, y, z = (float(v) for v in position)
+    return (x, y, z), _quaternion(rotation)
+
+
+def _matrix(x: float, y: float, z: float, w: float) -> np.ndarray:
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def _quaternion(m: np.ndarray) -> tuple[float, float, float, float]:
+    """x, y, z, w of a rotation matrix (Shepperd's method: stable for every rotation)."""
+    trace = m[0, 0] + m[1, 1] + m[2, 2]
+    if trace > 0:
+        s = 2.0 * math.sqrt(1.0 + trace)
+        q = ((m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, s / 4)
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
+        q = (s / 4, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s, (m[2, 1] - m[1, 2]) / s)
+    elif m[1, 1] > m[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
+        q = ((m[0, 1] + m[1, 0]) / s, s / 4, (m[1, 2] + m[2, 1]) / s, (m[0, 2] - m[2, 0]) / s)
+    else:
+        s = 2.0 * math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
+        q = ((m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, s / 4, (m[1, 0] - m[0, 1]) / s)
+    x, y, z, w = (float(v) for v in q)
+    return (x, y, z, w)

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import rclpy
+from rclpy.exceptions import ParameterUninitializedException
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -122,13 +123,20 @@ class JointStatePublisher(Node):
         )
         self.source_subscriptions = [
             self.create_subscription(JointState, str(topic), self.on_source_state, 10)
-            for topic in (self.get_parameter("source_list").value or [])
+            for topic in self.source_list()
         ]
         self.publisher = self.create_publisher(JointState, "joint_states", 10)
         rate = float(self.get_parameter("rate").value)
         if not math.isfinite(rate) or rate <= 0.0:
             raise ValueError(f"rate must be a positive number of Hz, got {rate}")
         self.timer = self.create_timer(1.0 / rate, self.on_timer)
+
+    def source_list(self) -> list[str]:
+        """The source topics; none when the parameter was declared without a value."""
+        try:
+            return list(self.get_parameter("source_list").value or [])
+        except ParameterUninitializedException:
+            return []
 
     def configure_robot(self, description: str) -> None:
         model = parse_urdf(description)

@@ -90,8 +90,15 @@ class BufferCore:
         self._ids: dict[str, int] = {"NO_PARENT": 0}
         self._names: list[str] = ["NO_PARENT"]
         self._frames: list[TimeCache | StaticCache | None] = [None]
+        self._parents: list[int] = [0]  # each frame's newest parent (0: none), for _shortcut
         self._authority: dict[int, str] = {}
         self._parent_warned: set[tuple[int, int]] = set()
+        self.last_problem = ""  # the newest warning or error logged (not upstream's API)
+
+    def _say(self, level: str, text: str) -> None:
+        """Log as tf2 does; keep the newest warning or error for tools that show it."""
+        self.last_problem = text
+        _log(level, text)
 
     # -- input -----------------------------------------------------------------
     def set_transform(self, transform: TransformStamped, authority: str) -> bool:
@@ -101,31 +108,47 @@ class BufferCore:
         return self._set(transform, authority, True)
 
     def _set(self, msg: TransformStamped, authority: str, is_static: bool) -> bool:
-        frame_id = msg.header.frame_id
-        child = msg.child_frame_id
+        tr, ro = msg.transform.translation, msg.transform.rotation
+        return self._set_fields(
+            msg.header.frame_id,
+            msg.child_frame_id,
+            msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec,
+            (tr.x, tr.y, tr.z),
+            (ro.x, ro.y, ro.z, ro.w),
+            authority,
+            is_static,
+        )
+
+    def _set_fields(
+        self,
+        frame_id: str,
+        child: str,
+        stamp: int,
+        t: Vec,
+        q: Quat,
+        authority: str,
+        is_static: bool,
+    ) -> bool:
+        """tf2's setTransform on the fields of one TransformStamped (stamp in ns)."""
         frame_id = frame_id[1:] if frame_id.startswith("/") else frame_id
         child = child[1:] if child.startswith("/") else child
-        tr, ro = msg.transform.translation, msg.transform.rotation
-        t: Vec = (tr.x, tr.y, tr.z)
-        q: Quat = (ro.x, ro.y, ro.z, ro.w)
-        stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
         ok = True
         if child == frame_id:
-            _log(
+            self._say(
                 "error",
                 f'TF_SELF_TRANSFORM: Ignoring transform from authority "{authority}" with '
                 f'frame_id and  child_frame_id "{child}" because they are the same',
             )
             ok = False
         if not child:
-            _log(
+            self._say(
                 "error",
                 f'TF_NO_CHILD_FRAME_ID: Ignoring transform from authority "{authority}" '
                 "because child_frame_id not set ",
             )
             ok = False
         if not frame_id:
-            _log(
+            self._say(
                 "error",
                 f'TF_NO_FRAME_ID: Ignoring transform with child_frame_id "{child}"  from '
                 f'authority "{authority}" because frame_id not set',
@@ -133,7 +156,7 @@ class BufferCore:
             ok = False
         total = t[0] + t[1] + t[2] + q[0] + q[1] + q[2] + q[3]
         if total != total and any(math.isnan(v) for v in (*t, *q)):  # cheap test first
-            _log(
+            self._say(
                 "error",
                 f'TF_NAN_INPUT: Ignoring transform for child_frame_id "{child}" from authority '
                 f'"{authority}" because of a nan value in the transform '
@@ -141,7 +164,7 @@ class BufferCore:
             )
             ok = False
         elif abs(quat_norm2(q) - 1.0) >= QUATERNION_NORMALIZATION_TOLERANCE:
-            _log(
+            self._say(
                 "error",
                 f'TF_DENORMALIZED_QUATERNION: Ignoring transform for child_frame_id "{child}" '
                 f'from authority "{authority}" because of an invalid quaternion in the '
@@ -160,7 +183,7 @@ class BufferCore:
             else:
                 self._warn_new_parent(cache, child_id, parent_id, authority)
             if not cache.insert(stamp, (parent_id, q, t)):
-                _log(
+                self._say(
                     "warning",
                     f"TF_OLD_DATA ignoring data from the past for frame {child} at time "
                     f"{display_time(stamp)} according to authority {authority}\n"
@@ -168,6 +191,7 @@ class BufferCore:
                 )
                 return False
             self._authority[child_id] = authority
+            self._parents[child_id] = cache.latest_time_and_parent()[1]
         return True
 
     def _warn_new_parent(
@@ -178,7 +202,7 @@ class BufferCore:
         if old in (0, parent_id) or (child_id, parent_id) in self._parent_warned:
             return
         self._parent_warned.add((child_id, parent_id))
-        _log(
+        self._say(
             "warning",
             f'TF_PARENT_CHANGED: frame "{self._names[child_id]}" had parent '
             f'"{self._names[old]}" and now gets parent "{self._names[parent_id]}" from '
@@ -201,6 +225,7 @@ class BufferCore:
             self._ids[name] = number
             self._names.append(name)
             self._frames.append(None)
+            self._parents.append(0)
         return number
 
     def _validate(self, function: str, frame_id: str) -> int:
@@ -391,6 +416,65 @@ class BufferCore:
             acc.q, acc.t = compose(inv_q, inv_t, acc.src_q, acc.src_t)
         return tc.NO_ERROR, time_ns, "", acc
 
+    def _shortcut(self, time_ns: int, target: int, source: int) -> tuple[Quat, Vec, int] | None:
+        """A successful walk's result, composing only the links below the common ancestor.
+
+        tf2's walk composes both paths all the way up to the root, where the
+        links above the frames' common ancestor cancel out. Here the tree's
+        shape is taken from each frame's newest parent (a list lookup), the
+        common ancestor found on it, and only the links below it are
+        interpolated and composed, each checked to have that parent at
+        ``time_ns``: the same transform for fewer operations. Whenever the
+        walk would not succeed that way (a missing link, another parent at
+        that time, no common ancestor, a loop) this returns None and tf2's own
+        walk runs, with its error and its message.
+        """
+        if time_ns == 0:
+            code, time_ns, _message = self._latest_common_time(target, source)
+            if code != tc.NO_ERROR:
+                return None
+        parents = self._parents
+        up: dict[int, int] = {}  # source and its ancestors (by newest parent)
+        frame = source
+        while frame and frame not in up:
+            up[frame] = parents[frame]
+            frame = parents[frame]
+        if frame:
+            return None  # a loop: tf2's walk says so
+        down: list[int] = []  # target and its ancestors below the common one
+        frame = target
+        while frame not in up:
+            if not frame or frame in down:
+                return None
+            down.append(frame)
+            frame = parents[frame]
+        common = frame
+        frames = self._frames
+        q: Quat = IDENTITY_Q
+        t: Vec = ZERO_V
+        first = True
+        for frame, parent in up.items():
+            if frame == common:
+                break
+            data = frames[frame].get_data(time_ns)  # type: ignore[union-attr]
+            if isinstance(data, CacheError) or data[0] != parent:
+                return None
+            if first:
+                q, t, first = data[1], data[2], False
+            else:
+                q, t = compose(data[1], data[2], q, t)
+        if down:
+            tq: Quat = IDENTITY_Q
+            tt: Vec = ZERO_V
+            for k, frame in enumerate(down):
+                data = frames[frame].get_data(time_ns)  # type: ignore[union-attr]
+                if isinstance(data, CacheError) or data[0] != parents[frame]:
+                    return None
+                tq, tt = (data[1], data[2]) if k == 0 else compose(data[1], data[2], tq, tt)
+            inv_q, inv_t = invert(tq, tt)
+            q, t = (inv_q, inv_t) if first else compose(inv_q, inv_t, q, t)
+        return q, t, time_ns
+
     # -- lookups -------------------------------------------------------------------
     def _lookup(self, target_frame: str, source_frame: str, time_ns: int) -> tuple[Quat, Vec, int]:
         with self._lock:
@@ -402,6 +486,9 @@ class BufferCore:
                 return IDENTITY_Q, ZERO_V, time_ns
             target = self._validate("lookupTransform argument target_frame", target_frame)
             source = self._validate("lookupTransform argument source_frame", source_frame)
+            found = self._shortcut(time_ns, target, source)
+            if found is not None:
+                return found
             code, used, message, acc = self._walk(time_ns, target, source, True)
         if code != tc.NO_ERROR or acc is None:
             raise _RAISE.get(code, TransformException)(message)

@@ -104,8 +104,27 @@ class TimeCache:
         )
 
     def get_parent(self, time_ns: int) -> int | CacheError:
-        found = self.get_data(time_ns)
+        parent = self.parent_at(time_ns)
+        if parent:
+            return parent
+        found = self.get_data(time_ns)  # no parent then: the error, with its message
         return found if isinstance(found, CacheError) else found[0]
+
+    def parent_at(self, time_ns: int) -> int:
+        """The parent at ``time_ns`` (tf2's getParent: the older neighbour's), 0 if none.
+
+        Only a bisection: no interpolation and no error message, for walks
+        that need the tree's shape before any maths.
+        """
+        stamps, lo = self._stamps, self._lo
+        n = len(stamps)
+        if n == lo:
+            return 0
+        if time_ns == 0:
+            return self._data[-1][0]
+        if time_ns < stamps[lo] or time_ns > stamps[-1]:
+            return 0
+        return self._data[bisect_right(stamps, time_ns, lo) - 1][0]
 
     def latest_time_and_parent(self) -> tuple[int, int]:
         if len(self._stamps) == self._lo:
@@ -172,6 +191,9 @@ class StaticCache:
         return self._entry
 
     def get_parent(self, time_ns: int) -> int | CacheError:
+        return self._entry[0] if self._entry is not None else 0
+
+    def parent_at(self, time_ns: int) -> int:
         return self._entry[0] if self._entry is not None else 0
 
     def latest_time_and_parent(self) -> tuple[int, int]:

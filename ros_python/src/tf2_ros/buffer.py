@@ -23,6 +23,7 @@ from rclpy.time import Time
 from tf2_msgs.srv import FrameGraph
 from tf2_py import BufferCore
 
+from tf2_ros._wire import Entry
 from tf2_ros.buffer_interface import NO_TIMEOUT, BufferInterface
 
 
@@ -69,6 +70,12 @@ class Buffer(BufferCore, BufferInterface):
         stored = super().set_transform_static(transform, authority)
         self._call_new_data_callbacks()
         return stored
+
+    def _set_entries(self, entries: list[Entry], authority: str, is_static: bool) -> None:
+        """Every transform of one message (decoded by ``_wire``), then the waiters once."""
+        for frame_id, child, stamp, t, q in entries:
+            self._set_fields(frame_id, child, stamp, t, q, authority, is_static)
+        self._call_new_data_callbacks()
 
     def _call_new_data_callbacks(self) -> None:
         if not self._new_data_callbacks:

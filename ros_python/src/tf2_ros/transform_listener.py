@@ -14,8 +14,10 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile
+from rclpy.serialization import deserialize_message
 from tf2_msgs.msg import TFMessage
 
+from tf2_ros._wire import decode_tf_message
 from tf2_ros.buffer import Buffer
 
 
@@ -49,11 +51,29 @@ class TransformListener:
         self.node = node
         # Reentrant: a callback may wait for a transform while these keep arriving.
         self.group = ReentrantCallbackGroup()
+        # The bytes are read here (tf2_ros._wire) unless a subclass handles messages itself
+        # or the buffer's set_transform is someone else's: then rclpy's messages, as upstream.
+        raw = (
+            type(self).callback is TransformListener.callback
+            and type(self).static_callback is TransformListener.static_callback
+            and type(buffer).set_transform is Buffer.set_transform
+            and type(buffer).set_transform_static is Buffer.set_transform_static
+        )
         self.tf_sub = node.create_subscription(
-            TFMessage, "/tf", self.callback, qos, callback_group=self.group
+            TFMessage,
+            "/tf",
+            self._raw_callback if raw else self.callback,
+            qos,
+            callback_group=self.group,
+            raw=raw,
         )
         self.tf_static_sub = node.create_subscription(
-            TFMessage, "/tf_static", self.static_callback, static_qos, callback_group=self.group
+            TFMessage,
+            "/tf_static",
+            self._raw_static_callback if raw else self.static_callback,
+            static_qos,
+            callback_group=self.group,
+            raw=raw,
         )
         if spin_thread:
             self.executor = SingleThreadedExecutor()
@@ -83,6 +103,20 @@ class TransformListener:
         """Stop listening (destroys both subscriptions)."""
         self.node.destroy_subscription(self.tf_sub)
         self.node.destroy_subscription(self.tf_static_sub)
+
+    def _raw_callback(self, data: bytes) -> None:
+        entries = decode_tf_message(data)
+        if entries is None:
+            self.callback(deserialize_message(data, TFMessage))
+        else:
+            self.buffer._set_entries(entries, "default_authority", False)
+
+    def _raw_static_callback(self, data: bytes) -> None:
+        entries = decode_tf_message(data)
+        if entries is None:
+            self.static_callback(deserialize_message(data, TFMessage))
+        else:
+            self.buffer._set_entries(entries, "default_authority", True)
 
     def callback(self, data: TFMessage) -> None:
         who = "default_authority"

@@ -1,4 +1,4 @@
-"""Reference solution: publish "ready" once, in a way late subscribers still receive it."""
+"""Reference solution: a status that late subscribers still receive, kept up to date."""
 
 import rclpy
 from rclpy.executors import ExternalShutdownException
@@ -15,7 +15,12 @@ class StatusAnnouncer(Node):
         qos = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self.publisher = self.create_publisher(String, "robot_status", qos)
         self.publisher.publish(String(data="ready"))
-        self.get_logger().info("status published")
+        self.get_logger().info("status published: ready")
+        self.subscription = self.create_subscription(String, "status_updates", self.on_update, 10)
+
+    def on_update(self, msg):
+        self.publisher.publish(String(data=msg.data))
+        self.get_logger().info(f"status published: {msg.data}")
 
 
 def main():

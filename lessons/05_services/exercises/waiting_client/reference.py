@@ -1,4 +1,6 @@
-"""Reference solution: wait for /add_two_ints, ask for 20 + 22, log the answer."""
+"""Reference solution: wait for /add_two_ints, ask for the sum of two numbers, log the answer."""
+
+import sys
 
 import rclpy
 from rclpy.executors import ExternalShutdownException
@@ -19,14 +21,21 @@ class Asker(Node):
         return self.client.call_async(AddTwoInts.Request(a=a, b=b))
 
 
+def numbers(argv):
+    """The two numbers from the command line (python asker.py 5 7), else 20 and 22."""
+    words = rclpy.utilities.remove_ros_args(argv)[1:]
+    return (int(words[0]), int(words[1])) if len(words) >= 2 else (20, 22)
+
+
 def main():
     rclpy.init()
+    a, b = numbers(sys.argv)
     node = Asker()
     try:
         node.wait_for_server()
-        future = node.ask(20, 22)
+        future = node.ask(a, b)
         rclpy.spin_until_future_complete(node, future)
-        node.get_logger().info(f"20 + 22 = {future.result().sum}")
+        node.get_logger().info(f"{a} + {b} = {future.result().sum}")
         rclpy.spin(node)  # keep the node running once the answer is logged
     except (KeyboardInterrupt, ExternalShutdownException):
         pass

@@ -11,7 +11,12 @@ class StatusAnnouncer(Node):
         super().__init__("status_announcer")
         self.publisher = self.create_publisher(String, "robot_status", 10)
         self.publisher.publish(String(data="ready"))
-        self.get_logger().info("status published")
+        self.get_logger().info("status published: ready")
+        self.subscription = self.create_subscription(String, "status_updates", self.on_update, 10)
+
+    def on_update(self, msg):
+        self.publisher.publish(String(data=msg.data))
+        self.get_logger().info(f"status published: {msg.data}")
 
 
 def main():

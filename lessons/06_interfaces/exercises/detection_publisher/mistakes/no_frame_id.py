@@ -1,27 +1,33 @@
 """A plausible mistake: the header is left empty, so nobody knows the frame."""
 
 import rclpy
+from geometry_msgs.msg import Point
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from tutorial_interfaces.msg import DetectedObject
+
+FOCAL_PX = 600.0  # the camera's focal length, in pixels
+CENTRE_U, CENTRE_V = 320.0, 240.0  # the image centre (a 640x480 camera)
+BALL_RADIUS_M = 0.03  # the ball is 6 cm across
 
 
 class DetectionPublisher(Node):
     def __init__(self):
         super().__init__("detection_publisher")
         self.publisher = self.create_publisher(DetectedObject, "detections", 10)
-        self.timer = self.create_timer(0.5, self.on_timer)
+        self.subscription = self.create_subscription(Point, "circles", self.on_circle, 10)
 
-    def on_timer(self):
+    def on_circle(self, circle):
         msg = DetectedObject()
         msg.label = "red_ball"
-        msg.pixel_x = 320.0
-        msg.pixel_y = 180.0
-        msg.radius_px = 24.0
+        msg.pixel_x = circle.x
+        msg.pixel_y = circle.y
+        msg.radius_px = circle.z
         # A nested message is already there: fill in its fields.
-        msg.position_in_camera.x = 0.15
-        msg.position_in_camera.y = -0.05
-        msg.position_in_camera.z = 1.2
+        depth = FOCAL_PX * BALL_RADIUS_M / circle.z
+        msg.position_in_camera.x = (circle.x - CENTRE_U) * depth / FOCAL_PX
+        msg.position_in_camera.y = (circle.y - CENTRE_V) * depth / FOCAL_PX
+        msg.position_in_camera.z = depth
         self.publisher.publish(msg)
 
 

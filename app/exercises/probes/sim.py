@@ -1,0 +1,360 @@
+"""What the simulation probes share (registers no kind): the world's controls, a recorder
+of the robot's ground truth, random start poses, and the verdict's numbers.
+
+A simulation probe grades behaviour, the way Duckietown and JdeRobot grade:
+it puts the robot at a start pose the learner does not choose (drawn from the
+exercise's ranges with the grading's seed, and redrawn until the room allows
+it), lets the learner's node drive, and measures what the robot really did
+from ``/ground_truth/odom`` and the world file's floor plan, never from the
+learner's own outputs.
+
+One trial:
+
+1. wait for ``/sim_world`` (the exercise's setup starts it) and read its
+   world, start pose and real-time factor;
+2. set ``use_sim_time`` on the learner's node, as a simulator's launch file
+   does, so its timers count simulated seconds;
+3. pause the physics, set the start pose (and anything the learner's node is
+   told, such as a goal), reset the world, set the grading's real-time
+   factor (faster than real time: judged in simulated seconds, it changes
+   nothing but the wait) and go on;
+4. record the ground truth until the probe has seen enough;
+5. put back what was changed: the world's parameters and ``use_sim_time``.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Any
+
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from rcl_interfaces.msg import Parameter
+from rcl_interfaces.srv import GetParameters, SetParameters
+from std_srvs.srv import Empty
+
+from app.exercises.probes.base import ProbeContext, draw
+from app.lessons.checks._sim_topics import SIM_NODE, Pose, pose_of, world_map, wrap
+from app.lessons.checks._world_map import WorldMap
+from app.ros import params
+from app.ros.calls import wait_for_server, wait_future
+from app.ros.errors import Ros2Error
+
+READY_WAIT_SEC = 30.0  # a world starting on a busy machine: MuJoCo, the model, the camera
+SERVICE_SEC = 10.0  # a world stepping on a busy machine can be slow to answer
+TOUCH = 0.01  # m: the body this close to an obstacle touches it
+# Slower than this (m/s, rad/s) over a few seconds, the robot stands still: a slow final
+# approach (a few cm/s) still counts as moving.
+STILL_SPEED, STILL_TURN = 0.005, 0.01
+ASKED_SPEED, ASKED_TURN = 0.01, 0.02  # a /cmd_vel below both asks for no real motion
+DEFAULT_RTF = 2.0
+QUIET_WAIT = 3.0  # s at most for the samples sent before a pause to arrive
+WORLD_PARAMS = ("x", "y", "yaw", "real_time_factor", "camera_rate")
+
+
+@dataclass(frozen=True)
+class Sample:
+    """One ground-truth pose: simulation time, position, heading."""
+
+    t: float
+    x: float
+    y: float
+    yaw: float
+
+
+class Recorder:
+    """Every /ground_truth/odom and /odom message as planar poses, and when /cmd_vel last
+    asked for motion (the executor thread writes).
+
+    /cmd_vel only tells the probe when to stop watching (a robot that stands still while
+    its node still asks it to move was held up, e.g. by a busy machine, and is watched on);
+    the verdict comes from the ground truth.
+    """
+
+    def __init__(self, ctx: ProbeContext) -> None:
+        self._node = ctx.call.node
+        self._lock = threading.Lock()
+        self.truth: list[Sample] = []
+        self.odom: list[Pose] = []
+        self.moving_asked = 0.0  # monotonic time /cmd_vel last asked for motion
+        self._subs = [
+            self._node.create_subscription(Odometry, "/ground_truth/odom", self._on_truth, 50),
+            self._node.create_subscription(Odometry, "/odom", self._on_odom, 50),
+            self._node.create_subscription(Twist, "/cmd_vel", self._on_cmd_vel, 50),
+        ]
+
+    def _on_cmd_vel(self, msg: Twist) -> None:
+        if abs(msg.linear.x) > ASKED_SPEED or abs(msg.angular.z) > ASKED_TURN:
+            with self._lock:
+                self.moving_asked = time.monotonic()
+
+    def asked_to_move(self, within: float = 1.0) -> bool:
+        """Whether /cmd_vel asked for motion in the last ``within`` s of wall-clock time."""
+        with self._lock:
+            return time.monotonic() - self.moving_asked < within
+
+    def _on_truth(self, msg: Odometry) -> None:
+        pose = pose_of(msg)
+        with self._lock:
+            self.truth.append(Sample(pose.t, pose.x, pose.y, pose.yaw))
+
+    def _on_odom(self, msg: Odometry) -> None:
+        with self._lock:
+            self.odom.append(pose_of(msg))
+
+    def newest(self) -> Sample | None:
+        with self._lock:
+            return self.truth[-1] if self.truth else None
+
+    def count(self) -> int:
+        with self._lock:
+            return len(self.truth)
+
+    def since(self, t0: float) -> list[Sample]:
+        with self._lock:
+            return [s for s in self.truth if s.t > t0]
+
+    def odom_since(self, t0: float) -> list[Pose]:
+        with self._lock:
+            return [p for p in self.odom if p.t > t0]
+
+    def close(self) -> None:
+        for sub in self._subs:
+            self._node.destroy_subscription(sub)
+
+
+def _parameter(name: str, value: Any) -> Parameter:
+    return Parameter(name=name, value=params.parameter_value(value))
+
+
+class Services:
+    """Service clients kept for a whole probe: a fresh client per call would wait for
+    discovery each time, seconds on a busy machine."""
+
+    def __init__(self, ctx: ProbeContext) -> None:
+        self._ctx = ctx
+        self._clients: dict[tuple[str, type], Any] = {}
+
+    def call(self, name: str, srv_type: type, request: Any) -> Any:
+        key = (name, srv_type)
+        if key not in self._clients:
+            self._clients[key] = self._ctx.call.node.create_client(srv_type, name)
+        client = self._clients[key]
+        what = f"service '{name}'"
+        wait_for_server(self._ctx.call, client.service_is_ready, SERVICE_SEC, what)
+        return wait_future(self._ctx.call, client.call_async(request), SERVICE_SEC, what)
+
+    def get(self, node: str, names: list[str]) -> dict[str, Any]:
+        request = GetParameters.Request(names=names)
+        response = self.call(f"{node}/get_parameters", GetParameters, request)
+        values = [params.python_value(v) for v in response.values]
+        return dict(zip(names, values, strict=True))
+
+    def set(self, node: str, values: dict[str, Any]) -> None:
+        """Set several parameters in one request; a refusal raises with the node's reason."""
+        request = SetParameters.Request(parameters=[_parameter(k, v) for k, v in values.items()])
+        response = self.call(f"{node}/set_parameters", SetParameters, request)
+        for name, result in zip(values, response.results, strict=False):
+            if not result.successful:
+                raise Ros2Error(f"{node} refused {name}={values[name]!r}: {result.reason}")
+
+    def empty(self, name: str) -> None:
+        self.call(name, Empty, Empty.Request())
+
+    def close(self) -> None:
+        for client in self._clients.values():
+            self._ctx.call.node.destroy_client(client)
+        self._clients.clear()
+
+
+@dataclass
+class World:
+    """The running simulation as the probe found it: its floor plan, what to put back,
+    and the clients to drive it."""
+
+    name: str
+    plan: WorldMap
+    saved: dict[str, Any]
+    rtf: float
+    services: Services
+
+
+def _wait_for_world(ctx: ProbeContext, recorder: Recorder) -> None:
+    deadline = time.monotonic() + READY_WAIT_SEC
+    names: set[str] = set()
+    while recorder.newest() is None or f"{SIM_NODE}/set_parameters" not in names:
+        if time.monotonic() > deadline:
+            raise Ros2Error(
+                f"no simulation: {SIM_NODE} did not publish /ground_truth/odom within "
+                f"{READY_WAIT_SEC:g} s (the exercise starts it: is another world running?)"
+            )
+        ctx.call.sleep(0.2)
+        names = {name for name, _ in ctx.call.node.get_service_names_and_types()}
+
+
+@contextmanager
+def simulation(ctx: ProbeContext, rtf: float) -> Iterator[tuple[World, Recorder]]:
+    """The world, ready for trials; afterwards its parameters and the learner's clock as before."""
+    recorder = Recorder(ctx)
+    services = Services(ctx)
+    learner_sim_time: bool | None = None
+    world: World | None = None
+    try:
+        _wait_for_world(ctx, recorder)
+        current = services.get(SIM_NODE, ["world", *WORLD_PARAMS])
+        name = str(current.pop("world"))
+        world = World(name, world_map(name), current, rtf, services)
+        try:
+            clock = services.get(ctx.learner_node, ["use_sim_time"])
+            learner_sim_time = bool(clock["use_sim_time"])
+            services.set(ctx.learner_node, {"use_sim_time": True})
+        except Ros2Error as exc:
+            raise Ros2Error(
+                f"could not set use_sim_time on {ctx.learner_node}: {exc} (is its executor busy?)"
+            ) from None
+        yield world, recorder
+    finally:
+        try:
+            if world is not None:
+                services.set(SIM_NODE, world.saved)
+            if learner_sim_time is not None:
+                services.set(ctx.learner_node, {"use_sim_time": learner_sim_time})
+        except Ros2Error:
+            pass  # the world or the node is gone: nothing to put back
+        services.close()
+        recorder.close()
+
+
+def release(
+    ctx: ProbeContext,
+    world: World,
+    recorder: Recorder,
+    start: tuple[float, float, float],
+    learner: dict[str, Any] | None = None,
+) -> float:
+    """Put the robot at ``start`` (paused), tell the learner's node ``learner``, and go.
+
+    Returns the simulation time the trial starts at: later samples are the trial's.
+    """
+    services = world.services
+    services.empty("/pause_physics")
+    x, y, yaw = start
+    # No camera during a trial: nothing graded looks at it, and rendering at a faster
+    # real-time factor would take the cores the learner's node needs.
+    trial = {"x": x, "y": y, "yaw": yaw, "real_time_factor": world.rtf, "camera_rate": 0.0}
+    services.set(SIM_NODE, trial)
+    services.empty("/reset_world")  # the robot at the start, odometry at zero, time goes on
+    if learner:
+        services.set(ctx.learner_node, learner)
+    # Paused, the world publishes nothing: once nothing has come for a while, what was on
+    # its way before the pause has arrived, and every later sample is the trial's.
+    count = recorder.count()
+    for _ in range(int(QUIET_WAIT / 0.1)):
+        ctx.call.sleep(0.1)
+        if recorder.count() == count:
+            break
+        count = recorder.count()
+    newest = recorder.newest()
+    assert newest is not None
+    services.empty("/unpause_physics")
+    return newest.t
+
+
+def draw_pose(
+    ctx: ProbeContext,
+    ranges: dict[str, Any],
+    fits: Callable[[float, float, float], bool],
+    tries: int = 20000,
+) -> tuple[float, float, float]:
+    """A pose drawn from ``{x, y, yaw}`` ranges, drawn again until ``fits`` accepts it."""
+    for _ in range(tries):
+        x, y, yaw = (float(draw(ctx.rng, ranges[k])) for k in ("x", "y", "yaw"))
+        if fits(x, y, yaw):
+            return x, y, yaw
+    raise ValueError(f"no pose drawn from {ranges} fits the world in {tries} tries")
+
+
+def run_until(
+    ctx: ProbeContext,
+    recorder: Recorder,
+    t0: float,
+    start: tuple[float, float, float],
+    sim_seconds: float,
+    rtf: float,
+    done: Callable[[list[Sample]], bool],
+) -> tuple[list[Sample], str]:
+    """Samples from ``t0`` (the first at ``start``) until ``done`` says so or ``sim_seconds``
+    of simulation pass.
+
+    The wall-clock bound is generous (a busy machine runs the world slower than asked);
+    past it, the second value says how far the simulation got.
+    """
+    wall_limit = sim_seconds / max(rtf, 0.25) * 4.0 + 20.0
+    deadline = time.monotonic() + wall_limit
+    while True:
+        samples = recorder.since(t0)
+        # A sample from before the reset that arrived late is not the trial's.
+        while samples and math.hypot(samples[0].x - start[0], samples[0].y - start[1]) > 0.03:
+            samples.pop(0)
+        if samples and (samples[-1].t - t0 >= sim_seconds or done(samples)):
+            return samples, ""
+        if time.monotonic() > deadline:
+            got = samples[-1].t - t0 if samples else 0.0
+            return samples, (
+                f"the simulation ran only {got:.1f} of {sim_seconds:g} s in {wall_limit:.0f} s "
+                "of wall-clock time (the machine is too busy to grade now)"
+            )
+        ctx.call.sleep(0.1)
+
+
+def elapsed(samples: list[Sample], t0: float) -> float:
+    return samples[-1].t - t0 if samples else 0.0
+
+
+def at_rest(samples: list[Sample], seconds: float) -> bool:
+    """The robot stood still (position and heading) over the last ``seconds``."""
+    if not samples or samples[-1].t - samples[0].t < seconds:
+        return False
+    end = samples[-1]
+    window = [s for s in samples if s.t >= end.t - seconds]
+    first = window[0]
+    moved = math.hypot(end.x - first.x, end.y - first.y)
+    turned = abs(wrap(end.yaw - first.yaw))
+    return moved <= STILL_SPEED * seconds and turned <= STILL_TURN * seconds
+
+
+def path_length(samples: list[Sample]) -> float:
+    return sum(math.hypot(b.x - a.x, b.y - a.y) for a, b in zip(samples, samples[1:], strict=False))
+
+
+@dataclass(frozen=True)
+class Touch:
+    """Where the body came closest to the room: distance, what, when (s into the trial)."""
+
+    distance: float
+    name: str
+    at: float
+
+
+def closest_touch(plan: WorldMap, samples: list[Sample], t0: float) -> Touch:
+    best = Touch(math.inf, "", 0.0)
+    for s in samples:
+        near = plan.clearance(s.x, s.y, s.yaw)
+        if near.distance < best.distance:
+            best = Touch(near.distance, near.name, s.t - t0)
+    return best
+
+
+def touch_text(touch: Touch) -> str:
+    if touch.distance <= TOUCH:
+        return f"the robot touched {touch.name} at {touch.at:.1f} s"
+    return f"the body never came closer than {touch.distance:.2f} m to anything ({touch.name})"
+
+
+def pose_text(pose: tuple[float, float, float]) -> str:
+    return f"(x={pose[0]:.2f}, y={pose[1]:.2f}, yaw={pose[2]:.2f})"

@@ -1,0 +1,123 @@
+"""What the topic probes share (registers no kind): a reader for the node's answers, waiting
+for its subscription, sending one input and reading the answer to it, and why nothing came.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile
+
+from app.exercises.probes.base import ProbeContext, same
+from app.ros.monitor import TopicMonitor
+from app.ros.names import node_fqn
+from app.ros.qos import matching_qos
+
+# Reaches reliable and best-effort subscribers alike.
+SEND_QOS = QoSProfile(depth=10)
+MATCH_WAIT_SEC = 5.0  # for the learner's subscription to appear
+ANSWER_WAIT_SEC = 2.0  # for one answer to one input
+RESENDS = 3  # an input is sent again when no answer came (discovery may lag)
+
+
+def split_name(fqn: str) -> tuple[str, str]:
+    namespace, _, name = fqn.rpartition("/")
+    return namespace or "/", name
+
+
+def listen(ctx: ProbeContext, topic: str, msg_type: type) -> TopicMonitor:
+    """A reader for the node's answers, reliable when its publisher is (big messages)."""
+    qos = matching_qos(ctx.call.node, topic, depth=20)
+    return TopicMonitor(ctx.call.node, topic, msg_type, keep=20, qos=qos)
+
+
+def wait_subscribed(ctx: ProbeContext, publisher: Any, topic: str) -> str:
+    """'' once someone subscribes to ``topic``, else why not."""
+    deadline = time.monotonic() + MATCH_WAIT_SEC
+    while publisher.get_subscription_count() == 0:
+        if time.monotonic() > deadline:
+            return f"nothing subscribes to {topic} (waited {MATCH_WAIT_SEC:g} s)"
+        ctx.call.sleep(0.05)
+    ctx.call.sleep(0.3)  # let the learner's publisher find our reader too
+    return ""
+
+
+def exchange(
+    ctx: ProbeContext, publisher: Any, monitor: TopicMonitor, message: Any, stamp_sec: int
+) -> Any | None:
+    """Send ``message`` stamped ``stamp_sec`` s and return the answer to it, or None.
+
+    An answer with our stamp belongs to this input. One with a zero stamp (a
+    node that does not copy the header) is taken as the answer to the newest
+    input. Any other stamp (a late answer to an earlier input, or to someone
+    else's) is skipped.
+    """
+    message.header.stamp.sec, message.header.stamp.nanosec = stamp_sec, 0
+    seen = monitor.count
+    for _ in range(RESENDS):
+        publisher.publish(message)
+        deadline = time.monotonic() + ANSWER_WAIT_SEC
+        while time.monotonic() < deadline:
+            monitor.wait_for_count(seen + 1, 0.1)
+            ctx.call.check_cancel()
+            for _arrival, answer in monitor.messages_since(seen):
+                seen += 1
+                stamp = answer.header.stamp
+                if stamp.sec == stamp_sec or (stamp.sec == 0 and stamp.nanosec == 0):
+                    return answer
+    return None
+
+
+def fmt(values: Any) -> str:
+    return "(" + ", ".join(f"{float(v):.3f}" for v in values) + ")"
+
+
+def profile_text(qos: QoSProfile) -> str:
+    """'best_effort, volatile' for a profile."""
+    return f"{qos.reliability.name.lower()}, {qos.durability.name.lower()}"
+
+
+def publishers_note(node: Node, topic: str, type_text: str, durability: str = "") -> str:
+    """Why nothing may have arrived: no publisher, another type, or volatile history."""
+    infos = node.get_publishers_info_by_topic(topic)
+    if not infos:
+        return f"nothing publishes on {topic}"
+    types = sorted({info.topic_type for info in infos})
+    if type_text not in types:
+        return f"{topic} is published as {', '.join(types)}, not {type_text}"
+    if durability == "transient_local":
+        volatile = [
+            node_fqn(i.node_name, i.node_namespace)
+            for i in infos
+            if i.qos_profile.durability != DurabilityPolicy.TRANSIENT_LOCAL
+        ]
+        if volatile:
+            return (
+                f"{', '.join(volatile)} publishes with volatile durability: it keeps nothing "
+                "for a subscriber that joins later"
+            )
+    return ""
+
+
+def with_note(text: str, note: str) -> str:
+    return f"{text} ({note})" if note else text
+
+
+def difference(actual: Any, expected: Any, tolerance: float, path: str) -> str:
+    """'' when ``actual`` has every expected field (deeply), else the first that differs."""
+    if isinstance(expected, dict):
+        if not isinstance(actual, dict):
+            return f"{path} = {actual!r}, expected {expected!r}"
+        for key, want in expected.items():
+            where = f"{path}.{key}" if path else key
+            if key not in actual:
+                return f"the message has no field {where}"
+            found = difference(actual[key], want, tolerance, where)
+            if found:
+                return found
+        return ""
+    if same(actual, expected, tolerance):
+        return ""
+    return f"{path} = {actual!r}, expected {expected!r}"

@@ -1,0 +1,107 @@
+"""Probe ``turtle_frame``: the grader teleports a turtle to drawn poses; the learner's
+``world -> turtle`` transform on /tf must follow each one.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+from app.exercises.probes.base import ProbeContext, draw, register_probe
+from app.exercises.probes.tf import (
+    WORLD_MAX,
+    WORLD_MIN,
+    FrameTap,
+    Seen,
+    angle_between,
+    pose_text,
+    teleport,
+)
+from app.exercises.report import Result
+from app.lessons.schema import Spec
+from app.ros.errors import Ros2Error
+
+
+def _frame_mistake(seen: Seen, x: float, y: float, theta: float, tol: float) -> str:
+    """What a wrong transform most likely got wrong, in words."""
+    if not seen.unit:
+        return (
+            "the rotation is not a unit quaternion: compute it from theta with sin/cos of theta/2"
+        )
+    if math.hypot(seen.x - y, seen.y - x) < tol and math.hypot(seen.x - x, seen.y - y) >= tol:
+        return "x and y are swapped"
+    if math.hypot(seen.x - x, seen.y - y) >= tol:
+        return "the translation is not the turtle's position"
+    if angle_between(seen.yaw, -theta) < 0.05:
+        return "the heading has the wrong sign"
+    return "the heading (rotation about z) is not the turtle's theta"
+
+
+@register_probe(
+    "turtle_frame",
+    required="",
+    optional="turtle parent poses tolerance within",
+    defaults={"x": [WORLD_MIN, WORLD_MAX], "y": [WORLD_MIN, WORLD_MAX], "theta": [-3.0, 3.0]},
+    words="teleports the turtle to random poses; after each, /tf must carry parent -> turtle "
+    "at that pose (position and heading)",
+    draws="random turtle poses (x, y, theta)",
+)
+def run(ctx: ProbeContext, p: Spec) -> Result:
+    """Teleport the turtle to random poses; /tf must carry parent -> turtle at each pose."""
+    turtle, parent = p.get("turtle", "turtle1"), p.get("parent", "world")
+    tol, count = float(p.get("tolerance", 0.01)), int(p.get("poses", 4))
+    name = f"frame {parent} -> {turtle} follows the pose"
+    tap = FrameTap(ctx)
+    tried: list[str] = []
+    try:
+        for _ in range(count):
+            x, y, theta = (round(float(draw(ctx.rng, p[k])), 2) for k in ("x", "y", "theta"))
+            asked = time.monotonic()
+            try:
+                teleport(ctx, turtle, x, y, theta)
+            except Ros2Error as exc:
+                return Result(name, False, f"could not teleport {turtle}: {exc}")
+            deadline = asked + float(p.get("within", 3.0))
+            seen = None
+            while time.monotonic() < deadline:
+                seen = tap.get(turtle)
+                if seen is not None and seen.arrival > asked + 0.1 and seen.parent == parent:
+                    if (
+                        math.hypot(seen.x - x, seen.y - y) < tol
+                        and abs(seen.z) < tol
+                        and angle_between(seen.yaw, theta) < 0.02
+                        and seen.unit
+                    ):
+                        break
+                ctx.call.sleep(0.05)
+            else:
+                want = pose_text(x, y, theta)
+                if seen is None:
+                    frames = tap.children_of()
+                    heard = ", ".join(f"{a} -> {c}" for c, a in frames.items()) or "nothing"
+                    return Result(
+                        name, False, f"no transform for the child frame '{turtle}' on /tf "
+                        f"(heard: {heard})"
+                    )  # fmt: skip
+                if seen.parent != parent:
+                    return Result(
+                        name,
+                        False,
+                        f"'{turtle}' has the parent '{seen.parent}' on /tf; expected the parent "
+                        f"'{parent}' (header.frame_id is the parent, child_frame_id the turtle)",
+                    )
+                if seen.arrival <= asked + 0.1:
+                    return Result(
+                        name, False, f"teleported {turtle} to {want}; no new transform came after"
+                    )
+                got = pose_text(seen.x, seen.y, seen.yaw)
+                return Result(
+                    name,
+                    False,
+                    f"teleported {turtle} to {want}; /tf says {got}: "
+                    f"{_frame_mistake(seen, x, y, theta, tol)}",
+                )
+            tried.append(pose_text(x, y, theta))
+        return Result(name, True, f"{count} random poses, each on /tf, e.g. {tried[0]}")
+    finally:
+        tap.close()

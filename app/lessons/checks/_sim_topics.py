@@ -1,0 +1,94 @@
+"""What the simulation checks share: the world's topics, poses from Odometry, stamps.
+
+sim_world publishes ``/odom`` (wheel odometry, frame ``odom``) and
+``/ground_truth/odom`` (frame ``world``) in the same physics step, with the
+same stamp, so the checks pair them by stamp. Stamps are simulation time.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import TYPE_CHECKING, Any
+
+from app.lessons.checks._world_map import WorldMap, load_world_map
+
+if TYPE_CHECKING:
+    from app.lessons.runtime import LessonRuntime
+
+ODOM_TYPE = "nav_msgs/msg/Odometry"
+TRUTH = "/ground_truth/odom"
+ODOM = "/odom"
+CLOCK = "/clock"
+SIM_NODE = "/sim_world"
+WALL_CLOCK_SECONDS = 1e8  # a stamp beyond this (1973) is wall-clock time, not simulation time
+
+
+@dataclass(frozen=True)
+class Pose:
+    """A planar pose with the simulation time it was stamped at."""
+
+    t: float
+    x: float
+    y: float
+    yaw: float
+
+    def text(self) -> str:
+        return f"({self.x:.2f}, {self.y:.2f}, {self.yaw:.2f} rad)"
+
+
+def seconds(stamp: Any) -> float:
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
+def yaw_of(q: Any) -> float:
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def wrap(angle: float) -> float:
+    return math.atan2(math.sin(angle), math.cos(angle))
+
+
+def pose_of(msg: Any) -> Pose:
+    """The planar pose of a nav_msgs/Odometry message."""
+    p = msg.pose.pose
+    return Pose(seconds(msg.header.stamp), p.position.x, p.position.y, yaw_of(p.orientation))
+
+
+def relative(start: tuple[float, float, float], pose: Pose) -> Pose:
+    """``pose`` (world frame) seen from ``start`` (x, y, yaw): what odometry should say."""
+    sx, sy, syaw = start
+    dx, dy = pose.x - sx, pose.y - sy
+    c, s = math.cos(syaw), math.sin(syaw)
+    return Pose(pose.t, c * dx + s * dy, -s * dx + c * dy, wrap(pose.yaw - syaw))
+
+
+def truth_at(rt: LessonRuntime, stamp: float, within: float = 0.02) -> Pose | None:
+    """The ground-truth pose stamped closest to ``stamp`` (None if none within ``within`` s)."""
+    best: Pose | None = None
+    for _, msg in rt.tap(TRUTH, ODOM_TYPE).newest():
+        pose = pose_of(msg)
+        if best is None or abs(pose.t - stamp) < abs(best.t - stamp):
+            best = pose
+        if pose.t < stamp - within:
+            break
+    return best if best is not None and abs(best.t - stamp) <= within else None
+
+
+@lru_cache(maxsize=8)
+def world_map(world: str) -> WorldMap:
+    """A world's floor plan, read once (its file does not change while a lesson runs)."""
+    return load_world_map(world)
+
+
+def bearing_words(angle: float) -> str:
+    """Where a bearing points, for a learner: ahead, to the left, behind, to the right."""
+    degrees = math.degrees(wrap(angle))
+    if abs(degrees) <= 30:
+        where = "ahead"
+    elif abs(degrees) >= 150:
+        where = "behind"
+    else:
+        where = "to the left" if degrees > 0 else "to the right"
+    return f"{degrees:+.0f} deg, {where}"
