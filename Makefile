@@ -17,11 +17,13 @@ EDITOR := app/exercises/editor
 EDITOR_STAMP := $(EDITOR)/node_modules/.classroom-setup
 HUB_PROXY := app/hub/proxy
 HUB_PROXY_STAMP := $(HUB_PROXY)/node_modules/.classroom-setup
+AXE := tests/browser/axe
+AXE_STAMP := $(AXE)/node_modules/.classroom-setup
 ARGS ?=
 
 .PHONY: setup run test browser sandbox lint bench screenshots clean render
 
-setup: $(STAMP) $(EDITOR_STAMP) $(HUB_PROXY_STAMP) render
+setup: $(STAMP) $(EDITOR_STAMP) $(HUB_PROXY_STAMP) $(AXE_STAMP) render
 
 # The exercise code editor (Ace), from the npm registry at the version the lock file pins.
 $(EDITOR_STAMP): $(EDITOR)/package.json $(EDITOR)/package-lock.json
@@ -38,6 +40,12 @@ $(HUB_PROXY_STAMP): $(HUB_PROXY)/package.json $(HUB_PROXY)/package-lock.json $(E
 	@echo "== installing JupyterHub's configurable-http-proxy (npm)"
 	npm ci --prefix $(HUB_PROXY) --no-audit --no-fund --loglevel=error
 	@touch $(HUB_PROXY_STAMP)
+
+# axe-core, the accessibility checker the browser tests inject into the page (npm, like the editor).
+$(AXE_STAMP): $(AXE)/package.json $(AXE)/package-lock.json $(EDITOR_STAMP)
+	@echo "== installing axe-core for the accessibility tests (npm)"
+	npm ci --prefix $(AXE) --no-audit --no-fund --loglevel=error
+	@touch $(AXE_STAMP)
 
 $(STAMP): pyproject.toml ros_python/pyproject.toml $(INTERFACE_FILES)
 	@test -n "$(PYTHON)" || { echo "error: ROS 2 Jazzy wheels need CPython 3.10, 3.11 or 3.12; none found" >&2; exit 1; }
@@ -106,4 +114,4 @@ screenshots: setup browser
 	$(VPY) tests/run.py --script docs/screenshots.py
 
 clean:
-	rm -rf $(VENV) $(EDITOR)/node_modules $(HUB_PROXY)/node_modules $(addsuffix /build,$(INTERFACES)) .mypy_cache .import_linter_cache
+	rm -rf $(VENV) $(EDITOR)/node_modules $(HUB_PROXY)/node_modules $(AXE)/node_modules $(addsuffix /build,$(INTERFACES)) .mypy_cache .import_linter_cache

@@ -11,9 +11,12 @@ import os
 import threading
 import time
 from collections.abc import Callable
+from typing import cast
 
 import viser
 
+from app.catalog import UnknownNodeError, lookup
+from app.catalog import names as catalog_names
 from app.exercises.editor_server import EditorHub
 from app.exercises.grader import Grader
 from app.exercises.model import load_exercises
@@ -41,10 +44,13 @@ from app.ros.rosout import RosoutLog
 from app.ros.runtime import RosRuntime
 from app.ros2cli.console_panel import ConsolePanel
 from app.stage.window import Stage
-from app.supervisor import Supervisor
-from app.ui import TAB_NAMES, MarkdownView, Panel
+from app.supervisor import NodeState, Supervisor
+from app.ui import GROUP_OF, TAB_NAMES, TOOL_GROUPS, MarkdownView, Panel
 from app.ui.loop import UiLoop
+from app.ui.page_fixes import page_fixes_html
 from app.ui.page_links import PageLinks
+from app.ui.starting import StartRequests
+from app.ui.tab_opener import TabOpener
 
 log = logging.getLogger(__name__)
 
@@ -60,6 +66,10 @@ _ICONS = {
     "Parameters": viser.Icon.ADJUSTMENTS, "Console": viser.Icon.TERMINAL,
     "Services": viser.Icon.ARROWS_EXCHANGE, "Actions": viser.Icon.ROCKET,
     "Lifecycle": viser.Icon.PROGRESS, "Logs": viser.Icon.FILE_TEXT, "Bags": viser.Icon.DATABASE,
+}  # fmt: skip
+_GROUP_ICONS = {
+    "Learn": viser.Icon.SCHOOL, "Run": viser.Icon.PLAYER_PLAY, "Inspect": viser.Icon.ZOOM_IN,
+    "Interact": viser.Icon.HAND_CLICK, "See": viser.Icon.EYE, "Record": viser.Icon.PLAYER_RECORD,
 }  # fmt: skip
 
 
@@ -89,13 +99,19 @@ class Dashboard:
         self.lessons = LessonRuntime(runtime.node, supervisor)
         self.rosout = RosoutLog(runtime.node)
         self._stop = threading.Event()
+        self.start_requests = StartRequests()  # Start clicks the stage shows at once
+        self._catalog_names = frozenset(catalog_names())
         self.graph = GraphSnapshot()
+        self._tools: dict[str, Panel] = {}
         self._panels: list[Panel] = self._build_gui()
         self._ui_thread = threading.Thread(target=self._ui_loop, name="ui-refresh", daemon=True)
 
     def _build_gui(self) -> list[Panel]:
         gui, ui, node = self.server.gui, self.ui, self.runtime.node
-        gui.configure_theme(titlebar_content=None, control_width="large", show_share_button=False)
+        gui.configure_theme(
+            titlebar_content=None, control_width="large", show_share_button=False, show_logo=False
+        )
+        gui.add_html(page_fixes_html())  # contrast and button names viser leaves out
         # Both cost a lot where WebGL runs in software (no GPU: headless
         # browsers, many classroom VMs). The shadow pass of the arm on the grid
         # alone stalled the page ~100 ms on every redraw (measured; findings.md).
@@ -103,20 +119,35 @@ class Dashboard:
         self.server.scene.configure_default_lights(cast_shadow=False)
         self.server.scene.add_grid("/grid", width=4.0, height=4.0, cell_size=0.25)
         self.server.scene.add_frame("/world", axes_length=0.3, axes_radius=0.01)
+        # One line: where am I (the domain learners compare when two dashboards share a room).
         gui.add_markdown(
-            "## ROS 2 Classroom\n"
-            f"Domain id **{os.environ.get('ROS_DOMAIN_ID', '0')}** · "
-            "this dashboard is the ROS node `/classroom_dashboard`."
+            f"**ROS 2 Classroom** · Domain id **{os.environ.get('ROS_DOMAIN_ID', '0')}** · "
+            "node `/classroom_dashboard`"
         )
         self.notice = MarkdownView(gui)  # in a classroom: the teacher's latest message
         # One window docked on the left: the lesson's code and the learner's own.
         side_window = gui.add_panel()
         side_window.dock_left()
         side_window.set_width(560)
+        opener = TabOpener(gui, {name: [GROUP_OF[name], name] for name in TAB_NAMES})
         # The stage: what the current step is about (the live graph, ...), chosen by the lesson.
         self._rates = SharedRates(node)  # the stage and the Graph tab measure a topic once
-        stage = Stage(gui, ui, node, side_window, self._rates.client(), self.page_links)
+        stage = Stage(
+            gui,
+            ui,
+            node,
+            side_window,
+            self._rates.client(),
+            self.page_links,
+            starting=self._starting_nodes,
+            program_output=self._program_output,
+            inspect=self._inspect,
+            open_tool=opener.open,
+        )
         stage.follow_window(self.server)
+        # The current step's title, buttons, checks and Back/Next: above the tools, so they
+        # stay in view whichever tool is open (the step's text is in Learn › Lessons).
+        step_card = gui.add_folder("This step")
         builders: dict[str, Callable[[], Panel]] = {
             "Lessons": lambda: LessonsPanel(
                 gui,
@@ -127,6 +158,9 @@ class Dashboard:
                 side_window,
                 self._exercise_marks,
                 stage.show,
+                step_card=step_card,
+                open_tool=opener.open,
+                start_requests=self.start_requests,
             ),
             "Exercise": lambda: ExercisePanel(
                 gui,
@@ -140,7 +174,7 @@ class Dashboard:
                 self.exercise_settings,
                 open_code=lambda: stage.show("code"),
             ),
-            "Nodes": lambda: NodesPanel(gui, ui, self.supervisor),
+            "Nodes": lambda: NodesPanel(gui, ui, self.supervisor, self.start_requests),
             "Turtlesim": lambda: TurtlesimPanel(gui, ui, node, self.supervisor, self.page_links),
             "Graph": lambda: GraphPanel(gui, node, self._rates.client()),
             "Echo": lambda: EchoPanel(gui, node),
@@ -155,16 +189,69 @@ class Dashboard:
             "Logs": lambda: LogsPanel(gui, self.rosout),
             "Bags": lambda: BagsPanel(gui, ui, node),
         }
-        assert tuple(builders) == TAB_NAMES, "every tab lessons may name has a panel"
-        tabs = gui.add_tab_group()
-        panels: list[Panel] = []
-        for name in TAB_NAMES:
-            with tabs.add_tab(name, _ICONS[name]):
-                panels.append(builders[name]())
+        assert set(builders) == set(TAB_NAMES), "every tool lessons may name has a panel"
+        # Tools grouped as a learner thinks of them: a tab per group, a tab per tool inside.
+        groups = gui.add_tab_group()
+        built: dict[str, Panel] = {}
+        for group, names in TOOL_GROUPS.items():
+            with groups.add_tab(group, _GROUP_ICONS[group]):
+                tools = gui.add_tab_group()
+                for name in names:
+                    with tools.add_tab(name, _ICONS[name]):
+                        built[name] = builders[name]()
+        panels = [built[name] for name in TAB_NAMES]
+        self._tools = built
         # A lesson's `console` buttons type their command into the Console tab.
         console = next(p for p in panels if isinstance(p, ConsolePanel))
         self.lessons.console = console.run_for_lesson
         return [stage, *panels]
+
+    def _starting_nodes(self) -> list[str]:
+        """Catalog nodes that are starting: clicked (until the supervisor has the process),
+        or whose process runs but has not joined the ROS graph yet."""
+        statuses = self.supervisor.statuses()
+        names = {name for name, status in statuses.items() if status.state is NodeState.STARTING}
+        for name, asked_at in self.start_requests.pending().items():
+            status = statuses.get(name)
+            taken = status is not None and (status.started_at or 0.0) >= asked_at - 0.5
+            if taken or (status is not None and status.state is NodeState.RUNNING):
+                self.start_requests.done(name)  # the supervisor's state says the rest
+            else:
+                names.add(name)
+        found = []
+        for name in sorted(names):
+            try:
+                found.append(lookup(name).node_name)
+            except UnknownNodeError:  # a learner's own program: drawn once it joins
+                pass
+        return found
+
+    def _inspect(self, kind: str, name: str, type_text: str) -> None:
+        """A box clicked on the stage: the tools that show more of it pick it (UI thread)."""
+        tools = self._tools
+        if kind == "topic":
+            cast(TopicsPanel, tools["Topics"]).preselect(name)
+            cast(EchoPanel, tools["Echo"]).show_topic(name, type_text)
+        elif kind == "node":
+            cast(ParametersPanel, tools["Parameters"]).preselect(name)
+            cast(NodesPanel, tools["Nodes"]).preselect(name)
+        elif kind == "service":
+            cast(ServicesPanel, tools["Services"]).preselect(name)
+        elif kind == "action":
+            cast(ActionsPanel, tools["Actions"]).preselect(name)
+
+    def _program_output(self) -> tuple[str, list[str]]:
+        """The learner's most recently started program (not a catalog node): its name and
+        state, and its last lines of output."""
+        own = [
+            status
+            for name, status in self.supervisor.statuses().items()
+            if name not in self._catalog_names
+        ]
+        if not own:
+            return "", []
+        latest = max(own, key=lambda status: status.started_at or 0.0)
+        return f"{latest.name} · {latest.describe()}", self.supervisor.output(latest.name, 40)
 
     def _exercise_marks(self, lesson_id: str) -> str:
         """The outline's exercise column: ✓ for each exercise passed, ○ for each open."""

@@ -121,7 +121,7 @@ def run(seconds: float, rounds: int) -> dict[str, Any]:
             context = browser.new_context(viewport={"width": 1366, "height": 768})
             page = context.new_page()
             page.goto(url)
-            page.get_by_role("tab", name="Nodes").wait_for(timeout=30_000)
+            page.get_by_role("tab", name="Learn", exact=True).wait_for(timeout=30_000)
             _choose(page, "On stage", "Live ROS graph")
             started = time.monotonic()
             page.wait_for_function(f"() => ({BOXES_JS})() >= {3 * NODES}", timeout=60_000)

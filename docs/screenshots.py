@@ -27,8 +27,11 @@ from playwright.sync_api import Browser, Locator, Page, expect, sync_playwright 
 from app.dds import configure_dds_env  # noqa: E402
 from app.exercises.model import load_exercises  # noqa: E402
 from app.lessons.schema import load_course  # noqa: E402
+from app.ui import GROUP_OF  # noqa: E402
 
 IMAGES = ROOT / "docs" / "images"
+LAPTOP = {"width": 1366, "height": 768}  # a school laptop: each stage is shown at this size
+DESK = {"width": 1500, "height": 900}
 PORT = 8193
 CLASS_PORT = 8311  # the teacher page one below
 
@@ -58,12 +61,20 @@ def _dismiss_toasts(page: Page) -> None:
         button.click()
 
 
-def _lesson(page: Page, unit: int, step: int) -> None:
-    """Open lesson ``unit`` at step ``step`` (1-based) with Next, as a learner does."""
-    lesson = next(lesson for lesson in load_course().lessons if lesson.unit == unit)
-    page.get_by_role("tab", name="Lessons").click()
+def _tool(page: Page, name: str) -> None:
+    """Open a tool as a learner does: its group's tab (Learn, Run, ...), then its own."""
+    page.get_by_role("tab", name=GROUP_OF[name], exact=True).click()
+    page.get_by_role("tab", name=name, exact=True).click()
+
+
+def _lesson(page: Page, unit: int | str, step: int) -> None:
+    """Open lesson ``unit`` (a number or a lesson id) at step ``step`` (1-based) with Next."""
+    lesson = next(lesson for lesson in load_course().lessons if unit in (lesson.unit, lesson.id))
+    _tool(page, "Lessons")
     _choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
     heading = page.get_by_text(re.compile(r"^Step \d+ of \d+")).filter(visible=True).first
+    titles = "|".join(re.escape(s.title) for s in lesson.steps)  # this lesson's, not the last's
+    expect(heading).to_have_text(re.compile(rf"^Step \d+ of {len(lesson.steps)}: ({titles})"))
     for _ in range(len(lesson.steps)):  # the lesson opens where the learner left it
         match = re.match(r"Step (\d+)", heading.inner_text())
         at = int(match.group(1)) if match else step
@@ -84,18 +95,54 @@ def topics_lesson(page: Page) -> None:
     page.screenshot(path=str(IMAGES / "lesson.png"))
 
 
+def _stage_shot(page: Page, name: str, settle_ms: int = 2500) -> None:
+    """The screen at 1366x768, as a school laptop shows it: ``stage-<name>.png``."""
+    page.set_viewport_size(LAPTOP)
+    page.wait_for_timeout(settle_ms)
+    page.screenshot(path=str(IMAGES / f"stage-{name}.png"))
+    page.set_viewport_size(DESK)
+
+
 def stage_graph(page: Page) -> None:
-    """The same moment on a school laptop's 1366x768: the lesson's stage, the live graph."""
-    page.set_viewport_size({"width": 1366, "height": 768})
+    """The same lesson at 1366x768 with a service server too: a call travels as a pulse."""
+    _start(page, "add_two_ints_server")
+    _tool(page, "Services")
+    expect(_shown(page, "Type: tutorial_interfaces/srv/AddTwoInts")).to_be_visible(timeout=30_000)
+    page.set_viewport_size(LAPTOP)
     expect(page.locator('svg.stage-graph g[data-name="/listener2"]')).to_be_visible()
     page.wait_for_timeout(2500)  # rates settle, dots on their way
-    page.screenshot(path=str(IMAGES / "stage.png"))
-    page.set_viewport_size({"width": 1500, "height": 900})
+    page.get_by_role("button", name="Call", exact=True).click()
+    page.wait_for_function(  # a pulse (the request, then the response) on its way
+        "() => [...document.querySelectorAll('svg.stage-graph g.sg-pulse')]"
+        ".some((g) => getComputedStyle(g).visibility === 'visible')",
+        polling=30,
+        timeout=10_000,
+    )
+    page.screenshot(path=str(IMAGES / "stage-graph.png"))
+    page.set_viewport_size(DESK)
+
+
+def stage_turtlesim(page: Page) -> None:
+    """The turtlesim lesson: turtlesim's window on stage, the trail it drew, the step beside."""
+    _lesson(page, "01_turtlesim_cli", 3)
+    _stage_shot(page, "turtlesim")
+
+
+def stage_tf(page: Page) -> None:
+    """The tf2 lesson's view_frames step: the live TF tree of the turtle demo on stage."""
+    _tool(page, "Nodes")
+    _choose(page, "Launch group", "turtle_tf2_demo")
+    page.get_by_role("button", name="Start group", exact=True).click()
+    _lesson(page, "13_tf2_turtlesim", 4)
+    expect(page.locator("div.stage-tf").get_by_text("turtle2").first).to_be_visible(timeout=60_000)
+    _stage_shot(page, "tf", settle_ms=4000)  # rates and buffer lengths settle
+    _tool(page, "Nodes")  # a clean world for the pictures that follow
+    page.get_by_role("button", name="Stop group", exact=True).click()
 
 
 def live_graph(page: Page) -> None:
     """The talker and both listeners as the Graph tab draws them (the nodes keep running)."""
-    page.get_by_role("tab", name="Graph").click()
+    _tool(page, "Graph")
     expect(_shown(page, "/listener2")).to_be_visible(timeout=30_000)
     page.wait_for_timeout(2500)  # a few graph refreshes: rates settle
     page.screenshot(path=str(IMAGES / "graph.png"))
@@ -104,7 +151,7 @@ def live_graph(page: Page) -> None:
 def lifecycle_drawing(page: Page) -> None:
     """A managed node configured by clicking the drawing's edge."""
     _start(page, "lifecycle_talker")
-    page.get_by_role("tab", name="Lifecycle").click()
+    _tool(page, "Lifecycle")
     edge = page.locator('g.live-edge a[aria-label^="configure:"]')
     edge.locator("text").click(timeout=30_000)
     expect(page.get_by_text("Transitioning successful").first).to_be_visible(timeout=30_000)
@@ -114,10 +161,10 @@ def lifecycle_drawing(page: Page) -> None:
 
 def arm_scene(page: Page) -> None:
     """camera -> coordinate transform -> arm: the 3D view follows the arm by itself."""
-    page.get_by_role("tab", name="Nodes").click()
+    _tool(page, "Nodes")
     _choose(page, "Launch group", "camera_to_arm")
     page.get_by_role("button", name="Start group", exact=True).click()
-    page.get_by_role("tab", name="3D view").click()
+    _tool(page, "3D view")
     expect(page.get_by_text("gripper at").first).to_be_visible(timeout=60_000)
     _choose(page, "On stage", "3D scene")  # the stage steps aside: the scene gets the room
     page.wait_for_timeout(500)
@@ -127,11 +174,13 @@ def arm_scene(page: Page) -> None:
         page.wait_for_timeout(150)
     page.wait_for_timeout(4000)  # the arm on its way to the target
     page.screenshot(path=str(IMAGES / "scene.png"))
+    _lesson(page, "13_frames_and_arm", 4)  # a unit whose stage is the 3D scene
+    _stage_shot(page, "scene", settle_ms=4000)
 
 
 def turtlesim_drive(page: Page) -> None:
     """Turtlesim in its tab: started and driven with the arrow keys, a turn left in the trail."""
-    page.get_by_role("tab", name="Turtlesim").click()
+    _tool(page, "Turtlesim")
     page.get_by_role("button", name="Start turtlesim_node", exact=True).click()
     expect(_shown(page, "turtles: turtle1")).to_be_visible(timeout=30_000)
     page.get_by_role("button", name="Start turtle_teleop_key", exact=True).click()
@@ -142,10 +191,11 @@ def turtlesim_drive(page: Page) -> None:
         page.wait_for_timeout(250)
     page.wait_for_timeout(2500)  # turtlesim stops the turtle 1 s after the last key
     page.screenshot(path=str(IMAGES / "turtlesim.png"))
+    stage_turtlesim(page)
 
 
 def _console(page: Page, command: str, shown: str) -> None:
-    page.get_by_role("tab", name="Console").click()
+    _tool(page, "Console")
     field = page.get_by_text("Command", exact=True).locator("visible=true").first
     field.locator("xpath=ancestor::div[contains(@class,'mantine-Flex-root')][1]//input").fill(
         command
@@ -164,7 +214,7 @@ def tf_panel(page: Page) -> None:
     )
     _console(page, "ros2 run turtle_tf2_py fixed_frame_tf2_broadcaster", "[exit code 0]")
     _choose(page, "On stage", "3D scene")
-    page.get_by_role("tab", name="TF").click()
+    _tool(page, "TF")
     expect(_shown(page, "3 frames in 1 tree")).to_be_visible(timeout=60_000)
     expect(_shown(page, "- Translation: [-1.000, 2.000")).to_be_visible(timeout=30_000)
     page.wait_for_timeout(1500)
@@ -174,7 +224,7 @@ def tf_panel(page: Page) -> None:
 
 
 def _start(page: Page, node: str) -> None:
-    page.get_by_role("tab", name="Nodes").click()
+    _tool(page, "Nodes")
     _choose(page, "Catalog node", node)
     page.get_by_role("button", name="Start", exact=True).click()
     expect(page.get_by_text(f"Started {node}").first).to_be_visible(timeout=30_000)
@@ -184,7 +234,7 @@ def exercise_graded(page: Page) -> None:
     """An exercise mid-way: a plausible mistake, Run, Check, and the reason shown."""
     exercise = load_exercises().get("multiply_service")
     wrong = (exercise.path / "mistakes" / "adds.py").read_text(encoding="utf-8")
-    page.get_by_role("tab", name="Exercise").click()
+    _tool(page, "Exercise")
     _choose(page, "Exercise", f"{exercise.unit:02d} · {exercise.title}")
     _choose(page, "On stage", "Code")
     page.get_by_role("tab", name="Your code").click()
@@ -203,6 +253,7 @@ def exercise_graded(page: Page) -> None:
     page.get_by_text("Task", exact=True).click()
     page.wait_for_timeout(800)
     page.screenshot(path=str(IMAGES / "exercise.png"))
+    _stage_shot(page, "code", settle_ms=1500)
 
 
 @contextmanager
@@ -222,7 +273,7 @@ def _running(argv: list[str], env: dict[str, str], log: Path, ready: str) -> Ite
 
 
 def _open(browser: Browser, url: str, width: int = 1500) -> Page:
-    page = browser.new_page(viewport={"width": width, "height": 900})
+    page = browser.new_page(viewport={**DESK, "width": width})
     page.goto(url)
     page.get_by_role("tab").first.wait_for()
     _dismiss_toasts(page)
@@ -240,7 +291,7 @@ def learner_dashboard(browser: Browser, env: dict[str, str], tmp: str) -> None:
         page = _open(browser, f"http://127.0.0.1:{PORT}/")
         try:
             takes = (topics_lesson, stage_graph, live_graph, lifecycle_drawing, turtlesim_drive)
-            takes += (exercise_graded, tf_panel)
+            takes += (stage_tf, exercise_graded, tf_panel)
             for take in (*takes, arm_scene):  # the scene folds the code away
                 take(page)
         except Exception:

@@ -11,7 +11,11 @@ ROS concepts shown
   and returns it;
 - the service type is generated from a ``.srv`` file: the part above ``---``
   is the request, the part below is the response;
-- a server is idle until a request arrives; it does not poll.
+- a server is idle until a request arrives; it does not poll;
+- service introspection (new in Jazzy): ``configure_introspection`` makes the
+  server announce each request and response on the hidden topic
+  ``/add_two_ints/_service_event`` (here only that they happened, not their
+  contents), so tools can show calls as they happen.
 
 Try it: ``ros2-classroom run add_two_ints_server``, then
 ``ros2-classroom run add_two_ints_client`` (adds 2 and 3), or from a full ROS
@@ -20,6 +24,8 @@ install ``ros2 service call /add_two_ints tutorial_interfaces/srv/AddTwoInts
 """
 
 from rclpy.node import Node
+from rclpy.qos import qos_profile_system_default
+from rclpy.service_introspection import ServiceIntrospectionState
 from tutorial_interfaces.srv import AddTwoInts
 
 from nodes.common.run import spin_node
@@ -31,6 +37,9 @@ class AddTwoIntsServer(Node):
     def __init__(self) -> None:
         super().__init__("add_two_ints_server")
         self.service = self.create_service(AddTwoInts, "add_two_ints", self.on_add_two_ints)
+        self.service.configure_introspection(
+            self.get_clock(), qos_profile_system_default, ServiceIntrospectionState.METADATA
+        )
         self.get_logger().info("Ready: call /add_two_ints with two integers a and b")
 
     def on_add_two_ints(

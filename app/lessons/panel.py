@@ -15,6 +15,7 @@ from typing import Any
 import viser
 
 from app import PROJECT_ROOT
+from app.catalog import UnknownNodeError, lookup_group
 from app.lessons.progress import ProgressStore
 from app.lessons.runtime import FAIL, PASS, LessonRuntime
 from app.lessons.schema import IMAGE_TYPES, STATIC_DIR, Course, Lesson, Spec
@@ -22,8 +23,24 @@ from app.ros.graph import GraphSnapshot
 from app.ui import MarkdownView, assign
 from app.ui.code_view import python_listing
 from app.ui.loop import UiLoop
+from app.ui.starting import StartRequests
 
 _MARKS = {PASS: "✓", FAIL: "✗", "waiting": "…"}
+# A step button's icon says what it does; the label says it in words.
+_ACTION_ICONS = {
+    "open_panel": viser.Icon.EXTERNAL_LINK,
+    "stop": viser.Icon.PLAYER_STOP,
+    "stop_group": viser.Icon.PLAYER_STOP,
+    "stop_own": viser.Icon.PLAYER_STOP,
+    "console": viser.Icon.TERMINAL,
+    "workspace_command": viser.Icon.TERMINAL,
+    "workspace_edit": viser.Icon.PENCIL,
+    "workspace_write": viser.Icon.PENCIL,
+    "call_service": viser.Icon.SEND,
+    "send_goal": viser.Icon.SEND,
+    "publish": viser.Icon.SEND,
+    "set_param": viser.Icon.ADJUSTMENTS,
+}
 _CHOOSE = "(choose an answer)"
 
 
@@ -70,6 +87,18 @@ class _HtmlView:
         return self._content
 
 
+def _started_by(action: Spec) -> list[str]:
+    """The catalog nodes a step button starts (the stage draws them at the click)."""
+    if action.kind == "start":
+        return [action["catalog_node"]]
+    if action.kind == "start_group":
+        try:
+            return list(lookup_group(action["group"]).members)
+        except UnknownNodeError:
+            return []
+    return []
+
+
 def _label(lesson: Lesson) -> str:
     return f"{lesson.unit:02d} · {lesson.title}"
 
@@ -85,7 +114,14 @@ class LessonsPanel:
         side_window: Any,
         exercise_marks: Callable[[str], str] = lambda _lesson_id: "",
         show_stage: Callable[[str], None] = lambda _stage: None,
+        *,
+        step_card: Any = None,
+        open_tool: Callable[[str], None] = lambda _tool: None,
+        start_requests: StartRequests | None = None,
     ) -> None:
+        """``step_card``: a folder for the step's title, buttons, checks and Back/Next (the
+        dashboard puts it above its tools, so they stay in view); made here when None.
+        ``open_tool(name)`` brings a tool's tab into view (a step's `open_panel` button)."""
         self._gui = gui
         self._ui = ui
         self._course = course
@@ -93,6 +129,8 @@ class LessonsPanel:
         self._progress = progress
         self._exercise_marks = exercise_marks
         self._show_stage = show_stage  # the stage shows what each step names
+        self._open_tool = open_tool
+        self._requests = start_requests or StartRequests()  # the stage shows a Start at once
         self._dynamic: list[Any] = []
         by_label = {_label(lesson): lesson for lesson in course.lessons}
         self._by_label = by_label
@@ -100,19 +138,25 @@ class LessonsPanel:
             gui.add_markdown("No lessons could be loaded.\n\n" + "\n".join(course.errors))
             return
         current = course.lesson(progress.current_lesson() or "") or course.lessons[0]
+        # The reading column: which lesson, its title, the step's text and picture.
         self._selector = gui.add_dropdown("Lesson", list(by_label), initial_value=_label(current))
         self._header = MarkdownView(gui)
         self._text = MarkdownView(gui)
         self._picture = _HtmlView(gui)
         self._command = MarkdownView(gui)
-        self._actions = gui.add_folder("Do this step")
-        self._checks = MarkdownView(gui)
-        self._message = MarkdownView(gui)
-        self._back = gui.add_button("Back", icon=viser.Icon.ARROW_LEFT)
-        self._next = gui.add_button("Next", icon=viser.Icon.ARROW_RIGHT)
+        with gui.add_folder("Goals of this lesson", expand_by_default=False):
+            self._goals = MarkdownView(gui)
         with gui.add_folder("Course outline", expand_by_default=False):
             self._outline = MarkdownView(gui)
             self._reset = gui.add_button("Reset my progress", color="gray")
+        # What the learner does: the step card (title, buttons, checks, Back/Next).
+        self._card = step_card if step_card is not None else gui.add_folder("This step")
+        with self._card:
+            self._actions = gui.add_folder(None)  # the step's own buttons, rebuilt per step
+            self._checks = MarkdownView(gui)
+            self._message = MarkdownView(gui)
+            self._back = gui.add_button("Back", icon=viser.Icon.ARROW_LEFT)
+            self._next = gui.add_button("Next", icon=viser.Icon.ARROW_RIGHT)
         # The code the lesson talks about sits beside the text, in the side
         # window docked on the left (the learner can minimise or move it).
         with side_window.add_tab("Code of this lesson", viser.Icon.CODE):
@@ -123,7 +167,7 @@ class LessonsPanel:
         self._back.on_click(ui.callback(lambda: self._select(self._lesson, self._step - 1)))
         self._next.on_click(ui.callback(self._go_next))
         self._reset.on_click(ui.callback(self._do_reset))
-        self._select(current, self._step)
+        self._select(current, self._step, reading=False)
 
     # -- navigation --------------------------------------------------------
 
@@ -147,16 +191,16 @@ class LessonsPanel:
         self._message.show("Progress reset.")
         self._select(self._lesson, 0)
 
-    def _select(self, lesson: Lesson, step: int) -> None:
+    def _select(self, lesson: Lesson, step: int, reading: bool = True) -> None:
+        """Show ``step`` of ``lesson``; ``reading``: bring its text into view (a new step is
+        read first, even if the learner had a tool open for the last one)."""
         step = max(0, min(step, len(lesson.steps) - 1))
         self._lesson, self._step = lesson, step
         self._progress.set_position(lesson.id, step)
         current = lesson.steps[step]
-        goals = "\n".join(f"- {goal}" for goal in lesson.goals)
-        self._header.show(
-            f"### {lesson.title}\n{lesson.summary}\n\n**Goals**\n{goals}\n\n"
-            f"**Step {step + 1} of {len(lesson.steps)}: {current.title}**"
-        )
+        self._card.label = f"Step {step + 1} of {len(lesson.steps)}: {current.title}"
+        self._header.show(f"### {lesson.title}\n{lesson.summary}")
+        self._goals.show("\n".join(f"- {goal}" for goal in lesson.goals))
         self._text.show(_without_title(current.text))
         self._picture.show(picture_html(current.image, current.image_alt) if current.image else "")
         self._command.show(f"In a terminal: `{current.command}`" if current.command else "")
@@ -165,6 +209,8 @@ class LessonsPanel:
         self._message.show("")
         self._rebuild_step_widgets()
         self._back.disabled = step == 0
+        if reading:
+            self._open_tool("Lessons")
 
     def _source_listing(self, lesson: Lesson) -> str:
         parts = [
@@ -181,7 +227,8 @@ class LessonsPanel:
         with self._actions:
             for action in step.actions:
                 label = action.get("label") or f"{action.kind.replace('_', ' ')}"
-                button = self._gui.add_button(label, icon=viser.Icon.PLAYER_PLAY)
+                icon = _ACTION_ICONS.get(action.kind, viser.Icon.PLAYER_PLAY)
+                button = self._gui.add_button(label, icon=icon)
                 button.on_click(self._ui.callback(self._perform, action))
                 self._dynamic.append(button)
             for check in step.checks:
@@ -197,11 +244,19 @@ class LessonsPanel:
                 self._dynamic.append(self._gui.add_markdown("_Nothing to click: read on._"))
 
     def _perform(self, action: Spec) -> None:
+        if action.kind == "open_panel":  # at once, on this thread: the page opens the tab
+            self._open_tool(action["panel"])
+        starting = _started_by(action)
+        for name in starting:
+            self._requests.asked(name)
+
+        def failed(text: str) -> None:
+            for name in starting:
+                self._requests.done(name)
+            self._message.show(f"⚠ {text}")
+
         self._ui.run_job(
-            lambda: self._live.perform(action),
-            self._message.show,
-            lambda text: self._message.show(f"⚠ {text}"),
-            lane="lessons",
+            lambda: self._live.perform(action), self._message.show, failed, lane="lessons"
         )
 
     def _answer(self, check: Spec, quiz: viser.GuiDropdownHandle) -> None:

@@ -10,7 +10,7 @@ from app.ros.context import panel_context
 from app.ros.convert import ConversionError, import_type, to_yaml, yaml_inline
 from app.ros.errors import Ros2Error
 from app.ros.graph import GraphSnapshot
-from app.ui import MarkdownView, code_block, set_options
+from app.ui import MarkdownView, assign, code_block, set_options
 from app.ui.forms import FormSlot
 from app.ui.loop import UiLoop
 
@@ -35,6 +35,12 @@ class ActionsPanel:
         self._send.on_click(ui.callback(self._do_send))
         self._cancel.on_click(ui.callback(self._do_cancel))
         self._selector.on_update(ui.callback(self._rebuild_form))
+
+    def preselect(self, name: str) -> None:
+        """Pick ``name`` (a click on the stage graph; UI thread); one not listed is left."""
+        if name in self._selector.options and name != self._selector.value:
+            assign(self._selector, name)
+            self._rebuild_form()
 
     def _rebuild_form(self) -> None:
         name = self._selector.value

@@ -1,4 +1,7 @@
-"""Echo panel: the latest messages on /chatter, as `ros2 topic echo /chatter` shows them."""
+"""Echo panel: the latest messages on a topic, as `ros2 topic echo <topic>` shows them.
+
+/chatter until the learner clicks another topic on the stage graph.
+"""
 
 from __future__ import annotations
 
@@ -8,6 +11,8 @@ import viser
 from rclpy.node import Node
 from std_msgs.msg import String
 
+from app.panels.graph_svg import HEAVY_TYPES
+from app.ros.convert import ConversionError, import_type, to_yaml
 from app.ros.graph import GraphSnapshot
 from app.ros.monitor import TopicMonitor
 from app.ui import MarkdownView, code_block
@@ -16,17 +21,48 @@ TOPIC = "/chatter"
 SHOWN_MESSAGES = 10
 FAST_HZ = 50.0
 RATE_WINDOW_SEC = 5.0
+MAX_LINES = 40  # of one message's YAML
+
+
+def message_text(msg: object) -> str:
+    """One message as echo prints it: `data: '...'` for a string, YAML otherwise."""
+    if isinstance(msg, String):
+        return f"data: {msg.data!r}"
+    text = to_yaml(msg).rstrip()
+    lines = text.splitlines()
+    return "\n".join(lines[:MAX_LINES] + (["…"] if len(lines) > MAX_LINES else []))
 
 
 class EchoPanel:
     def __init__(self, gui: viser.GuiApi, node: Node) -> None:
+        self._node = node
+        self._topic = TOPIC
+        self._note = ""
         self._tap = TopicMonitor(node, TOPIC, String, keep=50, qos=10)
         self._view = MarkdownView(gui)
 
+    def show_topic(self, topic: str, type_text: str) -> None:
+        """Echo ``topic`` instead (a click on the stage graph; UI thread)."""
+        if topic == self._topic or not type_text:
+            return
+        if type_text in HEAVY_TYPES:
+            self._note = f"`{topic}` carries {type_text}: see it in **See › 3D view**."
+            return
+        try:
+            msg_type = import_type(type_text, "msg")
+        except ConversionError as exc:
+            self._note = f"⚠ {exc}"
+            return
+        old, self._note = self._tap, ""
+        self._tap = TopicMonitor(self._node, topic, msg_type, keep=50, qos=10)
+        self._topic = topic
+        old.close()
+
     def refresh(self, graph: GraphSnapshot) -> None:
+        topic = self._topic
         recent = self._tap.recent(SHOWN_MESSAGES)
         lines = [
-            f"[{time.strftime('%H:%M:%S', time.localtime(t))}] data: {msg.data!r}"
+            f"[{time.strftime('%H:%M:%S', time.localtime(t))}] {message_text(msg)}"
             for t, msg in recent
         ]
         # The publisher's rate by its own clock; samples this view missed are
@@ -37,11 +73,16 @@ class EchoPanel:
         rate_text = rate_text or "no messages lately"
         if rate and rate > FAST_HZ:  # say so: most messages scroll by unseen
             rate_text += f" · ⚠ too fast to read: showing only the newest {SHOWN_MESSAGES}"
-        header = f"`ros2 topic echo {TOPIC}` · {self._tap.count} received · {rate_text}"
-        hint = (
-            "" if graph.publishers(TOPIC) else "\n\n_No publisher on this topic: start **talker**._"
+        header = f"`ros2 topic echo {topic}` · {self._tap.count} received · {rate_text}"
+        hint = ""
+        if not graph.publishers(topic):
+            start = " start **talker**." if topic == TOPIC else " start one."
+            hint = f"\n\n_No publisher on this topic:{start}_"
+        pick = "\n\n_Click another topic on the stage graph to echo it._"
+        note = f"\n\n{self._note}" if self._note else ""
+        self._view.show(
+            header + hint + note + "\n\n" + code_block(lines, "(waiting for messages)") + pick
         )
-        self._view.show(header + hint + "\n\n" + code_block(lines, "(waiting for messages)"))
 
     def close(self) -> None:
         self._tap.close()

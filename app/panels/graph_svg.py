@@ -267,15 +267,17 @@ def render_svg(vertices: list[Vertex], edges: list[Edge], per_row: int = PER_ROW
 
 def legend_html() -> str:
     """One line explaining colours and dashes, above the picture."""
+    # Dark text on the light chips in both colour schemes; the note in the theme's own
+    # dimmed colour (a fixed gray was unreadable in dark mode).
     chips = "".join(
         f'<span style="background:{fill};border:1px solid {stroke};border-radius:{radius}px;'
-        f'padding:1px 6px;margin-right:6px">{kind}</span>'
+        f'padding:1px 6px;margin-right:6px;color:#111">{kind}</span>'
         for kind, (fill, stroke, radius) in STYLE.items()
     )
     return (
         f'<div style="font-family:sans-serif;font-size:12px;margin-bottom:4px">{chips}'
-        '<span style="color:#555">arrows: publisher → topic → subscriber, '
-        "server → service/action; dashed: client</span></div>"
+        '<span style="color:var(--mantine-color-dimmed)">arrows: publisher → topic → '
+        "subscriber, server → service/action; dashed: client</span></div>"
     )
 
 
@@ -299,8 +301,9 @@ def _short_type(type_text: str) -> str:
     return f"{parts[0]}/{parts[-1]}" if len(parts) == 3 else type_text
 
 
-def hidden_node(name: str) -> bool:
-    """A node ROS tools hide by default: some part of its name starts with '_'."""
+def hidden_name(name: str) -> bool:
+    """A name ROS tools hide by default: some part of it starts with '_' (a node
+    `/_ros2cli_123`, a topic `/turtlesim/_trails`, `/add_two_ints/_service_event`)."""
     return any(part.startswith("_") for part in name.split("/"))
 
 
@@ -311,8 +314,9 @@ def graph_picture(
     show_quiet: bool = False,
 ) -> tuple[list[Vertex], list[Edge]]:
     """Vertices and edges to draw; /rosout, /parameter_events, parameter and lifecycle
-    services are left out unless ``show_quiet`` (many nodes have them: they hide the rest).
-    ``rates`` maps a topic to its label, e.g. '2.0 Hz'."""
+    services and hidden names (a part starting with '_') are left out unless ``show_quiet``
+    (many nodes have them: they hide the rest). ``rates`` maps a topic to its label, e.g.
+    '2.0 Hz'."""
     rates = rates or {}
     vertices: dict[str, Vertex] = {}
     edges: list[Edge] = []
@@ -323,13 +327,17 @@ def graph_picture(
         return vertex.key
 
     def quiet_topic(name: str) -> bool:
-        return ACTION_MARKER in name or (not show_quiet and name in QUIET_TOPICS)
+        return ACTION_MARKER in name or (
+            not show_quiet and (name in QUIET_TOPICS or hidden_name(name))
+        )
 
     def quiet_service(name: str) -> bool:
-        return ACTION_MARKER in name or (not show_quiet and name.endswith(PARAMETER_SERVICES))
+        return ACTION_MARKER in name or (
+            not show_quiet and (name.endswith(PARAMETER_SERVICES) or hidden_name(name))
+        )
 
     # Hidden nodes (a name part starting with '_', as `ros2 node list` hides them) too.
-    nodes = [n for n in nodes if show_quiet or not hidden_node(n.name)]
+    nodes = [n for n in nodes if show_quiet or not hidden_name(n.name)]
     for node in nodes:
         me = add("node", node.name)
         for topic, kind in sorted(node.publishes.items()):

@@ -10,6 +10,7 @@ from app.ros.graph import GraphSnapshot
 from app.supervisor import ACTIVE_STATES, NodeState, NodeStatus, Supervisor
 from app.ui import MarkdownView, assign, code_block
 from app.ui.loop import UiLoop
+from app.ui.starting import StartRequests
 
 _STATE_ICONS = {
     NodeState.STARTING: "◐",
@@ -34,9 +35,16 @@ def _notes(status: NodeStatus, stale: bool) -> str:
 
 
 class NodesPanel:
-    def __init__(self, gui: viser.GuiApi, ui: UiLoop, supervisor: Supervisor) -> None:
+    def __init__(
+        self,
+        gui: viser.GuiApi,
+        ui: UiLoop,
+        supervisor: Supervisor,
+        start_requests: StartRequests | None = None,
+    ) -> None:
         self._ui = ui
         self._supervisor = supervisor
+        self._requests = start_requests or StartRequests()  # the stage shows them at once
         self._graph = GraphSnapshot()
         self._selector = gui.add_dropdown(
             "Catalog node",
@@ -78,7 +86,14 @@ class NodesPanel:
         work = {"start": self._do_start, "stop": self._do_stop, "restart": self._do_restart}[verb]
         if verb == "restart":
             self._message.show(f"Restarting **{name}**…")
-        self._ui.run_job(lambda: work(name), self._message.show, self._show_error, lane="nodes")
+        if verb == "start" and name in _ENTRY_NAMES:
+            self._requests.asked(name)
+        self._ui.run_job(
+            lambda: work(name),
+            self._message.show,
+            lambda text: self._start_failed(text, [name]),
+            lane="nodes",
+        )
 
     def _act_on_group(self, verb: str) -> None:
         name = self._group_selector.value
@@ -93,7 +108,21 @@ class NodesPanel:
             done = "Started" if verb == "start" else "Stopping"
             return f"{done} group **{group.name}**: {', '.join(group.members)}."
 
-        self._ui.run_job(work, self._message.show, self._show_error, lane="nodes")
+        members = list(lookup_group(name).members) if name in _GROUP_NAMES else []
+        if verb == "start":
+            for member in members:
+                self._requests.asked(member)
+        self._ui.run_job(
+            work,
+            self._message.show,
+            lambda text: self._start_failed(text, members),
+            lane="nodes",
+        )
+
+    def _start_failed(self, text: str, names: list[str]) -> None:
+        for name in names:
+            self._requests.done(name)
+        self._show_error(text)
 
     def _show_error(self, text: str) -> None:
         self._message.show(f"⚠ {text}")
@@ -113,6 +142,12 @@ class NodesPanel:
         return f"Restarted **{name}**."
 
     # -- UI thread -------------------------------------------------------------
+
+    def preselect(self, node_name: str) -> None:
+        """Pick the catalog entry that makes ROS node ``node_name`` (a stage click)."""
+        entry = next((e for e in ENTRIES if e.node_name == node_name), None)
+        if entry is not None:
+            assign(self._selector, entry.name)
 
     def _valid_selection(self) -> None:
         """Dropdown values come from the browser: anything outside the catalog is reset."""

@@ -25,7 +25,7 @@ from app.ros.context import CallContext, panel_context
 from app.ros.graph import GraphSnapshot, published_topics
 from app.ros.rates import RateBoard, rate_text
 from app.ros.rosout import RosoutLog, format_record
-from app.ui import MarkdownView, code_block, set_options
+from app.ui import MarkdownView, assign, code_block, set_options
 from app.ui.loop import UiLoop
 
 NONE = "(pick a node)"
@@ -148,6 +148,12 @@ class ParametersPanel:
         self._message = f"⚠️ {text}"
 
     # --- loading ---------------------------------------------------------------
+
+    def preselect(self, node: str) -> None:
+        """Show ``node``'s parameters (a click on the stage graph; UI thread)."""
+        if node in self._nodes and node != self._selector.value:
+            assign(self._selector, node)
+            self._select(node)
 
     def _select(self, choice: str) -> None:
         target = None if choice == NONE else choice

@@ -12,7 +12,7 @@ from app.ros.context import panel_context
 from app.ros.convert import ConversionError, import_type, message_repr, yaml_inline
 from app.ros.errors import Ros2Error
 from app.ros.graph import GraphSnapshot
-from app.ui import MarkdownView, set_options
+from app.ui import MarkdownView, assign, set_options
 from app.ui.forms import FormSlot
 from app.ui.loop import UiLoop
 
@@ -37,6 +37,12 @@ class ServicesPanel:
         self._result = MarkdownView(gui, "")
         self._call.on_click(ui.callback(self._do_call))
         self._selector.on_update(ui.callback(self._rebuild_form))
+
+    def preselect(self, name: str) -> None:
+        """Pick ``name`` (a click on the stage graph; UI thread); one not listed is left."""
+        if name in self._selector.options and name != self._selector.value:
+            assign(self._selector, name)
+            self._rebuild_form()
 
     def _rebuild_form(self) -> None:
         name = self._selector.value

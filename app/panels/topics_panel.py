@@ -142,6 +142,15 @@ class TopicsPanel:
 
     # --- selection -------------------------------------------------------------
 
+    def preselect(self, topic: str) -> None:
+        """Follow ``topic`` (a click on the stage graph; UI thread)."""
+        if topic not in self._types:
+            return  # not on the graph (yet): the list would not keep it
+        if topic != self._selector.value:
+            set_options(self._selector, [NONE, *sorted(self._types)])
+            assign(self._selector, topic)
+        self._select(topic)
+
     def _select(self, topic: str) -> None:
         """Follow another topic: a new monitor, form and plot (UI thread)."""
         chosen = None if topic == NONE else topic

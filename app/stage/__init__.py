@@ -11,6 +11,7 @@ STAGES: dict[str, str] = {
     "graph": "Live ROS graph",
     "turtlesim": "Turtlesim",
     "scene": "3D scene",
-    "code": "Code",
+    "tf": "TF tree",
+    "code": "Code",  # the lesson's or the learner's, with its output under it
 }
 DEFAULT_STAGE = "graph"  # a unit that names none: units 1-11 are about the graph

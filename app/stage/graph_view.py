@@ -8,6 +8,7 @@ a new picture only when the graph or a rate changes, never per frame.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from html import escape
 
 from app.panels.graph_svg import (
@@ -29,6 +30,8 @@ PER_ROW = 3  # the stage is about three boxes wide at 1:1
 TRAVEL_SEC = 1.0  # a dot takes this long along an edge
 MAX_DOTS = 8  # per edge; a faster topic moves batches (its rate is written on the edge)
 MAX_REMEMBERED = 500
+STARTING = "starting…"  # a node's second line while its process runs but ROS has not listed it
+LEG_SEC = 0.6  # a pulse's leg: caller to service/action box, or box to server
 STEP_X, STEP_Y = BOX_W + GAP_X, BOX_H + ROW_GAP
 
 
@@ -42,6 +45,11 @@ class StablePlaces:
     def __init__(self, per_row: int = PER_ROW) -> None:
         self.per_row = per_row
         self._at: dict[str, tuple[float, float]] = {}
+
+    def forget(self, key: str) -> None:
+        """Let ``key`` take a new place once (a node drawn 'starting…' before its edges were
+        known: once they are, it joins its group)."""
+        self._at.pop(key, None)
 
     def place(self, vertices: list[Vertex], edges: list[Edge]) -> list[Placed]:
         fresh = layout(vertices, edges, self.per_row)
@@ -73,10 +81,18 @@ def _overlaps(at: tuple[float, float], taken: list[tuple[float, float]]) -> bool
 def _free_cell(
     wish: tuple[float, float], taken: list[tuple[float, float]], per_row: int
 ) -> tuple[float, float]:
-    """``wish`` if free, else the first free grid cell from its row down."""
+    """``wish`` if free; else the nearest free place in its row (half a box at a time, left
+    or right: a second subscriber goes beside the first, not under it); else the first
+    free grid cell from the next row down."""
     if not _overlaps(wish, taken):
         return wish
-    row = max(0, round((wish[1] - MARGIN) / STEP_Y))
+    left, right = float(MARGIN), MARGIN + (per_row - 1) * STEP_X
+    for k in range(1, 2 * per_row + 1):
+        for sign in (1, -1):
+            x = wish[0] + sign * k * STEP_X / 2
+            if left - 1 <= x <= right + 1 and not _overlaps((x, wish[1]), taken):
+                return (x, wish[1])
+    row = max(0, round((wish[1] - MARGIN) / STEP_Y)) + 1
     while True:
         y = MARGIN + row * STEP_Y
         for column in range(per_row):
@@ -89,9 +105,10 @@ def _free_cell(
 def dot_timing(rate_hz: float) -> list[tuple[float, float, float]]:
     """(duration s, begin s, share of the duration spent travelling) for each dot.
 
-    At 2 Hz two dots a second leave the publisher; below 1/TRAVEL_SEC one dot
-    travels in TRAVEL_SEC and waits for the next message; above
-    MAX_DOTS/TRAVEL_SEC the dots stand for batches.
+    At 2 Hz two dots a second leave the publisher (each dot arrives once per
+    ``count / rate`` seconds, about TRAVEL_SEC, so arrivals match the rate);
+    below 1/TRAVEL_SEC one dot travels in TRAVEL_SEC and waits for the next
+    message; above MAX_DOTS/TRAVEL_SEC the dots stand for batches.
     """
     if rate_hz <= 0:
         return []
@@ -99,15 +116,60 @@ def dot_timing(rate_hz: float) -> list[tuple[float, float, float]]:
     if period >= TRAVEL_SEC:
         return [(period, 0.0, TRAVEL_SEC / period)]
     count = min(MAX_DOTS, max(1, round(TRAVEL_SEC * rate_hz)))
-    return [(TRAVEL_SEC, -i * TRAVEL_SEC / count, 1.0) for i in range(count)]
+    duration = count * period if count < MAX_DOTS else TRAVEL_SEC
+    return [(duration, -i * duration / count, 1.0) for i in range(count)]
 
 
-def _shape(p: Placed) -> str:
+# Colours come from the page's theme: light and dark palettes as CSS variables, switched
+# by the colour scheme Mantine (viser's UI kit) sets on <html>. Shapes and words carry
+# every meaning; colour only helps.
+_PALETTE = {
+    "light": {
+        "text": "#111", "dim": "#444", "edge": "#666", "halo": "#fff", "dot": "#1864ab",
+        "node": "#dbe4ff", "node-line": "#3b5bdb", "topic": "#d3f9d8", "topic-line": "#2b8a3e",
+        "service": "#fff4e6", "service-line": "#d9480f", "action": "#f3d9fa",
+        "action-line": "#9c36b5", "pulse": "#fff", "pulse-line": "#d9480f",
+    },
+    "dark": {
+        "text": "#f1f3f5", "dim": "#ced4da", "edge": "#adb5bd", "halo": "#1a1b1e",
+        "dot": "#74c0fc", "node": "#1f2b4d", "node-line": "#91a7ff", "topic": "#183a24",
+        "topic-line": "#69db7c", "service": "#47290f", "service-line": "#ffa94d",
+        "action": "#3b1f44", "action-line": "#e599f7", "pulse": "#25262b",
+        "pulse-line": "#ffa94d",
+    },
+}  # fmt: skip
+
+
+def _variables(scheme: str) -> str:
+    return ";".join(f"--sg-{name}:{value}" for name, value in _PALETTE[scheme].items())
+
+
+STAGE_CSS = (
+    f".stage-graph,.stage-legend{{{_variables('light')}}}"
+    f"[data-mantine-color-scheme=dark] .stage-graph,"
+    f"[data-mantine-color-scheme=dark] .stage-legend{{{_variables('dark')}}}"
+    ".stage-graph .sg-name{fill:var(--sg-text)}.stage-graph .sg-detail{fill:var(--sg-dim)}"
+    ".stage-graph .sg-edge{stroke:var(--sg-edge)}.stage-graph .sg-head{fill:var(--sg-edge)}"
+    ".stage-graph .sg-rate,.stage-graph .sg-note{fill:var(--sg-text);stroke:var(--sg-halo)}"
+    ".stage-graph .sg-dot{fill:var(--sg-dot);stroke:var(--sg-halo)}"
+    ".stage-graph .sg-pulse rect{fill:var(--sg-pulse);stroke:var(--sg-pulse-line)}"
+    ".stage-graph .sg-pulse text{fill:var(--sg-text)}"
+    + "".join(
+        f".stage-graph .sg-{kind}{{fill:var(--sg-{kind});stroke:var(--sg-{kind}-line)}}"
+        f".stage-legend .sg-{kind}{{background:var(--sg-{kind});border:1px solid "
+        f"var(--sg-{kind}-line);color:var(--sg-text)}}"
+        for kind in ("node", "topic", "service", "action")
+    )
+    + ".stage-graph .sg-action-inner{fill:none;stroke:var(--sg-action-line)}"
+    ".stage-legend{color:var(--sg-text)}"
+)
+
+
+def _shape(p: Placed, dashed: bool = False) -> str:
     """Node: a pill; topic: a box; service: a hexagon; action: a double box."""
-    fill, stroke, _radius = STYLE[p.vertex.kind]
     x, y, w, h = p.x, p.y, BOX_W, BOX_H
-    paint = f'fill="{fill}" stroke="{stroke}" stroke-width="1.5"'
     kind = p.vertex.kind
+    paint = f'class="sg-{kind}" stroke-width="1.5"' + (' stroke-dasharray="6,4"' if dashed else "")
     if kind == "node":
         return f'<rect x="{x:.0f}" y="{y:.0f}" width="{w}" height="{h}" rx="{h / 2:.0f}" {paint}/>'
     if kind == "service":
@@ -120,10 +182,53 @@ def _shape(p: Placed) -> str:
     box = f'<rect x="{x:.0f}" y="{y:.0f}" width="{w}" height="{h}" rx="2" {paint}/>'
     if kind == "action":
         box += (
-            f'<rect x="{x + 3:.0f}" y="{y + 3:.0f}" width="{w - 6}" height="{h - 6}" rx="1" '
-            f'fill="none" stroke="{stroke}" stroke-width="1"/>'
+            f'<rect class="sg-action-inner" x="{x + 3:.0f}" y="{y + 3:.0f}" width="{w - 6}" '
+            f'height="{h - 6}" rx="1" stroke-width="1"/>'
         )
     return box
+
+
+@dataclass(frozen=True)
+class PulseView:
+    """A pulse as drawn: ``age`` seconds since its travel began (negative: not yet)."""
+
+    kind: str  # request, response, goal, feedback, result
+    name: str  # the service or action it travels to or from
+    caller: str = ""  # the node drawn as the caller; '' when unknown
+    age: float = 0.0
+
+
+_OUTBOUND = ("request", "goal")  # caller -> box -> server; the others come back
+
+
+def _pulse_legs(
+    pulse: PulseView, server_paths: list[str], caller_path: str | None
+) -> list[tuple[str, bool, float]]:
+    """(path, travel it backwards, begin s) for each leg: a call goes from the caller to the
+    box and on to the server; an answer comes back the same way."""
+    callers = [caller_path] if caller_path else []
+    if pulse.kind in _OUTBOUND:
+        first, second = [(c, False) for c in callers], [(s, True) for s in server_paths]
+    else:
+        first, second = [(s, False) for s in server_paths], [(c, True) for c in callers]
+    later = LEG_SEC if first else 0.0  # no caller drawn: the server's leg comes at once
+    legs = [(path, back, 0.0) for path, back in first]
+    legs += [(path, back, later) for path, back in second]
+    return [(path, back, begin - pulse.age) for path, back, begin in legs]
+
+
+def _pulse_svg(pulse: PulseView, path: str, backwards: bool, begin: float) -> str:
+    reverse = 'keyPoints="1;0" keyTimes="0;1" calcMode="linear" ' if backwards else ""
+    width = 8 + 6 * len(pulse.kind)
+    return (
+        f'<g class="sg-pulse" data-kind="{pulse.kind}" data-name="{escape(pulse.name)}" '
+        f'visibility="hidden"><set attributeName="visibility" to="visible" '
+        f'begin="{begin:.3f}s" dur="{LEG_SEC}s"/>'
+        f'<animateMotion begin="{begin:.3f}s" dur="{LEG_SEC}s" fill="freeze" {reverse}'
+        f'path="{path}"/><rect x="{-width / 2:.0f}" y="-8" width="{width}" height="16" rx="8" '
+        f'stroke-width="1.5"/><text y="4" font-size="10" text-anchor="middle">{pulse.kind}'
+        "</text></g>"
+    )
 
 
 def stage_svg(
@@ -131,8 +236,12 @@ def stage_svg(
     edges: list[Edge],
     rates: dict[str, float],
     link: Callable[[int, str, str], str] | None = None,
+    pulses: list[PulseView] | tuple[PulseView, ...] = (),
+    starting: frozenset[str] = frozenset(),
 ) -> str:
-    """The picture; ``rates`` (topic -> Hz) sets how many dots move on its edges.
+    """The picture; ``rates`` (topic -> Hz) sets how many dots move on its edges,
+    ``pulses`` are calls and goals on their way, ``starting`` the nodes drawn dashed
+    because their process runs but the ROS graph does not list them yet.
 
     ``link(i, content, title)`` wraps the i-th box (``placed`` order) in a link.
     """
@@ -141,29 +250,37 @@ def stage_svg(
     width = max(right, 2 * MARGIN + PER_ROW * BOX_W + (PER_ROW - 1) * GAP_X)
     height = max((p.y for p in placed), default=0) + BOX_H + MARGIN + (0 if placed else 30)
     parts = [
-        f'<svg class="stage-graph" xmlns="http://www.w3.org/2000/svg" role="img" '
+        f'<svg class="stage-graph" xmlns="http://www.w3.org/2000/svg" role="group" '
         f'aria-label="Live ROS graph: {len(placed)} items" viewBox="0 0 {width:.0f} '
         f'{height:.0f}" width="100%" style="font-family:sans-serif;max-width:{width:.0f}px">',
+        f"<style>{STAGE_CSS}</style>",
         '<defs><marker id="sg-arrow" viewBox="0 0 10 10" refX="9" refY="5" markerWidth="7" '
-        'markerHeight="7" orient="auto-start-reverse"><path d="M0,0 L10,5 L0,10 z" '
-        'fill="#555"/></marker></defs>',
+        'markerHeight="7" orient="auto-start-reverse"><path class="sg-head" '
+        'd="M0,0 L10,5 L0,10 z"/></marker></defs>',
     ]
     if not placed:
         parts.append(
-            '<text x="10" y="24" font-size="13" fill="#555">Nothing on the graph yet: '
-            "start a node.</text>"
+            '<text class="sg-note" x="10" y="24" font-size="13" stroke-width="0">'
+            "Nothing on the graph yet: start a node.</text>"
         )
     labels, dots = [], []
+    servers: dict[str, list[str]] = {}  # service/action -> paths from its servers
+    clients: dict[tuple[str, str], str] = {}  # (service/action, client node) -> path
     for edge in edges:
         a, b = where.get(edge.source), where.get(edge.target)
         if a is None or b is None or a is b:
             continue
         path, mx, my = edge_path(a, b)
+        if a.vertex.kind == "node" and b.vertex.kind in ("service", "action"):
+            if edge.dashed:
+                clients[(b.vertex.name, a.vertex.name)] = path
+            else:
+                servers.setdefault(b.vertex.name, []).append(path)
         topic = next((v.name for v in (a.vertex, b.vertex) if v.kind == "topic"), "")
         dash = ' stroke-dasharray="5,4"' if edge.dashed else ""
         parts.append(
             f'<path class="sg-edge" data-source="{escape(a.vertex.name)}" '
-            f'data-target="{escape(b.vertex.name)}" d="{path}" fill="none" stroke="#777" '
+            f'data-target="{escape(b.vertex.name)}" d="{path}" fill="none" '
             f'stroke-width="1.4"{dash} marker-end="url(#sg-arrow)"/>'
         )
         for duration, begin, share in dot_timing(rates.get(topic, 0.0)):
@@ -173,38 +290,48 @@ def stage_svg(
                 else ""
             )
             dots.append(
-                f'<circle class="sg-dot" data-topic="{escape(topic)}" r="4" fill="#1971c2" '
-                'stroke="white" stroke-width="1" cx="0" cy="0">'
+                f'<circle class="sg-dot" data-topic="{escape(topic)}" '
+                f'data-edge="{escape(a.vertex.name)}>{escape(b.vertex.name)}" r="4" '
+                'stroke-width="1" cx="0" cy="0">'
                 f'<animateMotion dur="{duration:.3f}s" begin="{begin:.3f}s" '
                 f'repeatCount="indefinite" {timing}path="{path}"/></circle>'
             )
         if edge.label:
             labels.append(
                 f'<text class="sg-rate" x="{mx:.0f}" y="{my + 4:.0f}" font-size="11" '
-                'text-anchor="middle" fill="#222" stroke="white" stroke-width="3" '
+                'text-anchor="middle" stroke-width="3" '
                 f'paint-order="stroke">{escape(edge.label)}</text>'
             )
     for i, p in enumerate(placed):
         v = p.vertex
         cx = p.x + BOX_W / 2
         name_y = p.y + (14 if v.detail else 21)
+        waiting = v.kind == "node" and v.name in starting
         body = (
-            f'{_shape(p)}<text x="{cx:.0f}" y="{name_y:.0f}" font-size="12" '
-            f'text-anchor="middle" fill="#111">{escape(short(v.name))}</text>'
+            f'{_shape(p, waiting)}<text class="sg-name" x="{cx:.0f}" y="{name_y:.0f}" '
+            f'font-size="12" text-anchor="middle">{escape(short(v.name))}</text>'
         )
         if v.detail:
             body += (
-                f'<text x="{cx:.0f}" y="{p.y + 28:.0f}" font-size="10" text-anchor="middle" '
-                f'fill="#444">{escape(short(v.detail, 30))}</text>'
+                f'<text class="sg-detail" x="{cx:.0f}" y="{p.y + 28:.0f}" font-size="10" '
+                f'text-anchor="middle">{escape(short(v.detail, 30))}</text>'
             )
         title = f"{v.kind} {v.name}"
         body = (
             link(i, body, f"Inspect {title}") if link else f"<title>{escape(title)}</title>{body}"
         )
+        state = "starting" if waiting else "on-graph"
         parts.append(
-            f'<g class="sg-vertex" data-kind="{v.kind}" data-name="{escape(v.name)}">{body}</g>'
+            f'<g class="sg-vertex" data-kind="{v.kind}" data-name="{escape(v.name)}" '
+            f'data-state="{state}">{body}</g>'
         )
-    parts += dots + labels  # dots above the curves, labels on top of all
+    moving = []
+    for pulse in pulses:
+        caller_path = clients.get((pulse.name, pulse.caller)) if pulse.caller else None
+        for path, backwards, begin in _pulse_legs(pulse, servers.get(pulse.name, []), caller_path):
+            if begin + LEG_SEC > 0:  # this leg is still to come or under way
+                moving.append(_pulse_svg(pulse, path, backwards, begin))
+    parts += dots + moving + labels  # dots and pulses above the curves, labels on top of all
     parts.append("</svg>")
     return "".join(parts)
 
@@ -213,13 +340,14 @@ def stage_legend() -> str:
     """Shapes and words, so colour is never the only key."""
     shapes = {"node": "pill", "topic": "box", "service": "hexagon", "action": "double box"}
     chips = "".join(
-        f'<span style="background:{fill};border:1px solid {stroke};'
-        f"border-radius:{'10' if kind == 'node' else '2'}px;padding:1px 6px;margin-right:6px;"
-        f'color:#111">{kind} ({shapes[kind]})</span>'
-        for kind, (fill, stroke, _r) in STYLE.items()
+        f'<span class="sg-{kind}" style="border-radius:{"10" if kind == "node" else "2"}px;'
+        f'padding:1px 6px;margin-right:6px">{kind} ({shapes[kind]})</span>'
+        for kind in STYLE
     )
     return (
-        f'<div style="font-family:sans-serif;font-size:12px;line-height:1.9">{chips}<br>'
+        f'<style>{STAGE_CSS}</style><div class="stage-legend" style="font-family:sans-serif;'
+        f'font-size:12px;line-height:1.9">{chips}<br>'
         "publisher → topic → subscriber; server → service/action; dashed: client. "
-        "Blue dots are messages, at the rate written on the edge.</div>"
+        "Dots are messages, at the rate written on the edge; a labelled pulse is a service "
+        "call (request, response) or an action's goal, feedback and result.</div>"
     )

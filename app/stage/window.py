@@ -9,6 +9,7 @@ drawn in a window docked on the left; "code" shows the code window instead;
 from __future__ import annotations
 
 import html
+import json
 import time
 from collections.abc import Callable
 from typing import Any
@@ -17,14 +18,26 @@ import viser
 from rclpy.node import Node
 
 from app.panels.graph_panel import SharedRatesClient
-from app.panels.graph_svg import Vertex, graph_picture, topics_to_measure
+from app.panels.graph_svg import Edge, Vertex, graph_picture, topics_to_measure
 from app.ros.graph import GraphSnapshot, NodeEndpoints, node_endpoints
 from app.ros.rates import RateBoard, rate_text
 from app.stage import DEFAULT_STAGE, STAGES
-from app.stage.graph_view import PER_ROW, STEP_X, StablePlaces, stage_legend, stage_svg
+from app.stage.graph_view import (
+    PER_ROW,
+    STARTING,
+    STEP_X,
+    PulseView,
+    StablePlaces,
+    stage_legend,
+    stage_svg,
+)
+from app.stage.pulses import CallWatch, Pulse, caller_of
+from app.stage.tf_stage import TfStage
+from app.stage.turtlesim_stage import TurtlesimStage
 from app.ui import MarkdownView, assign
 from app.ui.loop import UiLoop
 from app.ui.page_links import SINK, SINK_FRAME, PageLinks
+from app.ui.page_script import page_script
 
 PICTURE_PERIOD_SEC = 1.0
 MAX_PICKS = 300  # boxes that answer a click (a larger graph: the first ones)
@@ -35,12 +48,32 @@ CONTROL_WIDTH = 480
 CONTROL_PANEL_ROOM = CONTROL_WIDTH + 28  # and its margins
 MIN_WIDTH, MAX_WIDTH = 400, 3000  # up to the panel: no 3D scene peeks out between
 REFIT_PX = 24  # a smaller change of the window is not worth moving the stage
-SETTLE_SEC = 1.5  # after the stage changes, the browser's reports describe the old layout
-_DOCKED = ("graph", "turtlesim", "code")  # stages shown in a docked window
+# Runs in the page (app.ui.page_script): report the window's width now and after resizes.
+_REPORT_WIDTH = """
+const url = new URL(%s, parent.location.href).href;
+const report = () => fetch(url + '/' + Math.round(parent.innerWidth), {cache: 'no-store'})
+  .catch(() => {});
+let timer = 0;
+const onResize = () => { clearTimeout(timer); timer = setTimeout(report, 150); };
+if (parent.__stageWidthOff) parent.__stageWidthOff();
+parent.addEventListener('resize', onResize);
+parent.__stageWidthOff = () => parent.removeEventListener('resize', onResize);
+window.addEventListener('pagehide', () => parent.__stageWidthOff && parent.__stageWidthOff());
+report();
+"""
 RATE_CHANGE = 0.15  # a rate must move this much (share) before the dots are re-timed
-_TURTLESIM_NOTE = (
-    "### Turtlesim\nTurtlesim's window is in the **Turtlesim** tab of the panel on the "
-    "right: start `turtlesim_node` there and drive with the arrow keys."
+_IN_WINDOW = ("graph", "turtlesim", "tf")  # stages drawn in the stage window
+# A clicked box's tools (set to it already): (tool, button label).
+_TOOLS_FOR: dict[str, tuple[tuple[str, str], ...]] = {
+    "topic": (("Echo", "Echo {name}"), ("Topics", "Rate, plot and publish {name} in Topics")),
+    "node": (("Parameters", "Parameters of {name}"), ("Nodes", "{name} in Run › Nodes")),
+    "service": (("Services", "Call {name} in Services"),),
+    "action": (("Actions", "Send a goal to {name} in Actions"),),
+}
+OUTPUT_LINES = 40
+NO_OUTPUT = (
+    "_Nothing has run yet._ **Run my node** (Learn › Exercise) runs your code; what it "
+    "prints and logs shows here."
 )
 
 
@@ -59,8 +92,21 @@ class Stage:
         code_window: Any,
         rates: SharedRatesClient | None = None,
         links: PageLinks | None = None,
+        starting: Callable[[], list[str]] = lambda: [],
+        program_output: Callable[[], tuple[str, list[str]]] = lambda: ("", []),
+        inspect: Callable[[str, str, str], None] = lambda _kind, _name, _type: None,
+        open_tool: Callable[[str], None] = lambda _tool: None,
     ) -> None:
+        """``starting()``: nodes whose process was just started and that the ROS graph does
+        not list yet (drawn at once, marked 'starting…', so a click on Start shows).
+        ``program_output()``: the learner's latest program (its state) and its last lines,
+        shown under the code. ``inspect(kind, name, type)``: a box was clicked (the tools
+        preselect it); ``open_tool(name)`` brings a tool's tab into view."""
+        self._program_output = program_output
+        self._inspect = inspect
+        self._open_tool = open_tool
         self._node = node
+        self._starting = starting
         self._links = links
         self._picked: list[Vertex] = []  # the boxes in the picture, in link order
         self._inspected = ""  # Vertex.key the learner clicked
@@ -71,9 +117,14 @@ class Stage:
         self._ui = ui
         self._code_window = code_window
         self.width = STAGE_WIDTH
-        self._settled = 0.0
+        self._fitted = False
         self._rates: RateBoard | SharedRatesClient = rates or RateBoard(node)
         self._places = StablePlaces()
+        # Calls and goals as pulses: an event wakes the UI loop, which draws it at once.
+        self._calls = CallWatch(node, on_event=lambda: ui.post(lambda: None))
+        self._drawn_pulses: set[tuple[str, str, float]] = set()
+        self._alone: set[str] = set()  # node boxes drawn without an edge
+        self._callers: dict[tuple[str, str], str] = {}
         self._shown_rates: dict[str, float] = {}
         self._last_picture = 0.0
         self._drawn_nodes: tuple[str, ...] = ()
@@ -107,48 +158,54 @@ class Stage:
                 self._inspector = MarkdownView(
                     gui, "_Click a box in the graph to see what it offers and uses._"
                 )
-            self._note = MarkdownView(gui, _TURTLESIM_NOTE, visible=False)
+                # The tools that show more of the clicked box (already set to it).
+                self._tool_buttons = [
+                    gui.add_button("", icon=viser.Icon.EXTERNAL_LINK, visible=False)
+                    for _ in range(2)
+                ]
+                for i, button in enumerate(self._tool_buttons):
+                    button.on_click(ui.callback(self._open_inspected_tool, i))
+            self.turtlesim = TurtlesimStage(gui, ui, node, links)
+            self.tf = TfStage(gui, node)
+        # Under the code: what the learner's program printed (the exercise's output).
+        self._output_window = gui.add_panel()
+        self._output_window.dock_below(code_window)
+        with self._output_window.add_tab("Output of my node", viser.Icon.TERMINAL_2):
+            self._output = MarkdownView(gui, NO_OUTPUT)
         self.show(DEFAULT_STAGE)
 
     def follow_window(self, server: viser.ViserServer) -> None:
         """Size the stage to the browser's window: all the room the control panel leaves.
 
-        Every camera message carries the canvas's width: the window minus the
-        docked windows, except the first one of a page, sent before the docks
-        are laid out, which is the whole window (seen: 1366, then 408 with a
-        954 px dock, at 1366x768).
+        The page reports its window's width through a page link when it loads
+        and after each resize (the camera messages' canvas width cannot tell:
+        it is the window minus whatever the docks were at that moment).
         """
-
-        def on_connect(client: viser.ClientHandle) -> None:
-            first = [True]
-
-            def on_camera(camera: viser.CameraHandle) -> None:
-                whole, first[0] = first[0], False
-                self._ui.post(lambda: self._fit(camera.image_width, whole))
-
-            client.camera.on_update(on_camera)
-
-        server.on_client_connect(on_connect)
         server.gui.main_panel.set_width(CONTROL_WIDTH)
-
-    def _fit(self, canvas: int, whole_window: bool) -> None:
-        if canvas <= 0:
+        if self._links is None:
             return
-        if whole_window:
-            window = canvas
-        elif time.monotonic() < self._settled:
-            return  # sent before our last change: it describes the old layout
-        else:
-            window = canvas + (self.width if self.current in _DOCKED else 0)
+        href = self._links.register_value("stage.window", self._on_window_width)
+        server.gui.add_html(page_script(_REPORT_WIDTH % json.dumps(href), "window width"))
+
+    def _on_window_width(self, value: str) -> None:
+        """The link's action (viser's asyncio thread): only checks and posts."""
+        if value.isdigit() and len(value) <= 5:
+            width = int(value)
+            self._ui.post(lambda: self._fit(width))
+
+    def _fit(self, window: int) -> None:
         wanted = max(MIN_WIDTH, min(MAX_WIDTH, window - CONTROL_PANEL_ROOM))
-        if abs(wanted - self.width) >= REFIT_PX:
+        if abs(wanted - self.width) >= REFIT_PX or not self._fitted:
+            self._fitted = True
             self.width = wanted
-            self._window.set_width(wanted)
-            self._code_window.set_width(wanted)
-            self._settled = time.monotonic() + SETTLE_SEC
+            self._set_widths()
             # Wider stage, more boxes a row (boxes already placed stay where they are).
             self._places.per_row = max(PER_ROW, (wanted - 40) // STEP_X)
             self._last_picture = 0.0
+
+    def _set_widths(self) -> None:
+        for window in (self._window, self._code_window, self._output_window):
+            window.set_width(self.width)
 
     def show(self, stage: str) -> None:
         """Put ``stage`` on (an unknown name is ignored: lessons are validated at load)."""
@@ -156,24 +213,38 @@ class Stage:
             return
         self.current = stage
         assign(self._selector, STAGES[stage])
-        self._window.visible = stage in ("graph", "turtlesim")
+        self._window.visible = stage in _IN_WINDOW
         self._graph_box.visible = stage == "graph"
-        self._note.handle.visible = stage == "turtlesim"
+        self.turtlesim.set_active(stage == "turtlesim")
+        self.tf.set_active(stage == "tf")
         self._code_window.visible = stage == "code"
-        self._settled = time.monotonic() + SETTLE_SEC
+        self._output_window.visible = stage == "code"
+        if stage == "code" and self._fitted:
+            self._set_widths()  # the column the code and its output share
         self._last_picture = 0.0  # draw at once
         if stage != "graph":
             self._rates.watch({})  # no subscriptions for a picture nobody sees
+            self._calls.watch({}, {})
 
     def refresh(self, graph: GraphSnapshot) -> None:
+        if self.current == "turtlesim":
+            self.turtlesim.refresh(graph)
+        elif self.current == "tf":
+            self.tf.refresh()
+        elif self.current == "code":
+            self._output.show(_output_text(*self._program_output()))
         if self.current != "graph":
             return
         now = time.monotonic()
-        joined_or_left = graph.nodes != self._drawn_nodes  # drawn at once, not on the next tick
-        if now - self._last_picture < PICTURE_PERIOD_SEC and not joined_or_left:
+        starting = tuple(n for n in self._starting() if n not in graph.nodes)
+        # A node that joined, left or was just started is drawn at once, not on the next tick.
+        joined_or_left = (*graph.nodes, *starting) != self._drawn_nodes
+        pulses = self._calls.recent(now)
+        fresh = {(p.kind, p.name, p.shown_at) for p in pulses} - self._drawn_pulses
+        if now - self._last_picture < PICTURE_PERIOD_SEC and not (joined_or_left or fresh):
             return
         self._last_picture = now
-        self._drawn_nodes = tuple(graph.nodes)
+        self._drawn_nodes = (*graph.nodes, *starting)
         own = self._node.get_fully_qualified_name()
         endpoints = [
             found
@@ -186,17 +257,46 @@ class Stage:
         rates = {topic: self._steady_rate(topic) for topic in self._rates.watched()}
         labels = {topic: rate_text(rate) for topic, rate in rates.items()}
         vertices, edges = graph_picture(endpoints, labels, show_quiet=quiet)
+        vertices += [Vertex("node", name, STARTING) for name in starting]
+        # A node drawn alone (starting, or its endpoints not discovered yet) joins its
+        # group's place once its first edge is known; every other box stays put.
+        linked = {key for e in edges for key in (e.source, e.target)}
+        for key in self._alone & linked:
+            self._places.forget(key)
+        self._alone = {f"node:{v.name}" for v in vertices if v.kind == "node"} - linked
         placed = self._places.place(vertices, edges)
         self._picked = [p.vertex for p in placed]
         self._endpoints = endpoints
+        self._calls.watch(*_calls_to_watch(vertices, endpoints))
+        self._drawn_pulses = {(p.kind, p.name, p.shown_at) for p in pulses}
+        views = [
+            PulseView(p.kind, p.name, self._caller(p, edges), now - p.shown_at) for p in pulses
+        ]
         link = self._link if self._links is not None else None
-        svg = stage_svg(placed, edges, rates, link)
+        svg = stage_svg(placed, edges, rates, link, views, frozenset(starting))
         if self._links is not None:
             svg = SINK_FRAME + svg
         if svg != self._svg:
             self._svg = svg
             self._picture.content = svg
         self._inspector.show(self._inspection(labels))
+
+    def _caller(self, pulse: Pulse, edges: list[Edge]) -> str:
+        """The node drawn as the one who called or sent the goal; '' when unknown."""
+        if pulse.caller_id:  # a service event names its caller
+            key = (pulse.name, pulse.caller_id)
+            if key not in self._callers:
+                if len(self._callers) > MAX_PICKS:
+                    self._callers.clear()
+                self._callers[key] = caller_of(self._node, pulse.name, pulse.caller_id)
+            return self._callers[key]
+        # An action's goal does not: the one client on the graph, unless this dashboard
+        # (not drawn) may have sent it from its Actions tool.
+        users = {e.source for e in edges if e.dashed and e.target == f"action:{pulse.name}"}
+        own = node_endpoints(self._node, self._node.get_fully_qualified_name())
+        if len(users) != 1 or (own is not None and pulse.name in own.action_clients):
+            return ""
+        return next(iter(users)).partition(":")[2]
 
     def _picker(self, index: int) -> Callable[[], None]:
         """The link's action: runs in viser's asyncio thread, so it only posts."""
@@ -211,9 +311,34 @@ class Stage:
         return f'<a href="{href}" target="{SINK}"><title>{html.escape(title)}</title>{content}</a>'
 
     def _pick(self, index: int) -> None:
-        if 0 <= index < len(self._picked):
-            self._inspected = self._picked[index].key
-            self._last_picture = 0.0  # answer at once
+        if not 0 <= index < len(self._picked):
+            return
+        vertex = self._picked[index]
+        self._inspected = vertex.key
+        self._last_picture = 0.0  # answer at once
+        self._inspect(vertex.kind, vertex.name, self._full_type(vertex))
+        tools = _TOOLS_FOR.get(vertex.kind, ())
+        for i, button in enumerate(self._tool_buttons):
+            if i < len(tools):
+                button.label = tools[i][1].format(name=vertex.name)
+            button.visible = i < len(tools)
+
+    def _full_type(self, vertex: Vertex) -> str:
+        """A topic's, service's or action's full type name ('' for a node)."""
+        for e in self._endpoints:
+            for table in (
+                e.publishes, e.subscribes, e.servers, e.clients, e.action_servers,
+                e.action_clients,
+            ):  # fmt: skip
+                if vertex.name in table and vertex.kind != "node":
+                    return table[vertex.name]
+        return ""
+
+    def _open_inspected_tool(self, index: int) -> None:
+        kind = self._inspected.partition(":")[0]
+        tools = _TOOLS_FOR.get(kind, ())
+        if index < len(tools):
+            self._open_tool(tools[index][0])
 
     def _inspection(self, labels: dict[str, str]) -> str:
         """What the clicked box offers and uses, as `ros2 node info` / `topic info` say."""
@@ -222,6 +347,11 @@ class Stage:
             return "_Click a box in the graph to see what it offers and uses._"
         if kind == "node":
             found = next((e for e in self._endpoints if e.name == name), None)
+            if found is None and name in self._drawn_nodes:
+                return (
+                    f"**Node `{name}`** is starting: its process runs, and the ROS graph "
+                    "lists it once discovery has found it (usually within a second or two)."
+                )
             if found is None:
                 return f"**{name}** has left the graph."
             parts = [f"**Node `{name}`** · `ros2 node info {name}`"]
@@ -248,13 +378,11 @@ class Stage:
                 + (f" · {rate}" if rate else "")
                 + f"\n- publishers: {', '.join(users['pub']) or 'none'}"
                 + f"\n- subscribers: {', '.join(users['sub']) or 'none'}"
-                + "\n\nSee its messages in the **Echo** tab, its rate in **Topics**."
             )
         return (
             f"**{kind.capitalize()} `{name}`**"
             + f"\n- served by: {', '.join(users['serve']) or 'none'}"
             + f"\n- used by: {', '.join(users['use']) or 'none'}"
-            + f"\n\nCall it from the **{'Actions' if kind == 'action' else 'Services'}** tab."
         )
 
     def _steady_rate(self, topic: str) -> float:
@@ -269,3 +397,31 @@ class Stage:
 
     def close(self) -> None:
         self._rates.close()
+        self._calls.close()
+        self.turtlesim.close()
+        self.tf.close()
+
+
+def _calls_to_watch(
+    vertices: list[Vertex], endpoints: list[NodeEndpoints]
+) -> tuple[dict[str, str], dict[str, str]]:
+    """The services and actions in the picture, with their full types."""
+    shown = {v.name for v in vertices if v.kind in ("service", "action")}
+    services: dict[str, str] = {}
+    actions: dict[str, str] = {}
+    for e in endpoints:
+        for table, out in (
+            (e.servers, services), (e.clients, services),
+            (e.action_servers, actions), (e.action_clients, actions),
+        ):  # fmt: skip
+            for name, kind in table.items():
+                if name in shown:
+                    out.setdefault(name, kind)
+    return services, actions
+
+
+def _output_text(program: str, lines: list[str]) -> str:
+    if not program:
+        return NO_OUTPUT
+    body = "\n".join(lines[-OUTPUT_LINES:]) or "(no output yet)"
+    return f"**{program}**\n```\n{body}\n```"

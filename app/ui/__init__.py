@@ -1,4 +1,4 @@
-"""What every browser front end shares: the UI thread, its widgets and the tab names.
+"""What every browser front end shares: the UI thread, its widgets and the tools' names.
 
 Threading model (every panel follows it; see ``UiLoop``):
 
@@ -24,12 +24,22 @@ from typing import Any, Protocol
 
 from app.ros.graph import GraphSnapshot
 
-# The dashboard's tabs, in order. Lessons name them ("Open the Lifecycle tab")
-# and are checked against this list when they load.
-TAB_NAMES = (
-    "Lessons", "Exercise", "Nodes", "Turtlesim", "Graph", "Echo", "3D view", "TF", "Topics",
-    "Parameters", "Console", "Services", "Actions", "Lifecycle", "Logs", "Bags",
-)  # fmt: skip
+# The dashboard's tools, grouped as a learner thinks of them: what I learn with, what I
+# run, what I watch flowing through the running system, how I ask its nodes to do or
+# change something, what I see in 3D, what I record. Each group is a tab holding its
+# tools' tabs, one row each. A new tool joins the group it belongs to.
+TOOL_GROUPS: dict[str, tuple[str, ...]] = {
+    "Learn": ("Lessons", "Exercise"),
+    "Run": ("Nodes", "Console", "Turtlesim"),
+    "Inspect": ("Graph", "TF", "Topics", "Echo", "Logs"),
+    "Interact": ("Services", "Actions", "Parameters", "Lifecycle"),
+    "See": ("3D view",),
+    "Record": ("Bags",),
+}
+# Every tool tab, in order. Lessons name them ("Open the Lifecycle tool") and are
+# checked against this list when they load.
+TAB_NAMES = tuple(name for names in TOOL_GROUPS.values() for name in names)
+GROUP_OF = {name: group for group, names in TOOL_GROUPS.items() for name in names}
 
 
 class Panel(Protocol):

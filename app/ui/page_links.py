@@ -48,6 +48,7 @@ class PageLinks:
         self._secret = secrets.token_urlsafe(16)
         self._lock = threading.Lock()
         self._actions: dict[str, Callable[[], None]] = {}
+        self._valued: dict[str, Callable[[str], None]] = {}
 
     def register(self, name: str, action: Callable[[], None]) -> str:
         """Make ``action`` reachable by a link; returns the link's address."""
@@ -55,6 +56,18 @@ class PageLinks:
             raise ValueError(f"a page link name needs a-z, 0-9, '_', '.', '-': {name!r}")
         with self._lock:
             self._actions[name] = action
+        return self.href(name)
+
+    def register_value(self, name: str, action: Callable[[str], None]) -> str:
+        """Like ``register``, for a link that carries one value: ``<address>/<value>``.
+
+        The page appends what it reports (e.g. its window's width); the value is
+        a-z, 0-9, '_', '.', '-' only, and ``action`` must still check it.
+        """
+        if not _NAME.match(name):
+            raise ValueError(f"a page link name needs a-z, 0-9, '_', '.', '-': {name!r}")
+        with self._lock:
+            self._valued[name] = action
         return self.href(name)
 
     def href(self, name: str) -> str:
@@ -73,8 +86,14 @@ class PageLinks:
         secret, _, name = path[len(PREFIX) :].partition("/")
         if not secrets.compare_digest(secret.encode(), self._secret.encode()):
             return None
+        name, _, value = name.partition("/")
         with self._lock:
-            return self._actions.get(name)
+            if not value:
+                return self._actions.get(name)
+            valued = self._valued.get(name)
+        if valued is None or not _NAME.match(value):
+            return None
+        return lambda: valued(value)
 
     # -- server extension (viser's asyncio thread) -------------------------------
 

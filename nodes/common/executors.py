@@ -39,9 +39,7 @@ class SteadyMultiThreadedExecutor(MultiThreadedExecutor):
         self, timeout_sec=None, wait_condition: Callable[[], bool] = lambda: False
     ) -> None:
         try:
-            handler, _entity, _node = self.wait_for_ready_callbacks(
-                timeout_sec, None, wait_condition
-            )
+            handler = self.wait_for_ready_callbacks(timeout_sec, None, wait_condition)[0]
         except (
             ExternalShutdownException,
             ShutdownException,

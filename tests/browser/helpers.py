@@ -6,12 +6,18 @@ import re
 import time
 
 import pytest
-from playwright.sync_api import Page, expect
+from playwright.sync_api import Locator, Page, expect
 from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+from app.ui import GROUP_OF
 
 
 def open_tab(page: Page, name: str) -> None:
-    page.get_by_role("tab", name=name).click()
+    """Open a tool's tab as a learner does: its group's tab first (Inspect, then Echo)."""
+    group = GROUP_OF.get(name)
+    if group is not None:
+        page.get_by_role("tab", name=group, exact=True).click()
+    page.get_by_role("tab", name=name, exact=True).click()
 
 
 def choose(page: Page, label: str, option: str) -> None:
@@ -87,3 +93,64 @@ _CUT_OFF_JS = """([selector, text]) => {
 def cut_off_at_panel_edge(page: Page, selector: str, text: str) -> list[str]:
     """What sticks out of the scrolling panel that holds ``selector`` with ``text`` (none: [])."""
     return page.evaluate(_CUT_OFF_JS, [selector, text])
+
+
+# Why an element is not fully in view: outside the window, clipped by a scrolling box
+# (the control panel scrolled), or covered by something else; '' when the learner sees it.
+_OUT_OF_VIEW_JS = """(elements) => elements.map((el) => {
+  const r = el.getBoundingClientRect();
+  const at = (b) => `${Math.round(b.top)}..${Math.round(b.bottom)} x ${Math.round(b.left)}..`
+    + `${Math.round(b.right)}`;
+  if (!r.width || !r.height) return 'not shown';
+  if (r.top < -0.5 || r.left < -0.5 || r.bottom > innerHeight + 0.5 || r.right > innerWidth + 0.5)
+    return `outside the ${innerWidth}x${innerHeight} window at ${at(r)}`;
+  for (let box = el.parentElement; box; box = box.parentElement) {
+    const style = getComputedStyle(box);
+    if (!/(auto|scroll|hidden|clip)/.test(style.overflowX + style.overflowY)) continue;
+    const b = box.getBoundingClientRect();
+    if (r.top < b.top - 0.5 || r.bottom > b.bottom + 0.5 || r.left < b.left - 0.5
+        || r.right > b.right + 0.5)
+      return `at ${at(r)}, cut off by a scrolling box at ${at(b)}`;
+  }
+  const hit = document.elementFromPoint(r.left + r.width / 2, r.top + r.height / 2);
+  if (!hit || !(hit === el || el.contains(hit) || hit.contains(el)))
+    return `covered by ${hit ? hit.tagName + ' ' + (hit.innerText || '').slice(0, 30) : 'nothing'}`;
+  return '';
+})"""
+
+
+def out_of_view(page: Page, controls: dict[str, Locator]) -> list[str]:
+    """Each control (name -> locator) the learner cannot see whole without scrolling.
+
+    Waits for each to be on the page (up to 10 s), then looks at all of them at once.
+    """
+    handles = [locator.first.element_handle(timeout=10_000) for locator in controls.values()]
+    reasons = page.evaluate(_OUT_OF_VIEW_JS, handles)
+    return [f"{name}: {why}" for name, why in zip(controls, reasons, strict=True) if why]
+
+
+CHECK_LINE = re.compile(r"^(✓|✗|…) (pass|fail|waiting)")
+
+
+def step_controls(page: Page, lesson, index: int) -> dict[str, Locator]:
+    """What a learner needs of step ``index`` of ``lesson`` (its title, buttons, quiz
+    answers, check lines, Back and Next), by name; waits for the title and for as many
+    check lines as the step has (``out_of_view`` waits for the rest)."""
+    step = lesson.steps[index]
+    title = f"Step {index + 1} of {len(lesson.steps)}: {step.title}"
+    controls = {"title": page.get_by_text(title, exact=True)}
+    expect(controls["title"]).to_be_visible()
+    for action in step.actions:
+        label = action.get("label") or action.kind.replace("_", " ")
+        controls[f"button {label!r}"] = page.get_by_role("button", name=label, exact=True)
+    checks = page.locator("li").filter(has_text=CHECK_LINE).filter(visible=True)
+    expect(checks).to_have_count(len(step.checks))
+    for i, check in enumerate(step.checks):
+        if check.kind == "quiz":
+            controls[f"answer to {check['question']!r}"] = page.get_by_label(
+                check["question"], exact=True
+            )
+        controls[f"check {i + 1}"] = checks.nth(i)
+    controls["Back"] = page.get_by_role("button", name="Back", exact=True)
+    controls["Next"] = page.get_by_role("button", name="Next", exact=True)
+    return controls

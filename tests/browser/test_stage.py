@@ -3,6 +3,7 @@ can pick another, and the live graph grows and shows messages moving on /chatter
 
 from __future__ import annotations
 
+import re
 import time
 
 import pytest
@@ -10,7 +11,14 @@ from playwright.sync_api import Page, expect
 
 from app.lessons.schema import load_course
 from app.stage import STAGES
-from tests.browser.helpers import choose, open_tab, start_node
+from tests.browser.helpers import (
+    choose,
+    expect_text,
+    open_tab,
+    out_of_view,
+    start_node,
+    step_controls,
+)
 from tests.conftest import ARTIFACTS
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -32,10 +40,18 @@ def _node_names(node) -> list[str]:
 
 def _on_stage(page: Page) -> list[str]:
     """Which stages the page shows, read from what is visible ([] is the 3D scene)."""
-    graph = page.locator("svg.stage-graph").filter(visible=True).count() > 0
-    code = page.get_by_role("tab", name="Code of this lesson").filter(visible=True).count() > 0
-    turtle = page.get_by_text("Turtlesim's window is in the").filter(visible=True).count() > 0
-    return [name for name, on in (("graph", graph), ("code", code), ("turtlesim", turtle)) if on]
+
+    def shown(locator) -> bool:
+        return locator.filter(visible=True).count() > 0
+
+    seen = {
+        "graph": shown(page.locator("svg.stage-graph")),
+        "code": shown(page.get_by_role("tab", name="Code of this lesson"))
+        and shown(page.get_by_role("tab", name="Output of my node")),
+        "turtlesim": shown(page.get_by_text("Arrow keys drive turtle1 while this window")),
+        "tf": shown(page.locator("div.stage-tf")),
+    }
+    return [name for name, on in seen.items() if on]
 
 
 def _wait_stage(page: Page, wanted: str, timeout: float = 5.0) -> None:
@@ -75,8 +91,10 @@ def test_every_lesson_puts_its_stage_on_and_the_learner_can_switch(browser, dash
         for lesson in load_course().lessons:
             choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
             _wait_stage(page, lesson.stage)
-            # The step's controls stay in view: Next is on screen without scrolling the page.
-            expect(page.get_by_role("button", name="Next", exact=True)).to_be_visible()
+            # Every control of the step is in view without scrolling: title, buttons,
+            # answers, checks, Back and Next.
+            hidden = out_of_view(page, step_controls(page, lesson, 0))
+            assert not hidden, f"{lesson.id} at {size}: " + "; ".join(hidden)
         for name, label in STAGES.items():  # the learner's own choice
             choose(page, "On stage", label)
             _wait_stage(page, name)
@@ -85,42 +103,71 @@ def test_every_lesson_puts_its_stage_on_and_the_learner_can_switch(browser, dash
         page.context.close()
 
 
+# How many times each edge's dots have reached its end so far, by the page's own
+# animation clock (a dot arrives each time its motion completes), and which picture.
+_ARRIVALS = """() => {
+  const svg = document.querySelector('svg.stage-graph');
+  svg.__id = svg.__id || Math.random();
+  const now = svg.getCurrentTime();
+  const counts = {};
+  for (const motion of svg.querySelectorAll('circle.sg-dot > animateMotion')) {
+    const edge = motion.parentElement.dataset.edge;
+    const done = Math.floor((now - motion.getStartTime()) / motion.getSimpleDuration());
+    counts[edge] = (counts[edge] || 0) + Math.max(0, done);
+  }
+  return {picture: svg.__id, at: now, counts};
+}"""
+
+
+def _arrival_rates(page: Page, seconds: float) -> dict[str, float]:
+    """Dots arriving per second on each edge over ``seconds``, across picture changes
+    (each edge over the time it was drawn)."""
+    arrived: dict[str, int] = {}
+    drawn: dict[str, float] = {}
+    before = page.evaluate(_ARRIVALS)
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        page.wait_for_timeout(250)
+        now = page.evaluate(_ARRIVALS)
+        if now["picture"] == before["picture"]:  # a new picture restarts its clock
+            for edge, count in now["counts"].items():
+                if edge in before["counts"]:
+                    arrived[edge] = arrived.get(edge, 0) + count - before["counts"][edge]
+                    drawn[edge] = drawn.get(edge, 0.0) + now["at"] - before["at"]
+        before = now
+    short = {edge: round(t, 1) for edge, t in drawn.items() if t < seconds / 2}
+    assert not short, f"the picture kept changing: edges measured only {short} s"
+    return {edge: arrived[edge] / drawn[edge] for edge in arrived}
+
+
 @pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
 def test_the_graph_grows_and_messages_move_on_chatter(browser, dashboard, probe, size):
     page = _open(browser, dashboard, size)
     try:
         choose(page, "On stage", STAGES["graph"])
         talker = page.locator('svg.stage-graph g.sg-vertex[data-name="/talker"]')
-        start_node(page, "talker")
-        # From the moment DDS lists /talker (a probe node sees it) to the box on stage.
-        on_ros_graph = on_stage = None
-        deadline = time.monotonic() + 20
-        while (on_stage is None or on_ros_graph is None) and time.monotonic() < deadline:
-            now = time.monotonic()
-            if on_ros_graph is None and "/talker" in _node_names(probe.node):
-                on_ros_graph = now
-            if on_stage is None and talker.count():
-                on_stage = now
-            page.wait_for_timeout(30)
-        assert on_ros_graph is not None and on_stage is not None, "/talker never showed"
-        grew = on_stage - on_ros_graph  # negative: the stage saw it before the probe did
-        assert grew < 1.0, f"/talker on stage {grew:.2f} s after it joined the ROS graph"
+        open_tab(page, "Nodes")
+        choose(page, "Catalog node", "talker")
+        start = page.get_by_role("button", name="Start", exact=True)
+        start.click()
+        clicked = time.monotonic()
+        # The box is on stage within a second of the click (drawn 'starting…' until DDS
+        # lists the node), then stands for the node the ROS graph lists.
+        expect(talker).to_be_attached(timeout=10_000)
+        grew = time.monotonic() - clicked
+        assert grew < 1.0, f"/talker on stage {grew:.2f} s after the Start click"
+        expect(talker).to_have_attribute("data-state", "on-graph", timeout=20_000)
+        assert "/talker" in _node_names(probe.node)  # what DDS lists, as any ROS tool sees it
         start_node(page, "listener")
         expect(page.locator('svg.stage-graph g.sg-vertex[data-name="/listener"]')).to_be_visible()
-        dots = page.locator('svg.stage-graph circle.sg-dot[data-topic="/chatter"]')
-        # talker -> /chatter -> listener, 2 Hz: two dots on each of the two edges.
-        expect(dots).to_have_count(4, timeout=10_000)
-        expect(page.get_by_text("2.0 Hz").filter(visible=True).first).to_be_visible()
-        # The dots move in the browser: their places change between looks.
-        places = set()
-        for _ in range(6):
-            box = dots.first.bounding_box()
-            assert box is not None
-            places.add((round(box["x"]), round(box["y"])))
-            page.wait_for_timeout(150)
-        assert len(places) >= 3, f"the first dot was at {places} in 0.9 s"
+        expect(page.get_by_text("2.0 Hz").filter(visible=True).first).to_be_visible(timeout=15_000)
+        heard = page.locator('svg.stage-graph circle.sg-dot[data-edge="/chatter>/listener"]')
+        expect(heard).to_have_count(2, timeout=15_000)  # once DDS has listed its subscription
+        # Messages move at the topic's rate: dots arriving per second, counted in the page.
+        rates = _arrival_rates(page, 4.0)
+        for edge in ("/talker>/chatter", "/chatter>/listener"):
+            assert 1.5 <= rates.get(edge, 0) <= 2.5, f"{edge}: {rates} dots/s at 2 Hz"
         # ...without the server resending the picture for them (a steady 2 Hz draws once).
-        page.wait_for_timeout(3000)
         alive = page.evaluate("() => document.querySelector('svg.stage-graph').getCurrentTime()")
         assert alive > 2.5, f"the picture was replaced {alive:.1f} s ago"
         # A click on a box inspects it, as `ros2 topic info` / `ros2 node info` would.
@@ -133,4 +180,95 @@ def test_the_graph_grows_and_messages_move_on_chatter(browser, dashboard, probe,
         expect(talker).to_be_visible()
     finally:
         page.screenshot(path=str(ARTIFACTS / f"stage-graph-{size[0]}.png"))
+        page.context.close()
+
+
+# Notes every pulse the page ever shows (kind and name), however briefly it is drawn.
+_RECORD_PULSES = """() => {
+  window.__pulses = new Set();
+  const note = (root) => root.querySelectorAll && root.querySelectorAll('g.sg-pulse')
+    .forEach((g) => window.__pulses.add(`${g.dataset.kind} ${g.dataset.name}`));
+  new MutationObserver((changes) => changes.forEach((c) => c.addedNodes.forEach(note)))
+    .observe(document.body, {childList: true, subtree: true});
+}"""
+
+
+def _field(page: Page, label: str):
+    """The input beside a viser label (the label's `for` does not point at the input)."""
+    text = page.get_by_text(label, exact=True).locator("visible=true").first
+    return text.locator("xpath=ancestor::div[contains(@class,'mantine-Flex-root')][1]//input")
+
+
+def _pulses_seen(page: Page, wanted: set[str], timeout: float = 20.0) -> set[str]:
+    deadline = time.monotonic() + timeout
+    while True:
+        seen = set(page.evaluate("() => [...window.__pulses]"))
+        if wanted <= seen or time.monotonic() > deadline:
+            return seen
+        page.wait_for_timeout(200)
+
+
+def test_a_service_call_and_an_action_goal_travel_as_pulses(browser, dashboard):
+    page = _open(browser, dashboard, SIZES[0])
+    try:
+        choose(page, "On stage", STAGES["graph"])
+        start_node(page, "add_two_ints_server")
+        start_node(page, "fibonacci_action_server")
+        server = 'svg.stage-graph g.sg-vertex[data-kind="{}"][data-name="{}"]'
+        expect(page.locator(server.format("service", "/add_two_ints"))).to_be_visible()
+        expect(page.locator(server.format("action", "/fibonacci"))).to_be_visible()
+        page.evaluate(_RECORD_PULSES)
+        # A call from the Services tool: its request and its response travel.
+        open_tab(page, "Services")
+        expect(page.get_by_text("Type: tutorial_interfaces/srv/AddTwoInts")).to_be_visible(
+            timeout=30_000
+        )
+        page.get_by_role("button", name="Call", exact=True).click()
+        call = {"request /add_two_ints", "response /add_two_ints"}
+        seen = _pulses_seen(page, call)
+        assert call <= seen, f"pulses seen: {sorted(seen)}"
+        # A Fibonacci goal from the Actions tool: goal, feedback and result.
+        open_tab(page, "Actions")
+        expect(page.get_by_text("Type: tutorial_interfaces/action/Fibonacci")).to_be_visible(
+            timeout=30_000
+        )
+        _field(page, "order (int32)").fill("3")
+        page.get_by_role("button", name="Send goal", exact=True).click()
+        goal = {"goal /fibonacci", "feedback /fibonacci", "result /fibonacci"}
+        seen = _pulses_seen(page, goal, timeout=30.0)
+        assert goal <= seen, f"pulses seen: {sorted(seen)}"
+        expect(page.get_by_text("Status: SUCCEEDED").filter(visible=True)).to_be_visible()
+    finally:
+        page.screenshot(path=str(ARTIFACTS / "stage-pulses.png"))
+        page.context.close()
+
+
+def test_a_click_on_a_box_sets_the_tools_to_it(browser, dashboard):
+    """A topic clicked on stage is echoed and followed in Topics; a node's parameters show."""
+    page = _open(browser, dashboard, SIZES[0])
+    try:
+        choose(page, "On stage", STAGES["graph"])
+        start_node(page, "parameters_node")
+        greeting = page.locator('svg.stage-graph g.sg-vertex[data-name="/greeting"] a')
+        expect(greeting).to_be_visible(timeout=20_000)
+        greeting.click()
+        page.get_by_role("button", name="Echo /greeting", exact=True).click()
+        expect(page.get_by_role("tab", name="Echo", exact=True)).to_have_attribute(
+            "aria-selected", "true"
+        )
+        expect_text(page, "ros2 topic echo /greeting")
+        expect_text(page, re.compile(r"\] data: '"), timeout=20_000)  # its messages
+        page.get_by_role("button", name="Rate, plot and publish /greeting in Topics").click()
+        topic = page.get_by_label("Topic", exact=True).filter(visible=True)
+        expect(topic).to_have_value("/greeting")
+        page.locator('svg.stage-graph g.sg-vertex[data-name="/parameters_node"] a').click()
+        page.get_by_role("button", name="Parameters of /parameters_node", exact=True).click()
+        expect(page.get_by_role("tab", name="Parameters", exact=True)).to_have_attribute(
+            "aria-selected", "true"
+        )
+        expect(page.get_by_label("Node", exact=True).filter(visible=True)).to_have_value(
+            "/parameters_node"
+        )
+    finally:
+        page.screenshot(path=str(ARTIFACTS / "stage-inspect.png"))
         page.context.close()

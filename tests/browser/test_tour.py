@@ -1,11 +1,12 @@
-"""Every tab renders for a learner, with nodes running: each shows what it is for."""
+"""Every tool renders for a learner, with nodes running: each shows what it is for, and the
+tools sit in a row of groups (Learn, Run, Inspect, See, Record), each group's tools in one row."""
 
 from __future__ import annotations
 
 import pytest
 from playwright.sync_api import expect
 
-from app.ui import TAB_NAMES
+from app.ui import TAB_NAMES, TOOL_GROUPS
 from tests.browser.helpers import choose, click, cut_off_at_panel_edge, expect_text, open_tab
 from tests.conftest import ARTIFACTS
 
@@ -19,20 +20,30 @@ EXPECTED = {
     "Lessons": "Course outline",
     "Exercise": "Run my node",
     "Nodes": "All catalog nodes",
+    "Console": "Type a command as the tutorials write it",
     "Turtlesim": "ros2 run turtlesim turtlesim_node",
     "Graph": "ros2 node list",
-    "Echo": "data: 'Hello World:",
-    "3D view": "draws live topics",
     "TF": "No TF frames yet",
     "Topics": "/chatter",
-    "Parameters": "A node's parameters are settings",
-    "Console": "Type a command as the tutorials write it",
+    "Echo": "data: 'Hello World:",
+    "Logs": "records seen",
     "Services": "Show parameter services",
     "Actions": "No action on the graph",
+    "Parameters": "A node's parameters are settings",
     "Lifecycle": "Start lifecycle_talker in the Nodes tab",
-    "Logs": "records seen",
+    "3D view": "draws live topics",
     "Bags": "Record topics into a bag",
 }
+
+
+def _row_of(page, names) -> list[float]:
+    """The top edges of the visible tabs named ``names`` (one value: they share a row)."""
+    tops = []
+    for name in names:
+        box = page.get_by_role("tab", name=name, exact=True).bounding_box()
+        assert box is not None, f"tab {name!r} is not on screen"
+        tops.append(round(box["y"]))
+    return sorted(set(tops))
 
 
 def test_every_tab_renders_without_errors(page):
@@ -40,20 +51,23 @@ def test_every_tab_renders_without_errors(page):
     choose(page, "Launch group", "chatter_demo")
     click(page, "Start group")
     expect_text(page, "Started group")
-    tabs = page.get_by_role("tab")
+    tabs = page.get_by_role("tab").filter(visible=True)
     expect(tabs.first).to_be_visible()
     names = [name.strip() for name in tabs.all_inner_texts()]
     # The stage window docked on the left has a tab of its own; the code window is off stage.
     side = [name for name in names if name in SIDE_WINDOW_TABS + STAGE_TABS]
     assert side == list(STAGE_TABS)
-    names = [name for name in names if name not in STAGE_TABS]
-    assert tuple(names) == TAB_NAMES == tuple(EXPECTED)
-    for name in names:
+    assert [name for name in names if name in TOOL_GROUPS] == list(TOOL_GROUPS)
+    assert len(_row_of(page, TOOL_GROUPS)) == 1, "the groups' tabs wrap onto a second row"
+    assert TAB_NAMES == tuple(EXPECTED)
+    for name in TAB_NAMES:
         open_tab(page, name)
         expect_text(page, EXPECTED[name])
+        group = next(g for g, tools in TOOL_GROUPS.items() if name in tools)
+        assert len(_row_of(page, TOOL_GROUPS[group])) == 1, f"{group}'s tools wrap"
         page.screenshot(path=str(ARTIFACTS / f"tour-{name.replace(' ', '_')}.png"))
         text = page.locator("body").inner_text()
         assert "Traceback" not in text, name
-        assert cut_off_at_panel_edge(page, "[role=tab]", "Lessons") == [], (
+        assert cut_off_at_panel_edge(page, "[role=tab]", "Learn") == [], (
             f"{name}: cut off at the panel's right edge"
         )

@@ -9,10 +9,10 @@ from pathlib import Path
 import pytest
 
 from app.lessons.schema import LESSONS_DIR, LessonError, load_course, load_lesson
-from app.panels.graph_svg import Edge, Vertex, graph_picture
+from app.panels.graph_svg import Edge, Vertex, graph_picture, topics_to_measure
 from app.ros.graph import NodeEndpoints
 from app.stage import DEFAULT_STAGE, STAGES
-from app.stage.graph_view import MAX_DOTS, StablePlaces, dot_timing, stage_svg
+from app.stage.graph_view import MAX_DOTS, PulseView, StablePlaces, dot_timing, stage_svg
 
 
 def test_every_lesson_names_a_known_stage():
@@ -48,8 +48,8 @@ def test_a_unit_without_stage_gets_the_default_and_a_step_can_override(tmp_path)
 def test_an_unknown_stage_is_a_clear_error(tmp_path):
     with pytest.raises(LessonError, match=r"unknown stage 'movie' \(stages: graph, turtlesim"):
         load_lesson(_copy(tmp_path, 'stage = "movie"\n'))
-    with pytest.raises(LessonError, match=r"steps\[0\]: unknown stage 'tf'"):
-        load_lesson(_copy(tmp_path / "b", 'stage = "graph"\n', 'stage = "tf"\n'))
+    with pytest.raises(LessonError, match=r"steps\[0\]: unknown stage 'film'"):
+        load_lesson(_copy(tmp_path / "b", 'stage = "graph"\n', 'stage = "film"\n'))
     with pytest.raises(LessonError, match="field 'stage' must be str"):
         load_lesson(_copy(tmp_path / "c", "stage = 3\n"))
 
@@ -96,12 +96,40 @@ def test_hidden_nodes_and_quiet_topics_are_folded_unless_asked():
     assert names == {"/talker", "/chatter", "/rosout", "/_ros2cli_daemon"}
 
 
+def test_hidden_topics_and_services_are_folded_and_not_measured_unless_asked():
+    """turtlesim's pen trails and teleop's key topic are plumbing: no box, no rate counted."""
+    sim = _endpoints("/turtlesim", publishes=["/turtle1/pose", "/turtlesim/_trails"])
+    sim = NodeEndpoints(
+        **{
+            **sim.__dict__,
+            "servers": {"/spawn": "turtlesim/srv/Spawn", "/turtlesim/_snap": "x/srv/S"},
+        }
+    )
+    teleop = _endpoints("/teleop_turtle", publishes=["/turtle1/cmd_vel", "/teleop_turtle/_key"])
+    follower = _endpoints("/follower", subscribes=["/turtlesim/_trails"])
+    nodes = [sim, teleop, follower]
+    picture = graph_picture(nodes)
+    names = {v.name for v in picture[0]}
+    assert "/turtlesim/_trails" not in names and "/teleop_turtle/_key" not in names
+    assert "/turtlesim/_snap" not in names and "/spawn" in names
+    assert {"/turtle1/pose", "/turtle1/cmd_vel", "/follower"} <= names
+    assert set(topics_to_measure(picture, nodes)) == {"/turtle1/pose", "/turtle1/cmd_vel"}
+    shown = graph_picture(nodes, show_quiet=True)
+    assert {"/turtlesim/_trails", "/teleop_turtle/_key", "/turtlesim/_snap"} <= {
+        v.name for v in shown[0]
+    }
+    assert "/turtlesim/_trails" in topics_to_measure(shown, nodes)
+
+
 def test_dots_follow_the_rate_and_are_capped():
     assert dot_timing(0.0) == []
     (slow,) = dot_timing(0.5)  # one dot, travels 1 s, waits 1 s
     assert slow == (2.0, 0.0, 0.5)
     two = dot_timing(2.0)
     assert [begin for _d, begin, _s in two] == [0.0, -0.5]
+    for rate in (1.3, 2.0, 2.4, 5.0, 7.0):  # arrivals per second (dots / duration) = the rate
+        timing = dot_timing(rate)
+        assert len(timing) / timing[0][0] == pytest.approx(rate)
     assert len(dot_timing(1000.0)) == MAX_DOTS
 
 
@@ -113,4 +141,58 @@ def test_the_svg_animates_dots_on_both_edges_of_a_topic():
     assert svg.count("<animateMotion") == 4
     assert "2.0 Hz" in svg
     quiet = stage_svg(StablePlaces().place(vertices, edges), edges, {})
-    assert "sg-dot" not in quiet
+    assert '<circle class="sg-dot"' not in quiet
+
+
+def _pulse_legs_in(svg: str) -> list[tuple[str, str, float, bool]]:
+    """(kind, name, begin s, travels backwards) of each pulse leg drawn in ``svg``."""
+    legs = re.findall(
+        r'<g class="sg-pulse" data-kind="(\w+)" data-name="([^"]+)".*?'
+        r'<animateMotion begin="(-?[\d.]+)s"([^>]*)>',
+        svg,
+    )
+    return [(kind, name, float(b), 'keyPoints="1;0"' in rest) for kind, name, b, rest in legs]
+
+
+def test_a_call_travels_from_its_caller_to_the_server_and_back():
+    vertices = [
+        Vertex("node", "/server"), Vertex("service", "/add"), Vertex("node", "/client"),
+        Vertex("node", "/other_client"),
+    ]  # fmt: skip
+    edges = [
+        Edge("node:/server", "service:/add"),
+        Edge("node:/client", "service:/add", dashed=True),
+        Edge("node:/other_client", "service:/add", dashed=True),
+    ]
+    placed = StablePlaces().place(vertices, edges)
+    request = PulseView("request", "/add", caller="/client", age=0.0)
+    response = PulseView("response", "/add", caller="/client", age=-1.2)  # after the request
+    svg = stage_svg(placed, edges, {}, pulses=[request, response])
+    assert _pulse_legs_in(svg) == [
+        ("request", "/add", 0.0, False),  # /client -> /add
+        ("request", "/add", 0.6, True),  # /add -> /server, against the server's arrow
+        ("response", "/add", 1.2, False),  # /server -> /add
+        ("response", "/add", 1.8, True),  # /add -> /client
+    ]
+    # Unknown caller (this dashboard, not drawn): only the server's leg, at once.
+    svg = stage_svg(placed, edges, {}, pulses=[PulseView("goal", "/add")])
+    assert _pulse_legs_in(svg) == [("goal", "/add", 0.0, True)]
+    # Half way through: the first leg is over and left out, the second under way.
+    svg = stage_svg(placed, edges, {}, pulses=[PulseView("request", "/add", "/client", 0.9)])
+    assert _pulse_legs_in(svg) == [("request", "/add", -0.3, True)]
+    assert (
+        stage_svg(placed, edges, {}, pulses=[PulseView("result", "/add", "", 5.0)]).count(
+            'class="sg-pulse"'
+        )
+        == 0
+    )
+    assert ">request</text>" in stage_svg(placed, edges, {}, pulses=[request])  # said in words
+
+
+def test_a_started_node_is_drawn_dashed_until_the_graph_lists_it():
+    vertices = [Vertex("node", "/talker", "starting…")]
+    placed = StablePlaces().place(vertices, [])
+    svg = stage_svg(placed, [], {}, starting=frozenset({"/talker"}))
+    assert 'data-name="/talker" data-state="starting"' in svg and "stroke-dasharray" in svg
+    svg = stage_svg(StablePlaces().place([Vertex("node", "/talker")], []), [], {})
+    assert 'data-state="on-graph"' in svg and "stroke-dasharray" not in svg

@@ -1,0 +1,62 @@
+"""What the page needs so that everyone can use it: contrast and names viser leaves out.
+
+An accessibility checker (axe-core, in tests/browser/test_accessibility.py)
+found, in viser's own widgets: white text on mid blue, green, red and gray
+buttons (contrast 2.3-3.6, WCAG asks 4.5), gray labels on white (3.3) and
+message text on dark gray (3.5), and icon-only buttons without a name (a
+message's close button, the viewer's settings button), and images without alt
+text (viser's image widget shows a label, not an alt). The dashboard sends
+this once: darker button colours and labels in both colour schemes (CSS
+variables of Mantine, viser's UI kit), and a page script that names the
+unnamed buttons as they appear.
+"""
+
+from __future__ import annotations
+
+from app.ui.page_script import page_script
+
+# Filled buttons (white text) and dimmed labels, each at least 4.5:1 against its background.
+_CSS = (
+    ":root[data-mantine-color-scheme]{"
+    "--mantine-primary-color-filled:#1971c2!important;"
+    "--mantine-primary-color-filled-hover:#1864ab!important;"
+    "--mantine-color-blue-filled:#1971c2!important;--mantine-color-blue-filled-hover:#1864ab!important;"
+    "--mantine-color-green-filled:#2b7a3b!important;"
+    "--mantine-color-green-filled-hover:#236630!important;"
+    "--mantine-color-red-filled:#c92a2a!important;--mantine-color-red-filled-hover:#a82323!important;"
+    "--mantine-color-gray-filled:#495057!important;--mantine-color-gray-filled-hover:#343a40!important}"
+    ":root[data-mantine-color-scheme=light]{--mantine-color-dimmed:#5c636a!important}"
+    ":root[data-mantine-color-scheme=dark]{--mantine-color-dimmed:#b1b5b9!important}"
+    ".mantine-Notification-description{color:var(--mantine-color-dimmed)!important}"
+)
+
+_NAME_BUTTONS = """
+const doc = parent.document;
+const nameOf = (button) => {
+  if (button.matches('.mantine-Notification-closeButton')) return 'Close this message';
+  if (button.querySelector('.tabler-icon-adjustments')) return 'Viewer settings';
+  return '';
+};
+const fix = () => {
+  for (const button of doc.querySelectorAll('button:not([aria-label]):not([title])')) {
+    if (button.innerText.trim()) continue;
+    const name = nameOf(button);
+    if (name) button.setAttribute('aria-label', name);
+  }
+  // viser's image widget (turtlesim's window, camera images) has a label but no alt text.
+  for (const img of doc.querySelectorAll('img:not([alt])')) {
+    const box = img.parentElement && img.parentElement.parentElement;
+    const label = box && box.firstElementChild && box.firstElementChild.tagName === 'P'
+      ? box.firstElementChild.innerText.trim() : '';
+    img.setAttribute('alt', label ? `${label} (live picture)` : 'live picture');
+  }
+};
+if (parent.__classroomNamer) parent.__classroomNamer.disconnect();
+parent.__classroomNamer = new parent.MutationObserver(fix);
+parent.__classroomNamer.observe(doc.body, {childList: true, subtree: true});
+fix();
+"""
+
+
+def page_fixes_html() -> str:
+    return f"<style>{_CSS}</style>" + page_script(_NAME_BUTTONS, "button names")
