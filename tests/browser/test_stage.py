@@ -19,7 +19,8 @@ from tests.browser.helpers import (
     start_node,
     step_controls,
 )
-from tests.conftest import ARTIFACTS
+from tests.conftest import ARTIFACTS, wait_until
+from tests.integration.core_helpers import DISCOVERY_TIMEOUT
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
@@ -157,7 +158,12 @@ def test_the_graph_grows_and_messages_move_on_chatter(browser, dashboard, probe,
         grew = time.monotonic() - clicked
         assert grew < 1.0, f"/talker on stage {grew:.2f} s after the Start click"
         expect(talker).to_have_attribute("data-state", "on-graph", timeout=20_000)
-        assert "/talker" in _node_names(probe.node)  # what DDS lists, as any ROS tool sees it
+        # What DDS lists, as any ROS tool sees it (this probe discovers on its own time).
+        wait_until(
+            lambda: "/talker" in _node_names(probe.node),
+            timeout=DISCOVERY_TIMEOUT,
+            what=lambda: f"/talker in the probe's graph: {_node_names(probe.node)}",
+        )
         start_node(page, "listener")
         expect(page.locator('svg.stage-graph g.sg-vertex[data-name="/listener"]')).to_be_visible()
         expect(page.get_by_text("2.0 Hz").filter(visible=True).first).to_be_visible(timeout=15_000)
