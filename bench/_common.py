@@ -166,8 +166,16 @@ def open_dashboard(browser: Any, url: str, init_js: str | None = None) -> Any:
     if init_js:
         page.add_init_script(init_js)
     page.goto(url)
-    page.get_by_role("tab", name="Nodes").wait_for(timeout=30_000)
+    page.get_by_role("tab", name="Learn", exact=True).wait_for(timeout=30_000)
     return page
+
+
+def open_tool(page: Any, name: str) -> None:
+    """Open a dashboard tool as a learner does: its group's tab (Run, Inspect...), then its own."""
+    from app.ui import GROUP_OF
+
+    page.get_by_role("tab", name=GROUP_OF[name], exact=True).click()
+    page.get_by_role("tab", name=name, exact=True).click()
 
 
 def machine() -> dict[str, Any]:

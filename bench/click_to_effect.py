@@ -27,6 +27,7 @@ from bench._common import (
     configure_dds,
     launch_browser,
     open_dashboard,
+    open_tool,
     require_private_netns,
     rounded,
     start_dashboard,
@@ -66,7 +67,7 @@ def timed_click(page: Any, button: Any, pattern: str, timeout_ms: float = 20_000
 
 
 def start_node(page: Any, name: str) -> None:
-    page.get_by_role("tab", name="Nodes").click()
+    open_tool(page, "Nodes")
     page.get_by_label("Catalog node").click()
     page.get_by_role("option", name=name, exact=True).click()
     page.get_by_role("button", name="Start", exact=True).click()
@@ -74,7 +75,7 @@ def start_node(page: Any, name: str) -> None:
 
 def lifecycle_clicks(page: Any, repeats: int) -> list[float]:
     start_node(page, "lifecycle_talker")
-    page.get_by_role("tab", name="Lifecycle").click()
+    open_tool(page, "Lifecycle")
     initial = page.get_by_text(re.compile(r"Current state of /lifecycle_talker: unconfigured"))
     initial.first.wait_for(timeout=30_000)
     times = []
@@ -93,7 +94,7 @@ def lifecycle_clicks(page: Any, repeats: int) -> list[float]:
 
 def service_clicks(page: Any, repeats: int) -> list[float]:
     start_node(page, "add_two_ints_server")
-    page.get_by_role("tab", name="Services").click()
+    open_tool(page, "Services")
     deadline = time.monotonic() + 30
     while True:  # pick /add_two_ints once the dashboard lists it
         page.get_by_role("combobox", name="Service", exact=True).click()

@@ -49,6 +49,7 @@ from bench._common import (
     configure_dds,
     free_port,
     launch_browser,
+    open_tool,
     require_private_netns,
     spawn,
     start_dashboard,
@@ -374,7 +375,7 @@ def pick_cloud_topic(browser, url: str) -> None:
     try:
         page = context.new_page()
         page.goto(url)
-        page.get_by_role("tab", name="3D view").click()
+        open_tool(page, "3D view")
         deadline = time.monotonic() + 30
         while True:
             page.get_by_label("Cloud topic").click()

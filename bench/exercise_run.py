@@ -41,6 +41,7 @@ from bench._common import (
     free_port,
     launch_browser,
     open_dashboard,
+    open_tool,
     ratio,
     require_private_netns,
     rounded,
@@ -200,7 +201,7 @@ def run(repeats: int, checks: int) -> dict[str, Any]:
             browser = launch_browser(pw)
             page = open_dashboard(browser, url, PROBE_JS)
             # The Exercise tab on multiply_service, its code open in the editor.
-            page.get_by_role("tab", name="Exercise").click()
+            open_tool(page, "Exercise")
             page.get_by_label("Exercise").click()
             label = re.compile(rf"^{exercise.unit:02d} · {re.escape(exercise.title)}")
             page.get_by_role("option", name=label).click()
@@ -214,7 +215,7 @@ def run(repeats: int, checks: int) -> dict[str, Any]:
             stop_mine = page.get_by_role("button", name="Stop (Ctrl+C)", exact=True)
             check_button = page.get_by_role("button", name="Check my node", exact=True)
             # The Nodes tab on the catalog node.
-            page.get_by_role("tab", name="Nodes").click()
+            open_tool(page, "Nodes")
             page.get_by_label("Catalog node").click()
             page.get_by_role("option", name=CATALOG, exact=True).click()
             start_button = page.get_by_role("button", name="Start", exact=True)
@@ -228,7 +229,7 @@ def run(repeats: int, checks: int) -> dict[str, Any]:
 
             def start_and_stop(way: str) -> float:
                 tab, start, halt, fqn, marker = ways[way]
-                page.get_by_role("tab", name=tab).click()
+                open_tool(page, tab)
                 t0, clicked = main_frame_click(page, start)
                 seen = watch.when(fqn, True, t0)
                 born = spawned_at(dashboard.pid, marker, offset)
@@ -251,7 +252,7 @@ def run(repeats: int, checks: int) -> dict[str, Any]:
                 )
 
             # Check: the learner's node runs; time Check until every result shows.
-            page.get_by_role("tab", name="Exercise").click()
+            open_tool(page, "Exercise")
             t0, _ = main_frame_click(page, run_button)
             watch.when(LEARNER_FQN, True, t0)
             page.wait_for_timeout(1000)

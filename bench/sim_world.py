@@ -51,6 +51,7 @@ from bench._common import (
     configure_dds,
     launch_browser,
     open_dashboard,
+    open_tool,
     rate_from_stamps,
     require_private_netns,
     rounded,
@@ -229,7 +230,7 @@ def run(seconds: float) -> dict[str, Any]:
         with sync_playwright() as playwright:
             browser = launch_browser(playwright)
             page = open_dashboard(browser, url)
-            page.get_by_role("tab", name="3D view").click()
+            open_tool(page, "3D view")
             page.get_by_label("On stage").click()
             page.get_by_role("option", name="3D scene", exact=True).click()
             dash = psutil.Process(dashboard.pid)

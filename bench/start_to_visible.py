@@ -32,6 +32,7 @@ from bench._common import (
     configure_dds,
     launch_browser,
     open_dashboard,
+    open_tool,
     ratio,
     require_private_netns,
     rounded,
@@ -174,7 +175,7 @@ def run(trials: int) -> dict[str, Any]:
         with sync_playwright() as pw:
             browser = launch_browser(pw)
             page = open_dashboard(browser, url, GRAPH_PROBE_JS)
-            page.get_by_role("tab", name="Nodes").click()
+            open_tool(page, "Nodes")
             page.get_by_label("Catalog node").click()
             page.get_by_role("option", name=NODE, exact=True).click()
             start_button = page.get_by_role("button", name="Start", exact=True)

@@ -67,7 +67,7 @@ def one_start(browser: Any, kind: str) -> tuple[float, float]:
         page = context.new_page()
         page.goto(f"http://127.0.0.1:{port}")
         if kind == "dashboard":
-            page.get_by_role("tab", name="Nodes").wait_for(timeout=60_000)
+            page.get_by_role("tab", name="Learn", exact=True).wait_for(timeout=60_000)
         else:
             page.get_by_text("bare app").wait_for(timeout=60_000)
         shown = time.monotonic() - t0

@@ -45,7 +45,7 @@ RUNS: tuple[tuple[str, list[str]], ...] = (
     ("stage_graph", ["--seconds", "5", "--rounds", "2"]),
     ("tf2_lookup", ["--seconds", "5", "--lookups", "3000"]),
     ("hub_spawn", ["--counts", "1,5", "--seconds", "6"]),  # 20 learners: run it alone
-    ("colcon_build", ["--python-rounds", "4", "--interface-rounds", "2", "--run-rounds", "4"]),
+    ("colcon_build", ["--python-rounds", "4", "--interface-rounds", "2", "--run-rounds", "6"]),
 )
 
 # (figure, benchmark, key ("a|b" shows both), unit, aim text, aim test)

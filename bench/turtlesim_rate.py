@@ -34,6 +34,7 @@ from bench._common import (
     configure_dds,
     launch_browser,
     open_dashboard,
+    open_tool,
     rate_from_stamps,
     require_private_netns,
     rounded,
@@ -122,7 +123,7 @@ def run(seconds: float, turtles: int) -> dict[str, Any]:
         with sync_playwright() as pw:
             browser = launch_browser(pw)
             page = open_dashboard(browser, url)
-            page.get_by_role("tab", name="Turtlesim").click()
+            open_tool(page, "Turtlesim")
             page.get_by_role("button", name="Start turtlesim_node", exact=True).click()
             spawn = node.create_client(Spawn, "/spawn")
             if not spawn.wait_for_service(timeout_sec=60):

@@ -51,6 +51,7 @@ from bench._common import (
     free_port,
     launch_browser,
     open_dashboard,
+    open_tool,
     require_private_netns,
     rounded,
     spawn,
@@ -250,7 +251,7 @@ def run(seconds: float) -> dict[str, Any]:
                 # edges the same software renderer draws: no part of the 3D view's cost.
                 page.get_by_label("On stage").click()
                 page.get_by_role("option", name="3D scene", exact=True).click()
-                page.get_by_role("tab", name="3D view").click()
+                open_tool(page, "3D view")
                 for box in ("Frame names", "Frame axes"):  # a server-side setting: shared
                     checkbox = page.get_by_label(box, exact=True)
                     if checkbox.is_checked() != frames_shown:
