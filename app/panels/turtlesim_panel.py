@@ -21,30 +21,21 @@ import json
 from typing import Any
 
 import viser
-from rcl_interfaces.msg import ParameterEvent
 from rclpy.node import Node
-from rclpy.publisher import Publisher
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from rclpy.subscription import Subscription
-from std_msgs.msg import Empty, String, UInt8MultiArray
-from turtlesim.msg import Pose
+from std_msgs.msg import String
 
+from app.panels.turtlesim_feed import TurtlesimFeed, find_sims
 from app.panels.turtlesim_view import TurtlesimView
-from app.ros.context import panel_context
 from app.ros.graph import GraphSnapshot
-from app.ros.params import get_values, python_value
 from app.supervisor import Supervisor
 from app.ui import MarkdownView, set_options
 from app.ui.loop import UiLoop
 from app.ui.page_links import PageLinks
 
 NONE = "(no turtlesim)"
-TRAILS_SUFFIX = "/_trails"
-TRAILS_TYPE = "std_msgs/msg/UInt8MultiArray"
 POSE_TYPE = "turtlesim/msg/Pose"
 KEY_TOPIC = "/teleop_turtle/_key"
 TELEOP_NODE = "/teleop_turtle"
-BACKGROUND = ("background_r", "background_g", "background_b")
 # Browser key (KeyboardEvent.key, lower-cased) -> the key name turtle_teleop_key takes.
 KEYS = {
     "arrowup": "up", "arrowdown": "down", "arrowleft": "left", "arrowright": "right",
@@ -52,11 +43,6 @@ KEYS = {
 }  # fmt: skip
 DRIVE = {"↑": "up", "↓": "down", "←": "left", "→": "right"}
 HEADINGS = "G B V C D E R T"
-TRAILS_QOS = QoSProfile(
-    depth=50, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
-)
-# A viewer needs only the newest pose: best effort, one deep (no queue to work through).
-POSE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT)
 
 INTRO = (
     "Turtlesim's window, drawn live from ROS: the background from the node's "
@@ -134,18 +120,14 @@ class TurtlesimPanel:
         self._started: dict[str, str] = {}  # program -> what its Start button did
         self._nodes: tuple[str, ...] | None = None
         self._sims: list[str] = []
-        self._sim: str | None = None  # the followed node's full name
-        self._trails: Subscription | None = None
-        self._events: Subscription | None = None
-        self._requests: Publisher | None = None
-        self._poses: dict[str, tuple[str, Subscription]] = {}  # turtle -> (topic, subscription)
         self._keys = node.create_publisher(String, KEY_TOPIC, 10)
 
         gui.add_markdown(INTRO)
         self._selector = gui.add_dropdown("Turtlesim node", [NONE], initial_value=NONE)
         self._status = MarkdownView(gui, NOT_RUNNING)
         self._start_sim = gui.add_button("Start turtlesim_node", icon=viser.Icon.PLAYER_PLAY)
-        self.view = TurtlesimView(gui, self._ask_snapshot)
+        self.view = TurtlesimView(gui, lambda: self._feed.ask_snapshot())
+        self._feed = TurtlesimFeed(node, ui, self.view)
         self._teleop_hint = MarkdownView(gui, "")
         self._start_teleop = gui.add_button("Start turtle_teleop_key", icon=viser.Icon.KEYBOARD)
         gui.add_markdown(KEY_HELP)
@@ -189,107 +171,21 @@ class TurtlesimPanel:
 
     # -- following one sim -------------------------------------------------------
 
-    def _ask_snapshot(self) -> None:
-        """From the view's thread: the trails are out of step, ask the sim for a snapshot."""
-        publisher = self._requests
-        if publisher is not None:
-            try:
-                publisher.publish(Empty())
-            except Exception:  # swapped for another sim's just now: the view asks again
-                pass
-
     def _follow_selected(self) -> None:
-        wanted = self._selector.value if self._selector.value in self._sims else None
-        if wanted == self._sim:
-            return
-        self._unfollow()
-        self._sim = wanted
-        self.view.follow(wanted is not None)
-        if wanted is None:
-            return
-        node, view = self._node, self.view
-        self._requests = node.create_publisher(Empty, wanted + "/_trails_request", 10)
-
-        def on_trails(msg: UInt8MultiArray) -> None:
-            view.offer_trails(bytes(msg.data))
-
-        self._trails = node.create_subscription(
-            UInt8MultiArray, wanted + TRAILS_SUFFIX, on_trails, TRAILS_QOS
-        )
-        self._events = node.create_subscription(
-            ParameterEvent, "/parameter_events", lambda msg: self._on_event(wanted, msg), 100
-        )
-        ctx = panel_context(node)
-
-        def work() -> list[Any]:
-            return [python_value(v) for v in get_values(ctx, wanted, list(BACKGROUND))]
-
-        def done(values: list[Any]) -> None:
-            if self._sim == wanted and all(isinstance(v, int) for v in values):
-                view.set_background((values[0], values[1], values[2]))
-
-        self._ui.run_job(work, done, lambda _text: None)
-
-    def _on_event(self, sim: str, event: ParameterEvent) -> None:
-        """Executor thread: a background channel changed on the followed sim."""
-        if event.node != sim:
-            return
-        rgb = list(self.view.background)
-        for parameter in (*event.new_parameters, *event.changed_parameters):
-            if parameter.name in BACKGROUND:
-                value = python_value(parameter.value)
-                if isinstance(value, int):
-                    rgb[BACKGROUND.index(parameter.name)] = value
-        self.view.set_background((rgb[0], rgb[1], rgb[2]))
-
-    def _unfollow(self) -> None:
-        for subscription in (self._trails, self._events):
-            if subscription is not None:
-                self._node.destroy_subscription(subscription)
-        if self._requests is not None:
-            requests, self._requests = self._requests, None
-            self._node.destroy_publisher(requests)
-        self._trails = self._events = None
-        self._sync_turtles({})
-
-    def _sync_turtles(self, topics: dict[str, str]) -> None:
-        for name, (topic, subscription) in list(self._poses.items()):
-            if topics.get(name) != topic:
-                self._node.destroy_subscription(subscription)
-                del self._poses[name]
-        view = self.view
-        for name, topic in topics.items():
-            if name not in self._poses:
-
-                def on_pose(msg: Pose, name: str = name) -> None:
-                    view.offer_pose(name, msg.x, msg.y, msg.theta)
-
-                subscription = self._node.create_subscription(Pose, topic, on_pose, POSE_QOS)
-                self._poses[name] = (topic, subscription)
-        view.keep_turtles(set(topics))
-
-    def _find_sims(self) -> list[str]:
-        """Nodes publishing a trails topic (hidden names are not in the snapshot: ask DDS)."""
-        return sorted(
-            name[: -len(TRAILS_SUFFIX)]
-            for name, types in self._node.get_topic_names_and_types()
-            if name.endswith(TRAILS_SUFFIX)
-            and TRAILS_TYPE in types
-            and self._node.count_publishers(name) > 0
-        )
+        self._feed.follow(self._selector.value if self._selector.value in self._sims else None)
 
     # -- the UI thread's refresh ---------------------------------------------------
 
     def refresh(self, graph: GraphSnapshot) -> None:
         if graph.nodes != self._nodes or not self._sims:
             self._nodes = graph.nodes
-            sims = [s for s in self._find_sims() if graph.has_node(s)]
+            sims = [s for s in find_sims(self._node) if graph.has_node(s)]
             if sims != self._sims:
                 self._sims = sims
                 set_options(self._selector, sims or [NONE], keep_current=False)
         self._follow_selected()
-        sim = self._sim
-        self._sync_turtles(pose_topics(graph, sim) if sim else {})
+        sim = self._feed.sim
+        self._feed.sync_turtles(pose_topics(graph, sim) if sim else {})
         self._start_sim.visible = sim is None
         self._status.show(self._status_text(sim))
         teleop = graph.has_node(TELEOP_NODE)
@@ -306,7 +202,7 @@ class TurtlesimPanel:
         if sim is None:
             return NOT_RUNNING + self._start_note("turtlesim_node")
         stats = self.view.stats()
-        turtles = ", ".join(sorted(self._poses)) or "none yet"
+        turtles = ", ".join(self._feed.turtles) or "none yet"
         rate = f"{stats.rate_hz:.0f} frames/s" if stats.rate_hz else "idle"
         cost = f" · {stats.draw_ms:.1f} ms a frame" if stats.draw_ms is not None else ""
         trails = "" if stats.in_step else " · waiting for the trails"
@@ -317,5 +213,5 @@ class TurtlesimPanel:
 
     def close(self) -> None:
         self.view.close()
-        self._unfollow()
+        self._feed.follow(None)
         self._node.destroy_publisher(self._keys)

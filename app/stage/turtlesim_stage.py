@@ -15,30 +15,16 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable
-from typing import Any
 
 import viser
-from rcl_interfaces.msg import ParameterEvent
 from rclpy.node import Node
 from rclpy.publisher import Publisher
-from rclpy.subscription import Subscription
-from std_msgs.msg import Empty, String, UInt8MultiArray
-from turtlesim.msg import Pose
+from std_msgs.msg import String
 
-from app.panels.turtlesim_panel import (
-    BACKGROUND,
-    KEY_TOPIC,
-    KEYS,
-    POSE_QOS,
-    TRAILS_QOS,
-    TRAILS_SUFFIX,
-    TRAILS_TYPE,
-    pose_topics,
-)
+from app.panels.turtlesim_feed import TurtlesimFeed, find_sims
+from app.panels.turtlesim_panel import KEY_TOPIC, KEYS, pose_topics
 from app.panels.turtlesim_view import TurtlesimView
-from app.ros.context import panel_context
 from app.ros.graph import GraphSnapshot
-from app.ros.params import get_values, python_value
 from app.ui import MarkdownView
 from app.ui.loop import UiLoop
 from app.ui.page_links import PageLinks
@@ -85,16 +71,12 @@ class TurtlesimStage:
         self._ui = ui
         self._node = node
         self._active = False
-        self._sim: str | None = None
-        self._trails: Subscription | None = None
-        self._events: Subscription | None = None
-        self._requests: Publisher | None = None
-        self._poses: dict[str, tuple[str, Subscription]] = {}
         self._keys: Publisher | None = None
         self._box = gui.add_folder(None, visible=False)
         with self._box:
             self._status = MarkdownView(gui, NO_SIM)
-            self.view = TurtlesimView(gui, self._ask_snapshot)
+            self.view = TurtlesimView(gui, lambda: self._feed.ask_snapshot())
+            self._feed = TurtlesimFeed(node, ui, self.view)
             gui.add_markdown(KEY_HINT)
             if links is not None:
                 hrefs = {
@@ -122,110 +104,27 @@ class TurtlesimStage:
         self._active = active
         self._box.visible = active
         if not active:
-            self._follow(None)
-
-    def _ask_snapshot(self) -> None:
-        """From the view's thread: the trails are out of step, ask the sim for a snapshot."""
-        publisher = self._requests
-        if publisher is not None:
-            try:
-                publisher.publish(Empty())
-            except Exception:  # swapped for another sim's just now: the view asks again
-                pass
-
-    def _follow(self, sim: str | None) -> None:
-        if sim == self._sim:
-            return
-        for subscription in (self._trails, self._events):
-            if subscription is not None:
-                self._node.destroy_subscription(subscription)
-        if self._requests is not None:
-            self._node.destroy_publisher(self._requests)
-        self._trails = self._events = self._requests = None
-        self._sync_turtles({})
-        self._sim = sim
-        self.view.follow(sim is not None)
-        if sim is None:
-            return
-        node, view = self._node, self.view
-        self._requests = node.create_publisher(Empty, sim + "/_trails_request", 10)
-
-        def on_trails(msg: UInt8MultiArray) -> None:
-            view.offer_trails(bytes(msg.data))
-
-        self._trails = node.create_subscription(
-            UInt8MultiArray, sim + TRAILS_SUFFIX, on_trails, TRAILS_QOS
-        )
-        self._events = node.create_subscription(
-            ParameterEvent, "/parameter_events", lambda m: self._on_event(sim, m), 100
-        )
-        ctx = panel_context(node)
-
-        def work() -> list[Any]:
-            return [python_value(v) for v in get_values(ctx, sim, list(BACKGROUND))]
-
-        def done(values: list[Any]) -> None:
-            if self._sim == sim and all(isinstance(v, int) for v in values):
-                view.set_background((values[0], values[1], values[2]))
-
-        self._ui.run_job(work, done, lambda _text: None)
-
-    def _on_event(self, sim: str, event: ParameterEvent) -> None:
-        """Executor thread: a background channel changed on the followed sim."""
-        if event.node != sim:
-            return
-        rgb = list(self.view.background)
-        for parameter in (*event.new_parameters, *event.changed_parameters):
-            if parameter.name in BACKGROUND:
-                value = python_value(parameter.value)
-                if isinstance(value, int):
-                    rgb[BACKGROUND.index(parameter.name)] = value
-        self.view.set_background((rgb[0], rgb[1], rgb[2]))
-
-    def _sync_turtles(self, topics: dict[str, str]) -> None:
-        for name, (topic, subscription) in list(self._poses.items()):
-            if topics.get(name) != topic:
-                self._node.destroy_subscription(subscription)
-                del self._poses[name]
-        view = self.view
-        for name, topic in topics.items():
-            if name not in self._poses:
-
-                def on_pose(msg: Pose, name: str = name) -> None:
-                    view.offer_pose(name, msg.x, msg.y, msg.theta)
-
-                self._poses[name] = (
-                    topic,
-                    self._node.create_subscription(Pose, topic, on_pose, POSE_QOS),
-                )
-        view.keep_turtles(set(topics))
+            self._feed.follow(None)
 
     def _find_sim(self, graph: GraphSnapshot) -> str | None:
-        """The first node publishing a trails topic (hidden topics: ask DDS itself)."""
-        sims = sorted(
-            name[: -len(TRAILS_SUFFIX)]
-            for name, types in self._node.get_topic_names_and_types()
-            if name.endswith(TRAILS_SUFFIX)
-            and TRAILS_TYPE in types
-            and self._node.count_publishers(name) > 0
-        )
-        return next((s for s in sims if graph.has_node(s)), None)
+        """The first node publishing a trails topic that the graph lists."""
+        return next((s for s in find_sims(self._node) if graph.has_node(s)), None)
 
     def refresh(self, graph: GraphSnapshot) -> None:
         if not self._active:
             return
-        if self._sim is None or not graph.has_node(self._sim):
-            self._follow(self._find_sim(graph))
-        sim = self._sim
-        self._sync_turtles(pose_topics(graph, sim) if sim else {})
+        if self._feed.sim is None or not graph.has_node(self._feed.sim):
+            self._feed.follow(self._find_sim(graph))
+        sim = self._feed.sim
+        self._feed.sync_turtles(pose_topics(graph, sim) if sim else {})
         if sim is None:
             self._status.show(NO_SIM)
         else:
-            turtles = ", ".join(sorted(self._poses)) or "none yet"
+            turtles = ", ".join(self._feed.turtles) or "none yet"
             self._status.show(f"`{sim}` · turtles: {turtles}")
 
     def close(self) -> None:
         self.view.close()
-        self._follow(None)
+        self._feed.follow(None)
         if self._keys is not None:
             self._node.destroy_publisher(self._keys)
