@@ -171,10 +171,13 @@ def open_dashboard(browser: Any, url: str, init_js: str | None = None) -> Any:
 
 
 def open_tool(page: Any, name: str) -> None:
-    """Open a dashboard tool as a learner does: its group's tab (Run, Inspect...), then its own."""
+    """Open a dashboard tool as a learner does: its group's tab (Run, Inspect...), then its own
+    (a tab outside the groups, such as the stage window's, directly)."""
     from app.ui import GROUP_OF
 
-    page.get_by_role("tab", name=GROUP_OF[name], exact=True).click()
+    group = GROUP_OF.get(name)
+    if group is not None:
+        page.get_by_role("tab", name=group, exact=True).click()
     page.get_by_role("tab", name=name, exact=True).click()
 
 

@@ -9,15 +9,10 @@ import pytest
 from playwright.sync_api import Locator, Page, expect
 from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
-from app.ui import GROUP_OF
+from bench._common import open_tool
 
-
-def open_tab(page: Page, name: str) -> None:
-    """Open a tool's tab as a learner does: its group's tab first (Inspect, then Echo)."""
-    group = GROUP_OF.get(name)
-    if group is not None:
-        page.get_by_role("tab", name=group, exact=True).click()
-    page.get_by_role("tab", name=name, exact=True).click()
+# A tool's tab opened as a learner does: its group's tab first (Inspect, then Echo).
+open_tab = open_tool
 
 
 def choose(page: Page, label: str, option: str) -> None:
