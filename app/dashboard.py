@@ -43,6 +43,7 @@ from app.ros.graph import GraphSnapshot, snapshot
 from app.ros.rosout import RosoutLog
 from app.ros.runtime import RosRuntime
 from app.ros2cli.console_panel import ConsolePanel
+from app.scene.grid import add_floor_grid
 from app.stage.window import Stage
 from app.supervisor import NodeState, Supervisor
 from app.ui import GROUP_OF, TAB_NAMES, TOOL_GROUPS, MarkdownView, Panel
@@ -117,7 +118,7 @@ class Dashboard:
         # alone stalled the page ~100 ms on every redraw (measured; findings.md).
         self.server.scene.configure_environment_map(None)
         self.server.scene.configure_default_lights(cast_shadow=False)
-        self.server.scene.add_grid("/grid", width=4.0, height=4.0, cell_size=0.25)
+        add_floor_grid(self.server.scene, size=4.0, cell=0.25)  # lines: see app/scene/grid.py
         self.server.scene.add_frame("/world", axes_length=0.3, axes_radius=0.01)
         # One line: where am I (the domain learners compare when two dashboards share a room).
         gui.add_markdown(

@@ -22,7 +22,7 @@ from rclpy.task import Future
 
 from app.ros.context import CallContext
 from app.ros.convert import import_type, type_name
-from app.ros.errors import Cancelled, Ros2Error
+from app.ros.errors import Cancelled, NoAnswer, Ros2Error
 
 STATUS_NAMES = {
     GoalStatus.STATUS_UNKNOWN: "UNKNOWN",
@@ -46,7 +46,7 @@ def wait_future(ctx: CallContext, future: Future, timeout: float, what: str) -> 
             raise Cancelled()
         if time.monotonic() > deadline:
             future.cancel()
-            raise Ros2Error(f"no answer from {what} within {timeout:g} s")
+            raise NoAnswer(f"no answer from {what} within {timeout:g} s")
     exc = future.exception()
     if exc is not None:
         raise Ros2Error(f"{what} failed: {exc}")
@@ -76,15 +76,38 @@ def check_service_type(ctx: CallContext, name: str, srv_type: type) -> None:
 
 
 def call_service(
-    ctx: CallContext, name: str, srv_type: type, request: Any, timeout: float | None = None
+    ctx: CallContext,
+    name: str,
+    srv_type: type,
+    request: Any,
+    timeout: float | None = None,
+    *,
+    resend_unanswered: bool = False,
 ) -> Any:
-    """Send one request and return the response, or raise one clear Ros2Error."""
+    """Send one request and return the response, or raise one clear Ros2Error.
+
+    ``resend_unanswered``: for a request that is safe to repeat (a pure function, an
+    absolute teleport), send it once more when no answer came. A new client's first
+    answer can be lost: Fast DDS drops a reply whose reader the server has not yet
+    matched ("failed to send response (timeout): client will not receive response"),
+    which happens on a loaded machine while discovery lags. The second request goes
+    out once the reply path is matched; a server that never answers still fails.
+    """
     timeout = ctx.limits.service_timeout if timeout is None else timeout
     check_service_type(ctx, name, srv_type)
     client = ctx.node.create_client(srv_type, name)
+    what = f"service '{name}'"
     try:
-        wait_for_server(ctx, client.service_is_ready, timeout, f"service '{name}'")
-        return wait_future(ctx, client.call_async(request), timeout, f"service '{name}'")
+        wait_for_server(ctx, client.service_is_ready, timeout, what)
+        try:
+            return wait_future(ctx, client.call_async(request), timeout, what)
+        except NoAnswer:
+            if not resend_unanswered:
+                raise
+        try:
+            return wait_future(ctx, client.call_async(request), timeout, what)
+        except NoAnswer as exc:
+            raise NoAnswer(f"{exc} (the request was sent twice)") from None
     finally:
         ctx.node.destroy_client(client)
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import logging
 import threading
+from collections.abc import Callable
 
 from rclpy.node import Node
 
@@ -21,6 +22,22 @@ log = logging.getLogger(__name__)
 
 MAX_WATCHED = 30
 RATE_WINDOW_SEC = 3.0
+# A slow topic has few messages in 3 s: at 2 Hz, one message 0.1 s late moves the
+# figure from 2.0 to 1.9 Hz. Its window widens to hold this many intervals (up to
+# MAX_RATE_WINDOW_SEC), so one late message moves it by about 1 %.
+MIN_INTERVALS = 10
+MAX_RATE_WINDOW_SEC = 10.0
+
+
+def steady_rate(rate_hz: Callable[[float], float | None], window_sec: float) -> float:
+    """``rate_hz(window)`` over ``window_sec``, or over a window wide enough for
+    MIN_INTERVALS intervals when that holds fewer; 0.0 when silent in ``window_sec``."""
+    rate = rate_hz(window_sec)
+    if rate is None:
+        return 0.0
+    if 0 < rate * window_sec < MIN_INTERVALS:
+        rate = rate_hz(min(MAX_RATE_WINDOW_SEC, MIN_INTERVALS / rate)) or rate
+    return rate
 
 
 class RateBoard:
@@ -55,13 +72,13 @@ class RateBoard:
             return sorted(self._monitors)
 
     def rate(self, topic: str, window_sec: float = RATE_WINDOW_SEC) -> float | None:
-        """Messages per second over the last few seconds; 0.0 when silent, None if unwatched."""
+        """Messages per second over the last few seconds (longer for a slow topic: at least
+        MIN_INTERVALS intervals); 0.0 when silent in ``window_sec``, None if unwatched."""
         with self._lock:
             entry = self._monitors.get(topic)
         if entry is None:
             return None
-        rate = entry[1].rate_hz(window_sec=window_sec)  # as published, not as received
-        return rate if rate is not None else 0.0
+        return steady_rate(entry[1].rate_hz, window_sec)  # as published, not as received
 
     def close(self) -> None:
         with self._lock:

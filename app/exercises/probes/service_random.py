@@ -32,7 +32,9 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
         values = random_inputs(ctx.rng, p["inputs"])
         request = fill(srv_type.Request, values)
         try:
-            response = call_service(ctx.call, service, srv_type, request, timeout=3.0)
+            response = call_service(
+                ctx.call, service, srv_type, request, timeout=3.0, resend_unanswered=True
+            )  # a formula: repeating it is harmless
         except Ros2Error as exc:
             return Result(name, False, f"called with {values_text(values)}: {exc}")
         got = to_plain(getattr(response, p["field"]))

@@ -95,7 +95,14 @@ class FrameTap:
 
 def teleport(ctx: ProbeContext, turtle: str, x: float, y: float, theta: float) -> None:
     request = TeleportAbsolute.Request(x=x, y=y, theta=theta)
-    call_service(ctx.call, f"/{turtle}/teleport_absolute", TeleportAbsolute, request, timeout=3.0)
+    call_service(  # absolute: sending it twice puts the turtle in the same place
+        ctx.call,
+        f"/{turtle}/teleport_absolute",
+        TeleportAbsolute,
+        request,
+        timeout=3.0,
+        resend_unanswered=True,
+    )
 
 
 def pose_text(x: float, y: float, yaw: float) -> str:

@@ -1,0 +1,78 @@
+"""A request that is safe to repeat is sent once more when its answer does not come.
+
+On a loaded machine Fast DDS can drop a new client's first reply (the server has
+not matched the reply reader yet). Here a real service withholds its first answer
+past the deadline instead, which the client cannot tell from a dropped one.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import pytest
+from tutorial_interfaces.srv import AddTwoInts
+
+from app.ros.calls import call_service
+from app.ros.context import CallContext
+from app.ros.errors import NoAnswer
+
+
+@pytest.fixture
+def slow_first_answer(probe):
+    """/slow_add: answers a + b, but its first answer comes after 2.5 s; /never_add never."""
+    import rclpy
+    from rclpy.callback_groups import ReentrantCallbackGroup
+    from rclpy.executors import MultiThreadedExecutor
+
+    node = rclpy.create_node("slow_adder", context=probe.node.context)
+    calls: list[float] = []
+    never = threading.Event()
+
+    def add(request, response):
+        calls.append(time.monotonic())
+        if len(calls) == 1:
+            time.sleep(2.5)
+        response.sum = request.a + request.b
+        return response
+
+    def hang(request, response):
+        never.wait(8.0)
+        return response
+
+    group = ReentrantCallbackGroup()
+    node.create_service(AddTwoInts, "/slow_add", add, callback_group=group)
+    node.create_service(AddTwoInts, "/never_add", hang, callback_group=group)
+    executor = MultiThreadedExecutor(num_threads=4, context=probe.node.context)
+    executor.add_node(node)
+    spinner = threading.Thread(target=executor.spin, daemon=True)
+    spinner.start()
+    yield calls
+    never.set()
+    executor.shutdown()
+    spinner.join(5.0)
+    node.destroy_node()
+
+
+def test_the_unanswered_request_is_sent_again_and_its_answer_taken(probe, slow_first_answer):
+    ctx = CallContext(probe.node)
+    request = AddTwoInts.Request(a=20, b=22)
+    response = call_service(ctx, "/slow_add", AddTwoInts, request, 1.5, resend_unanswered=True)
+    assert response.sum == 42
+    assert len(slow_first_answer) == 2  # the first request was served, its answer was late
+
+
+def test_without_the_resend_the_late_answer_is_no_answer(probe, slow_first_answer):
+    ctx = CallContext(probe.node)
+    with pytest.raises(NoAnswer, match=r"no answer from service '/slow_add' within 1\.5 s$"):
+        call_service(ctx, "/slow_add", AddTwoInts, AddTwoInts.Request(a=1, b=2), 1.5)
+
+
+def test_a_server_that_never_answers_still_fails_after_the_resend(probe, slow_first_answer):
+    ctx = CallContext(probe.node)
+    started = time.monotonic()
+    with pytest.raises(NoAnswer, match=r"within 1 s \(the request was sent twice\)"):
+        call_service(
+            ctx, "/never_add", AddTwoInts, AddTwoInts.Request(), 1.0, resend_unanswered=True
+        )
+    assert 2.0 <= time.monotonic() - started < 6.0
