@@ -119,7 +119,6 @@ class Dashboard:
         self.server.scene.configure_environment_map(None)
         self.server.scene.configure_default_lights(cast_shadow=False)
         add_floor_grid(self.server.scene, size=4.0, cell=0.25)  # lines: see app/scene/grid.py
-        self.server.scene.add_frame("/world", axes_length=0.3, axes_radius=0.01)
         # One line: where am I (the domain learners compare when two dashboards share a room).
         gui.add_markdown(
             f"**ROS 2 Classroom** · Domain id **{os.environ.get('ROS_DOMAIN_ID', '0')}** · "
