@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import logging
 import threading
+import time
 from collections.abc import Callable
 
 from rclpy.node import Node
@@ -38,6 +39,43 @@ def steady_rate(rate_hz: Callable[[float], float | None], window_sec: float) -> 
     if 0 < rate * window_sec < MIN_INTERVALS:
         rate = rate_hz(min(MAX_RATE_WINDOW_SEC, MIN_INTERVALS / rate)) or rate
     return rate
+
+
+class RateHold:
+    """Rates as a drawing shows them: held against jitter, never held at a rough first figure.
+
+    A steady topic's figure wobbles (2.0, 1.99, 2.01 Hz); a drawing that redraws
+    on every wobble restarts its animation, so a shown rate changes only when a
+    reading moves by ``change`` (a share of it). But the first readings of a
+    topic come from a couple of messages: one a little late reads 1.9 Hz, and a
+    hold would keep that rough figure for good. So while the measurement is
+    still filling its window (MIN_INTERVALS intervals, at most
+    MAX_RATE_WINDOW_SEC after the topic was first heard), any reading that
+    reads differently (``rate_text``) replaces the shown one.
+    """
+
+    def __init__(self, change: float, clock: Callable[[], float] = time.monotonic) -> None:
+        self._change = change
+        self._clock = clock
+        self._held: dict[str, tuple[float, float]] = {}  # topic -> (shown rate, heard since)
+
+    def shown(self, topic: str, rate: float) -> float:
+        """The rate to show for ``topic`` given its latest reading (0.0: silent)."""
+        now = self._clock()
+        held = self._held.get(topic)
+        if held is None or (rate > 0) != (held[0] > 0):  # first reading, or heard / silent
+            self._held[topic] = (rate, now)
+            return rate
+        shown, since = held
+        settling = rate > 0 and now - since < min(MAX_RATE_WINDOW_SEC, MIN_INTERVALS / rate)
+        if settling:
+            moved = rate_text(rate) != rate_text(shown)
+        else:
+            moved = abs(rate - shown) > self._change * max(shown, 0.1)
+        if moved:
+            self._held[topic] = (rate, since)
+            return rate
+        return shown
 
 
 class RateBoard:

@@ -20,7 +20,7 @@ from rclpy.node import Node
 from app.panels.graph_panel import SharedRatesClient
 from app.panels.graph_svg import Edge, Vertex, graph_picture, topics_to_measure
 from app.ros.graph import GraphSnapshot, NodeEndpoints, node_endpoints
-from app.ros.rates import RateBoard, rate_text
+from app.ros.rates import RateBoard, RateHold, rate_text
 from app.stage import DEFAULT_STAGE, STAGES
 from app.stage.graph_view import (
     PER_ROW,
@@ -125,7 +125,7 @@ class Stage:
         self._drawn_pulses: set[tuple[str, str, float]] = set()
         self._alone: set[str] = set()  # node boxes drawn without an edge
         self._callers: dict[tuple[str, str], str] = {}
-        self._shown_rates: dict[str, float] = {}
+        self._shown_rates = RateHold(RATE_CHANGE)
         self._last_picture = 0.0
         self._drawn_nodes: tuple[str, ...] = ()
         self._svg = ""
@@ -386,14 +386,9 @@ class Stage:
         )
 
     def _steady_rate(self, topic: str) -> float:
-        """The measured rate, changed only when it moves by RATE_CHANGE: a new picture
-        restarts the dots, so 1.9 / 2.0 / 2.1 Hz jitter must not redraw it."""
-        rate = self._rates.rate(topic) or 0.0
-        before = self._shown_rates.get(topic)
-        if before is None or abs(rate - before) > RATE_CHANGE * max(before, 0.1):
-            self._shown_rates[topic] = rate
-            return rate
-        return before
+        """The measured rate, held against jitter: a new picture restarts the dots, so
+        1.9 / 2.0 / 2.1 Hz wobbles must not redraw it (``RateHold``)."""
+        return self._shown_rates.shown(topic, self._rates.rate(topic) or 0.0)
 
     def close(self) -> None:
         self._rates.close()

@@ -3,7 +3,7 @@
 import random
 
 from app.ros.monitor import published_rate_of
-from app.ros.rates import MIN_INTERVALS, rate_text, steady_rate
+from app.ros.rates import MIN_INTERVALS, RateHold, rate_text, steady_rate
 
 
 def _talker(hz: float, seconds: float, late: dict[int, float]):
@@ -53,3 +53,36 @@ def test_fast_topics_keep_the_short_window_and_silence_still_shows() -> None:
 
     assert round(steady_rate(spy, 3.0), 1) == 50.0 and calls == [3.0]
     assert steady_rate(_rate_hz(samples, now + 5.0), 3.0) == 0.0  # stopped 5 s ago
+
+
+class _Clock:
+    def __init__(self) -> None:
+        self.now = 100.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def test_a_rough_first_figure_is_not_held_once_the_window_fills() -> None:
+    """The stage's failure: the second message of a just-started talker came 30 ms late,
+    the first reading (one interval) said 1.9 Hz, and the hold kept it for good."""
+    clock = _Clock()
+    hold = RateHold(0.15, clock)
+    assert rate_text(hold.shown("/chatter", 1.0 / 0.53)) == "1.9 Hz"
+    clock.now += 2.0  # five intervals heard: the reading improves, and the drawing follows
+    assert rate_text(hold.shown("/chatter", 1.99)) == "2.0 Hz"
+    clock.now += 1.0  # a wobble that reads the same is not a change (no redraw)
+    assert hold.shown("/chatter", 2.004) == 1.99
+
+
+def test_a_settled_figure_holds_against_jitter_and_follows_a_real_change() -> None:
+    clock = _Clock()
+    hold = RateHold(0.15, clock)
+    hold.shown("/chatter", 2.0)
+    clock.now += MIN_INTERVALS / 2.0 + 0.5  # settled
+    assert hold.shown("/chatter", 1.94) == 2.0  # jitter: held ("2.0 Hz" stays drawn)
+    assert hold.shown("/chatter", 5.0) == 5.0  # the learner changed the timer: followed
+    assert hold.shown("/chatter", 0.0) == 0.0  # silent, at once
+    assert hold.shown("/chatter", 1.9) == 1.9  # heard again: settling anew
+    clock.now += 1.0
+    assert rate_text(hold.shown("/chatter", 2.0)) == "2.0 Hz"
