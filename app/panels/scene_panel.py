@@ -27,7 +27,7 @@ from app.scene import transforms as tf
 from app.scene.arm import ARM_PATH, ArmLayer
 from app.scene.camera_params import CameraParamSync
 from app.scene.drive import DriveControls, overview
-from app.scene.frames import BASE_PATH, CameraPose, FrameTree
+from app.scene.frames import CameraPose, FrameTree
 from app.scene.images import ImageLayer
 from app.scene.laser_scan import LaserScanLayer
 from app.scene.markers import MarkerLayer
@@ -142,6 +142,7 @@ class ScenePanel:
         self.world = WorldLayer(node, server)
         self.more_robots = NamespacedRobots(node, server)
         self._world_shown = False
+        self._desk_shown = (True, True)  # (the desk's frames and arm, its frustum)
         self._light = scene.add_light_ambient("/sim_world_light", intensity=0.9, visible=False)
 
         with gui.add_folder("Simulated world"):
@@ -267,24 +268,38 @@ class ScenePanel:
     def _stage_world(self, shown: bool) -> None:
         """A simulated world came (or went): set the scene for it (or back for the desk).
 
-        The lesson-13 desk at the origin hides; an ambient light shows the walls' sides
-        (the dashboard's lights come from above); the frames' names and axes go off, so
-        the small robot is not buried under twenty labels (the checkboxes bring them back).
+        An ambient light shows the walls' sides (the dashboard's lights come from
+        above); the frames' names and axes go off, so the small robot is not buried
+        under twenty labels (the checkboxes bring them back). The desk gives way to
+        it (``_follow_desk``).
         """
-        scene = self._server.scene
         self._light.visible = shown
-        self._pause_desk_arm(shown)
         assign(self._frame_names, not shown)
         assign(self._frame_axes, not shown)
         self._on_frame_display()
-        visible = not shown
-        self.frames.base.show_axes = visible
-        self.frames.camera.visible = visible
-        # The desk's label and arm are nodes of FrameTree and ArmLayer: replaced in place.
-        scene.add_label(
-            f"{BASE_PATH}/label", "base_link", position=(0.0, 0.0, -0.05), visible=visible
-        )
-        scene.add_frame(ARM_PATH, show_axes=False, visible=visible)
+
+    def _follow_desk(self, graph: GraphSnapshot) -> None:
+        """The lesson-13 desk gives way to what ROS describes in its place.
+
+        The desk is the view's own base_link and camera marks (axes, names, the
+        frustum) and the arm drawn straight from joint angles. Once a simulated
+        world or a robot from a running robot_state_publisher (a publisher of
+        /robot_description) is drawn, TF draws those frames
+        and links where they really are, as rviz would; the desk's copies would
+        only stand on top of them (and cost the browser every frame). What hangs
+        under the desk's frames (stamped points, clouds, markers) keeps showing.
+        The frustum stays while the learner shows the camera image on it.
+        """
+        robot = self.tf_view.robot_drawn and graph.publishers("/robot_description") > 0
+        desk = not (self._world_shown or robot)
+        frustum = desk or self._image_on_frustum.value is True
+        if (desk, frustum) == self._desk_shown:
+            return
+        if desk != self._desk_shown[0]:
+            self._pause_desk_arm(not desk)
+            self._server.scene.add_frame(ARM_PATH, show_axes=False, visible=desk)
+        self._desk_shown = (desk, frustum)
+        self.frames.show_marks(frames=desk, frustum=frustum)
 
     def _follow_world(self) -> None:
         shown = self.world.shown
@@ -301,8 +316,8 @@ class ScenePanel:
         self.drive.move_cameras(*view)  # the world has just appeared: show it whole
 
     def _pause_desk_arm(self, paused: bool) -> None:
-        """The desk arm's joint row stops following /joint_states by itself while a world is
-        drawn (the world's robots move on TF; the hidden desk arm would only cost CPU)."""
+        """The desk arm's joint row stops following /joint_states by itself while the desk
+        gives way (robots then move on TF; the hidden desk arm would only cost CPU)."""
         row = self._joint_row
         row.automatic = not paused
         if paused and not row.chosen_by_learner and row.dropdown.value != picker.NONE:
@@ -376,6 +391,7 @@ class ScenePanel:
         self.more_robots.refresh(graph)
         self.drive.refresh(graph)
         self._follow_world()
+        self._follow_desk(graph)
         self._world_info.show(
             "\n\n".join(t for t in (self.world.describe(), self.more_robots.describe()) if t)
         )

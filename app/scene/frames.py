@@ -90,7 +90,9 @@ class FrameTree:
         self._pose = pose or CameraPose()
         self._listeners: list[Callable[[CameraPose, str], None]] = []
         self.base = scene.add_frame(BASE_PATH, axes_length=0.2, axes_radius=0.008)
-        scene.add_label(f"{BASE_PATH}/label", "base_link", position=(0.0, 0.0, -0.05))
+        self.base_label = scene.add_label(
+            f"{BASE_PATH}/label", "base_link", position=(0.0, 0.0, -0.05)
+        )
         self.camera = scene.add_frame(
             CAMERA_PATH,
             axes_length=0.12,
@@ -98,7 +100,9 @@ class FrameTree:
             wxyz=self._pose.wxyz,
             position=self._pose.position,
         )
-        scene.add_label(f"{CAMERA_PATH}/label", "camera", position=(0.0, -0.06, 0.0))
+        self.camera_label = scene.add_label(
+            f"{CAMERA_PATH}/label", "camera", position=(0.0, -0.06, 0.0)
+        )
         self.frustum = scene.add_camera_frustum(
             f"{CAMERA_PATH}/frustum",
             fov=1.0,
@@ -144,6 +148,16 @@ class FrameTree:
         if path == CAMERA_PATH:
             p = tf.apply(self.pose.matrix(), p)
         return tf.as_xyz(p[0])
+
+    def show_marks(self, *, frames: bool, frustum: bool) -> None:
+        """Show or hide the desk's own marks: both frames' axes and names, and the frustum.
+
+        The frame nodes themselves stay visible: points, clouds and markers
+        stamped in base_link or camera hang under them and keep showing.
+        """
+        self.base.show_axes = self.camera.show_axes = frames
+        self.base_label.visible = self.camera_label.visible = frames
+        self.frustum.visible = frustum
 
     def show_gizmo(self, visible: bool) -> None:
         self.gizmo.visible = visible

@@ -287,6 +287,16 @@ class TfView:
         lines.append(("⚠️ " + self.robot_error) if self.robot_error else self.robot_status)
         return "\n\n".join(lines)
 
+    @property
+    def robot_drawn(self) -> bool:
+        """A robot from /robot_description is on screen: one of its links has a pose."""
+        robot, view = self._robot, self.view
+        return (
+            robot is not None
+            and view is not None
+            and any(link in view.poses for link in robot.links)
+        )
+
     def poses(self) -> dict[str, np.ndarray]:
         view = self.view
         return dict(view.poses) if view is not None else {}

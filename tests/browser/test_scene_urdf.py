@@ -4,10 +4,12 @@ A real robot_state_publisher (ours, as a process) publishes the tutorial's
 flexible robot; the test publishes /joint_states and watches the page: the
 robot's links appear, the gripper slides when its joint moves, a frame can
 be made the Fixed Frame, and a broken description is one line in the panel.
+While the robot is described, the lesson-13 desk's own frames give way.
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import signal
@@ -35,6 +37,9 @@ HAS_VISUAL_JS = (
     ".some((k) => k.startsWith(n + '/visual'))"
 )
 HAS_NODE_JS = "(n) => !!window.__viserMutable && (n in window.__viserMutable.nodeRefFromName)"
+# The lesson-13 desk's own camera frustum: it gives way while a robot_state_publisher runs.
+DESK_FRUSTUM = "/base_link/camera/frustum"
+SHOWN_JS = "(n) => { const o = window.__viserMutable.nodeRefFromName[n]; return !!o && o.visible; }"
 MOVED_JS = (
     "([name, old, far]) => { const o = window.__viserMutable.nodeRefFromName[name];"
     " if (!o) return false; o.updateWorldMatrix(true, false); const e = o.matrixWorld.elements;"
@@ -64,6 +69,7 @@ def test_robot_appears_moves_and_bad_description_is_one_line(page, probe, ros_en
         page.wait_for_function(
             HAS_NODE_JS, arg="/tf_view/frames/head/name", polling=100, timeout=20_000
         )
+        page.wait_for_function(f"(n) => !({SHOWN_JS})(n)", arg=DESK_FRUSTUM, timeout=20_000)
         start = world_position(page, POLE)
         assert start is not None
         page.wait_for_function(MOVED_JS, arg=[POLE, start, 0.05], polling=100, timeout=20_000)
@@ -98,9 +104,15 @@ def test_robot_appears_moves_and_bad_description_is_one_line(page, probe, ros_en
         expect(page.get_by_text("Stale (publisher silent)").first).to_be_visible(timeout=20_000)
         status = page.get_by_text("Stale (publisher silent)").first.inner_text()
         assert "gripper_pole" in status and "left_leg," not in status
+
+        # No robot_state_publisher any more: the desk comes back.
+        probe.node.destroy_publisher(bad)
+        os.killpg(rsp.pid, signal.SIGINT)
+        page.wait_for_function(SHOWN_JS, arg=DESK_FRUSTUM, polling=200, timeout=30_000)
     finally:
         repeater.stop()
-        os.killpg(rsp.pid, signal.SIGINT)
+        with contextlib.suppress(ProcessLookupError):  # the test may have stopped it
+            os.killpg(rsp.pid, signal.SIGINT)
         try:
             rsp.wait(timeout=10)
         except subprocess.TimeoutExpired:
