@@ -118,7 +118,7 @@ class Dashboard:
         # alone stalled the page ~100 ms on every redraw (measured; findings.md).
         self.server.scene.configure_environment_map(None)
         self.server.scene.configure_default_lights(cast_shadow=False)
-        add_floor_grid(self.server.scene, size=4.0, cell=0.25)  # lines: see app/scene/grid.py
+        add_floor_grid(self.server.scene)  # 4 m, half-metre cells: see app/scene/grid.py
         # One line: where am I (the domain learners compare when two dashboards share a room).
         gui.add_markdown(
             f"**ROS 2 Classroom** · Domain id **{os.environ.get('ROS_DOMAIN_ID', '0')}** · "

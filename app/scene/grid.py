@@ -7,6 +7,13 @@ classroom VMs and hub servers) that per-pixel work over most of the canvas
 was the 3D view's largest cost: with the robot moving it took the frame rate
 from that of a bare scene to about 0.6x of it (bench/urdf_draw.py,
 README). Lines cost only the pixels they light.
+
+Even so, in software WebGL every long line costs the browser about half a
+millisecond a frame, whatever its thickness or how the lines are grouped
+into draw calls (measured: 34 lines 58-62 ms a frame, 18 lines 48-53, 10
+lines 50, none 40-46). So the cells are half a metre, not a quarter: rviz's
+grid has metre cells, and the desk arm's half-metre reach still reads
+against them.
 """
 
 from __future__ import annotations
@@ -34,7 +41,7 @@ def grid_lines(size: float, cell: float) -> tuple[np.ndarray, np.ndarray]:
     return as_array(cells), as_array(sections)
 
 
-def add_floor_grid(scene: viser.SceneApi, size: float = 4.0, cell: float = 0.25) -> None:
+def add_floor_grid(scene: viser.SceneApi, size: float = 4.0, cell: float = 0.5) -> None:
     """A ``size`` x ``size`` metre grid with ``cell`` metre cells on the z = 0 plane."""
     cells, sections = grid_lines(size, cell)
     scene.add_frame(GRID_PATH, show_axes=False)

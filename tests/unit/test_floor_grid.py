@@ -20,3 +20,10 @@ def test_every_line_spans_the_grid_on_the_floor() -> None:
     lengths = np.linalg.norm(lines[:, 1] - lines[:, 0], axis=1)
     assert np.allclose(lengths, 4.0)
     assert np.abs(lines).max() == 2.0
+
+
+def test_the_dashboard_grid_has_half_metre_cells_and_18_lines() -> None:
+    """Each line costs a software-WebGL browser every frame (app/scene/grid.py)."""
+    cells, sections = grid_lines(4.0, 0.5)
+    assert len(cells) + len(sections) == 18
+    assert sorted({round(float(x), 6) for x in cells[::2, 0, 0]}) == [-1.5, -0.5, 0.5, 1.5]
