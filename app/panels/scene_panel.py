@@ -283,12 +283,12 @@ class ScenePanel:
 
         The desk is the view's own base_link and camera marks (axes, names, the
         frustum) and the arm drawn straight from joint angles. Once a simulated
-        world or a robot from a running robot_state_publisher (a publisher of
-        /robot_description) is drawn, TF draws those frames
-        and links where they really are, as rviz would; the desk's copies would
-        only stand on top of them (and cost the browser every frame). What hangs
-        under the desk's frames (stamped points, clouds, markers) keeps showing.
-        The frustum stays while the learner shows the camera image on it.
+        world, or a robot from a running robot_state_publisher (a publisher of
+        /robot_description), is drawn, TF draws those frames and links where
+        they really are, as rviz would; the desk's copies would only stand on
+        top of them (and cost the browser every frame). What hangs under the
+        desk's frames (stamped points, clouds, markers) keeps showing. The
+        frustum stays while the learner shows the camera image on it.
         """
         robot = self.tf_view.robot_drawn and graph.publishers("/robot_description") > 0
         desk = not (self._world_shown or robot)
