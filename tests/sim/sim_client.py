@@ -78,9 +78,14 @@ class SimClient(Node):
         self.create_subscription(Clock, "/clock", self.on_clock, 100)
         self.create_subscription(Log, "/rosout", self.on_log, 100)
         latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        # /tf_static has several latched writers (sim_world's mount, each robot's
+        # robot_state_publisher): a late joiner gets one sample from each at once, and a
+        # queue of one keeps only the newest until the executor takes it. tf2_ros's
+        # listener keeps 100; so does this client.
+        static = QoSProfile(depth=100, durability=DurabilityPolicy.TRANSIENT_LOCAL)
         # Every transform seen, by child frame: (parent, translation, rotation x y z w, static).
         self.transforms: dict[str, tuple[str, list[float], list[float], bool]] = {}
-        self.create_subscription(TFMessage, "/tf_static", self._tf_keeper(True), latched)
+        self.create_subscription(TFMessage, "/tf_static", self._tf_keeper(True), static)
         self.create_subscription(TFMessage, "/tf", self._tf_keeper(False), 100)
         for topic, kind in (
             ("/robot_description", String),

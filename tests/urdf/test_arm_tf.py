@@ -47,9 +47,12 @@ def test_arm_joints_become_tf_that_agree_with_its_pose(supervisor, probe) -> Non
         with lock:
             poses.append(msg)
 
-    latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    # As tf2_ros's listener: /tf_static's several latched writers (the camera's static
+    # transform, the arm's robot_state_publisher) each send a sample to a late joiner at
+    # once, and a queue of one would keep only the newest.
+    static = QoSProfile(depth=100, durability=DurabilityPolicy.TRANSIENT_LOCAL)
     probe.node.create_subscription(TFMessage, "/tf", on_tf, 100)
-    probe.node.create_subscription(TFMessage, "/tf_static", on_tf, latched)
+    probe.node.create_subscription(TFMessage, "/tf_static", on_tf, static)
     probe.node.create_subscription(PoseStamped, "/end_effector_pose", on_pose, 10)
     for member in lookup_group("arm_tf").members:
         supervisor.start(member)
