@@ -130,12 +130,7 @@ def test_joint_sliders_drive_joint_state_publisher(page) -> None:
     )
     slider = row.get_by_role("slider").first
     slider.wait_for(timeout=20_000)
-    page.wait_for_function(
-        "(n) => { const o = window.__viserMutable.nodeRefFromName[n]; return !!o && o.visible; }",
-        arg=POLE,
-        polling=100,
-        timeout=30_000,
-    )
+    page.wait_for_function(SHOWN_JS, arg=POLE, polling=100, timeout=30_000)
     start = world_position(page, POLE)
     assert start is not None
     slider.focus()

@@ -1,8 +1,10 @@
 """The 3D view's floor grid: lines every cell, darker ones on whole metres."""
 
+import inspect
+
 import numpy as np
 
-from app.scene.grid import grid_lines
+from app.scene.grid import add_floor_grid, grid_lines
 
 
 def test_a_4m_grid_of_quarter_metre_cells_has_17_lines_each_way() -> None:
@@ -23,7 +25,9 @@ def test_every_line_spans_the_grid_on_the_floor() -> None:
 
 
 def test_the_dashboard_grid_has_half_metre_cells_and_18_lines() -> None:
-    """Each line costs a software-WebGL browser every frame (app/scene/grid.py)."""
-    cells, sections = grid_lines(4.0, 0.5)
+    """Each line costs a software-WebGL browser every frame (app/scene/grid.py); the
+    dashboard draws add_floor_grid's defaults."""
+    defaults = inspect.signature(add_floor_grid).parameters
+    cells, sections = grid_lines(defaults["size"].default, defaults["cell"].default)
     assert len(cells) + len(sections) == 18
     assert sorted({round(float(x), 6) for x in cells[::2, 0, 0]}) == [-1.5, -0.5, 0.5, 1.5]
