@@ -92,13 +92,19 @@ class ActionsPanel:
             self._actions = graph.actions
             set_options(self._selector, list(graph.actions) or [NONE], keep_current=False)
             self._rebuild_form()
+        elif self._selector.value in self._actions and self._selector.value not in self._types:
+            # An action is listed from its services, but its type is read from its
+            # topics, which discovery may bring later: ask again until they come.
+            self._rebuild_form()
         name = self._selector.value
         type_text = self._types.get(name)
-        self._info.show(
-            f"Type: `{type_text}` · `ros2 action info {name} -t`"
-            if type_text
-            else "_No action on the graph: start **fibonacci_action_server** in the Nodes tab._"
-        )
+        if type_text:
+            info = f"Type: `{type_text}` · `ros2 action info {name} -t`"
+        elif name in self._actions:
+            info = f"_`{name}` is on the graph; waiting for its topics to learn its type…_"
+        else:
+            info = "_No action on the graph: start **fibonacci_action_server** in the Nodes tab._"
+        self._info.show(info)
         run = self._run
         if run is None:
             self._view.show(self._message)

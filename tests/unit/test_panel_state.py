@@ -13,7 +13,7 @@ from typing import Any
 import pytest
 from rcl_interfaces.msg import ParameterDescriptor, ParameterType, ParameterValue
 
-from app.panels import lifecycle_panel, nodes_panel, parameters_panel
+from app.panels import actions_panel, lifecycle_panel, nodes_panel, parameters_panel
 from app.ros import lifecycle as lc
 from app.ros.graph import GraphSnapshot
 from app.ui.loop import UiLoop
@@ -219,3 +219,20 @@ def test_a_read_only_intent_runs_without_waking_the_loop_or_asking_a_redraw():
     ui.post(lambda: seen.append("click"))
     assert ui.wait(0.05) is True
     assert ui.apply_pending() == 1 and seen == ["snapshot", "click"]
+
+
+def test_an_action_whose_type_is_discovered_late_gets_its_form(monkeypatch):
+    """Its services list it before its topics give its type (a CI failure, stop 33)."""
+    answers = iter([None, None, "tutorial_interfaces/action/Fibonacci"])
+    monkeypatch.setattr(actions_panel, "action_type_of", lambda node, name: next(answers))
+    gui, ui = FakeGui(), UiLoop()
+    panel = actions_panel.ActionsPanel(gui, ui, FakeNode())  # type: ignore[arg-type]
+    graph = GraphSnapshot(actions=("/fibonacci",))
+    panel.refresh(graph)
+    assert "waiting for its topics" in gui.text()
+    assert gui.find("button", "Send goal").disabled
+    panel.refresh(graph)  # the graph is the same; the type is asked for again
+    panel.refresh(graph)
+    assert "Type: `tutorial_interfaces/action/Fibonacci`" in gui.text()
+    assert not gui.find("button", "Send goal").disabled
+    assert any(h.label.startswith("order") for h in gui.handles if not h.removed)
