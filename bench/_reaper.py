@@ -14,6 +14,7 @@ from __future__ import annotations
 import os
 import signal
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 MARK = "CLASSROOM_RUN_MARK"
@@ -61,8 +62,13 @@ def leftovers(mark: str) -> list[tuple[int, str]]:
 
 def end_leftovers(mark: str, grace: float = 5.0) -> list[str]:
     """Wait up to ``grace`` s for marked processes to end, kill the rest; describe them."""
+    return end_found(lambda: leftovers(mark), grace)
+
+
+def end_found(find: Callable[[], list[tuple[int, str]]], grace: float = 5.0) -> list[str]:
+    """Wait up to ``grace`` s until ``find()`` finds nothing, kill what it still finds."""
     deadline = time.monotonic() + grace
-    while (left := leftovers(mark)) and time.monotonic() < deadline:
+    while (left := find()) and time.monotonic() < deadline:
         time.sleep(0.2)
     described = []
     for pid, cmd in left:

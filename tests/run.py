@@ -27,8 +27,10 @@ import socket
 import struct
 import subprocess
 import sys
-import time
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # run as a script from anywhere
+from bench._reaper import end_found  # the run's reaper; it needs only the stdlib
 
 _SIOCGIFFLAGS = 0x8913
 _SIOCSIFFLAGS = 0x8914
@@ -72,21 +74,6 @@ def _left_in_namespace() -> list[tuple[int, str]]:
     return found
 
 
-def end_namespace(grace: float = 5.0) -> list[str]:
-    """Wait up to ``grace`` s for what is left in the namespace to end, kill the rest."""
-    deadline = time.monotonic() + grace
-    while (left := _left_in_namespace()) and time.monotonic() < deadline:
-        time.sleep(0.2)
-    killed = []
-    for pid, cmd in left:
-        try:
-            os.kill(pid, signal.SIGKILL)
-        except ProcessLookupError:
-            continue
-        killed.append(f"pid {pid}: {cmd}")
-    return killed
-
-
 def keep(command: list[str]) -> int:
     """Run ``command`` in this namespace, then end everything it left; its exit code."""
     child = subprocess.Popen(command)
@@ -98,7 +85,7 @@ def keep(command: list[str]) -> int:
     for sig in FORWARDED:
         signal.signal(sig, forward)
     code = child.wait()
-    killed = end_namespace()
+    killed = end_found(_left_in_namespace)
     if killed:
         print("\ntests/run.py: FAILED: processes of this run were still running (killed now):")
         print("\n".join(f"  {line}" for line in killed), flush=True)
