@@ -10,7 +10,6 @@ import argparse
 import ipaddress
 import logging
 import os
-import signal
 import socket
 import sys
 import threading
@@ -20,6 +19,7 @@ from typing import Any
 
 from app import catalog
 from app.dds import configure_this_process, validate_domain_id
+from app.stop_signals import set_on_signals
 
 EXIT_USAGE = 2
 
@@ -131,8 +131,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     )
     bag_folder.confine_to_folder()
     stop_requested = threading.Event()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, lambda *_: stop_requested.set())
+    set_on_signals(stop_requested)
 
     editor_hub = EditorHub()
     # Extra routes on viser's server: links, then the page's base-path shim, then the editor.
@@ -335,8 +334,7 @@ def cmd_classroom(args: argparse.Namespace) -> int:
     if args.reveal_solution_after is not None:
         flags += ("--reveal-solution-after", str(args.reveal_solution_after))
     stop_requested = threading.Event()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, lambda *_: stop_requested.set())
+    set_on_signals(stop_requested)
     room = classroom.Classroom(learners, os.environ, host=args.host, serve_flags=flags)
     configure_this_process(network=args.network)  # the teacher page's DDS participant
     return classroom.run(room, stop_requested, lambda line: print(line, flush=True), teacher)

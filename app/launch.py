@@ -12,7 +12,6 @@ learner would write for the same group, for the lessons to display.
 from __future__ import annotations
 
 import json
-import signal
 import sys
 import threading
 from collections.abc import Mapping
@@ -22,6 +21,7 @@ from typing import Any, TextIO
 import yaml
 
 from app.catalog import CatalogEntry, LaunchGroup, lookup, lookup_group
+from app.stop_signals import set_on_signals
 from app.supervisor import ACTIVE_STATES, NodeState, Supervisor
 
 PACKAGE = "tutorial_nodes"  # the package name our `ros2 run` commands use
@@ -215,6 +215,5 @@ def launch_in_foreground(name: str, env: Mapping[str, str]) -> int:
     """``ros2-classroom launch``: run a group until Ctrl+C (SIGINT) or SIGTERM."""
     lookup_group(name)  # an unknown name fails before anything starts
     stop = threading.Event()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, lambda *_: stop.set())
+    set_on_signals(stop)
     return run_group(name, env, stop=stop)

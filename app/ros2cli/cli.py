@@ -8,7 +8,6 @@ created only for verbs that need the graph; Ctrl+C stops a streaming verb
 from __future__ import annotations
 
 import os
-import signal
 import sys
 import threading
 from typing import cast
@@ -18,8 +17,8 @@ from rclpy.node import Node
 from app.ros.context import CLI_LIMITS
 from app.ros2cli.common import TerminalContext
 from app.ros2cli.parser import needs_ros, run_argv
+from app.stop_signals import set_on_signals
 
-STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 ROS2CLI_GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface")
 EXIT_INTERRUPTED_OTHER = 130  # our other commands (bag, run, ...): the shell's convention
 
@@ -48,7 +47,7 @@ def main(argv: list[str]) -> int:
 
     # Ctrl+C (or SIGTERM) asks the running verb to stop at its next wait, so it
     # always cleans up (subscriptions, publishers) instead of dying mid-call.
-    previous = {sig: signal.signal(sig, lambda *_: cancel.set()) for sig in STOP_SIGNALS}
+    restore_handlers = set_on_signals(cancel)
     # Hidden, and without parameter services, as ros2cli's own node is.
     runtime = RosRuntime(f"_ros2_classroom_cli_{os.getpid()}", quiet=True)
     ctx = TerminalContext(
@@ -61,6 +60,5 @@ def main(argv: list[str]) -> int:
         return code  # ros2cli's verbs: as `ros2` ends after Ctrl+C (parser.EXIT_INTERRUPTED)
     finally:
         runtime.shutdown()
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        restore_handlers()
         sys.stdout.flush()
