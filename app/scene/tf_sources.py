@@ -52,6 +52,8 @@ MAX_TAKES = 400  # per topic and poll: a flood cannot starve the rest of the loo
 GRAPH_EVERY_SEC = 1.0  # re-read which GID belongs to which node...
 GRAPH_SOON_SEC = 0.25  # ...sooner when a sample came from a GID not known yet
 CONFLICT_SEC = 5.0  # a second parent seen this recently is still news
+RATE_WINDOW = 20  # arrivals a frame's rate is measured over...
+RATE_MIN_ARRIVALS = 5  # ...and the fewest that give one: from 2 or 3, one late sample skews it
 RCL_RET_OK = 0
 RCL_RET_SUBSCRIPTION_TAKE_FAILED = 401  # nothing to take
 TF_QOS = QoSProfile(depth=100, history=HistoryPolicy.KEEP_LAST)
@@ -214,7 +216,8 @@ class FrameInfo:
     static: bool = False
     publisher: str = ""  # "/node", "one of /a, /b", or "" (not known)
     publisher_here: bool = True  # that node is still on the graph
-    rate: float | None = None  # Hz, from arrival times
+    rate: float | None = None  # Hz, from arrival times (None: too few yet)
+    rate_samples: int = 0  # how many arrivals that rate is measured over
     age: float = 0.0  # seconds since its newest transform arrived
     stale: bool = False  # a dynamic frame silent for longer than its rate allows
     conflict: str = ""  # another parent seen lately, in words
@@ -226,11 +229,11 @@ class _Record:
     static: bool
     received: float
     gid: bytes
-    arrivals: deque[float] = field(default_factory=lambda: deque(maxlen=20))
+    arrivals: deque[float] = field(default_factory=lambda: deque(maxlen=RATE_WINDOW))
     others: dict[str, tuple[bytes, float]] = field(default_factory=dict)  # parent -> (gid, when)
 
     def rate(self) -> float | None:
-        if len(self.arrivals) < 2 or self.arrivals[-1] <= self.arrivals[0]:
+        if len(self.arrivals) < RATE_MIN_ARRIVALS or self.arrivals[-1] <= self.arrivals[0]:
             return None
         return (len(self.arrivals) - 1) / (self.arrivals[-1] - self.arrivals[0])
 
@@ -395,10 +398,11 @@ class TfSources:
             r.static,
             publisher,
             here,
-            r.rate(),
-            max(0.0, now - r.received),
-            r.stale(now),
-            "; ".join(conflicts),
+            rate=r.rate(),
+            rate_samples=len(r.arrivals),
+            age=max(0.0, now - r.received),
+            stale=r.stale(now),
+            conflict="; ".join(conflicts),
         )
 
     def _publisher(self, gid: bytes, topic: str) -> tuple[str, bool]:

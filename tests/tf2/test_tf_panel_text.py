@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from app.panels.tf_panel import default_pair, describe, picture_path, stale_between, tree_markdown
-from app.scene.tf_sources import FrameInfo
+from app.scene.tf_sources import RATE_MIN_ARRIVALS, RATE_WINDOW, FrameInfo, _Record
 
 WORLD = FrameInfo("world", "")
 BASE = FrameInfo("base_link", "world", rate=50.0, age=0.01, publisher="/robot_state_publisher")
@@ -72,3 +72,15 @@ def test_the_picture_is_the_one_view_frames_printed_last():
     ]
     assert picture_path(lines) == Path("/tmp/v/frames_2026-01-01_10.00.09.svg")
     assert picture_path(["view_frames: the picture is relative/frames_x.svg"]) is None
+
+
+def test_a_rate_needs_enough_arrivals_and_uses_the_newest_window():
+    record = _Record("world", False, 0.0, b"")
+    for k in range(RATE_MIN_ARRIVALS - 1):
+        record.arrivals.append(k / 10)
+    assert record.rate() is None  # from a few arrivals one late sample would skew it
+    record.arrivals.append((RATE_MIN_ARRIVALS - 1) / 10)
+    assert abs(record.rate() - 10.0) < 1e-9
+    for k in range(RATE_MIN_ARRIVALS, 100):
+        record.arrivals.append(k / 10 if k < 50 else 5.0 + (k - 50) / 20)  # 10 Hz, then 20 Hz
+    assert len(record.arrivals) == RATE_WINDOW and abs(record.rate() - 20.0) < 1e-9
