@@ -17,7 +17,10 @@ from app import PROJECT_ROOT
 from app.dds import configure_dds_env
 from bench import _reaper
 
-ARTIFACTS = PROJECT_ROOT / "test-artifacts"
+# One folder per xdist worker (tests/run.py): workers live in namespaces of
+# their own, so two of them may serve on the same port number and would write
+# the same dashboard-<port>.log.
+ARTIFACTS = PROJECT_ROOT / "test-artifacts" / os.environ.get("PYTEST_XDIST_WORKER", "")
 _domain_ids = itertools.count(1 + os.getpid() % 50)
 
 
@@ -147,7 +150,7 @@ class DashboardProcess:
         self.port = port
         self.url = f"http://127.0.0.1:{port}"
         self.log_path = ARTIFACTS / f"dashboard-{port}.log"
-        ARTIFACTS.mkdir(exist_ok=True)
+        ARTIFACTS.mkdir(parents=True, exist_ok=True)
         self._log = open(self.log_path, "wb")
         self.proc = subprocess.Popen(
             [sys.executable, "-m", "app", "serve", "--port", str(port), *(extra or [])],
@@ -221,7 +224,7 @@ def page(browser, dashboard, request):
     page = context.new_page()
     page.goto(dashboard.url)
     yield page
-    ARTIFACTS.mkdir(exist_ok=True)
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
     page.screenshot(path=str(ARTIFACTS / f"{request.node.name}.png"))
     context.close()
 

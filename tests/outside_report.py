@@ -57,7 +57,7 @@ def run_outside_client(
     finally:
         supervisor.shutdown()
     fail_on_leftover_nodes(f"the {label} tests")
-    ARTIFACTS.mkdir(exist_ok=True)
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
     (ARTIFACTS / f"{label}-client.out").write_text(f"{done.stdout}\n{done.stderr}")
     assert done.returncode == 0, done.stderr[-3000:]
     result = json.loads(done.stdout.strip().splitlines()[-1])

@@ -187,7 +187,7 @@ def test_teacher_follows_three_learners_on_two_hosts(ros_env, two_hosts, tmp_pat
     classroom_domain = int(env["ROS_DOMAIN_ID"])
     if classroom_domain in (40, 41, 50):
         classroom_domain += 20
-    ARTIFACTS.mkdir(exist_ok=True)
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
     progress_a, progress_b = tmp_path / "A", tmp_path / "B"
     room_a, log_a = _start_classroom(
         host_a, env, ARTIFACTS / "teacher-host-a.log", progress_a, "--learners", "2",

@@ -110,7 +110,7 @@ def test_nodes_on_one_host_dashboard_on_the_other(ros_env, two_hosts):
     env_a = env_b = env  # default discovery: multicast on the cable (224/4 routed above)
     port = free_port()
     log_path = ARTIFACTS / f"two-hosts-dashboard-{port}.log"
-    ARTIFACTS.mkdir(exist_ok=True)
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
     procs = []
     with open(log_path, "wb") as log:
         try:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import fcntl
 import json
 import time
 
@@ -16,9 +17,11 @@ FIGURES = PROJECT_ROOT / "test-artifacts" / "reliability-figures.json"
 def record(case: str, **figures: object) -> None:
     """Keep each case's measured figures in one JSON file (the issue asks for a table)."""
     FIGURES.parent.mkdir(exist_ok=True)
-    data = json.loads(FIGURES.read_text()) if FIGURES.exists() else {}
-    data[case] = figures
-    FIGURES.write_text(json.dumps(data, indent=1, sort_keys=True))
+    with open(FIGURES.with_suffix(".lock"), "w") as lock:  # test workers write it at once
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        data = json.loads(FIGURES.read_text()) if FIGURES.exists() else {}
+        data[case] = figures
+        FIGURES.write_text(json.dumps(data, indent=1, sort_keys=True))
     print(f"\n[{case}] {figures}")
 
 

@@ -68,7 +68,7 @@ def run_client(env: dict[str, str], *args: str) -> dict:
     assert done.returncode == 0, done.stderr[-3000:]
     report = json.loads(done.stdout.strip().splitlines()[-1])
     report["wall_seconds"] = round(time.monotonic() - started, 1)
-    ARTIFACTS.mkdir(exist_ok=True)  # every call, for reading after a failure
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)  # every call, for reading after a failure
     (ARTIFACTS / f"outside-client-{args[0]}.json").write_text(json.dumps(report, indent=1))
     return report
 

@@ -68,3 +68,68 @@ def test_a_run_ends_what_it_started_and_names_it(tmp_path, ending):
     assert "still running (killed now)" in out and f"pid {left}:" in out, out
     assert "# left behind" in out, out
     wait_until(lambda: _gone(left), timeout=10, what=f"pid {left} to be gone")
+
+
+# Run by `tests/run.py --workers 2`: each test notes its worker and namespace,
+# and the first leaves a program behind (in its own session, as a dashboard is).
+IN_WORKERS = """
+import os, pathlib, socket, subprocess, sys, time
+
+NOTES = pathlib.Path(os.environ["NOTES_DIR"])
+
+
+def _note(i):
+    time.sleep(0.5)  # so that both workers get tests
+    names = ",".join(name for _, name in socket.if_nameindex())
+    ns = os.readlink("/proc/self/ns/net")
+    (NOTES / f"{i}.txt").write_text(f"{os.environ['PYTEST_XDIST_WORKER']} {ns} {names}")
+
+
+def test_leaves_a_program():
+    child = subprocess.Popen(
+        [sys.executable, "-c", "import time; time.sleep(300)  # left in a worker"],
+        start_new_session=True,
+    )
+    (NOTES / "left.pid").write_text(str(child.pid))
+    _note(0)
+
+
+def test_1():
+    _note(1)
+
+
+def test_2():
+    _note(2)
+
+
+def test_3():
+    _note(3)
+"""
+
+
+def test_workers_have_namespaces_of_their_own_and_the_keeper_ends_what_they_leave(tmp_path):
+    tests, notes = tmp_path / "test_in_workers.py", tmp_path / "notes"
+    tests.write_text(IN_WORKERS)
+    notes.mkdir()
+    env = {k: v for k, v in os.environ.items() if k != "CLASSROOM_PRIVATE_NETNS"}
+    run = subprocess.run(
+        [sys.executable, "tests/run.py", "--workers", "2", "-c", "pyproject.toml", str(tests)],
+        cwd=PROJECT_ROOT,
+        env={**env, "NOTES_DIR": str(notes)},
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    out = run.stdout + run.stderr
+    assert "4 passed" in out, out
+    seen = [(notes / f"{i}.txt").read_text().split() for i in range(4)]
+    by_worker = {worker: (ns, names) for worker, ns, names in seen}
+    assert set(by_worker) == {"gw0", "gw1"}, seen  # both workers ran tests
+    assert by_worker["gw0"][0] != by_worker["gw1"][0], seen  # in two namespaces
+    assert all(ns != os.readlink("/proc/self/ns/net") for ns, _ in by_worker.values()), seen
+    assert all(names == "lo" for _, names in by_worker.values()), seen
+    left = int((notes / "left.pid").read_text())
+    assert run.returncode != 0, out
+    assert "still running (killed now)" in out and f"pid {left}:" in out, out
+    assert "# left in a worker" in out, out
+    wait_until(lambda: _gone(left), timeout=10, what=f"pid {left} to be gone")

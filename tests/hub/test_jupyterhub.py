@@ -37,7 +37,14 @@ from tests.hub.local_hub import PASSWORD, LocalHub
 
 # A watchdog, not a budget: the first test also spawns three learners' servers, which
 # on two busy shared cores has taken minutes.
-pytestmark = [pytest.mark.browser, pytest.mark.ros, pytest.mark.timeout(480)]
+# All on one test worker (tests/run.py): the module-scoped fixture (its JupyterHub) is
+# then made once, not once on every worker that runs one of these tests.
+pytestmark = [
+    pytest.mark.browser,
+    pytest.mark.ros,
+    pytest.mark.timeout(480),
+    pytest.mark.xdist_group(__name__),
+]
 
 LEARNERS = ("alice", "bob", "carol")
 # Besides the talker everyone starts, a node only this learner runs: seeing it
@@ -71,7 +78,7 @@ def hub(tmp_path_factory) -> Iterator[LocalHub]:
         pytest.fail("the hub test runs learners' DDS: run it with tests/run.py")
     env = dict(os.environ)
     configure_dds_env(env, domain_id=59, network=False)  # the hub's own processes
-    ARTIFACTS.mkdir(exist_ok=True)
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
     hub = LocalHub(
         tmp_path_factory.mktemp("hub"),
         env,

@@ -29,7 +29,14 @@ from tests.hub.local_hub import ADMIN_TOKEN, PASSWORD, LocalHub
 
 # A watchdog, not a budget: the first test also spawns two learners' servers, which
 # on two busy shared cores has taken minutes.
-pytestmark = [pytest.mark.browser, pytest.mark.ros, pytest.mark.timeout(480)]
+# All on one test worker (tests/run.py): the module-scoped fixture (its JupyterHub) is
+# then made once, not once on every worker that runs one of these tests.
+pytestmark = [
+    pytest.mark.browser,
+    pytest.mark.ros,
+    pytest.mark.timeout(480),
+    pytest.mark.xdist_group(__name__),
+]
 
 LEARNERS = ("dora", "erik")
 TEACHER = "tess"
@@ -43,7 +50,7 @@ def hub(tmp_path_factory) -> Iterator[LocalHub]:
         pytest.fail("the hub test runs learners' DDS: run it with tests/run.py")
     env = dict(os.environ)
     configure_dds_env(env, domain_id=69, network=False)  # the hub's own processes
-    ARTIFACTS.mkdir(exist_ok=True)
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
     hub = LocalHub(
         tmp_path_factory.mktemp("lean-hub"),
         env,

@@ -42,7 +42,7 @@ class JupyterServer:
         self.port = free_port()
         self.base = f"http://127.0.0.1:{self.port}"
         home.mkdir(parents=True, exist_ok=True)
-        ARTIFACTS.mkdir(exist_ok=True)
+        ARTIFACTS.mkdir(parents=True, exist_ok=True)
         self.log_path = ARTIFACTS / f"jupyter-{self.port}.log"
         self._log = open(self.log_path, "wb")
         self.proc = subprocess.Popen(
@@ -187,7 +187,7 @@ def test_the_dashboard_works_under_the_proxy_and_only_through_it(jupyter, browse
             urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=10)
         assert refused.value.code == 401
     finally:
-        ARTIFACTS.mkdir(exist_ok=True)
+        ARTIFACTS.mkdir(parents=True, exist_ok=True)
         page.screenshot(path=str(ARTIFACTS / "hub-server-proxy.png"))
         context.close()
     # The node started from the page ends with the server (ros_env checks it after).

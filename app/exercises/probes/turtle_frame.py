@@ -37,6 +37,46 @@ def _frame_mistake(seen: Seen, x: float, y: float, theta: float, tol: float) -> 
     return "the heading (rotation about z) is not the turtle's theta"
 
 
+def _matches(
+    seen: Seen | None, parent: str, after: float, pose: tuple[float, float, float], tol: float
+) -> bool:
+    x, y, theta = pose
+    return (
+        seen is not None
+        and seen.arrival > after
+        and seen.parent == parent
+        and math.hypot(seen.x - x, seen.y - y) < tol
+        and abs(seen.z) < tol
+        and angle_between(seen.yaw, theta) < 0.02
+        and seen.unit
+    )
+
+
+def _why_not(
+    tap: FrameTap,
+    seen: Seen | None,
+    turtle: str,
+    parent: str,
+    after: float,
+    pose: tuple[float, float, float],
+    tol: float,
+) -> str:
+    """Why the last transform seen for ``turtle`` does not show it at ``pose``."""
+    want = pose_text(*pose)
+    if seen is None:
+        heard = ", ".join(f"{a} -> {c}" for c, a in tap.children_of().items()) or "nothing"
+        return f"no transform for the child frame '{turtle}' on /tf (heard: {heard})"
+    if seen.parent != parent:
+        return (
+            f"'{turtle}' has the parent '{seen.parent}' on /tf; expected the parent "
+            f"'{parent}' (header.frame_id is the parent, child_frame_id the turtle)"
+        )
+    if seen.arrival <= after:
+        return f"teleported {turtle} to {want}; no new transform came after"
+    got = pose_text(seen.x, seen.y, seen.yaw)
+    return f"teleported {turtle} to {want}; /tf says {got}: {_frame_mistake(seen, *pose, tol)}"
+
+
 @register_probe(
     "turtle_frame",
     required="",
@@ -56,51 +96,20 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
     try:
         for _ in range(count):
             x, y, theta = (round(float(draw(ctx.rng, p[k])), 2) for k in ("x", "y", "theta"))
-            asked = time.monotonic()
+            after = time.monotonic() + 0.1  # a transform from before the teleport is no answer
             try:
                 teleport(ctx, turtle, x, y, theta)
             except Ros2Error as exc:
                 return Result(name, False, f"could not teleport {turtle}: {exc}")
-            deadline = asked + float(p.get("within", 3.0))
-            seen = None
-            while time.monotonic() < deadline:
-                seen = tap.get(turtle)
-                if seen is not None and seen.arrival > asked + 0.1 and seen.parent == parent:
-                    if (
-                        math.hypot(seen.x - x, seen.y - y) < tol
-                        and abs(seen.z) < tol
-                        and angle_between(seen.yaw, theta) < 0.02
-                        and seen.unit
-                    ):
-                        break
+            # `within` counts from the moment the turtle has moved: a teleport that
+            # took that long on a loaded machine once used it all up before the
+            # first look, and a correct node was told it sent nothing.
+            deadline = time.monotonic() + float(p.get("within", 3.0))
+            while not _matches(seen := tap.get(turtle), parent, after, (x, y, theta), tol):
+                if time.monotonic() >= deadline:
+                    why = _why_not(tap, seen, turtle, parent, after, (x, y, theta), tol)
+                    return Result(name, False, why)
                 ctx.call.sleep(0.05)
-            else:
-                want = pose_text(x, y, theta)
-                if seen is None:
-                    frames = tap.children_of()
-                    heard = ", ".join(f"{a} -> {c}" for c, a in frames.items()) or "nothing"
-                    return Result(
-                        name, False, f"no transform for the child frame '{turtle}' on /tf "
-                        f"(heard: {heard})"
-                    )  # fmt: skip
-                if seen.parent != parent:
-                    return Result(
-                        name,
-                        False,
-                        f"'{turtle}' has the parent '{seen.parent}' on /tf; expected the parent "
-                        f"'{parent}' (header.frame_id is the parent, child_frame_id the turtle)",
-                    )
-                if seen.arrival <= asked + 0.1:
-                    return Result(
-                        name, False, f"teleported {turtle} to {want}; no new transform came after"
-                    )
-                got = pose_text(seen.x, seen.y, seen.yaw)
-                return Result(
-                    name,
-                    False,
-                    f"teleported {turtle} to {want}; /tf says {got}: "
-                    f"{_frame_mistake(seen, x, y, theta, tol)}",
-                )
             tried.append(pose_text(x, y, theta))
         return Result(name, True, f"{count} random poses, each on /tf, e.g. {tried[0]}")
     finally:
