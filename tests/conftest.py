@@ -16,6 +16,7 @@ import pytest
 from app import PROJECT_ROOT
 from app.dds import configure_dds_env
 from bench import _reaper
+from tests import worker_plan
 
 # One folder per xdist worker (tests/run.py): workers live in namespaces of
 # their own, so two of them may serve on the same port number and would write
@@ -227,6 +228,18 @@ def page(browser, dashboard, request):
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     page.screenshot(path=str(ARTIFACTS / f"{request.node.name}.png"))
     context.close()
+
+
+@pytest.hookimpl(optionalhook=True, tryfirst=True)
+def pytest_xdist_make_scheduler(config: pytest.Config, log: object) -> object:
+    """tests/run.py's workers share the tests as tests/worker_plan.py says."""
+    return worker_plan.make_scheduler(config, log)
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    # Every worker collects, and all must list the same order: the plan is a pure function.
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        items[:] = worker_plan.spread(items)
 
 
 # Nothing a test started outlives the session: every process this session

@@ -170,7 +170,7 @@ def pytest_command(args: list[str]) -> list[str]:
     if workers <= 1:
         return command
     spawn = f"{workers}*popen//python={sys.executable} {Path(__file__).resolve()} --worker"
-    return [*command, "--tx", spawn, "--dist", "loadgroup"]
+    return [*command, "--tx", spawn, "--dist", "loadscope"]  # scheduler: tests/worker_plan.py
 
 
 def main() -> int:

@@ -29,9 +29,7 @@ from tests.browser.helpers import (
 from tests.conftest import ARTIFACTS, DashboardProcess, fail_on_leftover_nodes, free_port
 from tests.outside_report import private_dds_env
 
-# All on one test worker (tests/run.py): the module-scoped fixture (its dashboard) is
-# then made once, not once on every worker that runs one of these tests.
-pytestmark = [pytest.mark.browser, pytest.mark.ros, pytest.mark.xdist_group(__name__)]
+pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
 AXE = Path(__file__).parent / "axe" / "node_modules" / "axe-core" / "axe.min.js"
 COURSE = load_course()

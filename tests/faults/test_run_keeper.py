@@ -9,6 +9,7 @@ namespace it made and ends whatever is left in it once its child has ended.
 from __future__ import annotations
 
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -18,6 +19,7 @@ import pytest
 
 from app import PROJECT_ROOT
 from tests.conftest import wait_until
+from tests.worker_plan import ONE_WORKER
 
 # Starts a program in a session of its own (as the dashboard fixture does),
 # says its pid, then either waits to be killed or exits at once.
@@ -55,7 +57,12 @@ def test_a_run_ends_what_it_started_and_names_it(tmp_path, ending):
         text=True,
     )
     try:
-        wait_until(pid_file.exists, timeout=30, what="the script to start its program")
+        # write_text creates the file before it writes: wait for the number itself.
+        wait_until(
+            lambda: pid_file.exists() and pid_file.read_text().strip(),
+            timeout=30,
+            what="the script to start its program",
+        )
         left = int(pid_file.read_text())
         if how == "wait":
             run.send_signal(signal.SIGTERM)
@@ -70,50 +77,45 @@ def test_a_run_ends_what_it_started_and_names_it(tmp_path, ending):
     wait_until(lambda: _gone(left), timeout=10, what=f"pid {left} to be gone")
 
 
-# Run by `tests/run.py --workers 2`: each test notes its worker and namespace,
-# and the first leaves a program behind (in its own session, as a dashboard is).
-IN_WORKERS = """
-import os, pathlib, socket, subprocess, sys, time
+# Run by `tests/run.py --workers 2` as two modules (outside tests/, a module is
+# one unit of work, so each worker gets one): each test notes its worker and
+# namespace, and the first module leaves a program behind (in its own session,
+# as a dashboard is).
+NOTE = """
+import os, pathlib, socket, subprocess, sys
 
-NOTES = pathlib.Path(os.environ["NOTES_DIR"])
-
-
-def _note(i):
-    time.sleep(0.5)  # so that both workers get tests
+def note(name):
     names = ",".join(name for _, name in socket.if_nameindex())
     ns = os.readlink("/proc/self/ns/net")
-    (NOTES / f"{i}.txt").write_text(f"{os.environ['PYTEST_XDIST_WORKER']} {ns} {names}")
-
-
+    worker = os.environ["PYTEST_XDIST_WORKER"]
+    (pathlib.Path(os.environ["NOTES_DIR"]) / name).write_text(f"{worker} {ns} {names}")
+"""
+LEAVES = """
 def test_leaves_a_program():
     child = subprocess.Popen(
         [sys.executable, "-c", "import time; time.sleep(300)  # left in a worker"],
         start_new_session=True,
     )
-    (NOTES / "left.pid").write_text(str(child.pid))
-    _note(0)
-
-
-def test_1():
-    _note(1)
-
-
-def test_2():
-    _note(2)
-
-
-def test_3():
-    _note(3)
+    (pathlib.Path(os.environ["NOTES_DIR"]) / "left.pid").write_text(str(child.pid))
+    note("first")
+"""
+NOTES_ONLY = """
+def test_notes():
+    note("second")
 """
 
 
 def test_workers_have_namespaces_of_their_own_and_the_keeper_ends_what_they_leave(tmp_path):
-    tests, notes = tmp_path / "test_in_workers.py", tmp_path / "notes"
-    tests.write_text(IN_WORKERS)
+    notes = tmp_path / "notes"
     notes.mkdir()
+    tests = [tmp_path / "test_first.py", tmp_path / "test_second.py"]
+    tests[0].write_text(NOTE + LEAVES)
+    tests[1].write_text(NOTE + NOTES_ONLY)
     env = {k: v for k, v in os.environ.items() if k != "CLASSROOM_PRIVATE_NETNS"}
+    # The project's settings, and a rootdir that gives the two files distinct node ids.
+    command = [sys.executable, "tests/run.py", "--workers", "2", "-c", "pyproject.toml"]
     run = subprocess.run(
-        [sys.executable, "tests/run.py", "--workers", "2", "-c", "pyproject.toml", str(tests)],
+        [*command, "--rootdir", str(tmp_path), *map(str, tests)],
         cwd=PROJECT_ROOT,
         env={**env, "NOTES_DIR": str(notes)},
         capture_output=True,
@@ -121,10 +123,10 @@ def test_workers_have_namespaces_of_their_own_and_the_keeper_ends_what_they_leav
         timeout=120,
     )
     out = run.stdout + run.stderr
-    assert "4 passed" in out, out
-    seen = [(notes / f"{i}.txt").read_text().split() for i in range(4)]
+    assert "2 passed" in out, out
+    seen = [(notes / name).read_text().split() for name in ("first", "second")]
     by_worker = {worker: (ns, names) for worker, ns, names in seen}
-    assert set(by_worker) == {"gw0", "gw1"}, seen  # both workers ran tests
+    assert set(by_worker) == {"gw0", "gw1"}, seen  # both workers ran a module
     assert by_worker["gw0"][0] != by_worker["gw1"][0], seen  # in two namespaces
     assert all(ns != os.readlink("/proc/self/ns/net") for ns, _ in by_worker.values()), seen
     assert all(names == "lo" for _, names in by_worker.values()), seen
@@ -133,3 +135,24 @@ def test_workers_have_namespaces_of_their_own_and_the_keeper_ends_what_they_leav
     assert "still running (killed now)" in out and f"pid {left}:" in out, out
     assert "# left in a worker" in out, out
     wait_until(lambda: _gone(left), timeout=10, what=f"pid {left} to be gone")
+
+
+def test_a_one_worker_module_runs_whole_on_one_worker_and_the_rest_is_shared():
+    """tests/worker_plan.py's units, as the real run hands them out (not just as planned)."""
+    module = "tests/sim/test_sim_physics.py"
+    assert module in ONE_WORKER
+    env = {k: v for k, v in os.environ.items() if k != "CLASSROOM_PRIVATE_NETNS"}
+    run = subprocess.run(
+        [sys.executable, "tests/run.py", "--workers", "3", module, "tests/unit/test_cli.py", "-v"],
+        cwd=PROJECT_ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    out = run.stdout + run.stderr
+    assert run.returncode == 0, out
+    ran = re.findall(r"^\[(gw\d)\] .*PASSED (\S+)::", out, re.M)
+    workers_of = {path: {gw for gw, p in ran if p == path} for _, path in ran}
+    assert len(workers_of[module]) == 1, workers_of
+    assert len(workers_of["tests/unit/test_cli.py"]) > 1, workers_of

@@ -37,14 +37,7 @@ from tests.hub.local_hub import PASSWORD, LocalHub
 
 # A watchdog, not a budget: the first test also spawns three learners' servers, which
 # on two busy shared cores has taken minutes.
-# All on one test worker (tests/run.py): the module-scoped fixture (its JupyterHub) is
-# then made once, not once on every worker that runs one of these tests.
-pytestmark = [
-    pytest.mark.browser,
-    pytest.mark.ros,
-    pytest.mark.timeout(480),
-    pytest.mark.xdist_group(__name__),
-]
+pytestmark = [pytest.mark.browser, pytest.mark.ros, pytest.mark.timeout(480)]
 
 LEARNERS = ("alice", "bob", "carol")
 # Besides the talker everyone starts, a node only this learner runs: seeing it

@@ -26,10 +26,6 @@ from app.ros2cli import run_text
 from app.ros2cli.pkg import setup_workspace
 from app.supervisor import Supervisor
 
-# All on one test worker (tests/run.py): the module-scoped fixture (its built workspace) is
-# then made once, not once on every worker that runs one of these tests.
-pytestmark = pytest.mark.xdist_group(__name__)
-
 LIMITS = Limits(max_messages=3, max_seconds=6.0)
 TUTORIAL_CREATE = (
     "ros2 pkg create --build-type ament_python --license Apache-2.0 --node-name my_node my_package"

@@ -20,9 +20,7 @@ from app import PROJECT_ROOT
 from app.catalog import lookup_group
 from tests.outside_report import part, private_dds_env, run_outside_client
 
-# All on one test worker (tests/run.py): the module-scoped fixture (its MuJoCo run) is
-# then made once, not once on every worker that runs one of these tests.
-pytestmark = [pytest.mark.ros, pytest.mark.xdist_group(__name__)]
+pytestmark = pytest.mark.ros
 
 CLIENT = Path(__file__).with_name("sim_client.py")
 ROOM_HALF = 2.0  # inner faces of the room's walls at x, y = +-2 m

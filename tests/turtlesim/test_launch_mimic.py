@@ -55,8 +55,20 @@ def test_multisim_runs_two_turtlesims_and_mimic_couples_them(console, probe, sup
         timeout=DISCOVERY_TIMEOUT,
         what="both turtlesims",
     )
-    out = ok(console, "ros2 topic list")
-    assert {"/turtlesim1/turtle1/cmd_vel", "/turtlesim2/turtle1/pose"} <= set(out), out
+    # A node is on the graph before its subscriptions and publishers are: as in a
+    # terminal, `ros2 topic list` shows them all once discovery has caught up.
+    wanted = {"/turtlesim1/turtle1/cmd_vel", "/turtlesim2/turtle1/pose"}
+    listed: list[str] = []
+
+    def all_listed() -> bool:
+        listed[:] = ok(console, "ros2 topic list")
+        return wanted <= set(listed)
+
+    wait_until(
+        all_listed,
+        timeout=DISCOVERY_TIMEOUT,
+        what=lambda: f"{sorted(wanted)} in `ros2 topic list`: {listed}",
+    )
     # The same file twice would give the graph two nodes of one name: refused.
     code, out = console("ros2 launch turtlesim multisim.launch.py")
     assert code == 1 and out[-1].startswith("error: turtlesim multisim.launch.py is already"), out

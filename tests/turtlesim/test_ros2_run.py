@@ -144,21 +144,38 @@ def test_the_command_line_runs_package_and_executable_like_ros2_run(ros_env, pro
     import signal
     import subprocess
     import sys
+    import threading
 
     from app import PROJECT_ROOT
 
     argv = [sys.executable, "-m", "app", "run", "turtlesim", "turtlesim_node"]
     argv += ["--ros-args", "-r", "__node:=cli_turtle"]
     proc = subprocess.Popen(
-        argv, cwd=PROJECT_ROOT, env=ros_env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT
+        argv,
+        cwd=PROJECT_ROOT,
+        env=ros_env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
     )
+    assert proc.stdout is not None
+    lines: list[str] = []
+    reader = threading.Thread(target=lambda: lines.extend(proc.stdout), daemon=True)
+    reader.start()
+    started = "Starting turtlesim with node name /cli_turtle"
     try:
         wait_until(
             lambda: "/cli_turtle" in node_names(probe),
             timeout=DISCOVERY_TIMEOUT,
             what="the renamed turtlesim",
         )
+        # The node joins the graph in Node.__init__, before it logs its greeting.
+        wait_until(
+            lambda: any(started in line for line in lines),
+            timeout=DISCOVERY_TIMEOUT,
+            what=lambda: f"{started!r} in the output: {lines}",
+        )
     finally:
         proc.send_signal(signal.SIGINT)  # Ctrl+C, as in the terminal
-        output = proc.communicate(timeout=15)[0].decode()
-    assert "Starting turtlesim with node name /cli_turtle" in output, output
+        proc.wait(timeout=15)
+        reader.join(timeout=5)

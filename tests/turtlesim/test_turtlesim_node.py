@@ -18,9 +18,7 @@ import pytest
 
 from tests.outside_report import part, private_dds_env, run_outside_client
 
-# All on one test worker (tests/run.py): the module-scoped fixture (its turtlesim run) is
-# then made once, not once on every worker that runs one of these tests.
-pytestmark = [pytest.mark.ros, pytest.mark.xdist_group(__name__)]
+pytestmark = pytest.mark.ros
 
 CLIENT = Path(__file__).with_name("turtlesim_client.py")
 WORLD = (500 - 1) / 45

@@ -20,10 +20,7 @@ import pytest
 from app.dds import configure_dds_env
 from tests.conftest import _domain_ids, in_private_netns
 
-# All on one test worker (tests/run.py): the module-scoped fixture (its
-# robot_state_publisher run) is then made once, not once on every worker that
-# runs one of these tests.
-pytestmark = [pytest.mark.ros, pytest.mark.xdist_group(__name__)]
+pytestmark = pytest.mark.ros
 
 CLIENT = Path(__file__).with_name("rsp_client.py")
 MACROED = Path(__file__).parents[2] / "ros_python/src/urdf_tutorial/urdf/08-macroed.urdf.xacro"

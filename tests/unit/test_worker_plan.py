@@ -1,0 +1,41 @@
+"""The plan that shares the tests among tests/run.py's workers."""
+
+from __future__ import annotations
+
+from app import PROJECT_ROOT
+from tests.worker_plan import ONE_WORKER, spread, unit_of
+
+HUB = "tests/hub/test_jupyterhub.py"
+
+
+def _ids(folder: str, count: int, module: str = "test_x.py") -> list[str]:
+    return [f"tests/{folder}/{module}::test_{i}" for i in range(count)]
+
+
+def test_every_one_worker_module_exists():
+    # A renamed module would silently be shared out test by test again.
+    missing = [path for path in ONE_WORKER if not (PROJECT_ROOT / path).is_file()]
+    assert not missing, missing
+
+
+def test_a_one_worker_module_is_one_unit_and_other_tests_are_their_own():
+    assert unit_of(f"{HUB}::test_a") == unit_of(f"{HUB}::test_b[x::y]") == HUB
+    assert unit_of("tests/unit/test_cli.py::test_a") == "tests/unit/test_cli.py::test_a"
+
+
+def test_a_one_worker_module_stays_whole_and_in_its_written_order():
+    hub = [f"{HUB}::test_{name}" for name in ("spawn", "refuse", "teacher")]
+    order = spread([*_ids("browser", 4), *hub, *_ids("unit", 6)], nodeid_of=str)
+    at = order.index(hub[0])
+    assert order[at : at + 3] == hub
+
+
+def test_each_folders_tests_are_spread_over_the_whole_run():
+    browser, exercises, unit = _ids("browser", 10), _ids("exercises", 30), _ids("unit", 60)
+    order = spread([*browser, *exercises, *unit], nodeid_of=str)
+    assert sorted(order) == sorted([*browser, *exercises, *unit])
+    for folder in (browser, exercises, unit):
+        positions = [order.index(nodeid) for nodeid in folder]
+        assert positions == sorted(positions)  # the collection order within a folder
+        first_half = sum(p < len(order) / 2 for p in positions)
+        assert abs(first_half - len(folder) / 2) <= 1, (folder[0], positions)
