@@ -94,7 +94,8 @@ sandbox: setup
 			chmod o+x /root; fi;; esac
 
 # Every test runs inside a private network namespace with only loopback
-# (tests/run.py sets it up): DDS traffic cannot leave the machine.
+# (tests/run.py sets it up): DDS traffic cannot leave the machine. Three
+# pytest-xdist workers, each in a namespace of its own; ARGS="--workers 1" for one.
 test: setup browser sandbox lint
 	$(VPY) tests/run.py $(ARGS)
 

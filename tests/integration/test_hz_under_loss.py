@@ -94,14 +94,19 @@ def test_two_publishers_on_one_topic_and_the_hz_verb(probe, ros2):
         sent = publish_at(pubs, 200.0, 1.5)
         time.sleep(0.2)
         stats = monitor.published_rate()
+        arrived = monitor.rate()
     finally:
         view.shutdown()
-    assert stats is not None
+    assert stats is not None and arrived is not None
     if stats.writers == 2:  # an rclpy that names the writer (publisher_gid): per writer
         assert not stats.fallback and stats.rate == pytest.approx(true_rate(sent), rel=0.02)
     else:  # Jazzy's rclpy does not: the interleaved sequences are noticed, arrival rate used
         assert stats.fallback == INTERLEAVED and stats.published is None, stats
-        assert stats.rate == pytest.approx(true_rate(sent), rel=0.05)
+        # What arrived, as said ("the average above is what arrived"). Arrivals follow
+        # the subscriber's executor, so on a loaded machine they lag the sending (seen:
+        # 177.6 Hz for 200 sent); only the publisher's clock would be exact.
+        assert stats.rate == pytest.approx(arrived.rate, rel=1e-6), (stats, arrived)
+        assert stats.rate == pytest.approx(true_rate(sent), rel=0.25)
 
     # `ros2 topic hz` keeps ros2's lines and adds the publisher's rate after them.
     pub = probe.node.create_publisher(Int64, "/hz_probe", 10)
