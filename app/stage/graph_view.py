@@ -33,6 +33,8 @@ MAX_REMEMBERED = 500
 STARTING = "starting…"  # a node's second line while its process runs but ROS has not listed it
 LEG_SEC = 0.6  # a pulse's leg: caller to service/action box, or box to server
 STEP_X, STEP_Y = BOX_W + GAP_X, BOX_H + ROW_GAP
+EMPTY_NOTE = "Nothing on the graph yet: start a node."
+NOTE_ROOM = 30  # px above the boxes for a note line
 
 
 class StablePlaces:
@@ -219,14 +221,14 @@ def _pulse_legs(
 
 def _pulse_svg(pulse: PulseView, path: str, backwards: bool, begin: float) -> str:
     reverse = 'keyPoints="1;0" keyTimes="0;1" calcMode="linear" ' if backwards else ""
-    width = 8 + 6 * len(pulse.kind)
+    width = 10 + 7 * len(pulse.kind)
     return (
         f'<g class="sg-pulse" data-kind="{pulse.kind}" data-name="{escape(pulse.name)}" '
         f'visibility="hidden"><set attributeName="visibility" to="visible" '
         f'begin="{begin:.3f}s" dur="{LEG_SEC}s"/>'
         f'<animateMotion begin="{begin:.3f}s" dur="{LEG_SEC}s" fill="freeze" {reverse}'
         f'path="{path}"/><rect x="{-width / 2:.0f}" y="-8" width="{width}" height="16" rx="8" '
-        f'stroke-width="1.5"/><text y="4" font-size="10" text-anchor="middle">{pulse.kind}'
+        f'stroke-width="1.5"/><text y="4" font-size="11" text-anchor="middle">{pulse.kind}'
         "</text></g>"
     )
 
@@ -238,30 +240,41 @@ def stage_svg(
     link: Callable[[int, str, str], str] | None = None,
     pulses: list[PulseView] | tuple[PulseView, ...] = (),
     starting: frozenset[str] = frozenset(),
+    min_width: float = 0.0,
+    note: str | None = None,
 ) -> str:
     """The picture; ``rates`` (topic -> Hz) sets how many dots move on its edges,
     ``pulses`` are calls and goals on their way, ``starting`` the nodes drawn dashed
     because their process runs but the ROS graph does not list them yet.
 
+    Drawn at its natural size, never scaled down (the stage scrolls instead): at
+    least ``min_width`` px wide, so it fills the stage. ``note``: a line written
+    above the boxes (default: none, or that the graph is empty).
+
     ``link(i, content, title)`` wraps the i-th box (``placed`` order) in a link.
     """
+    if note is None:
+        note = "" if placed else EMPTY_NOTE
+    top = NOTE_ROOM if note else 0.0
+    placed = [Placed(p.vertex, p.x, p.y + top) for p in placed]
     where = {p.vertex.key: p for p in placed}
     right = max((p.x for p in placed), default=0) + BOX_W + MARGIN
-    width = max(right, 2 * MARGIN + PER_ROW * BOX_W + (PER_ROW - 1) * GAP_X)
-    height = max((p.y for p in placed), default=0) + BOX_H + MARGIN + (0 if placed else 30)
+    width = max(right, 2 * MARGIN + PER_ROW * BOX_W + (PER_ROW - 1) * GAP_X, min_width)
+    height = max((p.y for p in placed), default=top) + (BOX_H + MARGIN if placed else 0) + 8
     parts = [
         f'<svg class="stage-graph" xmlns="http://www.w3.org/2000/svg" role="group" '
         f'aria-label="Live ROS graph: {len(placed)} items" viewBox="0 0 {width:.0f} '
-        f'{height:.0f}" width="100%" style="font-family:sans-serif;max-width:{width:.0f}px">',
+        f'{height:.0f}" width="{width:.0f}" height="{height:.0f}" '
+        'style="font-family:sans-serif;display:block">',
         f"<style>{STAGE_CSS}</style>",
         '<defs><marker id="sg-arrow" viewBox="0 0 10 10" refX="9" refY="5" markerWidth="7" '
         'markerHeight="7" orient="auto-start-reverse"><path class="sg-head" '
         'd="M0,0 L10,5 L0,10 z"/></marker></defs>',
     ]
-    if not placed:
+    if note:
         parts.append(
-            '<text class="sg-note" x="10" y="24" font-size="13" stroke-width="0">'
-            "Nothing on the graph yet: start a node.</text>"
+            f'<text class="sg-note" x="{MARGIN}" y="20" font-size="13" stroke-width="0">'
+            f"{escape(note)}</text>"
         )
     labels, dots = [], []
     servers: dict[str, list[str]] = {}  # service/action -> paths from its servers
@@ -313,7 +326,7 @@ def stage_svg(
         )
         if v.detail:
             body += (
-                f'<text class="sg-detail" x="{cx:.0f}" y="{p.y + 28:.0f}" font-size="10" '
+                f'<text class="sg-detail" x="{cx:.0f}" y="{p.y + 28:.0f}" font-size="11" '
                 f'text-anchor="middle">{escape(short(v.detail, 30))}</text>'
             )
         title = f"{v.kind} {v.name}"

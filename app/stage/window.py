@@ -45,6 +45,7 @@ STAGE_WIDTH = 560  # until the browser says how wide its window is
 # The control panel (lesson text, tools) floats on the right: ~65 characters a line of
 # lesson text at viser's 14 px font, the 60-80 a reading column wants.
 CONTROL_WIDTH = 480
+PANEL_MARGIN = 14  # the floating control panel's gap to the window's edges
 CONTROL_PANEL_ROOM = CONTROL_WIDTH + 28  # and its margins
 MIN_WIDTH, MAX_WIDTH = 400, 3000  # up to the panel: no 3D scene peeks out between
 REFIT_PX = 24  # a smaller change of the window is not worth moving the stage
@@ -71,6 +72,9 @@ _TOOLS_FOR: dict[str, tuple[tuple[str, str], ...]] = {
     "action": (("Actions", "Send a goal to {name} in Actions"),),
 }
 OUTPUT_LINES = 40
+STAGE_PADDING = 40  # the stage window's borders, folder margins and scroll bar
+OWN_DETAIL = "this dashboard"
+ONLY_OWN = "Only this dashboard's own node is on the graph: start a node and watch it join."
 NO_OUTPUT = (
     "_Nothing has run yet._ **Run my node** (Learn › Exercise) runs your code; what it "
     "prints and logs shows here."
@@ -118,6 +122,8 @@ class Stage:
         self._code_window = code_window
         self.width = STAGE_WIDTH
         self._fitted = False
+        self._widths_due = 0.0
+        self._main_panel: viser.MainPanelHandle | None = None  # placed by follow_window
         self._rates: RateBoard | SharedRatesClient = rates or RateBoard(node)
         self._places = StablePlaces()
         # Calls and goals as pulses: an event wakes the UI loop, which draws it at once.
@@ -181,7 +187,8 @@ class Stage:
         and after each resize (the camera messages' canvas width cannot tell:
         it is the window minus whatever the docks were at that moment).
         """
-        server.gui.main_panel.set_width(CONTROL_WIDTH)
+        self._main_panel = server.gui.main_panel
+        self._place_control_panel()
         if self._links is None:
             return
         href = self._links.register_value("stage.window", self._on_window_width)
@@ -207,26 +214,51 @@ class Stage:
         for window in (self._window, self._code_window, self._output_window):
             window.set_width(self.width)
 
+    def _place_control_panel(self) -> None:
+        """The 3D scene on stage: the control panel docks on the right, so viser insets
+        the canvas to the stage's area and centres the scene there (floating, the panel
+        covered the canvas's right third). Any other stage: it floats beside the stage
+        window, which takes all the room left of it."""
+        if self._main_panel is None:
+            return
+        if self.current == "scene":
+            self._main_panel.dock_right()
+        else:
+            self._main_panel.float(x=-PANEL_MARGIN, y=PANEL_MARGIN)
+        self._main_panel.set_width(CONTROL_WIDTH)
+
     def show(self, stage: str) -> None:
         """Put ``stage`` on (an unknown name is ignored: lessons are validated at load)."""
         if stage not in STAGES:
             return
         self.current = stage
         assign(self._selector, STAGES[stage])
-        self._window.visible = stage in _IN_WINDOW
+        windows = [
+            (self._window, stage in _IN_WINDOW),
+            (self._code_window, stage == "code"),
+            (self._output_window, stage == "code"),
+        ]
+        # Off first, then on: for a moment both docked on the left, the client squeezed
+        # the newcomer to its 300 px default and kept it there (the graph in lessons 3-10
+        # was a 300 px strip after the code stage of lesson 2).
+        for window, on in sorted(windows, key=lambda pair: pair[1]):
+            window.visible = on
         self._graph_box.visible = stage == "graph"
         self.turtlesim.set_active(stage == "turtlesim")
         self.tf.set_active(stage == "tf")
-        self._code_window.visible = stage == "code"
-        self._output_window.visible = stage == "code"
-        if stage == "code" and self._fitted:
-            self._set_widths()  # the column the code and its output share
+        # A window docked again takes the client's default width: give it the stage's.
+        self._set_widths()
+        self._widths_due = time.monotonic() + 0.05
+        self._place_control_panel()
         self._last_picture = 0.0  # draw at once
         if stage != "graph":
             self._rates.watch({})  # no subscriptions for a picture nobody sees
             self._calls.watch({}, {})
 
     def refresh(self, graph: GraphSnapshot) -> None:
+        if self._widths_due and time.monotonic() > self._widths_due:
+            self._widths_due = 0.0
+            self._set_widths()
         if self.current == "turtlesim":
             self.turtlesim.refresh(graph)
         elif self.current == "tf":
@@ -258,6 +290,12 @@ class Stage:
         labels = {topic: rate_text(rate) for topic, rate in rates.items()}
         vertices, edges = graph_picture(endpoints, labels, show_quiet=quiet)
         vertices += [Vertex("node", name, STARTING) for name in starting]
+        note = ""
+        if not vertices:  # the dashboard is a node too: say so rather than 'nothing'
+            vertices = [Vertex("node", own, OWN_DETAIL)]
+            note = ONLY_OWN
+            if (mine := node_endpoints(self._node, own)) is not None:
+                endpoints = [*endpoints, mine]  # inspected like any other node
         # A node drawn alone (starting, or its endpoints not discovered yet) joins its
         # group's place once its first edge is known; every other box stays put.
         linked = {key for e in edges for key in (e.source, e.target)}
@@ -273,7 +311,11 @@ class Stage:
             PulseView(p.kind, p.name, self._caller(p, edges), now - p.shown_at) for p in pulses
         ]
         link = self._link if self._links is not None else None
-        svg = stage_svg(placed, edges, rates, link, views, frozenset(starting))
+        svg = stage_svg(
+            placed, edges, rates, link, views, frozenset(starting), self.width - STAGE_PADDING, note
+        )
+        # Natural size, never shrunk to fit (its text stays readable): a wider graph scrolls.
+        svg = f'<div style="overflow:auto">{svg}</div>'
         if self._links is not None:
             svg = SINK_FRAME + svg
         if svg != self._svg:
