@@ -448,12 +448,12 @@ def cmd_ros2(args: argparse.Namespace) -> int:
     configure_this_process(domain_id=args.domain_id, network=args.network)
     from app.ros2cli.cli import main as ros2_main
 
-    return ros2_main([args.group, *args.words])
+    return ros2_main([*filter(None, [args.group]), *args.words], prog=args.prog)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(prog: str = "ros2-classroom") -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog="ros2-classroom", description="A browser-based teaching dashboard for ROS 2 Jazzy."
+        prog=prog, description="A browser-based teaching dashboard for ROS 2 Jazzy."
     )
     sub = parser.add_subparsers(dest="command", required=True)
 
@@ -478,6 +478,7 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="allow a --host other than loopback; every browser then needs the access token",
     )
+    parser.set_defaults(prog=prog)
     serve.add_argument(
         "--token",
         default=os.environ.get("CLASSROOM_TOKEN"),
@@ -628,9 +629,9 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, prog: str = "ros2-classroom") -> int:
     argv = sys.argv[1:] if argv is None else argv
-    parser = build_parser()
+    parser = build_parser(prog)
     if argv[:1] and argv[0] in ROS2_GROUPS:
         # Options before the verb (`topic -h`, `topic --include-hidden-topics type X`) are the
         # verb's, as in `ros2`: hand them on instead of rejecting them here.
@@ -641,5 +642,26 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return args.func(args)
     except (CliError, catalog.UnknownNodeError, ValueError) as exc:
-        print(f"ros2-classroom: error: {exc}", file=sys.stderr)
+        print(f"{prog}: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
+
+
+def ros2(argv: list[str] | None = None) -> int:
+    """The ``ros2`` command of a terminal (issue 37): ``ros2 topic list`` is
+    ``ros2-classroom topic list``, ``ros2 run``/``ros2 launch`` are its ``run``/``launch``.
+
+    Anything else (``ros2``, ``ros2 --help``, a command we lack) goes to the
+    Console's parser, which lists the groups and says what is wrong. DDS stays
+    on loopback as for every command of ours (``ros2 GROUP --network ...`` opts in).
+    """
+    argv = sys.argv[1:] if argv is None else argv
+    # The venv is this machine's ROS install: it stays under a sourced workspace, as
+    # /opt/ros/jazzy does (that workspace's setup.bash set AMENT_PREFIX_PATH without it).
+    prefixes = [p for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
+    if sys.prefix not in prefixes:
+        os.environ["AMENT_PREFIX_PATH"] = os.pathsep.join([*prefixes, sys.prefix])
+    if argv[:1] and argv[0] in (*ROS2_GROUPS, "run", "launch"):
+        return main(argv, prog="ros2")
+    return cmd_ros2(
+        argparse.Namespace(domain_id=None, network=False, group=None, words=argv, prog="ros2")
+    )

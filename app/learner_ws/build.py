@@ -16,8 +16,9 @@ the learner's ``setup.py`` and ``CMakeLists.txt``, i.e. learner code, so:
   allows learner code, and then contained like exercise code.
 
 CMake packages (rosidl interface packages) get the ROS wheels' prefix and our
-toolchain file (``cmake/toolchain.cmake``) through the environment; the
-learner's CMakeLists.txt stays as the tutorial writes it.
+toolchain file (``cmake/toolchain.cmake``) from our colcon extension
+(``colcon_extension``), as ``colcon build`` in a terminal does; the learner's
+CMakeLists.txt stays as the tutorial writes it.
 """
 
 from __future__ import annotations
@@ -33,7 +34,6 @@ from app.learner_ws.folder import LearnerWorkspace
 from app.ros.errors import Ros2Error
 from app.supervisor import LearnerProgram
 
-TOOLCHAIN = Path(__file__).resolve().parent / "cmake" / "toolchain.cmake"
 PROGRAM_PREFIX = "colcon:"
 VERBS = ("build", "test", "test-result", "list", "graph", "info")
 _PACKAGE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]*$")
@@ -109,7 +109,8 @@ def check_words(words: list[str]) -> list[str]:
 
 
 def build_env(workspace: LearnerWorkspace) -> dict[str, str]:
-    """What colcon gets over the supervisor's environment."""
+    """What colcon gets over the supervisor's environment: the Console's sourced workspaces
+    (a terminal's shell has its own); the toolchain comes from our colcon extension."""
     sourced = overlay.child_env()
     venv_bin = str(Path(sys.executable).parent)  # cmake, ninja and colcon of the venv
     ours = [str(p) for p in overlay.overlay()]
@@ -120,9 +121,6 @@ def build_env(workspace: LearnerWorkspace) -> dict[str, str]:
         "PYTHONPATH": sourced["PYTHONPATH"],
         "LD_LIBRARY_PATH": sourced["LD_LIBRARY_PATH"],
         "PATH": os.pathsep.join([venv_bin, sourced["PATH"]]),
-        "CMAKE_TOOLCHAIN_FILE": str(TOOLCHAIN),
-        "CLASSROOM_PYTHON": sys.executable,
-        "CLASSROOM_UNDERLAY": sys.prefix,
         "PYTHONUNBUFFERED": "1",
         "PYTHONDONTWRITEBYTECODE": "1",
         "COLCON_HOME": str(workspace.root / ".colcon"),

@@ -32,8 +32,11 @@ def _note(line: str) -> None:
     print(line, file=sys.stderr, flush=True)
 
 
-def main(argv: list[str]) -> int:
-    """Run one verb; the caller has already configured DDS for this process."""
+def main(argv: list[str], prog: str = "ros2-classroom") -> int:
+    """Run one verb; the caller has already configured DDS for this process.
+
+    ``prog`` names the command in usage lines (``ros2`` for the terminal's ``ros2``).
+    """
     cancel = threading.Event()
     if not needs_ros(argv):
         # Verbs that need no ROS (interface ...) never touch the node: none is made.
@@ -41,7 +44,7 @@ def main(argv: list[str]) -> int:
         return run_argv(
             TerminalContext(node=no_node, write=_print, limits=CLI_LIMITS, note=_note),
             argv,
-            "ros2-classroom",
+            prog,
         )
     from app.ros.runtime import RosRuntime
 
@@ -54,7 +57,7 @@ def main(argv: list[str]) -> int:
         node=runtime.node, write=_print, limits=CLI_LIMITS, cancel=cancel, note=_note
     )
     try:
-        code = run_argv(ctx, argv, "ros2-classroom")
+        code = run_argv(ctx, argv, prog)
         if cancel.is_set() and not (argv[:1] and argv[0] in ROS2CLI_GROUPS):
             return EXIT_INTERRUPTED_OTHER
         return code  # ros2cli's verbs: as `ros2` ends after Ctrl+C (parser.EXIT_INTERRUPTED)

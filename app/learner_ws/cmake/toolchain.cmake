@@ -1,26 +1,25 @@
 # ROS 2 Classroom: what colcon's CMake needs to build against the ROS wheels.
-# Given to every CMake package of a learner's workspace through the
-# CMAKE_TOOLCHAIN_FILE environment variable, so the learner's CMakeLists.txt
-# stays exactly as the tutorials write it.
+# Given to every CMake package of a learner's workspace by our colcon extension
+# (app/learner_ws/colcon_extension.py appends -DCMAKE_TOOLCHAIN_FILE=<this file>,
+# -DPython3_EXECUTABLE and -DCLASSROOM_UNDERLAY to `colcon build`'s --cmake-args),
+# in the Console and in a terminal alike, so the learner's CMakeLists.txt stays
+# exactly as the tutorials write it.
 #
 # * The ROS packages live in the prefix of the Python that runs the build
-#   (the project's virtual environment), CLASSROOM_UNDERLAY in the build's
-#   environment: AMENT_PREFIX_PATH and CMAKE_PREFIX_PATH end with it.
+#   (the project's virtual environment), CLASSROOM_UNDERLAY: AMENT_PREFIX_PATH
+#   and CMAKE_PREFIX_PATH end with it.
 # * Tests of ament_cmake packages need ament_lint_auto, which has no wheel:
 #   BUILD_TESTING is off unless the command line turns it on.
 # * After each project's CMakeLists.txt, drop include directories of the
 #   wheels' build machine (/opt/python/...) from imported targets.
-if(DEFINED ENV{CLASSROOM_PYTHON})
-  set(Python3_EXECUTABLE "$ENV{CLASSROOM_PYTHON}" CACHE FILEPATH "the workspace's Python")
-endif()
-if(DEFINED ENV{CLASSROOM_UNDERLAY})
+if(DEFINED CLASSROOM_UNDERLAY)
   # The wheels' prefix after whatever the workspace's own packages put first.
   if(DEFINED ENV{AMENT_PREFIX_PATH} AND NOT "$ENV{AMENT_PREFIX_PATH}" STREQUAL "")
-    set(ENV{AMENT_PREFIX_PATH} "$ENV{AMENT_PREFIX_PATH}:$ENV{CLASSROOM_UNDERLAY}")
+    set(ENV{AMENT_PREFIX_PATH} "$ENV{AMENT_PREFIX_PATH}:${CLASSROOM_UNDERLAY}")
   else()
-    set(ENV{AMENT_PREFIX_PATH} "$ENV{CLASSROOM_UNDERLAY}")
+    set(ENV{AMENT_PREFIX_PATH} "${CLASSROOM_UNDERLAY}")
   endif()
-  list(APPEND CMAKE_PREFIX_PATH "$ENV{CLASSROOM_UNDERLAY}")
+  list(APPEND CMAKE_PREFIX_PATH "${CLASSROOM_UNDERLAY}")
 endif()
 set(BUILD_TESTING OFF CACHE BOOL "ament_lint_auto has no wheel")
 # The tutorials' cmake_minimum_required(VERSION 3.8) is fine on Jazzy's CMake 3.28;
