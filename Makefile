@@ -21,7 +21,7 @@ AXE := tests/browser/axe
 AXE_STAMP := $(AXE)/node_modules/.classroom-setup
 ARGS ?=
 
-.PHONY: setup run test browser sandbox lint bench screenshots clean render
+.PHONY: setup run test check browser sandbox lint docs bench screenshots clean render
 
 setup: $(STAMP) $(EDITOR_STAMP) $(HUB_PROXY_STAMP) $(AXE_STAMP) render
 
@@ -106,6 +106,13 @@ lint: setup
 	$(VENV)/bin/ruff format --check app nodes ros_python tests bench lessons docs tools
 	PYTHONPATH=$(CURDIR) $(VENV)/bin/lint-imports
 	PYTHONPATH=$(CURDIR) $(VPY) -m mypy
+	@$(MAKE) --no-print-directory docs
+
+# The documentation site (MkDocs with Material) into .site/, strictly: a broken link, a
+# missing page or a page left out of the navigation fails. Its architecture picture is
+# drawn from the code (tools/architecture.py), so it cannot go stale.
+docs: setup
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet
 
 bench: setup browser
 	$(VPY) tests/run.py --bench $(ARGS)
@@ -115,4 +122,4 @@ screenshots: setup browser
 	$(VPY) tests/run.py --script docs/screenshots.py
 
 clean:
-	rm -rf $(VENV) $(EDITOR)/node_modules $(HUB_PROXY)/node_modules $(AXE)/node_modules $(addsuffix /build,$(INTERFACES)) .mypy_cache .import_linter_cache
+	rm -rf $(VENV) .site $(EDITOR)/node_modules $(HUB_PROXY)/node_modules $(AXE)/node_modules $(addsuffix /build,$(INTERFACES)) .mypy_cache .import_linter_cache
