@@ -237,7 +237,7 @@ def _hub_path(hub_login: Any) -> str:
 
 def _progress_beacon(args: argparse.Namespace, dashboard: Any) -> Any:
     """In a classroom: report this learner's progress to the teacher (app/teacher/beacon.py)."""
-    from app.hub.progress_link import HubTarget
+    from app.teacher.hub_link import HubTarget
 
     hub = HubTarget.from_env()  # inside a JupyterHub server: HTTP to the teacher service
     if args.classroom_domain_id is None and hub is None:

@@ -37,7 +37,7 @@ from jupyterhub.services.auth import (
 from jupyterhub.utils import url_path_join
 from tornado import ioloop, web
 
-from app.hub.reports import ReportError, from_json
+from app.teacher.http_report import ReportError, from_json
 from app.teacher.record import (
     COLUMNS,
     MAX_NOTICE,

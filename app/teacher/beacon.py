@@ -26,12 +26,12 @@ from app.exercises import runner
 from app.exercises.model import Exercise, ExerciseBook
 from app.exercises.panel import ExerciseSettings
 from app.exercises.workspace import Workspace
-from app.hub.progress_link import HubLink, HubTarget, NoticeSink, ReportRefused, SettingsSink
 from app.lessons.runtime import LessonRuntime
 from app.lessons.schema import Course
 from app.ros.side_participant import SideParticipant
 from app.supervisor import Supervisor
 from app.teacher import wire
+from app.teacher.hub_link import HubLink, HubTarget, NoticeSink, ReportRefused, SettingsSink
 from app.teacher.record import MAX_CODE, MAX_ERROR, LearnerRecord, clip, plain_markdown
 from app.ui import MarkdownView
 from app.ui.loop import UiLoop

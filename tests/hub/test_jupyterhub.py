@@ -27,8 +27,8 @@ import pytest
 from playwright.sync_api import Browser, BrowserContext, Page, expect
 
 from app.dds import configure_dds_env
-from app.hub.reports import to_json
 from app.lessons.schema import load_course
+from app.teacher.http_report import to_json
 from app.teacher.record import LearnerRecord
 from tests.browser.helpers import choose, click, expect_text, open_tab
 from tests.browser.test_exercise import EXERCISE, _open_editor

@@ -1,4 +1,4 @@
-"""Progress reports over HTTP (app/hub/reports.py) and the spawner's domain pool, without a hub."""
+"""Progress reports over HTTP (app/teacher/http_report.py) and the spawner's domain pool."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ from dataclasses import replace
 
 import pytest
 
-from app.hub.reports import MAX_BODY, ReportError, from_json, to_json
 from app.hub.spawner import DomainPool
+from app.teacher.http_report import MAX_BODY, ReportError, from_json, to_json
 from app.teacher.record import MAX_CODE, LearnerRecord
 
 RECORD = LearnerRecord(

@@ -18,7 +18,7 @@ import urllib.request
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from app.hub.reports import to_json
+from app.teacher.http_report import to_json
 from app.teacher.record import LearnerRecord
 
 URL_ENV = "CLASSROOM_TEACHER_URL"
