@@ -99,6 +99,19 @@ sandbox: setup
 test: setup browser sandbox lint
 	$(VPY) tests/run.py $(ARGS)
 
+# Fast feedback for whoever changes the code: lint, types, contracts and the docs, the
+# unit tests, and one smoke test of each front end (panels and stage in a browser, the
+# ros2 verbs, a lesson walked on real nodes, an exercise graded). `make test` stays the
+# whole suite; this is the few minutes' subset to run before it.
+SMOKE := tests/unit \
+	tests/browser/test_first_smoke.py::test_start_watch_and_stop_talker_and_listener \
+	tests/integration/test_ros2cli_graph.py::test_node_topic_service_and_action_verbs \
+	"tests/integration/test_lessons_walk.py::test_every_step_of_the_lesson_passes_on_real_nodes[03_topics]" \
+	"tests/exercises/test_grading.py::test_grading[counter_publisher-reference]" \
+	"tests/exercises/test_grading.py::test_grading[counter_publisher-never_increments]"
+check: setup browser sandbox lint
+	$(VPY) tests/run.py --workers 2 $(SMOKE) $(ARGS)
+
 # Style, the layer contracts of pyproject.toml (import-linter) and types (mypy).
 # PYTHONPATH: check this checkout's app/, whatever the editable install points at.
 lint: setup
