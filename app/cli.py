@@ -22,6 +22,7 @@ from app.dds import configure_this_process, validate_domain_id
 from app.stop_signals import set_on_signals
 
 EXIT_USAGE = 2
+EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell tool killed by it reports
 
 
 class CliError(Exception):
@@ -660,8 +661,14 @@ def ros2(argv: list[str] | None = None) -> int:
     prefixes = [p for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
     if sys.prefix not in prefixes:
         os.environ["AMENT_PREFIX_PATH"] = os.pathsep.join([*prefixes, sys.prefix])
-    if argv[:1] and argv[0] in (*ROS2_GROUPS, "run", "launch"):
-        return main(argv, prog="ros2")
-    return cmd_ros2(
-        argparse.Namespace(domain_id=None, network=False, group=None, words=argv, prog="ros2")
-    )
+    try:
+        if argv[:1] and argv[0] in (*ROS2_GROUPS, "run", "launch"):
+            return main(argv, prog="ros2")
+        return cmd_ros2(
+            argparse.Namespace(domain_id=None, network=False, group=None, words=argv, prog="ros2")
+        )
+    except BrokenPipeError:
+        # `ros2 interface list | head`: the reader has all it wants; no traceback, as a
+        # shell tool ends. stdout goes nowhere so the interpreter's last flush stays quiet.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE

@@ -57,6 +57,12 @@ def test_ros2_help_lists_the_verb_groups(tmp_path):
     assert done.returncode == 0 and done.stdout.startswith("usage: ros2 topic"), done.stdout
 
 
+def test_ros2_into_a_closed_pipe_ends_quietly(tmp_path):
+    """A reader that stops early (`| head`) gets no traceback; here one that reads nothing."""
+    done = _shell('ros2 interface list | true\necho "${PIPESTATUS[0]}"', tmp_path)
+    assert done.stdout == "141\n" and done.stderr == "", done.stdout + done.stderr
+
+
 def test_interface_package_builds_with_colcon_in_a_terminal(tmp_path):
     """ros2 pkg create, Num.msg as the tutorial adds it, colcon build, source, ros2 ..."""
     src = tmp_path / "ros2_ws" / "src"
