@@ -21,6 +21,7 @@ loopback of their own and none of this is needed: domain 0 for all.
 from __future__ import annotations
 
 import os
+import sys
 import threading
 from typing import Any, ClassVar
 
@@ -72,6 +73,19 @@ class DomainPool:
             return dict(self._held)
 
 
+def with_project_commands(env: dict[str, Any], bin_dir: str | None = None) -> dict[str, Any]:
+    """The learner's server finds the project's commands first (``ros2``, ``colcon``).
+
+    A lab-mode terminal inherits its server's PATH, which the spawner copies from
+    the hub's: a hub started by path (``.venv/bin/jupyterhub``) without its venv on
+    PATH would give learners a terminal with no ``ros2``. The hub runs in the
+    project's environment, so its interpreter's folder is where those commands are.
+    """
+    bin_dir = bin_dir or os.path.dirname(sys.executable)
+    parts = [p for p in str(env.get("PATH", "")).split(os.pathsep) if p and p != bin_dir]
+    return {**env, "PATH": os.pathsep.join([bin_dir, *parts])}
+
+
 class ClassroomSystemUserSpawner(LocalProcessSpawner):
     """JupyterHub's local spawner (each learner as their own system user), plus a ROS domain id."""
 
@@ -85,7 +99,7 @@ class ClassroomSystemUserSpawner(LocalProcessSpawner):
         return self.user.name + (f":{self.name}" if self.name else "")
 
     def get_env(self) -> dict[str, Any]:
-        env = super().get_env()
+        env = with_project_commands(super().get_env())
         self.domain_id = self.pool.take(self._owner(), self.first_domain_id, self.last_domain_id)
         env["ROS_DOMAIN_ID"] = str(self.domain_id)
         return env

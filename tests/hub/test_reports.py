@@ -7,7 +7,7 @@ from dataclasses import replace
 
 import pytest
 
-from app.hub.spawner import DomainPool
+from app.hub.spawner import DomainPool, with_project_commands
 from app.teacher.http_report import MAX_BODY, ReportError, from_json, to_json
 from app.teacher.record import MAX_CODE, LearnerRecord
 
@@ -111,3 +111,10 @@ def test_a_restarted_hub_keeps_a_running_servers_domain_held():
     assert after.domain_id == 1 and Fresh.pool.take("bob", 1, 3) == 2  # ada's 1 stays hers
     after.clear_state()
     assert after.domain_id is None and "ros_domain_id" not in after.get_state()
+
+
+def test_learner_servers_find_the_project_commands_first():
+    """A lab-mode terminal gets ``ros2`` and ``colcon`` whatever PATH the hub had."""
+    env = with_project_commands({"PATH": "/usr/bin:/venv/bin:/bin", "X": "1"}, "/venv/bin")
+    assert env == {"PATH": "/venv/bin:/usr/bin:/bin", "X": "1"}
+    assert with_project_commands({}, "/venv/bin")["PATH"] == "/venv/bin"
