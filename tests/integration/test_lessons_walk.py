@@ -197,6 +197,7 @@ FAILING_CHECKS = [
     Spec("scan_nearest", {"below": 0.7, "tolerance": 0.05}),
     Spec("sim_time_stamps", {"frame": "carrot1"}),
     Spec("sim_paused", {}),
+    Spec("sim_time_factor", {"requested": 2.0}),
     Spec("quiz", {"question": "2+2?", "options": ["3", "4"], "answer": "4"}),
 ]
 

@@ -8,6 +8,7 @@ import threading
 from app.exercises.probes.base import ProbeContext, register_probe
 from app.exercises.report import Result
 from app.lessons.schema import Spec
+from app.ros.monitor import fitted_rate
 
 LOG_RATE_MIN_LINES = 6  # fewer is no rate to judge on
 
@@ -27,13 +28,13 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
     target = p.get("node", ctx.learner_node)
     logger = target.lstrip("/").replace("/", ".")
     text = p.get("text", "")
-    lines: list[tuple[float, str]] = []
+    lines: list[tuple[int, str]] = []  # (the node's log stamp in ns, text)
     lock = threading.Lock()
 
     def on_log(record: Log) -> None:
         if record.name == logger and text in record.msg:
             with lock:
-                lines.append((record.stamp.sec + record.stamp.nanosec * 1e-9, record.msg))
+                lines.append((record.stamp.sec * 1_000_000_000 + record.stamp.nanosec, record.msg))
 
     node = ctx.call.node
     sub = node.create_subscription(Log, "/rosout", on_log, 100)
@@ -48,8 +49,9 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
     what = f"lines containing {text!r}" if text else "log lines"
     if len(got) < LOG_RATE_MIN_LINES or got[-1] <= got[0]:
         return Result(name, False, f"{len(got)} {what} from {target} in {p.get('window', 5.0):g} s")
-    # By the node's own log stamps (its clock), so late delivery does not bend the rate.
-    rate = (len(got) - 1) / (got[-1] - got[0])
+    # By the node's own log stamps (its clock), so late delivery does not bend the rate;
+    # a line fitted through all of them, so one line logged late at an end does not either.
+    rate = fitted_rate(list(enumerate(got))) or (len(got) - 1) / ((got[-1] - got[0]) * 1e-9)
     measured = f"{rate:.2f} Hz over {len(got)} lines (the node's log stamps)"
     if p.get("numbered", False):
         skipped = _numbering_slip(texts, text)
