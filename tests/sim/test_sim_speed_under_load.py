@@ -129,3 +129,33 @@ def test_a_factor_the_computer_cannot_reach_passes_and_says_how_far_it_got(
     assert found, result.reason
     assert 1.1 <= float(found[1]) < 45, result.reason
     assert "simulated time still runs faster than the wall clock" in result.reason
+
+
+def test_sensor_rates_are_judged_in_simulated_time_on_a_loaded_computer(
+    lessons, supervisor, busy_cores
+):
+    """/odom is 30 Hz and /scan 10 Hz of simulated time: by their header stamps the checks
+    read that, while the wall-clock rate is whatever share of real time the world gets."""
+    supervisor.start("sim_world")  # with its camera, as the lesson starts it
+    wait_until(lambda: lessons.graph.has_node("/sim_world"), timeout=30, what="/sim_world")
+    checks = {
+        30.0: Spec("topic_rate", {"topic": "/odom", "type": "nav_msgs/msg/Odometry",
+                                  "min_hz": 25, "max_hz": 35, "stamps": True}),
+        10.0: Spec("topic_rate", {"topic": "/scan", "type": "sensor_msgs/msg/LaserScan",
+                                  "min_hz": 8, "max_hz": 12, "stamps": True}),
+    }  # fmt: skip
+    for hz, check in checks.items():
+        wait_until(
+            lambda c=check: lessons.evaluate(c).state == PASS,
+            timeout=30,
+            interval=0.5,
+            what=lambda c=check: f"{c.key}: {lessons.evaluate(c).reason}",
+        )
+        result = lessons.evaluate(check)
+        found = re.search(
+            r"at ([\d.]+) Hz over \d+ messages \(by their header stamps\)", result.reason
+        )
+        assert found, result.reason
+        wall = lessons.tap(check["topic"], check["type"]).published_rate(5.0)
+        print(f"{result.reason}; by the wall clock: {wall.rate if wall else 0:.2f} Hz")
+        assert abs(float(found[1]) - hz) <= 0.01 * hz, result.reason
