@@ -1,15 +1,19 @@
-"""The "Faster than real time" check holds on a computer that cannot keep up.
+"""The "Drive a robot" timing checks hold on a computer that cannot keep up.
 
 Two busy-loop processes take the cores (on top of whatever else runs) while
 sim_world is asked for real_time_factor 2. The old check wanted /clock at
 170-230 Hz and read 164 Hz on a loaded machine for good; ``sim_time_factor``
 judges what the lesson teaches: simulated time runs faster than the wall clock,
-at the factor the world reports achieving.
+at the factor the world reports achieving. The sensors' rates are judged in
+simulated time (their stamps), and a world held up by the computer (stopped
+with SIGSTOP here) is not taken for a paused one.
 """
 
 from __future__ import annotations
 
+import os
 import re
+import signal
 import subprocess
 import sys
 import threading
@@ -17,10 +21,12 @@ import time
 from collections.abc import Iterator
 
 import pytest
+from std_srvs.srv import Empty
 
 from app.lessons.runtime import PASS, LessonRuntime
 from app.lessons.schema import Spec
 from app.ros import params
+from app.ros.calls import call_service
 from app.ros.context import CallContext
 from app.ros.graph import snapshot
 from tests.conftest import wait_until
@@ -159,3 +165,28 @@ def test_sensor_rates_are_judged_in_simulated_time_on_a_loaded_computer(
         wall = lessons.tap(check["topic"], check["type"]).published_rate(5.0)
         print(f"{result.reason}; by the wall clock: {wall.rate if wall else 0:.2f} Hz")
         assert abs(float(found[1]) - hz) <= 0.01 * hz, result.reason
+
+
+def test_a_stalled_world_is_not_taken_for_a_paused_one(lessons, supervisor):
+    """A world that gets no CPU for 2 s sends no /clock either; only the world's own report
+    (0x over a whole second) tells that simulated time was stopped on purpose."""
+    paused = Spec("sim_paused", {})
+    status = supervisor.start("sim_world", ["-p", "camera_rate:=0.0"])
+    assert status.pid is not None
+    wait_until(lambda: lessons.graph.has_node("/sim_world"), timeout=30, what="/sim_world")
+    wait_until(lambda: "still ticks" in lessons.evaluate(paused).reason, timeout=20, what="/clock")
+    os.kill(status.pid, signal.SIGSTOP)  # the process group leader: sim_world itself
+    try:
+        time.sleep(2.0)
+        stalled = lessons.evaluate(paused)
+    finally:
+        os.kill(status.pid, signal.SIGCONT)
+    assert stalled.state != PASS, stalled.reason
+    # Paused on purpose: the world reports 0x, and the check passes.
+    call_service(CallContext(lessons.node), "/pause_physics", Empty, Empty.Request())
+    wait_until(
+        lambda: lessons.evaluate(paused).state == PASS,
+        timeout=15,
+        interval=0.5,
+        what=lambda: f"sim_paused: {lessons.evaluate(paused).reason}",
+    )

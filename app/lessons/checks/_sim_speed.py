@@ -182,6 +182,10 @@ class SimSpeedWatch:
         with self.lock:
             self.reports.append(report)
 
+    def newest_report(self) -> Report | None:
+        with self.lock:
+            return self.reports[-1] if self.reports else None
+
     def speed(self, seconds: float) -> SimSpeed | str:
         with self.lock:
             clock, reports = list(self.clock), list(self.reports)

@@ -7,6 +7,7 @@ from __future__ import annotations
 import time
 from typing import TYPE_CHECKING
 
+from app.lessons.checks._sim_speed import REPORTS, STILL, speed_watch_of
 from app.lessons.checks._sim_topics import CLOCK, SIM_NODE, seconds
 from app.lessons.checks.sim_time_stamps import newest_stamp
 from app.lessons.registry import FAIL, PASS, WAITING, CheckResult, register_check
@@ -23,8 +24,8 @@ DISCOVERY_SEC = 4.0  # a fresh subscription may hear nothing this long (Fast DDS
     required="",
     optional="quiet frame",
     words="simulation time stands still: no /clock for quiet seconds (1 unless given) while "
-    "/sim_world runs, and, if a frame is named, no new transform to it either (a node on "
-    "simulation time waits)",
+    "/sim_world runs and reports 0x on /real_time_factor, and, if a frame is named, no new "
+    "transform to it either (a node on simulation time waits)",
 )
 def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
     if not rt.graph.has_node(SIM_NODE):
@@ -48,6 +49,16 @@ def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
             )
         text = f"no {CLOCK} for {silent:.1f} s: simulation time stands at "
         text += f"{seconds(newest[1].clock):.2f} s"
+    # A world that gets no CPU (a loaded computer) sends no /clock either: only its own
+    # report, 0x over a whole second, tells that time was stopped (a 2 s stall passed).
+    report = speed_watch_of(rt).newest_report()
+    if report is None or report.factor >= STILL:
+        said = "nothing yet" if report is None else f"{report.factor:.2f}x"
+        return CheckResult(
+            WAITING,
+            f"{text}, but the world does not report simulated time standing still on "
+            f"{REPORTS} ({said}): a busy computer can hold up /clock too",
+        )
     frame = c.get("frame")
     if frame:
         seen = newest_stamp(rt, frame)
