@@ -176,6 +176,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
     domain = os.environ.get("ROS_DOMAIN_ID", "0")
     scope = "network (opt-in)" if args.network else "loopback only"
     query = f"/?token={token}" if token else _hub_path(hub_login)
+    if remote:
+        print(_containment_line(args.allow_learner_code), flush=True)
     print(
         f"ROS 2 Classroom is ready: http://{args.host}:{args.port}{query}  "
         f"(ROS domain {domain}, DDS {scope}). Press Ctrl+C to stop.",
@@ -194,6 +196,27 @@ def cmd_serve(args: argparse.Namespace) -> int:
     server.stop()
     print(f"Stopped in {time.monotonic() - started:.1f} s.", flush=True)
     return 0
+
+
+def _containment_line(allowed: bool) -> str:
+    """What happens to learner code on a dashboard served to others, said at start."""
+    from app.exercises.sandbox import sandbox_available
+
+    missing = sandbox_available()
+    if missing is None:
+        if allowed:
+            return (
+                "Learner code: runs contained (a uid of its own per program, Landlock file "
+                "rules, seccomp, ROS 2 over loopback only, CPU/memory/process limits)."
+            )
+        return "Learner code: off (add --allow-learner-code to run it contained)."
+    if allowed:
+        return (
+            "Learner code: REFUSED despite --allow-learner-code: this environment cannot "
+            f"contain it ({missing}). Lessons, catalog nodes and the Console work; running, "
+            "building and completing learner code are refused, never run uncontained."
+        )
+    return f"Learner code: off; containment is not available here either ({missing})."
 
 
 def _hub_singleuser(args: argparse.Namespace) -> Any:

@@ -40,6 +40,7 @@ import atexit
 import builtins
 import ctypes
 import errno
+import functools
 import importlib.util
 import ipaddress
 import linecache
@@ -171,6 +172,30 @@ def _maps_sandbox_ids(map_file: str) -> bool:
     return False
 
 
+@functools.cache
+def identity_problem() -> str | None:
+    """Why learner code cannot get a uid and group of its own here; None when it can.
+
+    Read once, from the id maps: as root in a user namespace that maps only a
+    few ids (``unshare -r``, rootless Podman/Docker, Kubernetes user
+    namespaces map 1 to 65536), chown, setgid and setuid to a sandbox id fail
+    with EINVAL. Without a uid of its own a learner's program would keep the
+    dashboard's (root's capabilities in the namespace included), signal its
+    processes and share its process limit: it would not be contained.
+    """
+    if os.geteuid() != 0:
+        return "the sandbox needs root: it runs learner code under a uid of its own"
+    if not (_maps_sandbox_ids("/proc/self/uid_map") and _maps_sandbox_ids("/proc/self/gid_map")):
+        return (
+            "this user namespace (a rootless container, a Kubernetes user namespace, "
+            "`unshare --map-root-user`) does not map the uids and gids "
+            f"{UID_BASE}..{UID_BASE + PID_MAX_LIMIT} that learner programs run under, so they "
+            "cannot be kept apart from the dashboard; run it as real root, or map that range "
+            "into the container"
+        )
+    return None
+
+
 def python_paths() -> list[str]:
     """Where this Python and its packages live: readable even inside a home folder."""
     paths = {sys.prefix, sys.base_prefix, sys.exec_prefix, sys.base_exec_prefix}
@@ -203,14 +228,8 @@ def missing() -> str | None:
         return "the sandbox needs Linux"
     if platform.machine() not in _SYSCALLS:
         return f"the sandbox knows no seccomp syscall table for {platform.machine()}"
-    if os.geteuid() != 0:
-        return "the sandbox needs root: it runs learner code under a uid of its own"
-    if not (_maps_sandbox_ids("/proc/self/uid_map") and _maps_sandbox_ids("/proc/self/gid_map")):
-        return (
-            "this user namespace maps only a few uids, the sandbox needs "
-            f"{UID_BASE}..{UID_BASE + PID_MAX_LIMIT} (run as real root, e.g. `unshare --net` "
-            "without --map-root-user)"
-        )
+    if problem := identity_problem():
+        return problem
     for path in python_paths():
         if blocked := _unreachable(path):
             return (

@@ -8,6 +8,7 @@ or a symbolic link, is refused with one clear line.
 
 from __future__ import annotations
 
+import errno
 import os
 import threading
 from dataclasses import dataclass
@@ -107,13 +108,22 @@ class LearnerWorkspace:
 
 
 def _to_group(folder: Path, group: int, mode: int) -> None:
-    """This one folder (no walk, no link followed) to ``group`` with ``mode``."""
+    """This one folder (no walk, no link followed) to ``group`` with ``mode``.
+
+    Where the group cannot be given, the folder stays the user's alone: not
+    root (EPERM), or a user namespace that does not map the sandbox's ids
+    (EINVAL: rootless Podman/Docker, Kubernetes user namespaces). No sandbox
+    runs there either (app.exercises.contain.missing says why), so contained
+    builds are refused; the group bits would only open it to the user's group.
+    """
     fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC)
     try:
         try:
             os.fchown(fd, -1, group)
-        except PermissionError:  # not root: no sandbox here either, builds are refused
-            pass
+        except OSError as exc:
+            if exc.errno not in (errno.EPERM, errno.EINVAL):
+                raise
+            mode &= 0o700
         os.fchmod(fd, mode)
     finally:
         os.close(fd)
