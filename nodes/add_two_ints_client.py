@@ -22,10 +22,11 @@ ROS concepts shown
 import sys
 
 import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.utilities import remove_ros_args
 from tutorial_interfaces.srv import AddTwoInts
+
+from nodes.common.run import stopped_quietly
 
 USAGE = "usage: add_two_ints_client A B [--ros-args ...]   (A and B are integers)"
 EXIT_USAGE = 2
@@ -71,15 +72,15 @@ def main(args=None) -> None:
 
     node = None
     try:
-        rclpy.init(args=args)
-        node = AddTwoIntsClient()
-        node.wait_for_server()
-        future = node.send_request(a, b)
-        rclpy.spin_until_future_complete(node, future)
-        response = future.result()
-        node.get_logger().info(f"Result of add_two_ints: {a} + {b} = {response.sum}")
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
+        # Ctrl+C or SIGTERM, even while it waits for the server: leave quietly.
+        with stopped_quietly():
+            rclpy.init(args=args)
+            node = AddTwoIntsClient()
+            node.wait_for_server()
+            future = node.send_request(a, b)
+            rclpy.spin_until_future_complete(node, future)
+            response = future.result()
+            node.get_logger().info(f"Result of add_two_ints: {a} + {b} = {response.sum}")
     finally:
         # Ctrl+C can arrive before the node exists: clean up only what was made.
         if node is not None:

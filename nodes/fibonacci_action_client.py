@@ -22,11 +22,12 @@ import sys
 import rclpy
 from action_msgs.msg import GoalStatus
 from rclpy.action import ActionClient
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.task import Future
 from rclpy.utilities import remove_ros_args
 from tutorial_interfaces.action import Fibonacci
+
+from nodes.common.run import stopped_quietly
 
 USAGE = "usage: fibonacci_action_client [ORDER] [--ros-args ...]   (ORDER: integer, default 10)"
 DEFAULT_ORDER = 10
@@ -99,13 +100,15 @@ def main(args=None) -> None:
     node = None
     succeeded = False
     try:
-        rclpy.init(args=args)
-        node = FibonacciActionClient()
-        node.send_goal(order)
-        rclpy.spin_until_future_complete(node, node.done)
-        succeeded = bool(node.done.result())
-    except (KeyboardInterrupt, ExternalShutdownException):
-        succeeded = True  # stopped on request: not a failure
+        # Ctrl+C or SIGTERM, even while it waits for the server: stopped on request,
+        # not a failure.
+        succeeded = True
+        with stopped_quietly():
+            rclpy.init(args=args)
+            node = FibonacciActionClient()
+            node.send_goal(order)
+            rclpy.spin_until_future_complete(node, node.done)
+            succeeded = bool(node.done.result())
     finally:
         # Ctrl+C can arrive before the node exists: clean up only what was made.
         if node is not None:

@@ -7,5 +7,7 @@ Our Python version of ROS 2's joint_state_publisher
 
 from joint_state_publisher.joint_state_publisher import main
 
+from nodes.common.run import run_program
+
 if __name__ == "__main__":
-    main()
+    run_program(main)  # Ctrl+C and SIGTERM end it the same quiet way

@@ -23,8 +23,9 @@ Try it: ``ros2-classroom run minimal_node`` and ``ros2 node list``.
 """
 
 import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
+
+from nodes.common.run import init_ros, ros_started, stopped_quietly
 
 TIMER_PERIOD_SEC = 0.2  # 5 Hz
 
@@ -41,11 +42,11 @@ class MinimalNode(Node):
 def main(args=None) -> None:
     node = None
     try:
-        rclpy.init(args=args)
-        node = MinimalNode()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass  # Ctrl+C (SIGINT) or SIGTERM: leave quietly
+        with stopped_quietly():  # Ctrl+C (SIGINT) or SIGTERM, at any point: leave quietly
+            init_ros(args)  # rclpy.init(args=args); rclpy's signal handlers come ...
+            node = MinimalNode()
+            ros_started()  # ... once the node is made (a stop during start-up is safe)
+            rclpy.spin(node)
     finally:
         # Ctrl+C can arrive before the node exists: clean up only what was made.
         if node is not None:

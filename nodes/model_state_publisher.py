@@ -14,10 +14,11 @@ import sys
 from pathlib import Path
 
 import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.parameter import Parameter
 from rclpy.utilities import remove_ros_args
 from robot_state_publisher.robot_state_publisher import RobotStatePublisher, StartupError
+
+from nodes.common.run import init_ros, ros_started, stopped_quietly
 
 ARM_URDF = Path(__file__).with_name("robots") / "robotic_arm" / "robot.urdf"
 
@@ -34,22 +35,22 @@ def read_description(path: Path) -> str:
 def main(args: list[str] | None = None) -> None:
     node: RobotStatePublisher | None = None
     try:
-        rclpy.init(args=args)
-        words = remove_ros_args(args if args is not None else sys.argv)
-        path = Path(words[1]) if len(words) > 1 else ARM_URDF
-        try:
-            text = read_description(path)
-        except Exception as exc:  # a missing file, bad xacro: one line, exit 2
-            print(f"model_state_publisher: error: cannot read {path}: {exc}", file=sys.stderr)
-            raise SystemExit(2) from None
-        description = Parameter("robot_description", Parameter.Type.STRING, text)
-        try:
-            node = RobotStatePublisher(parameter_overrides=[description])
-        except StartupError:
-            raise SystemExit(1) from None
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
+        with stopped_quietly():  # Ctrl+C or SIGTERM, even during start-up: leave quietly
+            init_ros(args)
+            words = remove_ros_args(args if args is not None else sys.argv)
+            path = Path(words[1]) if len(words) > 1 else ARM_URDF
+            try:
+                text = read_description(path)
+            except Exception as exc:  # a missing file, bad xacro: one line, exit 2
+                print(f"model_state_publisher: error: cannot read {path}: {exc}", file=sys.stderr)
+                raise SystemExit(2) from None
+            description = Parameter("robot_description", Parameter.Type.STRING, text)
+            try:
+                node = RobotStatePublisher(parameter_overrides=[description])
+            except StartupError:
+                raise SystemExit(1) from None
+            ros_started()
+            rclpy.spin(node)
     finally:
         if node is not None:
             node.destroy_node()

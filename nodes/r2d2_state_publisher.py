@@ -6,5 +6,7 @@ as a catalog node: R2-D2's joints on /joint_states and odom -> axis on /tf.
 
 from urdf_tutorial_r2d2.state_publisher import main
 
+from nodes.common.run import run_program
+
 if __name__ == "__main__":
-    main()
+    run_program(main)  # Ctrl+C and SIGTERM end it the same quiet way

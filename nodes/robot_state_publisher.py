@@ -9,5 +9,7 @@ argument.
 
 from robot_state_publisher.robot_state_publisher import main
 
+from nodes.common.run import run_program
+
 if __name__ == "__main__":
-    main()
+    run_program(main)  # Ctrl+C and SIGTERM end it the same quiet way

@@ -3,9 +3,9 @@
 It lives in ros_python/src/tf2_ros/tools/static_transform_publisher.py.
 """
 
-import sys
-
 from tf2_ros.tools.static_transform_publisher import main
 
+from nodes.common.run import run_program
+
 if __name__ == "__main__":
-    sys.exit(main())
+    run_program(main)  # Ctrl+C and SIGTERM end it the same quiet way

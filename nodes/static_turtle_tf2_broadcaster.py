@@ -14,9 +14,10 @@ import sys
 import numpy as np
 import rclpy
 from geometry_msgs.msg import TransformStamped
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from tf2_ros.static_transform_broadcaster import StaticTransformBroadcaster
+
+from nodes.common.run import init_ros, ros_started, stopped_quietly
 
 
 def quaternion_from_euler(ai: float, aj: float, ak: float) -> np.ndarray:
@@ -84,14 +85,16 @@ def main() -> None:
         logger.info("x y z roll pitch yaw must be numbers")
         sys.exit(2)
     # pass parameters and initialize node
-    rclpy.init()
-    node = StaticFramePublisher(args)
+    node = None
     try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
+        with stopped_quietly():  # Ctrl+C or SIGTERM, even during start-up: leave quietly
+            init_ros()
+            node = StaticFramePublisher(args)
+            ros_started()
+            rclpy.spin(node)
     finally:
-        node.destroy_node()
+        if node is not None:
+            node.destroy_node()
         rclpy.try_shutdown()
 
 

@@ -37,12 +37,12 @@ import rclpy
 from geometry_msgs.msg import Twist
 from rclpy.action import ActionClient
 from rclpy.action.client import ClientGoalHandle
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from std_msgs.msg import String
 from turtlesim.action import RotateAbsolute
 
-from nodes.common.run import RCLError
+from nodes.common.run import init_ros, ros_started, stopped_quietly
 from nodes.turtlesim_node import TOPIC_QOS, declare_rclcpp_parameters
 
 MOVES = {"up": (1.0, 0.0), "down": (-1.0, 0.0), "left": (0.0, 1.0), "right": (0.0, -1.0)}
@@ -131,24 +131,21 @@ def main(args=None) -> None:
     executor: SingleThreadedExecutor | None = None
     spinner: threading.Thread | None = None
     try:
-        rclpy.init(args=args)
-        node = TeleopTurtle()
-        executor = SingleThreadedExecutor()
-        executor.add_node(node)
-        print(BANNER, flush=True)
-        if sys.stdin.isatty():
-            spinner = threading.Thread(target=executor.spin, daemon=True)
-            spinner.start()
-            read_terminal_keys(node)
-        else:
-            print(f"(no terminal: reading key names from {node.key_subscription.topic_name})")
-            while rclpy.ok() and not node.quit.is_set():
-                executor.spin_once(timeout_sec=0.1)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except RCLError:
-        if rclpy.ok():
-            raise
+        with stopped_quietly():  # Ctrl+C or SIGTERM, even during start-up: leave quietly
+            init_ros(args)
+            node = TeleopTurtle()
+            executor = SingleThreadedExecutor()
+            executor.add_node(node)
+            ros_started()
+            print(BANNER, flush=True)
+            if sys.stdin.isatty():
+                spinner = threading.Thread(target=executor.spin, daemon=True)
+                spinner.start()
+                read_terminal_keys(node)
+            else:
+                print(f"(no terminal: reading key names from {node.key_subscription.topic_name})")
+                while rclpy.ok() and not node.quit.is_set():
+                    executor.spin_once(timeout_sec=0.1)
     finally:
         if executor is not None:
             executor.shutdown()

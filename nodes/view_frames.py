@@ -9,12 +9,13 @@ upstream's PDF and an SVG beside it), so the TF panel can show the tree.
 import os
 import shutil
 import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 from tf2_tools.view_frames import main
+
+from nodes.common.run import run_program
 
 PROJECT_ROOT = Path(__file__).resolve().parent.parent
 
@@ -47,8 +48,12 @@ if __name__ == "__main__":
         print(f"view_frames: writing into {folder}", flush=True)
         os.chdir(folder)
     started = time.time()
-    code = main()
-    picture = newest_picture(Path.cwd(), started) if code == 0 else None
-    if picture is not None:
-        print(f"view_frames: the picture is {picture.resolve()}", flush=True)
-    sys.exit(code)
+
+    def listen_and_draw() -> int:
+        code = main()
+        picture = newest_picture(Path.cwd(), started) if code == 0 else None
+        if picture is not None:
+            print(f"view_frames: the picture is {picture.resolve()}", flush=True)
+        return code
+
+    run_program(listen_and_draw)  # Ctrl+C and SIGTERM end it the same quiet way

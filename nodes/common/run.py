@@ -16,13 +16,16 @@ from __future__ import annotations
 import signal
 import sys
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from typing import TypeVar
 
 import rclpy
+from rclpy.exceptions import InvalidHandle
 from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions, install_signal_handlers
 
 NodeT = TypeVar("NodeT", bound=Node)
 
@@ -52,32 +55,93 @@ def spin_node(
     """
     node: NodeT | None = None
     spinner: Executor | None = None
-    spinning = threading.Event()
-    _sigint_ends_spin_quietly(spinning)
     try:
-        rclpy.init(args=args)
-        try:
-            node = make_node()
-        except ValueError as exc:
-            if program is None:
-                raise
-            print(f"{program}: error: {exc}", file=sys.stderr)
-            raise SystemExit(EXIT_BAD_PARAMETER) from None
-        spinning.set()
-        if executor is None:
-            rclpy.spin(node)
-        else:
-            spinner = _make_executor(executor, node)
-            spinner.add_node(node)
-            spinner.spin()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass  # Ctrl+C (SIGINT) or SIGTERM: leave quietly
-    except RCLError:
-        if rclpy.ok():
-            raise
-        # The signal shut ROS down while a callback was still publishing: leave quietly too.
+        with stopped_quietly():
+            init_ros(args)
+            try:
+                node = make_node()
+            except ValueError as exc:
+                if program is None or not rclpy.ok():
+                    raise
+                print(f"{program}: error: {exc}", file=sys.stderr)
+                raise SystemExit(EXIT_BAD_PARAMETER) from None
+            ros_started()
+            if executor is None:
+                rclpy.spin(node)
+            else:
+                spinner = _make_executor(executor, node)
+                spinner.add_node(node)
+                spinner.spin()
     finally:
         _teardown(node, spinner, before_shutdown)
+
+
+@contextmanager
+def stopped_quietly() -> Iterator[None]:
+    """Ctrl+C (SIGINT) or SIGTERM ends the block quietly, whatever ROS call it interrupts.
+
+    rclpy's signal thread shuts the context down while the main thread may be
+    inside any ROS call: spinning (ExternalShutdownException), publishing or
+    waiting for a server (RCLError: "context is invalid"), creating an entity
+    (ValueError), or using one already destroyed (InvalidHandle). With ROS
+    still up, those are real errors and go on.
+    """
+    try:
+        yield
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except (RCLError, ValueError, InvalidHandle):
+        if rclpy.ok():
+            raise
+    finally:
+        _start.end()  # a signal during the teardown is ignored, not raised
+
+
+def init_ros(args: list[str] | None = None) -> None:
+    """``rclpy.init`` without rclpy's signal handlers, which ``ros_started`` installs.
+
+    rclpy's handlers shut the context down from a native thread of theirs, at
+    once: during start-up that races the main thread creating the node's
+    publishers, services and action servers in Fast DDS (seen: a traceback
+    from ActionServer(), a SIGSEGV). Until the node is made, Ctrl+C and
+    SIGTERM are held instead and honoured by ``ros_started``: the node is
+    made whole first. Interrupting a constructor leaves what it started
+    running (sim_world's physics thread then crashed the exit, SIGSEGV). A
+    second signal interrupts the start-up where it is (KeyboardInterrupt), for
+    one that hangs; the supervisor's second signal is SIGTERM, then SIGKILL.
+    """
+    _start.clear()
+    _stop_signals_held_until_started()
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+
+
+def ros_started() -> None:
+    """The node is made: from now on rclpy's handlers end the spin (the context shuts down).
+
+    A stop held during start-up ends it here, at a safe point
+    (KeyboardInterrupt). rclpy's handlers go in before the start counts as
+    done, so a signal in between is held, not lost.
+    """
+    install_signal_handlers(SignalHandlerOptions.ALL)
+    _start.end()
+    if _start.requested:
+        raise KeyboardInterrupt
+
+
+class _StartUp:
+    """Stop signals seen while the node is being made (main thread only)."""
+
+    done = True
+    requested = 0
+
+    def clear(self) -> None:
+        self.done, self.requested = False, 0
+
+    def end(self) -> None:
+        self.done = True
+
+
+_start = _StartUp()
 
 
 # A node ends at most this long after Ctrl+C or SIGTERM, whatever hangs in its teardown.
@@ -113,28 +177,74 @@ def _teardown(
     finally:
         if armed:
             signal.alarm(0)
+            # Stopped. The interpreter's exit puts the default handlers back: a second
+            # Ctrl+C or SIGTERM then (a supervisor escalating) would turn this clean
+            # end into "killed by SIGTERM".
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                signal.signal(sig, signal.SIG_IGN)
 
 
-def _sigint_ends_spin_quietly(spinning: threading.Event) -> None:
-    """Ctrl+C while spinning ends the spin the way SIGTERM does, not by KeyboardInterrupt.
+def _stop_signals_held_until_started() -> None:
+    """Ctrl+C and SIGTERM: held during start-up (see ``init_ros``), then left to rclpy.
 
-    rclpy's own signal handler shuts the context down, so spin() returns by
-    ExternalShutdownException. Python's default handler would also raise
-    KeyboardInterrupt at whatever line runs at that moment; inside rclpy's
-    executor that can be halfway through building a Task, whose ``__del__``
-    then prints a traceback as the process ends. Before spinning (start-up),
-    Ctrl+C stays a KeyboardInterrupt. Set before ``rclpy.init``, which
-    chains its handler to this one (setting a handler afterwards would
-    replace rclpy's).
+    A KeyboardInterrupt raised at whatever line runs at that moment is not
+    safe: inside an import it is "ignored" and the start-up goes on (seen:
+    a node that then ignored SIGTERM for good), inside rclpy's executor it
+    can leave a half-built Task whose ``__del__`` prints a traceback. So
+    while spinning this handler does nothing: rclpy's own, chained to it,
+    shuts the context down and spin() returns by ExternalShutdownException.
+    After ``rclpy.try_shutdown`` (which puts this one back) a late signal is
+    ignored, so the teardown ends as it began.
     """
     if threading.current_thread() is not threading.main_thread():
         return
 
-    def on_sigint(signum: int, frame: object) -> None:
-        if not spinning.is_set():
+    def on_stop(signum: int, frame: object) -> None:
+        if _start.done:
+            return
+        _start.requested += 1
+        if _start.requested > 1:
             raise KeyboardInterrupt
 
-    signal.signal(signal.SIGINT, on_sigint)
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, on_stop)
+
+
+def spin_threads_end_quietly() -> None:
+    """A thread spinning an executor ends without a traceback when a signal shuts ROS down.
+
+    For programs that spin in a thread of their own (the tf2 tools): on Ctrl+C
+    or SIGTERM rclpy shuts the context down and ``executor.spin()`` raises
+    ExternalShutdownException in that thread, which Python would print as
+    an uncaught exception while the program itself ends normally.
+    """
+    previous = threading.excepthook
+
+    def hook(args: threading.ExceptHookArgs) -> None:
+        stopped = issubclass(args.exc_type, ExternalShutdownException) or (
+            not rclpy.ok() and issubclass(args.exc_type, (RCLError, InvalidHandle))
+        )
+        if stopped:
+            return
+        previous(args)
+
+    threading.excepthook = hook
+
+
+def run_program(main: Callable[[], int | None]) -> None:
+    """Run a ros_python program (a tf2 tool, robot_state_publisher ...) as a catalog node.
+
+    Those programs catch Ctrl+C (KeyboardInterrupt) themselves but not
+    SIGTERM, so SIGTERM is made Ctrl+C here. ROS errors of a context the
+    signal shut down meanwhile (a node still being made, a spin thread) end
+    the program quietly too, as in ``spin_node``.
+    """
+    signal.signal(signal.SIGTERM, signal.default_int_handler)
+    spin_threads_end_quietly()
+    code: int | None = 0
+    with stopped_quietly():
+        code = main()
+    sys.exit(code)
 
 
 def _make_executor(factory: type[Executor] | Callable[[NodeT], Executor], node: NodeT) -> Executor:
