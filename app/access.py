@@ -34,6 +34,8 @@ import websockets.asyncio.server as ws_server
 from websockets.asyncio.server import ServerConnection
 from websockets.http11 import Request, Response
 
+from app.ui import viser_threads
+
 TOKEN_ENV = "CLASSROOM_TOKEN"
 TOKEN_HEADER = "X-Classroom-Token"
 _TOKEN_SHAPE = re.compile(r"^[A-Za-z0-9_-]{16,128}$")
@@ -178,6 +180,8 @@ def make_server(
     app/hub/singleuser_auth.py), every request must pass it (fails closed)."""
     if token is not None and gate is not None:
         raise ValueError("one gate: an access token or another gate, not both")
+    # Before the server exists: it makes its broadcast buffer as it starts.
+    viser_threads.install()
     if token is None and extension is None and gate is None:
         return viser.ViserServer(host=host, port=port, verbose=False), None
     if token is not None:

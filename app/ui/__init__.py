@@ -16,6 +16,25 @@ Threading model (every panel follows it; see ``UiLoop``):
   shows the one-line error (``on_error``). Jobs of one lane run one after
   another, in click order.
 - Each panel has ``close()``; the dashboard calls it once, on shutdown.
+
+viser (1.1.1) from each thread:
+
+- Setting a handle's properties, ``add_*``, ``remove()``, ``flush()`` and
+  ``atomic()`` are safe from any thread (UI, job, executor, viser's pool or
+  its event loop) on a server made by ``app.access.make_server``: it installs
+  ``app.ui.viser_threads``. Bare viser woke its event loop from the calling
+  thread and could crash there (``deque mutated during iteration``, issue 38);
+  servers built without ``make_server`` (bench/ baselines, a few tests) still do.
+- Setting an input's ``value`` runs its update callbacks at once, on the
+  setter's thread (``event.client`` is None; ``UiLoop.callback`` ignores them).
+- Browser events run plain callbacks on viser's pool (32 threads) and
+  ``async def`` callbacks on the event loop thread. Blocking in the first
+  holds a pool thread, in the second freezes every browser: post an intent.
+- Calls that wait for a browser's answer (``client.get_render``,
+  ``client.local_storage.get_item``, ``request_share_url``) run as jobs:
+  never on the event loop thread (the answer needs that loop: they hang, up
+  to their timeout if any) nor on the UI thread (every panel would stall).
+  ``server.stop()`` joins the loop thread: never call it from that thread.
 """
 
 from __future__ import annotations
