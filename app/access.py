@@ -34,7 +34,7 @@ import websockets.asyncio.server as ws_server
 from websockets.asyncio.server import ServerConnection
 from websockets.http11 import Request, Response
 
-from app.ui import viser_threads
+from app import viser_threads
 
 TOKEN_ENV = "CLASSROOM_TOKEN"
 TOKEN_HEADER = "X-Classroom-Token"

@@ -22,7 +22,7 @@ viser (1.1.1) from each thread:
 - Setting a handle's properties, ``add_*``, ``remove()``, ``flush()`` and
   ``atomic()`` are safe from any thread (UI, job, executor, viser's pool or
   its event loop) on a server made by ``app.access.make_server``: it installs
-  ``app.ui.viser_threads``. Bare viser woke its event loop from the calling
+  ``app.viser_threads``. Bare viser woke its event loop from the calling
   thread and could crash there (``deque mutated during iteration``, issue 38);
   servers built without ``make_server`` (bench/ baselines, a few tests) still do.
 - Setting an input's ``value`` runs its update callbacks at once, on the

@@ -3,7 +3,7 @@
 viser 1.1.1 sets an ``asyncio.Event`` from whichever thread sets a handle
 (``AsyncMessageBuffer.push``) while the loop thread adds and removes that
 event's waiters, one per browser: under load our UI thread died with
-``RuntimeError: deque mutated during iteration``. app/ui/viser_threads.py,
+``RuntimeError: deque mutated during iteration``. app/viser_threads.py,
 installed by ``make_server``, hands those sets to the loop. Real server, real
 websocket clients (tests/wire_client.py); no DDS.
 """
