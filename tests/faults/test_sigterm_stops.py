@@ -236,3 +236,37 @@ def test_classroom_ends_cleanly_on_sigterm(ros_env, tmp_path):
             room.wait()
     _clean("classroom", code, (0,), "".join(lines) + out + err)
     assert "Stopping the classroom" in out
+
+
+def test_turtlesim_stopped_while_it_starts_ends_cleanly(ros_env):
+    """`ros2-classroom run turtlesim turtlesim_node`, SIGTERM at its greeting, again and again.
+
+    Turtlesim greets in its constructor, before its services and action server
+    exist: with rclpy's handler installed that early, about one stop in five
+    there ended in a traceback from ActionServer() (or worse).
+    """
+    for attempt in range(8):
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "app", "run", "turtlesim", "turtlesim_node"],
+            cwd=PROJECT_ROOT,
+            env={**ros_env, "PYTHONUNBUFFERED": "1"},
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            start_new_session=True,
+        )
+        try:
+            assert proc.stderr is not None
+            first = proc.stderr.readline()
+            assert "Starting turtlesim" in first, first
+            proc.send_signal(signal.SIGTERM)
+            out, err = proc.communicate(timeout=STOP_TIMEOUT)
+            code: int | None = proc.returncode
+        except subprocess.TimeoutExpired:
+            code, out, err = None, "", ""
+        finally:
+            if proc.poll() is None:
+                os.killpg(proc.pid, signal.SIGKILL)
+                proc.wait()
+        _clean(f"turtlesim (attempt {attempt + 1})", code, (0,), first + err + out)
