@@ -13,13 +13,19 @@ One trial:
 1. wait for ``/sim_world`` (the exercise's setup starts it) and read its
    world, start pose and real-time factor;
 2. set ``use_sim_time`` on the learner's node, as a simulator's launch file
-   does, so its timers count simulated seconds;
+   does, so its timers count simulated seconds (it stays set: see 5);
 3. pause the physics, set the start pose (and anything the learner's node is
    told, such as a goal), reset the world, set the grading's real-time
    factor (faster than real time: judged in simulated seconds, it changes
    nothing but the wait) and go on;
 4. record the ground truth until the probe has seen enough;
-5. put back what was changed: the world's parameters and ``use_sim_time``.
+5. put back the world's parameters. ``use_sim_time`` stays true, as a launch
+   file leaves it (the world runs on after a grading): turning it off makes
+   rclpy destroy the node's /clock subscription from a worker thread of the
+   learner's executor, and rclpy 7.1.6's MultiThreadedExecutor, building its
+   next wait set meanwhile, dies of that (``InvalidHandle: cannot use
+   Destroyable because destruction was requested``, a few trials in a
+   thousand; issue 38). Turning it on only creates entities, which is safe.
 """
 
 from __future__ import annotations
@@ -199,10 +205,10 @@ def _wait_for_world(ctx: ProbeContext, recorder: Recorder) -> None:
 
 @contextmanager
 def simulation(ctx: ProbeContext, rtf: float) -> Iterator[tuple[World, Recorder]]:
-    """The world, ready for trials; afterwards its parameters and the learner's clock as before."""
+    """The world, ready for trials; afterwards its parameters as before, the learner's node
+    left on simulation time (never turned off: that kills a multithreaded learner)."""
     recorder = Recorder(ctx)
     services = Services(ctx)
-    learner_sim_time: bool | None = None
     world: World | None = None
     try:
         _wait_for_world(ctx, recorder)
@@ -210,9 +216,7 @@ def simulation(ctx: ProbeContext, rtf: float) -> Iterator[tuple[World, Recorder]
         name = str(current.pop("world"))
         world = World(name, world_map(name), current, rtf, services)
         try:
-            clock = services.get(ctx.learner_node, ["use_sim_time"])
-            learner_sim_time = bool(clock["use_sim_time"])
-            services.set(ctx.learner_node, {"use_sim_time": True})
+            services.set(ctx.learner_node, {"use_sim_time": True})  # already true: no change
         except Ros2Error as exc:
             raise Ros2Error(
                 f"could not set use_sim_time on {ctx.learner_node}: {exc} (is its executor busy?)"
@@ -222,10 +226,8 @@ def simulation(ctx: ProbeContext, rtf: float) -> Iterator[tuple[World, Recorder]
         try:
             if world is not None:
                 services.set(SIM_NODE, world.saved)
-            if learner_sim_time is not None:
-                services.set(ctx.learner_node, {"use_sim_time": learner_sim_time})
         except Ros2Error:
-            pass  # the world or the node is gone: nothing to put back
+            pass  # the world is gone: nothing to put back
         services.close()
         recorder.close()
 

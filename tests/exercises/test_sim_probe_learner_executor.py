@@ -1,0 +1,97 @@
+"""A learner's node spun by rclpy's MultiThreadedExecutor lives through the simulation
+probes' trials, however many: our probes must not end it (issue 38).
+
+A trial sets ``use_sim_time`` on the learner's node, which makes rclpy create a /clock
+subscription in it. Putting ``use_sim_time`` back to false made rclpy destroy that
+subscription from a worker thread of the learner's executor while its spinning thread
+built the next wait set; rclpy 7.1.6 then raised ``InvalidHandle: cannot use Destroyable
+because destruction was requested`` out of ``spin`` (the subscription's event handler is
+skipped when entered, yet still added to the wait set), and the grading ended "Not
+graded: your program ended during the probes: crashed (exit code 1)". That clean-up
+alone kills it (no reset, no driving needed), a few trials in a thousand. rclpy fixed
+the executor upstream (it keeps only the waitables it could enter) after 7.1.6.
+
+Real processes: the MuJoCo world and copies of the wall_follower cheat (it spins a
+MultiThreadedExecutor, as in the CI run that failed), each under its own node name, with
+trials on all of them at once (more trials in the time).
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+from random import Random
+
+from app.exercises.model import load_exercises
+from app.exercises.probes.base import ProbeContext
+from app.exercises.probes.sim import simulation
+from app.ros.context import CallContext, Limits
+from app.ros.errors import Ros2Error
+from app.ros.graph import snapshot
+from app.supervisor import LearnerProgram
+from tests.exercises.cheats import cheat_code
+
+LEARNERS = 3
+# Per learner. Without the fix (measured on a loaded 2-core machine), one trial in about
+# 250 killed a learner: 450 trials end one in about 4 runs of 5, within 2.5 min.
+TRIALS = 150
+JOIN_SEC = 30.0  # a fresh process on a loaded machine: import rclpy, join the graph
+
+
+def test_multithreaded_learners_outlive_many_simulation_trials(probe, supervisor, tmp_path):
+    exercise = next(e for e in load_exercises().exercises if e.slug == "wall_follower")
+    source = cheat_code(exercise)
+    assert "MultiThreadedExecutor()" in source
+    script = tmp_path / "wall_follower.py"
+    script.write_text(source, encoding="utf-8")
+    for name in exercise.setup:
+        supervisor.start(name)
+    programs = {
+        f"learner_{k}": LearnerProgram(
+            f"learner_{k}",
+            f"/wall_follower_{k}",
+            (sys.executable, str(script), "--ros-args", "-r", f"__node:=wall_follower_{k}"),
+            tmp_path,
+        )
+        for k in range(LEARNERS)
+    }
+    ended = threading.Event()
+
+    def ended_text(name: str) -> str:
+        output = "\n".join(supervisor.output(name, last=12))
+        return f"{programs[name].node_name} {supervisor.status(name).describe()}:\n{output}"
+
+    def trials(name: str) -> None:
+        call = CallContext(probe.node, limits=Limits(service_timeout=3.0))
+        ctx = ProbeContext(call, programs[name].node_name, lambda *_: (True, ""), Random(7))
+        for trial in range(TRIALS):
+            if ended.is_set():  # another learner died: the test has failed
+                return
+            if not supervisor.status(name).active:  # it died right after the last clean-up
+                ended.set()
+                raise AssertionError(f"ended after trial {trial}: {ended_text(name)}")
+            try:
+                with simulation(ctx, 2.0):
+                    pass
+            except Ros2Error:
+                if supervisor.status(name).active:
+                    raise
+
+    try:
+        for program in programs.values():
+            supervisor.start_program(program)
+        deadline = time.monotonic() + JOIN_SEC
+        while not all(snapshot(probe.node).has_node(p.node_name) for p in programs.values()):
+            assert time.monotonic() < deadline, "the learners did not join the graph"
+            time.sleep(0.2)
+        with ThreadPoolExecutor(LEARNERS) as pool:
+            for done in [pool.submit(trials, name) for name in programs]:
+                done.result()
+        time.sleep(1.0)  # a death after the last trial's clean-up
+    finally:
+        dead = [ended_text(n) for n in programs if not supervisor.status(n).active]
+        for name in [*programs, *exercise.setup]:
+            supervisor.stop(name).result()
+    assert not dead, "\n".join(dead)
