@@ -145,8 +145,10 @@ class Dashboard:
             open_tool=opener.open,
         )
         stage.follow_window(self.server)
+        self._stage = stage
         # The current step's title, buttons, checks and Back/Next: above the tools, so they
         # stay in view whichever tool is open (the step's text is in Learn › Lessons).
+        position = MarkdownView(gui)  # "Lesson 4 of 20 · Step 1 of 6", above the card
         step_card = gui.add_folder("This step")
         builders: dict[str, Callable[[], Panel]] = {
             "Lessons": lambda: LessonsPanel(
@@ -161,6 +163,8 @@ class Dashboard:
                 step_card=step_card,
                 open_tool=opener.open,
                 start_requests=self.start_requests,
+                new_lesson=self._new_lesson,
+                position=position,
             ),
             "Exercise": lambda: ExercisePanel(
                 gui,
@@ -205,6 +209,11 @@ class Dashboard:
         console = next(p for p in panels if isinstance(p, ConsolePanel))
         self.lessons.console = console.run_for_lesson
         return [stage, *panels]
+
+    def _new_lesson(self) -> None:
+        """Another lesson was opened (UI thread): the views forget what the last one left."""
+        cast(ScenePanel, self._tools["3D view"]).forget_unpublished(self.graph)
+        self._stage.forget()
 
     def _starting_nodes(self) -> list[str]:
         """Catalog nodes that are starting: clicked (until the supervisor has the process),

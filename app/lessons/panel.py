@@ -20,6 +20,7 @@ from app.lessons.progress import ProgressStore
 from app.lessons.runtime import FAIL, PASS, LessonRuntime
 from app.lessons.schema import IMAGE_TYPES, STATIC_DIR, Course, Lesson, Spec
 from app.ros.graph import GraphSnapshot
+from app.supervisor import NodeStatus
 from app.ui import MarkdownView, assign
 from app.ui.code_view import python_listing
 from app.ui.loop import UiLoop
@@ -99,6 +100,27 @@ def _started_by(action: Spec) -> list[str]:
     return []
 
 
+def _stopped_by(action: Spec) -> list[str]:
+    """The supervisor's names of what a step's Stop button stops ([]: not a Stop)."""
+    if action.kind == "stop":
+        return [action["catalog_node"]]
+    if action.kind == "stop_group":
+        try:
+            return list(lookup_group(action["group"]).members)
+        except UnknownNodeError:
+            return []
+    if action.kind == "stop_own":  # app.ros2cli.pkg's program key
+        return [f"own:/{action['package']}/{action['executable']}"]
+    return []
+
+
+def _skip_label(not_passed: int) -> str:
+    """Next's label: it moves on either way, but says when that skips checks."""
+    if not not_passed:
+        return "Next"
+    return f"Skip ({not_passed} check{'s' if not_passed > 1 else ''} not passed)"
+
+
 def _label(lesson: Lesson) -> str:
     return f"{lesson.unit:02d} · {lesson.title}"
 
@@ -118,10 +140,15 @@ class LessonsPanel:
         step_card: Any = None,
         open_tool: Callable[[str], None] = lambda _tool: None,
         start_requests: StartRequests | None = None,
+        new_lesson: Callable[[], None] = lambda: None,
+        position: MarkdownView | None = None,
     ) -> None:
         """``step_card``: a folder for the step's title, buttons, checks and Back/Next (the
         dashboard puts it above its tools, so they stay in view); made here when None.
-        ``open_tool(name)`` brings a tool's tab into view (a step's `open_panel` button)."""
+        ``open_tool(name)`` brings a tool's tab into view (a step's `open_panel` button).
+        ``new_lesson()``: another lesson was opened (the dashboard clears what the last one
+        left in the views). ``position``: where the "Lesson i of n · Step j of m" line goes
+        (the dashboard puts it above the step card); made in the card when None."""
         self._gui = gui
         self._ui = ui
         self._course = course
@@ -131,6 +158,9 @@ class LessonsPanel:
         self._show_stage = show_stage  # the stage shows what each step names
         self._open_tool = open_tool
         self._requests = start_requests or StartRequests()  # the stage shows a Start at once
+        self._new_lesson = new_lesson
+        self._leftovers: list[str] = []  # nodes running when this lesson was opened
+        self._stop_buttons: list[tuple[Any, list[str]]] = []  # (button, what it stops)
         self._dynamic: list[Any] = []
         by_label = {_label(lesson): lesson for lesson in course.lessons}
         self._by_label = by_label
@@ -152,11 +182,18 @@ class LessonsPanel:
         # What the learner does: the step card (title, buttons, checks, Back/Next).
         self._card = step_card if step_card is not None else gui.add_folder("This step")
         with self._card:
+            # Where am I: lesson i of n, step j of m.
+            self._position = position if position is not None else MarkdownView(gui)
+            self._stop_leftovers = gui.add_button(
+                "", icon=viser.Icon.PLAYER_STOP, color="red", visible=False
+            )
             self._actions = gui.add_folder(None)  # the step's own buttons, rebuilt per step
             self._checks = MarkdownView(gui)
             self._message = MarkdownView(gui)
-            self._back = gui.add_button("Back", icon=viser.Icon.ARROW_LEFT)
-            self._next = gui.add_button("Next", icon=viser.Icon.ARROW_RIGHT)
+            # Back, Next and the Stops look different: gray goes back, blue goes on
+            # (orange while it would skip checks), red stops.
+            self._back = gui.add_button("Back", icon=viser.Icon.ARROW_LEFT, color="gray")
+            self._next = gui.add_button("Next", icon=viser.Icon.ARROW_RIGHT, color="blue")
         # The code the lesson talks about sits beside the text, in the side
         # window docked on the left (the learner can minimise or move it).
         with side_window.add_tab("Code of this lesson", viser.Icon.CODE):
@@ -167,6 +204,7 @@ class LessonsPanel:
         self._back.on_click(ui.callback(lambda: self._select(self._lesson, self._step - 1)))
         self._next.on_click(ui.callback(self._go_next))
         self._reset.on_click(ui.callback(self._do_reset))
+        self._stop_leftovers.on_click(ui.callback(self._stop_left_over))
         self._select(current, self._step, reading=False)
 
     # -- navigation --------------------------------------------------------
@@ -195,10 +233,20 @@ class LessonsPanel:
         """Show ``step`` of ``lesson``; ``reading``: bring its text into view (a new step is
         read first, even if the learner had a tool open for the last one)."""
         step = max(0, min(step, len(lesson.steps) - 1))
+        if lesson is not self._lesson:  # a lesson starts clean: nothing of the last one
+            self._leftovers = sorted(
+                name for name, status in self._statuses().items() if status.active
+            )
+            self._new_lesson()
         self._lesson, self._step = lesson, step
         self._progress.set_position(lesson.id, step)
         current = lesson.steps[step]
         self._card.label = f"Step {step + 1} of {len(lesson.steps)}: {current.title}"
+        number = self._course.lessons.index(lesson) + 1
+        self._position.show(
+            f"**Lesson {number} of {len(self._course.lessons)} · Step {step + 1} of "
+            f"{len(lesson.steps)}** · {lesson.title}"
+        )
         self._header.show(f"### {lesson.title}\n{lesson.summary}")
         self._goals.show("\n".join(f"- {goal}" for goal in lesson.goals))
         self._text.show(_without_title(current.text))
@@ -223,14 +271,24 @@ class LessonsPanel:
         for handle in self._dynamic:
             handle.remove()
         self._dynamic = []
+        self._stop_buttons = []
         step = self._lesson.steps[self._step]
+        statuses = self._statuses()
         with self._actions:
             for action in step.actions:
                 label = action.get("label") or f"{action.kind.replace('_', ' ')}"
                 icon = _ACTION_ICONS.get(action.kind, viser.Icon.PLAYER_PLAY)
-                button = self._gui.add_button(label, icon=icon)
+                stops = _stopped_by(action)
+                button = self._gui.add_button(
+                    label,
+                    icon=icon,
+                    color="red" if stops else None,
+                    disabled=bool(stops) and not _any_active(statuses, stops),
+                )
                 button.on_click(self._ui.callback(self._perform, action))
                 self._dynamic.append(button)
+                if stops:
+                    self._stop_buttons.append((button, stops))
             for check in step.checks:
                 if check.kind != "quiz":
                     continue
@@ -259,6 +317,17 @@ class LessonsPanel:
             lambda: self._live.perform(action), self._message.show, failed, lane="lessons"
         )
 
+    def _statuses(self) -> dict[str, NodeStatus]:
+        supervisor = getattr(self._live, "supervisor", None)  # (a runtime without processes)
+        return supervisor.statuses() if supervisor is not None else {}
+
+    def _stop_left_over(self) -> None:
+        names = self._leftovers
+        self._leftovers = []
+        for name in names:
+            self._live.supervisor.stop(name)  # returns at once; the process ends on its own
+        self._message.show(f"Stopping {', '.join(_ros_names(self._live, names))}.")
+
     def _answer(self, check: Spec, quiz: viser.GuiDropdownHandle) -> None:
         value = quiz.value
         if value == _CHOOSE:
@@ -281,8 +350,35 @@ class LessonsPanel:
         ]
         passed = set(self._progress.lesson(lesson.id)["passed"])
         status = "✓ step done" if index in passed else ""
+        not_passed = sum(result.state != PASS for _, result in results)
+        label = _skip_label(not_passed)
+        if self._next.label != label:
+            self._next.label = label
+            self._next.color = "orange" if not_passed else "blue"
+        self._show_stops()
         self._checks.show(("**Checks** " + status + "\n\n" + "\n".join(lines)) if lines else status)
         self._outline.show(self._outline_text(lesson))
+
+    def _show_stops(self) -> None:
+        """A Stop with nothing to stop is greyed; nodes an earlier lesson left are named."""
+        statuses = self._statuses()
+        for button, names in self._stop_buttons:
+            idle = not _any_active(statuses, names)
+            if button.disabled != idle:
+                button.disabled = idle
+        self._leftovers = [n for n in self._leftovers if _any_active(statuses, [n])]
+        shown = bool(self._leftovers)
+        if shown:
+            names = _ros_names(self._live, self._leftovers)
+            count = len(names)
+            label = (
+                f"Stop {count} node{'s' if count > 1 else ''} left from earlier lessons: "
+                + ", ".join(names)
+            )
+            if self._stop_leftovers.label != label:
+                self._stop_leftovers.label = label
+        if self._stop_leftovers.visible != shown:
+            self._stop_leftovers.visible = shown
 
     def _outline_text(self, current: Lesson) -> str:
         rows = []
@@ -304,3 +400,16 @@ class LessonsPanel:
 
     def close(self) -> None:
         """The dashboard owns the lesson runtime and closes it; nothing else is held."""
+
+
+def _any_active(statuses: dict[str, NodeStatus], names: list[str]) -> bool:
+    return any(status.active for name in names if (status := statuses.get(name)) is not None)
+
+
+def _ros_names(live: LessonRuntime, names: list[str]) -> list[str]:
+    """The supervisor's names as the ROS graph calls those nodes (/talker, /num_publisher)."""
+    shown = []
+    for name in names:
+        program = live.supervisor.program(name)
+        shown.append(program.node_name if program is not None else name)
+    return shown

@@ -250,6 +250,30 @@ class ScenePanel:
             lambda pose, source: ui.post(lambda: self._on_pose_changed(pose, source))
         )
 
+    def forget_unpublished(self, graph: GraphSnapshot) -> None:
+        """A new lesson starts clean: forget everything no running node publishes now.
+
+        Frames whose broadcaster left, a robot nobody describes any more, and
+        the clouds, scans, images, markers, joints and stamped points of topics
+        without a publisher; each row then follows by itself again, so what the
+        new lesson starts shows at once. What is still published stays.
+        """
+        rows = (
+            (self._cloud_row, self.clouds.select),
+            (self._scan_row, self.scan.select),
+            (self._image_row, self.images.select),
+            (self._marker_row, self.markers.select),
+            (self._joint_row, self._select_joints),
+        )
+        for row, select in rows:
+            topic = str(row.dropdown.value)
+            if topic != picker.NONE and graph.publishers(topic) == 0:
+                assign(row.dropdown, picker.NONE)
+                select(picker.NONE)
+                row.chosen_by_learner = False
+        self.stamped.forget_unpublished(graph)
+        self.tf_view.forget_unpublished(graph.publishers("/robot_description") > 0)
+
     def _frame_pose(self, frame: str) -> np.ndarray | None:
         """A TF frame's pose in the Fixed Frame, as the TF view last drew it (any thread)."""
         return self.tf_view.poses().get(frame)

@@ -95,6 +95,11 @@ class StampedLayer:
             colour = _COLOURS[len(self._followers) % len(_COLOURS)]
             self._followers[topic] = _StampedTopic(self, topic, is_pose, colour)
 
+    def forget_unpublished(self, graph: GraphSnapshot) -> None:
+        """Stop drawing the points and poses nobody publishes now (UI thread)."""
+        for topic in [t for t in self._followers if graph.publishers(t) == 0]:
+            self._followers.pop(topic).close()
+
     def describe(self) -> str:
         lines = [f.last for f in self._followers.values() if f.last]
         if not lines:

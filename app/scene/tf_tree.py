@@ -220,6 +220,14 @@ class TfStore:
             self.errors.clear()
             self.version += 1
 
+    def forget(self, children: set[str]) -> None:
+        """Drop these frames' transforms (a new lesson: their broadcasters are gone)."""
+        with self._lock:
+            for child in children:
+                self._frames.pop(child, None)
+            self.errors.clear()
+            self.version += 1
+
 
 def _top(frame: str, parents: dict[str, str]) -> str:
     seen = set()

@@ -76,6 +76,8 @@ class TfView:
         self._sent: dict[str, tuple[object, ...]] = {}  # scene path -> pose last sent
         self.view: TreeView | None = None
         self._root = server.scene.add_frame(TF_PATH, show_axes=False)
+        self._forget: set[str] | None = None  # frames to drop, handed to the drawing thread
+        self._forget_robot = False
         self._wake = threading.Event()
         self._stop = threading.Event()
         self._sources = tf_sources.shared(node)
@@ -116,7 +118,11 @@ class TfView:
                 break
             with self._lock:
                 description, self._description = self._description, None
+                forget, self._forget = self._forget, None
+                forget_robot, self._forget_robot = self._forget_robot, False
             try:
+                if forget is not None:
+                    self._drop(forget, forget_robot)
                 if description is not None:
                     self._load_robot(description)
                 version = self.store.version
@@ -156,6 +162,28 @@ class TfView:
             f"Robot **{drawing.name}**: {len(drawing.links)} links, {shown} with shapes{note}."
         )
         log.info("robot_description: robot %s with %d links", drawing.name, len(drawing.links))
+
+    def _drop(self, frames: set[str], robot: bool) -> None:
+        """Take forgotten frames (and a robot whose publisher left) off the scene."""
+        self.store.forget(frames)
+        gone = set(self._frames) - set(self.store.frames())
+        if robot:
+            for handle in self._visuals:
+                handle.remove()
+            self._visuals.clear()
+            self._robot = None
+            self.robot_joints = ()
+            self.robot_status = "No robot on /robot_description yet."
+        with self._server.atomic():
+            for frame in gone:
+                label = self._labels.pop(frame, None)
+                if label is not None:
+                    label.remove()
+                node = self._frames.pop(frame)
+                self._sent.pop(node.name, None)
+                self._placed.pop(frame, None)
+                node.remove()
+        self._logged.clear()
 
     def _log_once(self, line: str) -> None:
         if line not in self._logged:
@@ -257,6 +285,21 @@ class TfView:
     def set_display(self, *, names: bool, axes: bool) -> None:
         """Show or hide the frames' names and axes (the robot's shapes stay)."""
         self.show_names, self.show_axes = names, axes
+        self._restyle = True
+        self._wake.set()
+
+    def forget_unpublished(self, robot_published: bool) -> None:
+        """Forget every frame no running node sends now: whose broadcaster left the graph,
+        or a moving frame gone silent (a new lesson starts from what is live). The
+        robot's shapes go too unless /robot_description is still published."""
+        dropped = {
+            info.frame
+            for info in self._sources.frames()
+            if info.parent and (info.stale or not info.publisher_here)
+        }
+        with self._lock:
+            self._forget = dropped
+            self._forget_robot = not robot_published
         self._restyle = True
         self._wake.set()
 

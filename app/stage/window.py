@@ -255,6 +255,15 @@ class Stage:
             self._rates.watch({})  # no subscriptions for a picture nobody sees
             self._calls.watch({}, {})
 
+    def forget(self) -> None:
+        """A new lesson: its graph is laid out afresh, nothing inspected."""
+        self._places = StablePlaces(self._places.per_row)
+        self._alone.clear()
+        self._inspected = ""
+        for button in self._tool_buttons:
+            button.visible = False
+        self._last_picture = 0.0
+
     def refresh(self, graph: GraphSnapshot) -> None:
         if self._widths_due and time.monotonic() > self._widths_due:
             self._widths_due = 0.0
