@@ -43,6 +43,12 @@ _ACTION_ICONS = {
     "set_param": viser.Icon.ADJUSTMENTS,
 }
 _CHOOSE = "(choose an answer)"
+# How the screen works, said once, on the first step of the course.
+FIRST_SCREEN = (
+    "_New here?_ The **stage** on the left shows what the current step is about. The "
+    "**step card** below says what to do, with its buttons and live checks (✓ when "
+    "done); the tools are in the tabs under it, and the step's text in Learn › Lessons."
+)
 
 
 def _without_title(markdown: str) -> str:
@@ -243,10 +249,11 @@ class LessonsPanel:
         current = lesson.steps[step]
         self._card.label = f"Step {step + 1} of {len(lesson.steps)}: {current.title}"
         number = self._course.lessons.index(lesson) + 1
-        self._position.show(
+        where = (
             f"**Lesson {number} of {len(self._course.lessons)} · Step {step + 1} of "
             f"{len(lesson.steps)}** · {lesson.title}"
         )
+        self._position.show(f"{FIRST_SCREEN}\n\n{where}" if (number, step) == (1, 0) else where)
         self._header.show(f"### {lesson.title}\n{lesson.summary}")
         self._goals.show("\n".join(f"- {goal}" for goal in lesson.goals))
         self._text.show(_without_title(current.text))

@@ -8,7 +8,8 @@ message's close button, the viewer's settings button), and images without alt
 text (viser's image widget shows a label, not an alt). The dashboard sends
 this once: darker button colours and labels in both colour schemes (CSS
 variables of Mantine, viser's UI kit), and a page script that names the
-unnamed buttons as they appear.
+unnamed buttons as they appear. The same script shows viser's "software
+WebGL" notice once per browser, for a few seconds (it covered the stage).
 """
 
 from __future__ import annotations
@@ -51,12 +52,41 @@ const fix = () => {
     img.setAttribute('alt', label ? `${label} (live picture)` : 'live picture');
   }
 };
+// viser's "software WebGL" notice (no GPU: school laptops, VMs) covered the stage's corner
+// on every screen: shown once per browser and closed after a few seconds, then never again.
+const WEBGL = 'Software WebGL rendering detected';
+const SEEN = 'classroom.webglNoticeSeen';
+const quiet = () => {
+  for (const title of doc.querySelectorAll('.mantine-Notification-title')) {
+    const note = title.closest('.mantine-Notification-root');
+    if (!note || note.__classroomQuiet || title.innerText.trim() !== WEBGL) continue;
+    note.__classroomQuiet = true;
+    const close = () => {
+      const button = note.querySelector('.mantine-Notification-closeButton');
+      if (button) button.click();
+    };
+    let seen = false;
+    try {
+      seen = parent.localStorage.getItem(SEEN) === '1';
+      parent.localStorage.setItem(SEEN, '1');
+    } catch (e) { /* no storage (private mode): close it after a while each time */ }
+    if (seen) {
+      note.style.display = 'none';  // not even its closing animation
+      close();
+    } else parent.setTimeout(close, NOTICE_MS);
+  }
+};
+const fixAll = () => { fix(); quiet(); };
 if (parent.__classroomNamer) parent.__classroomNamer.disconnect();
-parent.__classroomNamer = new parent.MutationObserver(fix);
+parent.__classroomNamer = new parent.MutationObserver(fixAll);
 parent.__classroomNamer.observe(doc.body, {childList: true, subtree: true});
-fix();
+fixAll();
 """
 
 
+NOTICE_SEC = 8.0  # the WebGL notice's first (and only) showing
+
+
 def page_fixes_html() -> str:
-    return f"<style>{_CSS}</style>" + page_script(_NAME_BUTTONS, "button names")
+    script = _NAME_BUTTONS.replace("NOTICE_MS", str(int(NOTICE_SEC * 1000)))
+    return f"<style>{_CSS}</style>" + page_script(script, "button names")

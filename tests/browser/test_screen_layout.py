@@ -4,13 +4,14 @@ readable; the 3D scene is drawn in the stage's area, not under the column."""
 
 from __future__ import annotations
 
+import re
 import time
 
 import pytest
-from playwright.sync_api import Page
+from playwright.sync_api import Page, expect
 
 from app.lessons.schema import load_course
-from tests.browser.helpers import choose
+from tests.browser.helpers import choose, expect_text, out_of_view, step_controls
 from tests.conftest import ARTIFACTS
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -20,6 +21,7 @@ SIZES = [(1366, 768, 1.0), (1920, 1080, 1.0), (1093, 614, 1.25)]
 # The graph, then the code (lesson 2), the graph again, the 3D scene, the graph again.
 WALK = ("01_ros2_and_dds", "02_first_node", "03_topics", "12_images_opencv", "04_qos")
 MIN_TEXT_PX = 11
+NEXT_OR_SKIP = re.compile(r"^(Next|Skip \(\d+ checks? not passed\))$")
 
 # Where the stage and the column are, as drawn: the left dock (graph, code, turtlesim, TF)
 # or the 3D canvas; the column is the window that holds the tool groups' tabs.
@@ -103,4 +105,54 @@ def test_the_stage_is_all_the_room_left_of_the_column_in_every_lesson(browser, d
                 )
     finally:
         page.screenshot(path=str(ARTIFACTS / f"screen-layout-{width}.png"))
+        context.close()
+
+
+def test_the_webgl_notice_shows_once_per_browser(browser, dashboard):
+    """viser's 'software WebGL' notice (no GPU here) covered the stage's corner on every
+    screen: the first visit shows it for a few seconds, later ones not at all."""
+    context = browser.new_context(viewport={"width": 1366, "height": 768})
+    page = context.new_page()
+    notice = page.get_by_text("Software WebGL rendering detected").filter(visible=True)
+    try:
+        page.goto(dashboard.url)
+        expect(notice).to_be_visible(timeout=30_000)
+        expect(notice).to_have_count(0, timeout=20_000)  # closed by itself
+        page.reload()  # the same browser, later
+        page.get_by_role("tab", name="Lessons").wait_for()
+        for _ in range(40):  # never in view over 8 s
+            assert notice.count() == 0, "the WebGL notice came back"
+            page.wait_for_timeout(200)
+    finally:
+        page.screenshot(path=str(ARTIFACTS / "screen-webgl-notice.png"))
+        context.close()
+
+
+@pytest.mark.parametrize("size", SIZES[:2], ids=lambda s: f"{s[0]}x{s[1]}")
+def test_the_first_screen_says_how_it_works_and_shows_the_dashboards_node(browser, dashboard, size):
+    context = browser.new_context(viewport={"width": size[0], "height": size[1]})
+    page = context.new_page()
+    first = load_course().lessons[0]
+    try:
+        page.goto(dashboard.url)
+        page.get_by_role("tab", name="Lessons").wait_for()
+        intro = page.get_by_text("shows what the current step is about").filter(visible=True)
+        expect(intro).to_be_visible()
+        expect(page.get_by_text(f"Lesson 1 of {len(load_course().lessons)}")).to_be_visible()
+        # Its check says the dashboard is on the graph: the stage draws it, not "nothing".
+        expect_text(page, "pass: /classroom_dashboard is on the graph", timeout=30_000)
+        own = page.locator('svg.stage-graph g.sg-vertex[data-name="/classroom_dashboard"]')
+        expect(own).to_be_visible()
+        expect(page.get_by_text("Nothing on the graph yet").filter(visible=True)).to_have_count(0)
+        # The intro pushes none of the step's controls out of view.
+        controls = step_controls(page, first, 0)
+        controls["Next"] = page.get_by_role("button", name=NEXT_OR_SKIP)
+        controls["intro"] = intro
+        hidden = out_of_view(page, controls)
+        assert not hidden, "; ".join(hidden)
+        # Only the first screen carries it.
+        page.get_by_role("button", name=NEXT_OR_SKIP).click()
+        expect(intro).to_have_count(0)
+    finally:
+        page.screenshot(path=str(ARTIFACTS / f"screen-first-{size[0]}.png"))
         context.close()
