@@ -479,6 +479,7 @@ def build_parser(prog: str = "ros2-classroom") -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=prog, description="A browser-based teaching dashboard for ROS 2 Jazzy."
     )
+    parser.set_defaults(prog=prog)
     sub = parser.add_subparsers(dest="command", required=True)
 
     def dds_options(p: argparse.ArgumentParser) -> None:
@@ -502,7 +503,6 @@ def build_parser(prog: str = "ros2-classroom") -> argparse.ArgumentParser:
         action="store_true",
         help="allow a --host other than loopback; every browser then needs the access token",
     )
-    parser.set_defaults(prog=prog)
     serve.add_argument(
         "--token",
         default=os.environ.get("CLASSROOM_TOKEN"),
