@@ -7,6 +7,12 @@ dispatches to them; each kind lives in its own module (``app.lessons.checks``,
 ``app.lessons.actions``; ``app.lessons.registry`` says how to add one). Checks never block: a
 check that needs a service answer issues ``call_async`` and reports
 *waiting* until the answer is in.
+
+What checks subscribe to (topic taps, and shared watches such as the TF
+listener or the world's /clock) lives only while checks read it: once no
+check has read one for ``IDLE_SEC`` of looking (the learner moved on to
+another step or lesson), it is closed. A dashboard that once showed a
+simulation step no longer takes /clock at 100-200 messages a second for good.
 """
 
 from __future__ import annotations
@@ -14,7 +20,7 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import Any, Protocol, TypeVar
 
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
@@ -43,6 +49,17 @@ ROSOUT_QOS = QoSProfile(
     depth=1000, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
 )
 ROSOUT_KEEP = 500
+# A tap or watch no check has read for this long, while checks were looked at, is
+# closed; a stalled UI loop does not count (idle time runs between looks only).
+IDLE_SEC = 10.0
+SWEEP_SEC = 1.0  # how often idle ones are looked for
+
+
+class Closable(Protocol):
+    def close(self) -> None: ...
+
+
+W = TypeVar("W", bound=Closable)
 
 
 class LessonRuntime:
@@ -58,10 +75,16 @@ class LessonRuntime:
     def __init__(self, node: Node, supervisor: Supervisor) -> None:
         self.node = node
         self.supervisor = supervisor
-        self.graph = GraphSnapshot()
         self.lock = threading.Lock()
+        self._graph = GraphSnapshot()
         self._taps: dict[tuple[str, str], TopicMonitor] = {}
+        self._watches: dict[str, Closable] = {}  # shared by several checks (TF, sim speed)
+        self._read: dict[Any, float] = {}  # when a check last read each tap or watch
+        self._last_look = self._next_sweep = time.monotonic()
         self.tap_born: dict[tuple[str, str], float] = {}  # when each tap began to listen
+        # When a step's set_param action last changed a parameter (its node answered):
+        # a rate judged after it hears only the new setting (topic_rate).
+        self.changed_at: float | None = None
         self.services = ServicePoller(node, RECALL_PERIOD_SEC)
         self.goals: dict[str, GoalRun] = {}
         self.senders: dict[tuple[str, str], Any] = {}  # kept: a fresh one misses subscribers
@@ -82,13 +105,56 @@ class LessonRuntime:
                     keep=ROSOUT_KEEP if history else TAP_KEEP,
                     qos=ROSOUT_QOS if history else TAP_QOS,
                 )
+            self._read[key] = time.monotonic()
             return self._taps[key]
+
+    def watch(self, name: str, make: Callable[[Node], W]) -> W:
+        """The watch ``name`` several checks share, made on this node at the first use;
+        closed as a tap is, once no check reads it."""
+        with self.lock:
+            found = self._watches.get(name)
+            if found is None:
+                found = self._watches[name] = make(self.node)
+            self._read[name] = time.monotonic()
+            return found  # type: ignore[return-value]
+
+    @property
+    def graph(self) -> GraphSnapshot:
+        return self._graph
+
+    @graph.setter
+    def graph(self, graph: GraphSnapshot) -> None:
+        """Every user sets the graph once a pass (the UI loop, the grader): a look."""
+        self._graph = graph
+        self._look()
+
+    def _look(self) -> None:
+        """Close the taps and watches no check has read for IDLE_SEC of looking."""
+        now = time.monotonic()
+        with self.lock:
+            last, self._last_look = self._last_look, now
+            if now < self._next_sweep:
+                return
+            self._next_sweep = now + SWEEP_SEC
+            # Against the previous look, not now: after a stall of the UI loop, what the
+            # current step read just before it is not idle.
+            idle = [key for key, read in self._read.items() if last - read > IDLE_SEC]
+            closing: list[Closable] = []
+            for key in idle:
+                del self._read[key]
+                self.tap_born.pop(key, None)
+                tap = self._taps.pop(key, None)
+                watch = self._watches.pop(key, None)
+                closing += [each for each in (tap, watch) if each is not None]
+        for each in closing:
+            each.close()
 
     def close(self) -> None:
         with self.lock:
             taps, self._taps = list(self._taps.values()), {}
+            watches, self._watches = list(self._watches.values()), {}
             goals = list(self.goals.values())
-        for tap in taps:
+        for tap in [*taps, *watches]:
             tap.close()
         for run in goals:
             run.cancel()
@@ -100,6 +166,7 @@ class LessonRuntime:
         return ACTIONS[action.kind].perform(self, action)
 
     def evaluate(self, check: Spec) -> CheckResult:
+        self._look()
         try:
             return CHECKS[check.kind].evaluate(self, check)
         except (Ros2Error, ValueError, RuntimeError, catalog.UnknownNodeError) as exc:

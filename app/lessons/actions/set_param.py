@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+import time
+from typing import TYPE_CHECKING, Any
 
 from rcl_interfaces.srv import SetParameters
 
@@ -19,5 +20,12 @@ if TYPE_CHECKING:
 )
 def perform(rt: LessonRuntime, action: Spec) -> str:
     request = params.set_request(action["name"], action["value"])
-    rt.services.send(f"{action['node']}/set_parameters", SetParameters, request)
+    client = rt.services.client(f"{action['node']}/set_parameters", SetParameters)
+    rt.changed_at = time.monotonic()  # until the node answers, from the click
+
+    def answered(_future: Any) -> None:
+        # From now on the node runs with the new value: a rate judged later hears only it.
+        rt.changed_at = time.monotonic()
+
+    client.call_async(request).add_done_callback(answered)
     return f"Set {action['name']} = {action['value']!r} on {action['node']}."

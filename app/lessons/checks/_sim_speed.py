@@ -7,7 +7,7 @@ middleware with the world's own wall clock (``source_timestamp``), so the
 factor is measured on the publisher's clock: a busy dashboard that hears the
 messages late, or drops some, reads the same factor.
 
-One watch per ``LessonRuntime`` (as the TF watch): its callbacks only store;
+One watch per ``LessonRuntime`` (as the TF watch), while checks read it: its callbacks only store;
 the check reads a copy under the lock and never blocks. The math is in plain
 functions below, testable without ROS.
 """
@@ -17,7 +17,6 @@ from __future__ import annotations
 import math
 import threading
 import time
-import weakref
 from bisect import bisect_left
 from collections import deque
 from collections.abc import Sequence
@@ -200,15 +199,7 @@ class SimSpeedWatch:
         self._subscriptions = []
 
 
-_WATCHES: weakref.WeakKeyDictionary[LessonRuntime, SimSpeedWatch] = weakref.WeakKeyDictionary()
-_CREATE = threading.Lock()
-
-
 def speed_watch_of(rt: LessonRuntime) -> SimSpeedWatch:
-    """The runtime's sim-speed watch, subscribed on its node at the first use."""
-    with _CREATE:
-        watch = _WATCHES.get(rt)
-        if watch is None:
-            watch = _WATCHES[rt] = SimSpeedWatch(rt.node)
-            weakref.finalize(rt, watch.close)  # its subscriptions go with the runtime
-        return watch
+    """The runtime's sim-speed watch, subscribed on its node at the first use; the runtime
+    closes it once no check reads it (/clock comes at 100 Hz or more)."""
+    return rt.watch("sim_speed", SimSpeedWatch)

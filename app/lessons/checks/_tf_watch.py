@@ -7,8 +7,8 @@ raise tf2's own exceptions. Beside the buffer the watch keeps what a buffer
 does not say plainly: each frame's parent, and whether it came on /tf_static.
 
 One watch per ``LessonRuntime`` (created on first use, on the runtime's
-node): the subscriptions' callbacks run on the executor thread and only
-store; checks read under the lock and never block.
+node, closed once no check reads it): the subscriptions' callbacks run on the
+executor thread and only store; checks read under the lock and never block.
 """
 
 from __future__ import annotations
@@ -16,7 +16,6 @@ from __future__ import annotations
 import math
 import threading
 import time
-import weakref
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -117,19 +116,10 @@ class TfWatch:
             return sorted(child for child, info in self.frames.items() if info.parent == name)
 
 
-_WATCHES: weakref.WeakKeyDictionary[LessonRuntime, TfWatch] = weakref.WeakKeyDictionary()
-_CREATE = threading.Lock()
-
-
 def watch_of(rt: LessonRuntime) -> TfWatch:
-    """The runtime's TF watch, subscribed on its node at the first TF check."""
-    with _CREATE:
-        watch = _WATCHES.get(rt)
-        if watch is None:
-            watch = _WATCHES[rt] = TfWatch(rt.node)
-            # The runtime's life is the watch's: its subscriptions go when the runtime goes.
-            weakref.finalize(rt, watch.close)
-        return watch
+    """The runtime's TF watch, subscribed on its node at the first TF check; the runtime
+    closes it once no check reads it."""
+    return rt.watch("tf", TfWatch)
 
 
 def nobody_publishes(rt: LessonRuntime) -> bool:

@@ -37,7 +37,8 @@ def rate_samples_needed(check: Spec) -> int:
     optional="samples since stamps",
     words="the topic is published at a rate inside the window, judged on enough messages "
     "by the publisher's clock (with stamps = true, by the messages' header stamps: a "
-    "simulated sensor's rate in simulated time, the same on a slow computer)",
+    "simulated sensor's rate in simulated time, the same on a slow computer); after a "
+    "step's button changed a parameter, only what was sent after that counts",
 )
 def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
     """Judged on enough messages (``samples``, else about 1.5 s of the rate under test),
@@ -45,15 +46,21 @@ def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
     least 5 s) as long as those messages need at the slowest accepted rate (older ones
     do not count). ``since`` (a probe's, not a lesson file's: ``time.monotonic()`` when
     it changed the rate) leaves out every message that arrived before it: a window that
-    still held the old timer's messages read a mix of the two rates (8.987 Hz as 8.58)."""
+    still held the old timer's messages read a mix of the two rates (8.987 Hz as 8.58).
+    A lesson step's ``set_param`` button does the same for every rate judged after it
+    (``rt.changed_at``: lesson 08 sets /greeting's rate in one step and measures it in
+    the next; for about 5 s the window read a mix of 2 and 5 Hz)."""
     tap = rt.tap(c["topic"], c["type"])
     needed = rate_samples_needed(c)
     if c.get("stamps", False):
         return _by_stamps(rt, c, tap, needed)
     full = max(MIN_WINDOW_SEC, (needed + 1) / c["min_hz"]) if c["min_hz"] > 0 else None
     window, born = full, rt.tap_born.get((c["topic"], c["type"]), time.monotonic())
-    if "since" in c.fields:
-        born = max(born, float(c["since"]))
+    since = [float(c["since"])] if "since" in c.fields else []
+    if rt.changed_at is not None:
+        since.append(rt.changed_at)
+    if since:
+        born = max(born, *since)
         window = min(full or math.inf, max(0.0, time.monotonic() - born))
     stats = tap.published_rate(window)
     got = 0 if stats is None else (stats.published or stats.received)
