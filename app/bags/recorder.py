@@ -298,6 +298,13 @@ class Recorder:
     def _open(self) -> bool:
         try:
             self._writer.open()
+            # The MCAP header goes to the kernel now, not with the first flush a
+            # second later: a recording killed in its first second was a 0-byte
+            # file that `ros2 bag info` called damaged and `reindex` could not
+            # mend (found by tests/faults/test_kill_restart.py).
+            storage = self._writer.storage
+            if isinstance(storage, McapWriter):
+                storage.bio.flush()
             self._good_end = self._storage_end()
         except WriterError:
             self._open_error = f"cannot record into {self.path}: it already exists"
