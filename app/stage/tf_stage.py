@@ -113,20 +113,21 @@ class TfRecorder:
 
 
 def tf_tree_html(frames: dict[str, dict[str, Any]], recorded_time: float) -> str:
-    """tf2_tools' picture, scaled to the stage, on white paper in either colour scheme."""
+    """tf2_tools' picture at its natural size (never shrunk: its labels stay readable; a
+    big tree scrolls), on white paper in either colour scheme."""
     svg = render(frames, recorded_time)
     size = re.search(r'width="([\d.]+)" height="([\d.]+)"', svg)
     if size:
         width, height = size.groups()
         svg = svg.replace(
             size.group(0),
-            f'viewBox="0 0 {width} {height}" width="100%" style="max-width:{width}px" '
+            f'viewBox="0 0 {width} {height}" width="{width}" height="{height}" '
             f'role="img" aria-label="TF tree: {len(frames)} frames"',
             1,
         )
     return (
         '<div class="stage-tf" style="background:#fff;color:#000;border-radius:4px;'
-        f'padding:6px">{svg}</div>'
+        f'padding:6px;overflow:auto">{svg}</div>'
     )
 
 

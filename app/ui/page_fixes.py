@@ -25,7 +25,10 @@ _CSS = (
     "--mantine-color-green-filled:#2b7a3b!important;"
     "--mantine-color-green-filled-hover:#236630!important;"
     "--mantine-color-red-filled:#c92a2a!important;--mantine-color-red-filled-hover:#a82323!important;"
-    "--mantine-color-gray-filled:#495057!important;--mantine-color-gray-filled-hover:#343a40!important}"
+    "--mantine-color-gray-filled:#495057!important;--mantine-color-gray-filled-hover:#343a40!important;"
+    # Next while it would skip checks: orange, dark enough for white text (5.2:1).
+    "--mantine-color-orange-filled:#c2410c!important;"
+    "--mantine-color-orange-filled-hover:#9a3412!important}"
     ":root[data-mantine-color-scheme=light]{--mantine-color-dimmed:#5c636a!important}"
     ":root[data-mantine-color-scheme=dark]{--mantine-color-dimmed:#b1b5b9!important}"
     ".mantine-Notification-description{color:var(--mantine-color-dimmed)!important}"
