@@ -17,7 +17,7 @@ from tests.conftest import ARTIFACTS
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
 # A school laptop, a desk screen, and the laptop at 125 % browser zoom (its CSS pixels).
-SIZES = [(1366, 768, 1.0), (1920, 1080, 1.0), (1093, 614, 1.25)]
+SIZES = [(1366, 768, 1.0), (1920, 1080, 1.0), (1093, 614, 1.25), (2560, 1440, 1.0)]
 # The graph, then the code (lesson 2), the graph again, the 3D scene, the graph again.
 WALK = ("01_ros2_and_dds", "02_first_node", "03_topics", "12_images_opencv", "04_qos")
 MIN_TEXT_PX = 11
