@@ -87,7 +87,8 @@ class Recorder:
         self._lock = threading.Lock()
         self.truth: list[Sample] = []
         self.odom: list[Pose] = []
-        self.moving_asked = 0.0  # monotonic time /cmd_vel last asked for motion
+        # Simulation time (the newest ground-truth stamp) when /cmd_vel last asked for motion.
+        self.moving_asked = -math.inf
         self._subs = [
             self._node.create_subscription(Odometry, "/ground_truth/odom", self._on_truth, 50),
             self._node.create_subscription(Odometry, "/odom", self._on_odom, 50),
@@ -97,12 +98,15 @@ class Recorder:
     def _on_cmd_vel(self, msg: Twist) -> None:
         if abs(msg.linear.x) > ASKED_SPEED or abs(msg.angular.z) > ASKED_TURN:
             with self._lock:
-                self.moving_asked = time.monotonic()
+                self.moving_asked = self.truth[-1].t if self.truth else 0.0
 
     def asked_to_move(self, within: float = 1.0) -> bool:
-        """Whether /cmd_vel asked for motion in the last ``within`` s of wall-clock time."""
+        """Whether /cmd_vel asked for motion in the last ``within`` s of simulation time, the
+        clock the trial's ``hold`` counts in (a wall-clock second is 2 simulated s at 2x, and
+        fewer on a world slowed by a busy machine)."""
         with self._lock:
-            return time.monotonic() - self.moving_asked < within
+            newest = self.truth[-1].t if self.truth else 0.0
+            return 0.0 <= newest - self.moving_asked < within  # < 0: time reset since
 
     def _on_truth(self, msg: Odometry) -> None:
         pose = pose_of(msg)
