@@ -9,6 +9,7 @@ real page never would.
 
 from __future__ import annotations
 
+import re
 import threading
 import time
 from collections import Counter
@@ -19,6 +20,9 @@ import viser
 import zstandard
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import ClientConnection, connect
+
+# The step card's Next: until the step's checks pass it says what it would skip.
+NEXT_OR_SKIP = re.compile(r"^(Next|Skip \(\d+ checks? not passed\))$")
 
 
 def decode_frame(frame: bytes) -> list[dict[str, Any]]:
@@ -104,10 +108,16 @@ class WireClient:
 
     # -- queries -------------------------------------------------------------
 
-    def find(self, label: str, kind: str | None = None) -> str | None:
+    def find(self, label: str | re.Pattern[str], kind: str | None = None) -> str | None:
+        """A widget by its label as shown now (a pattern: the whole label matches it)."""
         with self.lock:
             for uuid, props in self.gui.items():
-                if props.get("label") == label and (kind is None or props["type"] == kind):
+                shown = props.get("label")
+                if isinstance(label, re.Pattern):
+                    named = isinstance(shown, str) and label.fullmatch(shown) is not None
+                else:
+                    named = shown == label
+                if named and (kind is None or props["type"] == kind):
                     return uuid
         return None
 
@@ -137,7 +147,7 @@ class WireClient:
         """What a page sends when a widget changes (or a button is clicked: True)."""
         self.send({"type": "GuiUpdateMessage", "uuid": uuid, "updates": {"value": value}})
 
-    def click(self, label: str) -> None:
+    def click(self, label: str | re.Pattern[str]) -> None:
         uuid = self.find(label, "GuiButtonMessage")
         assert uuid, f"no button {label!r}"
         self.set_value(uuid, True)

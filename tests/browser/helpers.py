@@ -10,6 +10,7 @@ from playwright.sync_api import Locator, Page, expect
 from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
 from bench._common import open_tool
+from tests.wire_client import NEXT_OR_SKIP
 
 # A tool's tab opened as a learner does: its group's tab first (Inspect, then Echo).
 open_tab = open_tool
@@ -42,6 +43,11 @@ def choose_when_listed(
 
 def click(page: Page, button: str) -> None:
     page.get_by_role("button", name=button, exact=True).click()
+
+
+def click_next(page: Page) -> None:
+    """Press the step card's Next, whichever of its two labels it shows now."""
+    page.get_by_role("button", name=NEXT_OR_SKIP).click()
 
 
 def start_node(page: Page, name: str) -> None:
@@ -147,5 +153,5 @@ def step_controls(page: Page, lesson, index: int) -> dict[str, Locator]:
             )
         controls[f"check {i + 1}"] = checks.nth(i)
     controls["Back"] = page.get_by_role("button", name="Back", exact=True)
-    controls["Next"] = page.get_by_role("button", name="Next", exact=True)
+    controls["Next"] = page.get_by_role("button", name=NEXT_OR_SKIP)
     return controls

@@ -19,8 +19,10 @@ from playwright.sync_api import Browser, Page, expect
 from app.lessons.schema import load_course
 from app.supervisor import Supervisor
 from tests.browser.helpers import (
+    NEXT_OR_SKIP,
     choose,
     click,
+    click_next,
     expect_text,
     open_tab,
     out_of_view,
@@ -112,7 +114,7 @@ def _go_to_step(page: Page, lesson, index: int) -> None:
     choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
     for at in range(index):
         expect_text(page, f"Step {at + 1} of {len(lesson.steps)}")
-        click(page, "Next")
+        click_next(page)
 
 
 def test_at_125_percent_zoom_the_steps_controls_stay_in_view(browser, dashboard_with_chatter):
@@ -137,11 +139,14 @@ def _focused(page: Page) -> str:
     return page.evaluate("() => (document.activeElement.innerText || '').trim()")
 
 
-def _tab_to(page: Page, name: str, backwards: bool = False, limit: int = 80) -> int:
+def _tab_to(
+    page: Page, name: str | re.Pattern[str], backwards: bool = False, limit: int = 80
+) -> int:
     """Press Tab (Shift+Tab) until the button called ``name`` has the focus; how many."""
     for count in range(1, limit + 1):
         page.keyboard.press("Shift+Tab" if backwards else "Tab")
-        if _focused(page) == name:
+        focused = _focused(page)
+        if focused == name or (isinstance(name, re.Pattern) and name.fullmatch(focused)):
             return count
     pytest.fail(f"{limit} presses of {'Shift+' if backwards else ''}Tab never reached {name!r}")
 
@@ -153,7 +158,7 @@ def test_the_keyboard_alone_moves_through_a_lesson(browser, dashboard_with_chatt
         _go_to_step(page, lesson, 0)  # (the mouse only picks the lesson to start from)
         page.locator("body").click(position={"x": 5, "y": 700})  # focus on the page itself
         total = len(lesson.steps)
-        _tab_to(page, "Next")
+        _tab_to(page, NEXT_OR_SKIP)
         page.keyboard.press("Enter")
         expect_text(page, f"Step 2 of {total}: {lesson.steps[1].title}")
         _tab_to(page, "Back", backwards=True)
@@ -167,7 +172,7 @@ def test_the_keyboard_alone_moves_through_a_lesson(browser, dashboard_with_chatt
             "aria-selected", "true"
         )
         # Focus shows where it is: the focused control draws an outline.
-        _tab_to(page, "Next")
+        _tab_to(page, NEXT_OR_SKIP)
         outline = page.evaluate("() => getComputedStyle(document.activeElement).outlineStyle")
         assert outline != "none", "the focused Next button shows no focus ring"
     finally:

@@ -6,7 +6,7 @@ import pytest
 from playwright.sync_api import expect
 
 from app.lessons.schema import load_course
-from tests.browser.helpers import choose, click, expect_text, open_tab
+from tests.browser.helpers import choose, click_next, expect_text, open_tab
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 COURSE = load_course()
@@ -41,7 +41,7 @@ def test_a_step_shows_its_picture_and_the_next_step_does_not(page, lesson, index
     open_tab(page, "Lessons")
     choose(page, "Lesson", _label(lesson))
     for _ in range(index):
-        click(page, "Next")
+        click_next(page)
     expect_text(page, f"Step {index + 1} of {len(lesson.steps)}: {step.title}")
 
     picture = page.get_by_role("img", name=step.image_alt, exact=True)
@@ -51,7 +51,7 @@ def test_a_step_shows_its_picture_and_the_next_step_does_not(page, lesson, index
     decoded = picture.evaluate("img => img.complete && img.naturalWidth")
     assert decoded and decoded > 0, "the browser could not decode the SVG"
 
-    click(page, "Next")
+    click_next(page)
     expect_text(page, f"Step {index + 2} of {len(lesson.steps)}")
     if not lesson.steps[index + 1].image:
         expect(page.get_by_role("img", name=step.image_alt, exact=True)).to_have_count(0)

@@ -8,7 +8,7 @@ import pytest
 from playwright.sync_api import expect
 
 from app.lessons.schema import load_course
-from tests.browser.helpers import choose, click, expect_text, open_tab
+from tests.browser.helpers import choose, click, click_next, expect_text, open_tab
 from tests.conftest import DashboardProcess, free_port
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -32,7 +32,7 @@ def complete_by_clicking(page, lesson, done_within_ms: int = 45_000) -> None:
                 choose(page, check["question"], check["answer"])
         expect(page.get_by_text("✓ step done")).to_be_visible(timeout=done_within_ms)
         if index + 1 < len(lesson.steps):
-            click(page, "Next")
+            click_next(page)
 
 
 def done_cells(page):

@@ -4,14 +4,13 @@ readable; the 3D scene is drawn in the stage's area, not under the column."""
 
 from __future__ import annotations
 
-import re
 import time
 
 import pytest
 from playwright.sync_api import Page, expect
 
 from app.lessons.schema import load_course
-from tests.browser.helpers import choose, expect_text, out_of_view, step_controls
+from tests.browser.helpers import NEXT_OR_SKIP, choose, expect_text, out_of_view, step_controls
 from tests.conftest import ARTIFACTS
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -21,7 +20,6 @@ SIZES = [(1366, 768, 1.0), (1920, 1080, 1.0), (1093, 614, 1.25), (2560, 1440, 1.
 # The graph, then the code (lesson 2), the graph again, the 3D scene, the graph again.
 WALK = ("01_ros2_and_dds", "02_first_node", "03_topics", "12_images_opencv", "04_qos")
 MIN_TEXT_PX = 11
-NEXT_OR_SKIP = re.compile(r"^(Next|Skip \(\d+ checks? not passed\))$")
 
 # Where the stage and the column are, as drawn: the left dock (graph, code, turtlesim, TF)
 # or the 3D canvas; the column is the window that holds the tool groups' tabs.

@@ -12,6 +12,7 @@ from playwright.sync_api import Page, expect
 from app.lessons.schema import load_course
 from app.stage import STAGES
 from tests.browser.helpers import (
+    NEXT_OR_SKIP,
     choose,
     expect_text,
     open_tab,
@@ -25,7 +26,6 @@ from tests.integration.core_helpers import DISCOVERY_TIMEOUT
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
 SIZES = [(1366, 768), (1920, 1080)]
-NEXT_OR_SKIP = re.compile(r"^(Next|Skip \(\d+ checks? not passed\))$")
 
 
 def _open(browser, dashboard, size: tuple[int, int]) -> Page:

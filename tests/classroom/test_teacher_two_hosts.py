@@ -48,7 +48,7 @@ QUIZ = "In ROS 2, how does a new node learn which other nodes exist?"  # unit 1,
 DRIVER = textwrap.dedent(
     """
     import json, sys, time, urllib.error, urllib.request
-    from tests.wire_client import WireClient
+    from tests.wire_client import NEXT_OR_SKIP, WireClient
     pages = {}
 
     def until(check, timeout):
@@ -78,9 +78,11 @@ DRIVER = textwrap.dedent(
                 seen = until(lambda: page.find(cmd["label"]), cmd.get("timeout", 15))
                 out = {"ok": bool(seen), "t": time.monotonic()}
             elif op == "click":
-                until(lambda: page.find(cmd["label"], "GuiButtonMessage"), 15)
+                # "Next" reads "Skip (N checks not passed)" until the step's checks pass.
+                label = NEXT_OR_SKIP if cmd["label"] == "Next" else cmd["label"]
+                until(lambda: page.find(label, "GuiButtonMessage"), 15)
                 out["t"] = time.monotonic()
-                page.click(cmd["label"])
+                page.click(label)
             elif op == "set":
                 uuid = until(lambda: page.find(cmd["label"]), 15)
                 if cmd.get("option"):  # a dropdown: wait until the value is offered

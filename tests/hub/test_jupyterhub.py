@@ -30,7 +30,7 @@ from app.dds import configure_dds_env
 from app.lessons.schema import load_course
 from app.teacher.http_report import to_json
 from app.teacher.record import LearnerRecord
-from tests.browser.helpers import choose, click, expect_text, open_tab
+from tests.browser.helpers import choose, click, click_next, expect_text, open_tab
 from tests.browser.test_exercise import EXERCISE, _open_editor
 from tests.conftest import ARTIFACTS, fail_on_leftover_nodes, in_private_netns, wait_until
 from tests.hub.local_hub import PASSWORD, LocalHub
@@ -214,7 +214,7 @@ def test_each_learner_passes_a_lesson_step_and_an_exercise(hub, room):
             if check.kind == "quiz":
                 choose(page, check["question"], check["answer"])
         expect(page.get_by_text("✓ step done").filter(visible=True)).to_be_visible(timeout=45_000)
-        click(page, "Next")
+        click_next(page)
         expect(_row(teacher, user)).to_contain_text(
             f"{lesson.unit} · 2/{len(lesson.steps)}", timeout=2_000
         )
