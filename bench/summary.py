@@ -46,6 +46,7 @@ RUNS: tuple[tuple[str, list[str]], ...] = (
     ("tf2_lookup", ["--seconds", "5", "--lookups", "3000"]),
     ("hub_spawn", ["--counts", "1,5", "--seconds", "6"]),  # 20 learners: run it alone
     ("colcon_build", ["--python-rounds", "4", "--interface-rounds", "2", "--run-rounds", "6"]),
+    ("soak", ["--minutes", "3"]),  # the real soak: --bench soak --minutes 30
 )
 
 # (figure, benchmark, key ("a|b" shows both), unit, aim text, aim test)
@@ -489,6 +490,8 @@ HEADLINE = {
     "hub_memory_overhead_percent": ("hub_spawn", "hub_memory_overhead_percent"),
     "colcon_build_ratio": ("colcon_build", "colcon_build_ratio"),
     "own_node_run_ratio": ("colcon_build", "own_node_run_ratio"),
+    "soak_rss_growth_percent": ("soak", "soak_rss_growth_percent"),
+    "soak_click_p95_ms": ("soak", "soak_click_p95_ms"),
 }
 
 ROWS += (
@@ -534,6 +537,49 @@ ROWS += (
     ),
 )
 
+ROWS += (
+    (
+        "Soak (5 browsers, camera→arm, MuJoCo world, learner's node): RSS growth after warm-up",
+        "soak",
+        "soak_rss_growth_percent",
+        "%",
+        "≤ 10",
+        lambda v: v <= 10,
+    ),
+    (
+        "Soak: dashboard threads growth after warm-up",
+        "soak",
+        "soak_threads_growth",
+        "threads",
+        "≤ 2 (flat)",
+        lambda v: v <= 2,
+    ),
+    (
+        "Soak: dashboard open file descriptors growth after warm-up",
+        "soak",
+        "soak_fds_growth",
+        "fds",
+        "≤ 2 (flat)",
+        lambda v: v <= 2,
+    ),
+    (
+        "Soak: errors and tracebacks in the log",
+        "soak",
+        "soak_log_errors",
+        "lines",
+        "0",
+        lambda v: v == 0,
+    ),
+    (
+        "Soak: open each tool tab at the end, p95 (p50)",
+        "soak",
+        "soak_click_p95_ms|soak_click_p50_ms",
+        "ms",
+        "< 150",
+        lambda v: v < 150,
+    ),
+)
+
 
 def last_json(output: str) -> dict[str, Any] | None:
     """The last line of ``output`` that parses as a JSON object, if any."""
@@ -550,6 +596,9 @@ def last_json(output: str) -> dict[str, Any] | None:
 
 
 BENCH_TIMEOUT_SEC = 300
+# Benchmarks that run longer by design: their own time plus the same margin.
+# (soak: 3 minutes, and five software-WebGL pages to set up on a loaded machine)
+BENCH_TIMEOUTS = {"soak": 3 * 60 + 2 * BENCH_TIMEOUT_SEC}
 
 
 def failure_reason(returncode: int, stdout: str, stderr: str) -> str:
@@ -584,12 +633,13 @@ def run_one(name: str, args: list[str]) -> tuple[dict[str, Any] | None, float, s
         start_new_session=True,  # a timeout ends its whole group, not just the first process
     )
     timed_out = ""
+    limit = BENCH_TIMEOUTS.get(name, BENCH_TIMEOUT_SEC)
     try:
-        stdout, stderr = proc.communicate(timeout=BENCH_TIMEOUT_SEC)
+        stdout, stderr = proc.communicate(timeout=limit)
     except subprocess.TimeoutExpired:
         os.killpg(proc.pid, signal.SIGKILL)
         stdout, stderr = proc.communicate()
-        timed_out = f"timed out after {BENCH_TIMEOUT_SEC} s"
+        timed_out = f"timed out after {limit} s"
     elapsed = time.monotonic() - t0
     lines = stdout.strip().splitlines()
     print("\n".join(lines[-8:]), flush=True)
