@@ -25,10 +25,10 @@ _CSS = (
     "--mantine-color-green-filled:#2b7a3b!important;"
     "--mantine-color-green-filled-hover:#236630!important;"
     "--mantine-color-red-filled:#c92a2a!important;--mantine-color-red-filled-hover:#a82323!important;"
-    "--mantine-color-gray-filled:#495057!important;--mantine-color-gray-filled-hover:#343a40!important;"
-    # Next while it would skip checks: orange, dark enough for white text (5.2:1).
-    "--mantine-color-orange-filled:#c2410c!important;"
-    "--mantine-color-orange-filled-hover:#9a3412!important}"
+    "--mantine-color-gray-filled:#495057!important;--mantine-color-gray-filled-hover:#343a40!important}"
+    # Orange (Next while it would skip checks) keeps Mantine's own: viser's theme picks the
+    # text colour from the palette (autoContrast), black on it, 7.8:1; a darker orange
+    # under that black text fell to 4.05.
     ":root[data-mantine-color-scheme=light]{--mantine-color-dimmed:#5c636a!important}"
     ":root[data-mantine-color-scheme=dark]{--mantine-color-dimmed:#b1b5b9!important}"
     ".mantine-Notification-description{color:var(--mantine-color-dimmed)!important}"
