@@ -149,9 +149,19 @@ def ended_state(code: int, stop_requested: bool, output: Iterable[str]) -> NodeS
     return NodeState.STOPPED if code > 0 and error in _INTERRUPTS else NodeState.CRASHED
 
 
-def _set_parent_death_signal() -> None:
-    """Runs in the child between fork and exec: die with the dashboard."""
-    _libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
+def die_with(parent: int) -> Callable[[], None]:
+    """What the child runs between fork and exec: die with the dashboard ``parent``.
+
+    The signal only comes for a death after it is set: a dashboard that died between
+    the fork and here left this child to another parent, so it ends at once.
+    """
+
+    def set_parent_death_signal() -> None:
+        _libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
+        if os.getppid() != parent:
+            os._exit(1)
+
+    return set_parent_death_signal
 
 
 class Supervisor:
@@ -332,7 +342,7 @@ class Supervisor:
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
             start_new_session=True,  # own process group: signals reach the whole node
-            preexec_fn=_set_parent_death_signal,
+            preexec_fn=die_with(os.getpid()),
         )
         proc = _Process(entry, popen, self._max_log_lines)
         with self._lock:

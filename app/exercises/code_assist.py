@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import IO, Any, Protocol
 
 from app.exercises.lint import Problem, lint
+from app.supervisor import die_with
 
 log = logging.getLogger(__name__)
 
@@ -173,7 +174,7 @@ class AssistProcess:
             cwd=cwd,
             env={**os.environ, "PYTHONUNBUFFERED": "1", "PYTHONDONTWRITEBYTECODE": "1"},
             start_new_session=True,
-            preexec_fn=_die_with_parent,
+            preexec_fn=die_with(os.getpid()),
         )
         self.problem = ""
         assert self._proc.stdout is not None
@@ -233,10 +234,3 @@ class AssistProcess:
         if proc is not None and proc.poll() is None:
             proc.kill()
             proc.wait(5)
-
-
-def _die_with_parent() -> None:
-    import ctypes
-    import signal
-
-    ctypes.CDLL(None).prctl(1, signal.SIGTERM, 0, 0, 0)  # PR_SET_PDEATHSIG
