@@ -23,6 +23,20 @@ from websockets.sync.client import ClientConnection, connect
 
 # The step card's Next: until the step's checks pass it says what it would skip.
 NEXT_OR_SKIP = re.compile(r"^(Next|Skip \(\d+ checks? not passed\))$")
+# What a rendering page reports about its camera (viser waits for one before it counts
+# the client as connected).
+CAMERA_REPORT = {
+    "type": "ViewerCameraMessage",
+    "wxyz": (1.0, 0.0, 0.0, 0.0),
+    "position": (3.0, 3.0, 3.0),
+    "fov": 1.0,
+    "near": 0.01,
+    "far": 1000.0,
+    "image_height": 900,
+    "image_width": 1400,
+    "look_at": (0.0, 0.0, 0.0),
+    "up_direction": (0.0, 0.0, 1.0),
+}
 
 
 def decode_frame(frame: bytes) -> list[dict[str, Any]]:
@@ -58,20 +72,7 @@ class WireClient:
         self._reader.start()
         # viser counts a client as connected (and runs its clicks) only after
         # the first camera report, which a page sends as soon as it renders.
-        self.send(
-            {
-                "type": "ViewerCameraMessage",
-                "wxyz": (1.0, 0.0, 0.0, 0.0),
-                "position": (3.0, 3.0, 3.0),
-                "fov": 1.0,
-                "near": 0.01,
-                "far": 1000.0,
-                "image_height": 900,
-                "image_width": 1400,
-                "look_at": (0.0, 0.0, 0.0),
-                "up_direction": (0.0, 0.0, 1.0),
-            }
-        )
+        self.send(CAMERA_REPORT)
 
     def _read(self) -> None:
         try:

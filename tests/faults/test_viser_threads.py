@@ -25,7 +25,7 @@ import viser
 from app.access import make_server
 from tests.conftest import wait_until
 from tests.faults.helpers import record
-from tests.wire_client import WireClient
+from tests.wire_client import CAMERA_REPORT, WireClient
 
 STEADY_CLIENTS = 12  # stay connected all along and must see every kind of update
 CHURNERS = 4  # threads that connect a client, keep it briefly, and close it, over and over
@@ -89,18 +89,6 @@ def _scene_updater(server: viser.ViserServer, n: int) -> Callable[[int], None]:
 
 
 KINDS = (_markdown_updater, _number_updater, _scene_updater)
-CAMERA = {
-    "type": "ViewerCameraMessage",
-    "wxyz": (1.0, 0.0, 0.0, 0.0),
-    "position": (3.0, 3.0, 3.0),
-    "fov": 1.0,
-    "near": 0.01,
-    "far": 1000.0,
-    "image_height": 900,
-    "image_width": 1400,
-    "look_at": (0.0, 0.0, 0.0),
-    "up_direction": (0.0, 0.0, 1.0),
-}
 
 
 def test_handles_set_from_many_threads_while_clients_come_and_go(server: viser.ViserServer):
@@ -145,7 +133,8 @@ def test_handles_set_from_many_threads_while_clients_come_and_go(server: viser.V
         try:
             while not stop.wait(ORBIT_SEC):
                 turn += 0.05
-                client.send({**CAMERA, "position": (3 * math.cos(turn), 3 * math.sin(turn), 3.0)})
+                orbit = (3 * math.cos(turn), 3 * math.sin(turn), 3.0)
+                client.send({**CAMERA_REPORT, "position": orbit})
         except BaseException:
             fail(f"orbit:\n{traceback.format_exc()}")
 
