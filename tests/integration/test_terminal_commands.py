@@ -11,6 +11,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from app.dds import LOOPBACK_PROFILE
 
 VENV_BIN = Path(sys.executable).parent
@@ -63,6 +65,10 @@ def test_ros2_into_a_closed_pipe_ends_quietly(tmp_path):
     assert done.stdout == "141\n" and done.stderr == "", done.stdout + done.stderr
 
 
+# An interface package and a Python package built from scratch: 133-141 s measured with
+# the machine at load 11-14 on 2 cores, past the suite's 180 s default once the CI run's
+# other workers load it more.
+@pytest.mark.timeout(420)
 def test_interface_package_builds_with_colcon_in_a_terminal(tmp_path):
     """ros2 pkg create, Num.msg as the tutorial adds it, colcon build, source, ros2 ..."""
     src = tmp_path / "ros2_ws" / "src"
