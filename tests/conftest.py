@@ -236,6 +236,32 @@ def pytest_xdist_make_scheduler(config: pytest.Config, log: object) -> object:
     return worker_plan.make_scheduler(config, log)
 
 
+# Tests that take the cores on purpose (to prove a check holds on a slow
+# computer) are marked ``loaded``: tests/run.py runs them after the rest, one at
+# a time, so their load never starves another worker's test.
+LOADED = "loaded"
+BUSY_LOOP = "while True: pass"
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line("markers", f"{LOADED}: takes the cores on purpose; runs alone")
+
+
+@pytest.fixture
+def busy_cores(request: pytest.FixtureRequest) -> Iterator[list[subprocess.Popen]]:
+    """Two processes that spin for the test's duration; ended whatever happens."""
+    if request.node.get_closest_marker(LOADED) is None:
+        pytest.fail(f"a test that uses busy_cores is marked @pytest.mark.{LOADED} (runs alone)")
+    loops = [subprocess.Popen([sys.executable, "-c", BUSY_LOOP]) for _ in range(2)]
+    try:
+        yield loops
+    finally:
+        for loop in loops:
+            loop.kill()
+        for loop in loops:
+            loop.wait(timeout=10)
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     # Every worker collects, and all must list the same order: the plan is a pure function.
     if os.environ.get("PYTEST_XDIST_WORKER"):

@@ -22,6 +22,9 @@ domain ids and ports need no coordination between them. A worker notes its
 namespace in a file the keeper reads, so the keeper ends what is left in
 every namespace of the run.
 
+Tests marked ``loaded`` take both cores on purpose; they run after the rest,
+one at a time, in a second pytest session (``pytest_phases``).
+
 Usage: ``python tests/run.py [--workers N] [pytest args]`` (``make test`` does
 this; ``--workers 1`` runs pytest in one process, as before); ``--bench
 [names]`` runs the benchmarks, ``--script FILE [args]`` one program.
@@ -55,6 +58,8 @@ NAMESPACES = "CLASSROOM_RUN_NAMESPACES"  # the file where workers note their nam
 # cores: eight tests that wait on real time failed (a MuJoCo run, turtlesim).
 DEFAULT_WORKERS = 3
 FORWARDED = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+LOADED = "loaded"  # the mark of tests that take the cores on purpose (tests/conftest.py)
+NO_TESTS = 5  # pytest's exit code when it selected no test
 
 
 def interfaces() -> list[str]:
@@ -175,6 +180,44 @@ def pytest_command(args: list[str]) -> list[str]:
     return [*command, "--tx", spawn, "--dist", "loadscope"]  # scheduler: tests/worker_plan.py
 
 
+def pytest_phases(args: list[str]) -> list[list[str]]:
+    """The tests in the workers, then the ``loaded`` ones alone, one at a time.
+
+    A loaded test takes both cores on purpose (to prove a check holds on a slow
+    computer); beside other workers it starved their tests of real time. A
+    run that picks its own marks (``-m``) is one phase.
+    """
+    if any(arg == "-m" or arg.startswith("-m") and not arg.startswith("--") for arg in args):
+        return [pytest_command(args)]
+    alone = list(args)
+    if "--workers" in alone[:-1]:
+        at = alone.index("--workers")
+        del alone[at : at + 2]
+    return [
+        pytest_command([*args, "-m", f"not {LOADED}"]),
+        pytest_command([*alone, "--workers", "1", "-m", LOADED]),
+    ]
+
+
+def run_phases(commands: list[list[str]], keeper: bool) -> int:
+    """Each phase in turn (all of them, whatever one says); the first failure's code.
+
+    pytest says 5 when a phase selected no test (a run of only loaded tests, or
+    none): that is a failure only when no phase ran any.
+    """
+    if not keeper and len(commands) == 1:
+        os.execv(sys.executable, commands[0])
+    codes = []
+    for number, command in enumerate(commands):
+        if number:
+            print(f"\ntests/run.py: the tests marked {LOADED}, alone, one at a time", flush=True)
+        codes.append(keep(command) if keeper else subprocess.call(command))
+    failed = [code for code in codes if code not in (0, NO_TESTS)]
+    if failed:
+        return failed[0]
+    return NO_TESTS if all(code == NO_TESTS for code in codes) else 0
+
+
 def main() -> int:
     args = sys.argv[1:]
     if args[:1] == ["--worker"]:
@@ -190,7 +233,12 @@ def main() -> int:
     elif args[:1] == ["--bench"]:
         command = [sys.executable, "-m", "bench", *args[1:]]
     else:
-        command = pytest_command(args)
+        phases = pytest_phases(args)
+        if not keeper:
+            return run_phases(phases, keeper=False)
+        with tempfile.NamedTemporaryFile("w", prefix="classroom-run-", suffix=".netns") as noted:
+            os.environ[NAMESPACES] = noted.name
+            return run_phases(phases, keeper=True)
     if not keeper:
         os.execv(sys.executable, command)
     with tempfile.NamedTemporaryFile("w", prefix="classroom-run-", suffix=".netns") as noted:

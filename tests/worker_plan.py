@@ -25,6 +25,7 @@ from typing import Any, TypeVar
 ONE_WORKER = frozenset(
     {
         "tests/browser/test_accessibility.py",
+        "tests/faults/test_sigterm_stops.py",
         "tests/hub/test_jupyterhub.py",
         "tests/hub/test_lean_hub.py",
         "tests/integration/test_learner_workspace.py",
@@ -35,6 +36,13 @@ ONE_WORKER = frozenset(
         "tests/urdf/test_rsp_outside.py",
     }
 )
+
+# Modules whose module-scoped fixture is cheap enough to make again on each
+# worker, and whose tests gain from being shared out (the reason says why).
+SHARED_MODULE_FIXTURES = {
+    "tests/exercises/test_grading.py": "one probe node and a supervisor; ~60 cases to share",
+    "tests/unit/test_slam_geometry.py": "synthetic frames rendered in memory in a second",
+}
 
 Item = TypeVar("Item")
 

@@ -36,6 +36,7 @@ import asyncio
 import http
 import json
 import logging
+import threading
 from collections.abc import Awaitable, Callable
 from pathlib import Path
 from typing import Any
@@ -58,6 +59,7 @@ SOCKET_PATH = PREFIX + "ws"
 EDITOR_DIR = Path(__file__).resolve().parent / "editor"
 ACE_DIR = EDITOR_DIR / "node_modules" / "ace-builds" / "src-min-noconflict"
 MAX_MESSAGE_BYTES = 1_000_000
+ATTACH_WAIT_SEC = 60.0  # the dashboard builds its panels within this, even on busy cores
 MAX_OPEN_FILES = 12  # tabs of workspace files; the oldest closes beyond that
 WATCH_SEC = 1.0  # how often open workspace files are compared with the disk
 ASSIST_SECONDS = 20.0  # the first completion parses rclpy (seconds on a busy machine)
@@ -116,6 +118,10 @@ class EditorHub:
         self._pending: dict[ServerConnection, asyncio.Event] = {}
         self._load: Callable[[str], str] = lambda slug: ""
         self._save: Callable[[str, str], None] = lambda slug, code: None
+        # Set once the Exercise panel has said where code lives: an editor that
+        # connects before (a reload while the dashboard restarts) waits for it, or
+        # its first save would be acknowledged and dropped.
+        self._attached = threading.Event()
         # Open workspace files (shared by this learner's editors), and what the
         # disk held when the hub last read or wrote each: a change by anything
         # else (the Console, a lesson's button) is pushed to the editors.
@@ -141,6 +147,7 @@ class EditorHub:
         rule for learner code, which the completion worker follows (see ``code_assist``)."""
         self._load, self._save = load, save
         self._policy, self._scratch = policy, scratch
+        self._attached.set()
 
     # -- hooks into the web server (see app.access.make_server) ---------------
 
@@ -178,6 +185,10 @@ class EditorHub:
         assert connection.request is not None
         query = parse_qs(urlsplit(connection.request.path).query)
         slug = (query.get("slug") or [""])[0]
+        if not await asyncio.to_thread(self._attached.wait, ATTACH_WAIT_SEC):
+            text = "the dashboard is still starting: reload this page in a moment"
+            await self._error(connection, EXERCISE, text)
+            return
         self._editors[connection] = slug
         if self._watcher is None or self._watcher.done():
             self._watcher = asyncio.create_task(self._watch())

@@ -239,7 +239,7 @@ def follow_build(ctx: CallContext, programs: Any, key: str, ws: LearnerWorkspace
     try:
         while True:
             before = shown
-            shown = _write_new(ctx, programs, key, shown)
+            shown = run.write_new_output(ctx, programs, key, shown)
             if shown != before:
                 last_news = time.monotonic()
             elif time.monotonic() - last_news >= PROGRESS_SEC:
@@ -248,7 +248,7 @@ def follow_build(ctx: CallContext, programs: Any, key: str, ws: LearnerWorkspace
                 ctx.write(f"(building for {last_news - started:.0f} s: {_progress(programs, key)})")
             status = programs.status(key)
             if not status.active:
-                shown = _write_new(ctx, programs, key, shown)
+                shown = run.write_new_output(ctx, programs, key, shown)
                 output = programs.output(key)
                 _explain_dash_spelling(ctx, output)
                 _point_at_errors(ctx, output, ws, status.exit_code)
@@ -273,10 +273,10 @@ def follow_build(ctx: CallContext, programs: Any, key: str, ws: LearnerWorkspace
             ctx.sleep(POLL_SEC)
     except Cancelled:
         programs.stop(key).result(timeout=15.0)
-        _write_new(ctx, programs, key, shown)
+        run.write_new_output(ctx, programs, key, shown)
         raise
     programs.stop(key).result(timeout=15.0)
-    _write_new(ctx, programs, key, shown)
+    run.write_new_output(ctx, programs, key, shown)
     ctx.write(f"error: {reason}")
     return 1
 
@@ -319,17 +319,6 @@ def _explain_dash_spelling(ctx: CallContext, lines: list[str]) -> None:
             "spelling but warns it will stop, and then your executables would not land in "
             "lib/<package>, where `ros2 run` looks: use script_dir and install_scripts)"
         )
-
-
-def _write_new(ctx: CallContext, programs: Any, key: str, shown: int) -> int:
-    """Write lines not shown yet; ``shown`` counts lines ever produced (the buffer is bounded)."""
-    status = programs.status(key)
-    lines = programs.output(key)
-    total = status.dropped_lines + len(lines)
-    new = lines[max(0, len(lines) - (total - shown)) :] if total > shown else []
-    for line in new:
-        ctx.write(line)
-    return total
 
 
 def _active(programs: Any, key: str) -> bool:
@@ -388,23 +377,12 @@ def _node_names(ctx: CallContext) -> set[str]:
 
 def _show_own_start(ctx: CallContext, programs: Any, key: str, before: set[str]) -> int:
     """Its output while it starts; all of it when it ends meanwhile (a script that prints)."""
-    shown = 0
-    waited = 0.0
-    limit = run.STARTUP_WAIT_SEC
-    new_nodes: set[str] = set()
-    while True:
-        shown = _write_new(ctx, programs, key, shown)
-        status = programs.status(key)
-        if not status.active:
-            shown = _write_new(ctx, programs, key, shown)
-            if status.exit_code != 0:
-                _explain_missing_module(ctx, programs.output(key), key.split("/")[1])
-            return 0 if status.exit_code == 0 else 1
-        new_nodes = _node_names(ctx) - before
-        if (new_nodes and shown) or waited >= limit:
-            break
-        ctx.sleep(POLL_SEC)
-        waited += POLL_SEC
+    status = run.follow_start(ctx, programs, key, lambda: _node_names(ctx) - before)
+    if not status.active:
+        if status.exit_code != 0:
+            _explain_missing_module(ctx, programs.output(key), key.split("/")[1])
+        return 0 if status.exit_code == 0 else 1
+    new_nodes = _node_names(ctx) - before
     stop = key.split(":", 1)[1]
     on_graph = f" as {', '.join(sorted(new_nodes))}" if new_nodes else ""
     ctx.write(

@@ -100,7 +100,9 @@ EXECUTABLES: dict[tuple[str, str], str] = {
     **_UPSTREAM,
 }
 
-STARTUP_WAIT_SEC = 3.0  # how long the verb shows a starting node's output
+STARTUP_WAIT_SEC = 5.0  # the longest the verb shows a starting node's output
+STARTUP_QUIET_SEC = 1.0  # ...and it stops once the node is up and this long quiet
+POLL_SEC = 0.1
 _NAME = r"[~/]?[A-Za-z_{][\w/{}~]*"  # a ROS name as a remap rule may write it
 _REMAP = re.compile(rf"^(?:(?P<node>[A-Za-z_]\w*):)?(?P<from>{_NAME}|__node|__ns)"
                     rf":=(?P<to>{_NAME})$")  # fmt: skip
@@ -305,26 +307,53 @@ def running_as(programs: Programs, key: str) -> str | None:
         return None
 
 
-def _show_start(ctx: CallContext, programs: Programs, key: str, fqn: str) -> int:
-    """Print what the node says while it starts; all of it if it ends meanwhile."""
+def write_new_output(ctx: CallContext, programs: Any, key: str, shown: int) -> int:
+    """Write lines not shown yet; ``shown`` counts lines ever produced (the buffer is bounded)."""
+    status = programs.status(key)
+    lines = programs.output(key)
+    total = status.dropped_lines + len(lines)
+    new = lines[max(0, len(lines) - (total - shown)) :] if total > shown else []
+    for line in new:
+        ctx.write(line)
+    return total
+
+
+def follow_start(ctx: CallContext, programs: Any, key: str, is_up: Any) -> Any:
+    """Write what a starting program says until it is up and has gone quiet; its status.
+
+    Up is ``is_up()`` (its node on the graph) with at least one line shown;
+    the start-up messages of a node come in a burst (turtlesim: its greeting,
+    then the first turtle), so the verb waits for STARTUP_QUIET_SEC without a
+    new line. A program that ends meanwhile has all its output written.
+    """
     shown = 0
-    waited = 0.0
+    waited = quiet = 0.0
     limit = min(STARTUP_WAIT_SEC, ctx.limits.max_seconds or STARTUP_WAIT_SEC)
     while True:
-        lines = programs.output(key)
-        for line in lines[shown:]:
-            ctx.write(line)
-        shown = len(lines)
+        now_shown = write_new_output(ctx, programs, key, shown)
+        quiet = 0.0 if now_shown != shown else quiet
+        shown = now_shown
         status = programs.status(key)
         if not status.active:
-            return 0 if status.exit_code == 0 else 1
-        seen = fqn in {
-            f"{ns.rstrip('/')}/{name}" for name, ns in ctx.node.get_node_names_and_namespaces()
-        }
-        if (seen and shown) or waited >= limit:
-            break
-        ctx.sleep(0.1)
-        waited += 0.1
+            write_new_output(ctx, programs, key, shown)
+            return status
+        if (shown and quiet >= STARTUP_QUIET_SEC and is_up()) or waited >= limit:
+            return status
+        ctx.sleep(POLL_SEC)
+        waited += POLL_SEC
+        quiet += POLL_SEC
+
+
+def _show_start(ctx: CallContext, programs: Programs, key: str, fqn: str) -> int:
+    """Print what the node says while it starts; all of it if it ends meanwhile."""
+
+    def is_up() -> bool:
+        names = ctx.node.get_node_names_and_namespaces()
+        return fqn in {f"{ns.rstrip('/')}/{name}" for name, ns in names}
+
+    status = follow_start(ctx, programs, key, is_up)
+    if not status.active:
+        return 0 if status.exit_code == 0 else 1
     ctx.write(
         f"({fqn} keeps running, pid {status.pid}: stop it with `ros2 run --stop {fqn}`"
         + (" or in the Nodes tab)" if ":" not in key else ")")

@@ -35,7 +35,7 @@ from tests.conftest import free_port, in_private_netns, wait_until
 
 pytestmark = pytest.mark.ros
 
-SLOTS = 6  # nodes started at once, each on its own domain
+SLOTS = 4  # nodes started at once, each on its own domain (beside two other workers)
 FIRST_DOMAIN = 70
 UP_TIMEOUT = 45.0  # start-up on two busy cores: MuJoCo and OpenCV nodes take a while
 # A stop during start-up waits for the node to be made whole (nodes/common/run.py), which

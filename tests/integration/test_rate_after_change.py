@@ -13,10 +13,7 @@ from __future__ import annotations
 
 import random
 import re
-import subprocess
-import sys
 import time
-from collections.abc import Iterator
 
 import pytest
 
@@ -53,24 +50,15 @@ PROBE = Spec(
 )
 
 
-@pytest.fixture
-def busy_cores(request) -> Iterator[None]:
-    """Two busy-loop processes for the test's duration when the test asks for them."""
-    loops = [
-        subprocess.Popen([sys.executable, "-c", "while True: pass"])
-        for _ in range(2 if request.param else 0)
-    ]
-    try:
-        yield
-    finally:
-        for loop in loops:
-            loop.kill()
-        for loop in loops:
-            loop.wait(timeout=10)
-
-
-@pytest.mark.parametrize("busy_cores", [False, True], ids=["idle", "loaded"], indirect=True)
-def test_the_rate_after_a_change_is_within_one_percent_of_the_timer(probe, supervisor, busy_cores):
+@pytest.mark.parametrize(
+    "loaded",
+    [pytest.param(False, id="idle"), pytest.param(True, id="loaded", marks=pytest.mark.loaded)],
+)
+def test_the_rate_after_a_change_is_within_one_percent_of_the_timer(
+    probe, supervisor, loaded, request
+):
+    if loaded:
+        request.getfixturevalue("busy_cores")  # tests/conftest.py: two busy loops
     lessons = LessonRuntime(probe.node, supervisor)
     call = CallContext(probe.node)
 

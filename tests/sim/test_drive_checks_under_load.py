@@ -20,9 +20,9 @@ from app.lessons.schema import load_course
 from app.ros.context import CONSOLE_LIMITS, CallContext
 from app.ros2cli import run_text
 from tests.conftest import wait_until
-from tests.sim.test_sim_speed_under_load import busy_cores, lessons  # noqa: F401 (fixtures)
+from tests.sim.test_sim_speed_under_load import lessons  # noqa: F401 (a fixture)
 
-pytestmark = pytest.mark.ros
+pytestmark = [pytest.mark.ros, pytest.mark.loaded]
 
 SLOWER = re.compile(r"the world ran at ([\d.]+)x of real time while the robot drove")
 
@@ -30,7 +30,7 @@ SLOWER = re.compile(r"the world ran at ([\d.]+)x of real time while the robot dr
 def test_drive_steps_pass_on_a_world_slower_than_real_time_and_say_so(
     lessons,  # noqa: F811
     supervisor,
-    busy_cores,  # noqa: F811
+    busy_cores,
 ):
     course = load_course()
     lesson = next(each for each in course.lessons if each.id == "13_wheeled_robot")

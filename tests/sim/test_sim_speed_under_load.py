@@ -14,8 +14,6 @@ from __future__ import annotations
 import os
 import re
 import signal
-import subprocess
-import sys
 import threading
 import time
 from collections.abc import Iterator
@@ -31,22 +29,7 @@ from app.ros.context import CallContext
 from app.ros.graph import snapshot
 from tests.conftest import wait_until
 
-pytestmark = pytest.mark.ros
-
-BUSY = "while True: pass"
-
-
-@pytest.fixture
-def busy_cores() -> Iterator[list[subprocess.Popen]]:
-    """Two processes that spin for the test's duration; ended whatever happens."""
-    loops = [subprocess.Popen([sys.executable, "-c", BUSY]) for _ in range(2)]
-    try:
-        yield loops
-    finally:
-        for loop in loops:
-            loop.kill()
-        for loop in loops:
-            loop.wait(timeout=10)
+pytestmark = [pytest.mark.ros, pytest.mark.loaded]
 
 
 @pytest.fixture

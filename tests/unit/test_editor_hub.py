@@ -282,3 +282,39 @@ def test_the_page_files_are_the_editors_and_aces(tmp_path):
     assert _file_for(PREFIX + "ace/ext-language_tools.js") == ACE_DIR / "ext-language_tools.js"
     assert _file_for(PREFIX + "assist_worker.py") is None
     assert Path(code_assist.WORKER).is_file()
+
+
+def test_an_editor_that_connects_before_the_panel_is_built_loses_no_save(tmp_path):
+    # The web server serves while the dashboard still builds its panels: an editor
+    # reloaded then used to get "" as its code and an acknowledged save that went
+    # nowhere (a SIGKILL right after lost the learner's code).
+    saved: dict[str, str] = {}
+    hub = EditorHub()
+
+    async def attach_later() -> None:
+        await asyncio.sleep(0.5)
+        hub.attach(lambda slug: saved.get(slug, "print('starter')\n"), saved.__setitem__,
+                   scratch=tmp_path)  # fmt: skip
+
+    async def main() -> None:
+        async def refuse(connection: Any) -> None:
+            raise AssertionError("only the editor's socket is used here")
+
+        async with serve(hub.wrap_handler(refuse), "127.0.0.1", 0) as server:
+            port = server.sockets[0].getsockname()[1]
+            url = f"ws://127.0.0.1:{port}{SOCKET_PATH}?slug=heartbeat_logger"
+            async with connect(url) as socket:
+                attaching = asyncio.create_task(attach_later())
+                editor = Editor(socket)
+                await editor.send(type="save", code="print('mine')\n", rev=1)
+                loaded = await editor.expect("load", file=None)
+                assert loaded["code"] == "print('starter')\n"  # the exercise's, not ""
+                await editor.expect("saved", rev=1)
+                assert saved == {"heartbeat_logger": "print('mine')\n"}
+                await attaching
+
+    try:
+        with concurrent.futures.ThreadPoolExecutor(1) as pool:
+            pool.submit(asyncio.run, main()).result()
+    finally:
+        hub.close()

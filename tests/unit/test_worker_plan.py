@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import re
+
 from app import PROJECT_ROOT
-from tests.worker_plan import ONE_WORKER, spread, unit_of
+from tests.worker_plan import ONE_WORKER, SHARED_MODULE_FIXTURES, spread, unit_of
 
 HUB = "tests/hub/test_jupyterhub.py"
+MODULE_FIXTURE = re.compile(r"^@pytest\.fixture\(.*scope=.module", re.M)
 
 
 def _ids(folder: str, count: int, module: str = "test_x.py") -> list[str]:
@@ -16,6 +19,19 @@ def test_every_one_worker_module_exists():
     # A renamed module would silently be shared out test by test again.
     missing = [path for path in ONE_WORKER if not (PROJECT_ROOT / path).is_file()]
     assert not missing, missing
+
+
+def test_every_module_fixture_is_made_once_or_said_to_be_cheap():
+    # A module fixture in a shared-out module is made again each time a worker
+    # comes back to the module: the SIGTERM module's (the whole catalog started
+    # and stopped) ran a dozen times and took half an hour of a CI run.
+    with_one = {
+        str(path.relative_to(PROJECT_ROOT))
+        for path in (PROJECT_ROOT / "tests").rglob("test_*.py")
+        if MODULE_FIXTURE.search(path.read_text(encoding="utf-8"))
+    }
+    unplanned = with_one - ONE_WORKER - set(SHARED_MODULE_FIXTURES)
+    assert not unplanned, f"module fixtures with no plan (tests/worker_plan.py): {unplanned}"
 
 
 def test_a_one_worker_module_is_one_unit_and_other_tests_are_their_own():
