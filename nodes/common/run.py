@@ -13,11 +13,13 @@ what was made (a signal can arrive at any point of start-up). A node's
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from types import FrameType
 from typing import TypeVar
 
 import rclpy
@@ -235,16 +237,39 @@ def run_program(main: Callable[[], int | None]) -> None:
     """Run a ros_python program (a tf2 tool, robot_state_publisher ...) as a catalog node.
 
     Those programs catch Ctrl+C (KeyboardInterrupt) themselves but not
-    SIGTERM, so SIGTERM is made Ctrl+C here. ROS errors of a context the
-    signal shut down meanwhile (a node still being made, a spin thread) end
-    the program quietly too, as in ``spin_node``.
+    SIGTERM, so SIGTERM is made Ctrl+C here (``interrupt_outside_imports``).
+    ROS errors of a context the signal shut down meanwhile (a node still
+    being made, a spin thread) end the program quietly too, as in ``spin_node``.
     """
-    signal.signal(signal.SIGTERM, signal.default_int_handler)
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, interrupt_outside_imports)
     spin_threads_end_quietly()
     code: int | None = 0
     with stopped_quietly():
         code = main()
     sys.exit(code)
+
+
+RETRY_SIGNAL_SEC = 0.05
+
+
+def interrupt_outside_imports(signum: int, frame: FrameType | None) -> None:
+    """Ctrl+C's KeyboardInterrupt, raised where it can end the program.
+
+    Raised inside Python's import machinery (an import still under way as
+    the node joins the graph, or its module-lock clean-up running in garbage
+    collection) it is printed as "Exception ignored ... KeyboardInterrupt"
+    with a traceback and lost. There the signal is sent again a moment later.
+    """
+    at = frame
+    while at is not None:
+        if at.f_code.co_filename.startswith("<frozen importlib"):
+            retry = threading.Timer(RETRY_SIGNAL_SEC, os.kill, (os.getpid(), signum))
+            retry.daemon = True
+            retry.start()
+            return
+        at = at.f_back
+    raise KeyboardInterrupt
 
 
 def _make_executor(factory: type[Executor] | Callable[[NodeT], Executor], node: NodeT) -> Executor:

@@ -76,3 +76,38 @@ def test_restoring_puts_the_old_handlers_back_and_ends_the_relay():
         restore()
     assert {sig: signal.getsignal(sig) for sig in before} == before
     assert not [t for t in threading.enumerate() if t.name == "stop-signals"]
+
+
+# SIGTERM while the program is inside Python's import machinery (here a frame
+# that says it is, as importlib's module-lock clean-up does in garbage collection).
+STOPPED_INSIDE_AN_IMPORT = """
+import os, signal, sys, time
+from nodes.common.run import interrupt_outside_imports
+
+signal.signal(signal.SIGTERM, interrupt_outside_imports)
+IN_IMPORT = compile(
+    "os.kill(os.getpid(), signal.SIGTERM)\\nend = time.monotonic() + 0.3\\n"
+    "while time.monotonic() < end: pass",
+    "<frozen importlib._bootstrap>", "exec",
+)
+try:
+    exec(IN_IMPORT)
+    print("import finished", flush=True)
+    time.sleep(5)
+    print("not stopped", flush=True)
+except KeyboardInterrupt:
+    print("interrupted", flush=True)
+"""
+
+
+def test_sigterm_inside_an_import_interrupts_after_it_not_in_it():
+    # A KeyboardInterrupt raised in importlib is printed ("Exception ignored") and lost.
+    run = subprocess.run(
+        [sys.executable, "-c", STOPPED_INSIDE_AN_IMPORT],
+        cwd=PROJECT_ROOT,
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
+    assert run.stdout == "import finished\ninterrupted\n", (run.stdout, run.stderr)
+    assert "Traceback" not in run.stderr, run.stderr
