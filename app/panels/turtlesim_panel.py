@@ -16,7 +16,6 @@ tab is shown, are left alone.
 
 from __future__ import annotations
 
-import html
 import json
 from typing import Any
 
@@ -31,6 +30,7 @@ from app.supervisor import Supervisor
 from app.ui import MarkdownView, set_options
 from app.ui.loop import UiLoop
 from app.ui.page_links import PageLinks
+from app.ui.page_script import listen_on_page, page_script
 
 NONE = "(no turtlesim)"
 POSE_TYPE = "turtlesim/msg/Pose"
@@ -80,16 +80,9 @@ const onKey = (event) => {{
   event.stopPropagation();
   fetch(new URL(links[name], parent.location.href), {{cache: "no-store"}}).catch(() => {{}});
 }};
-if (parent.__turtleKeysOff) parent.__turtleKeysOff();
-parent.addEventListener("keydown", onKey, true);
-parent.__turtleKeysOff = () => parent.removeEventListener("keydown", onKey, true);
-window.addEventListener("pagehide", () => parent.__turtleKeysOff && parent.__turtleKeysOff());
+{listen_on_page("__turtleKeysOff", "keydown", "onKey", capture=True)}
 """
-    document = f"<!doctype html><script>{script}</script>"
-    return (
-        f'<iframe hidden title="turtlesim keys" data-turtlesim-keys '
-        f'srcdoc="{html.escape(document, quote=True)}"></iframe>'
-    )
+    return page_script(script, "turtlesim keys", turtlesim_keys="")
 
 
 def pose_topics(graph: GraphSnapshot, sim_fqn: str) -> dict[str, str]:

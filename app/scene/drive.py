@@ -21,7 +21,6 @@ the robot moved, keeping each learner's own angle and distance.
 
 from __future__ import annotations
 
-import html
 import json
 import logging
 import threading
@@ -35,6 +34,7 @@ from std_msgs.msg import String
 from app.ros.graph import GraphSnapshot
 from app.ui import MarkdownView
 from app.ui.loop import UiLoop
+from app.ui.page_script import listen_on_page, page_script
 
 log = logging.getLogger(__name__)
 
@@ -85,16 +85,9 @@ const onKey = (event) => {{
   event.stopPropagation();
   button.click();
 }};
-if (parent.__simDriveKeysOff) parent.__simDriveKeysOff();
-parent.addEventListener("keydown", onKey, true);
-parent.__simDriveKeysOff = () => parent.removeEventListener("keydown", onKey, true);
-window.addEventListener("pagehide", () => parent.__simDriveKeysOff && parent.__simDriveKeysOff());
+{listen_on_page("__simDriveKeysOff", "keydown", "onKey", capture=True)}
 """
-    document = f"<!doctype html><script>{script}</script>"
-    return (
-        f'<iframe hidden title="robot drive keys" data-sim-drive-keys '
-        f'srcdoc="{html.escape(document, quote=True)}"></iframe>'
-    )
+    return page_script(script, "robot drive keys", sim_drive_keys="")
 
 
 def overview(low: np.ndarray, high: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -28,7 +28,7 @@ from app.ros.graph import GraphSnapshot
 from app.ui import MarkdownView
 from app.ui.loop import UiLoop
 from app.ui.page_links import PageLinks
-from app.ui.page_script import page_script
+from app.ui.page_script import listen_on_page, page_script
 
 NO_SIM = (
     "_turtlesim_node is not running._ Start it from the lesson's button, "
@@ -57,11 +57,7 @@ const onKey = (event) => {
   event.stopImmediatePropagation();
   fetch(new URL(links[name], parent.location.href), {cache: 'no-store'}).catch(() => {});
 };
-if (parent.__stageKeysOff) parent.__stageKeysOff();
-parent.addEventListener('keydown', onKey, true);
-parent.__stageKeysOff = () => parent.removeEventListener('keydown', onKey, true);
-window.addEventListener('pagehide', () => parent.__stageKeysOff && parent.__stageKeysOff());
-"""
+""" + listen_on_page("__stageKeysOff", "keydown", "onKey", capture=True).replace("%", "%%")
 
 
 class TurtlesimStage:

@@ -37,7 +37,7 @@ from app.stage.turtlesim_stage import TurtlesimStage
 from app.ui import MarkdownView, assign
 from app.ui.loop import UiLoop
 from app.ui.page_links import SINK, SINK_FRAME, PageLinks
-from app.ui.page_script import page_script
+from app.ui.page_script import listen_on_page, page_script
 
 PICTURE_PERIOD_SEC = 1.0
 MAX_PICKS = 300  # boxes that answer a click (a larger graph: the first ones)
@@ -50,18 +50,17 @@ CONTROL_PANEL_ROOM = CONTROL_WIDTH + 28  # and its margins
 MIN_WIDTH, MAX_WIDTH = 400, 3000  # up to the panel: no 3D scene peeks out between
 REFIT_PX = 24  # a smaller change of the window is not worth moving the stage
 # Runs in the page (app.ui.page_script): report the window's width now and after resizes.
-_REPORT_WIDTH = """
+_REPORT_WIDTH = (
+    """
 const url = new URL(%s, parent.location.href).href;
 const report = () => fetch(url + '/' + Math.round(parent.innerWidth), {cache: 'no-store'})
   .catch(() => {});
 let timer = 0;
 const onResize = () => { clearTimeout(timer); timer = setTimeout(report, 150); };
-if (parent.__stageWidthOff) parent.__stageWidthOff();
-parent.addEventListener('resize', onResize);
-parent.__stageWidthOff = () => parent.removeEventListener('resize', onResize);
-window.addEventListener('pagehide', () => parent.__stageWidthOff && parent.__stageWidthOff());
-report();
 """
+    + listen_on_page("__stageWidthOff", "resize", "onResize")
+    + "report();\n"
+)
 RATE_CHANGE = 0.15  # a rate must move this much (share) before the dots are re-timed
 _IN_WINDOW = ("graph", "turtlesim", "tf")  # stages drawn in the stage window
 # A clicked box's tools (set to it already): (tool, button label).

@@ -543,6 +543,8 @@ def check_files(var: Path, learner: Learner, course: Course, number: int) -> dic
                 f"{len(learner.code.allowed())} versions it may be"
             )
             learner.code.sent, learner.code.acked = [code], 0
+        else:  # killed before the first save landed: the starter is what comes back
+            learner.code.sent, learner.code.acked = [], -1
 
     ws = progress_dir / "default.ros2_ws"
     for name, versions in learner.files.items():

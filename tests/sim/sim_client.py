@@ -220,8 +220,17 @@ class SimClient(Node):
         return msg.pose.pose.position.x, msg.pose.pose.position.y
 
     def wait_sim(self, duration: float) -> None:
-        end = self.sim_time() + duration
-        wait(lambda: self.sim_time() >= end, what=f"{duration} s of simulation time")
+        """Until the simulation has run ``duration`` s. Right after a reset the last /clock
+        heard may still be the old time: a clock that goes back starts the count again."""
+        start = self.sim_time()
+
+        def ran() -> bool:
+            nonlocal start
+            now = self.sim_time()
+            start = min(start, now)
+            return now - start >= duration
+
+        wait(ran, what=f"{duration} s of simulation time")
 
     def log_since(self, mark: int, text: str) -> list[str]:
         with self.lock:
@@ -347,13 +356,15 @@ def teleop(c: SimClient) -> dict:
     keys = c.create_publisher(String, "/sim_teleop_key/_key", 10)
     wait(lambda: keys.get_subscription_count() > 0, what="the teleop's key topic")
     start_xy = c.truth()
+    first = c.sim_time()
     for _ in range(20):  # a held key repeats
         keys.publish(String(data="up"))
         time.sleep(0.05)
+    held = c.sim_time() - first  # simulated seconds: a busy computer holds the key longer
     c.wait_sim(1.0)  # the last command times out
     moved = (c.truth()[0] - start_xy[0], c.truth()[1] - start_xy[1])
     c.destroy_publisher(keys)
-    return {"moved": moved}
+    return {"moved": moved, "held_sim_sec": held}
 
 
 def sim_time(c: SimClient) -> dict:

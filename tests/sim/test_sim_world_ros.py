@@ -99,13 +99,20 @@ def test_the_world_is_published_as_markers_from_the_same_model(report):
 
 
 def test_the_sim_drive_group_teleop_drives_the_robot_forward(report):
-    dx, dy = part(report, "teleop")["moved"]
-    assert 0.1 < dx < 0.6 and abs(dy) < 0.05, (dx, dy)  # 0.3 m/s while the key is held
+    teleop = part(report, "teleop")
+    dx, dy = teleop["moved"]
+    # 0.3 m/s while the key is held, and until the last command times out (0.5 s of
+    # simulated time), give or take a /clock period at each end.
+    most = 0.3 * (teleop["held_sim_sec"] + 0.5 + 0.1)
+    assert 0.1 < dx < most and abs(dy) < 0.05, (dx, dy, teleop["held_sim_sec"])
 
 
 def test_a_node_with_use_sim_time_follows_the_clock_and_stops_when_paused(report):
     sim = part(report, "sim_time")
-    assert max(abs(offset) for offset in sim["offsets"]) < 0.1, sim["offsets"]
+    # The node's clock and the test's copy of /clock are two subscriptions of one process,
+    # handled in turn: on a loaded CI machine they were up to 0.12 s apart (a wall clock
+    # would be 1.8e9 s off).
+    assert max(abs(offset) for offset in sim["offsets"]) < 0.3, sim["offsets"]
     assert sim["paused"][1] == sim["paused"][0] > 0.0
 
 
