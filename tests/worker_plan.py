@@ -47,9 +47,20 @@ SHARED_MODULE_FIXTURES = {
 Item = TypeVar("Item")
 
 
+# One-worker modules that must not run at the same time either: they share a
+# unit. Two JupyterHubs at once (each with its learners' servers, dashboards and
+# a browser) took both cores for minutes and timed each other out.
+SAME_UNIT = {
+    "tests/hub/test_jupyterhub.py": "tests/hub/<both hubs>",
+    "tests/hub/test_lean_hub.py": "tests/hub/<both hubs>",
+}
+
+
 def unit_of(nodeid: str) -> str:
-    """The unit of work a test belongs to: its module, or the test alone."""
+    """The unit of work a test belongs to: its module (or its modules'), or the test alone."""
     module = nodeid.split("::", 1)[0]
+    if module in SAME_UNIT:
+        return SAME_UNIT[module]
     return module if module in ONE_WORKER else nodeid
 
 

@@ -94,10 +94,18 @@ def test_multisim_runs_two_turtlesims_and_mimic_couples_them(console, probe, sup
         "ros2 topic pub  /turtlesim1/turtle1/cmd_vel geometry_msgs/msg/Twist "
         '"{linear: {x: 2.0, y: 0.0, z: 0.0}, angular: {x: 0.0, y: 0.0, z: 1.8}}"',
     )
-    leader = pose_of(console, "/turtlesim1/turtle1/pose")
-    follower = pose_of(console, "/turtlesim2/turtle1/pose")
-    # Both moved; their speeds are not compared: 1 s after the 5 s pub ends, turtlesim
-    # stops the leader, and a loaded machine may read the poses after that.
+
+    # Compared once both stand still: 1 s after the pub ends turtlesim stops the leader,
+    # and mimic passes its zero speed on. Two reads a moment apart while they drive at
+    # 2 m/s differed by over half a metre on a loaded machine.
+    def both_still() -> tuple[dict, dict] | None:
+        poses = (
+            pose_of(console, "/turtlesim1/turtle1/pose"),
+            pose_of(console, "/turtlesim2/turtle1/pose"),
+        )
+        return poses if all(pose["linear_velocity"] == 0.0 for pose in poses) else None
+
+    leader, follower = wait_until(both_still, timeout=30, interval=0.5, what="both turtles still")
     for pose in (leader, follower):
         assert math.dist((pose["x"], pose["y"]), (CENTRE, CENTRE)) > 0.5, (leader, follower)
     # Same commands from the same start: the two turtles stay close together.

@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 
 from app import PROJECT_ROOT
-from tests.worker_plan import ONE_WORKER, SHARED_MODULE_FIXTURES, spread, unit_of
+from tests.worker_plan import ONE_WORKER, SAME_UNIT, SHARED_MODULE_FIXTURES, spread, unit_of
 
 HUB = "tests/hub/test_jupyterhub.py"
 MODULE_FIXTURE = re.compile(r"^@pytest\.fixture\(.*scope=.module", re.M)
@@ -19,6 +19,11 @@ def test_every_one_worker_module_exists():
     # A renamed module would silently be shared out test by test again.
     missing = [path for path in ONE_WORKER if not (PROJECT_ROOT / path).is_file()]
     assert not missing, missing
+
+
+def test_the_two_hub_modules_never_run_at_once():
+    assert unit_of(f"{HUB}::test_a") == unit_of("tests/hub/test_lean_hub.py::test_b")
+    assert set(SAME_UNIT) <= ONE_WORKER
 
 
 def test_every_module_fixture_is_made_once_or_said_to_be_cheap():
@@ -35,7 +40,8 @@ def test_every_module_fixture_is_made_once_or_said_to_be_cheap():
 
 
 def test_a_one_worker_module_is_one_unit_and_other_tests_are_their_own():
-    assert unit_of(f"{HUB}::test_a") == unit_of(f"{HUB}::test_b[x::y]") == HUB
+    assert unit_of(f"{HUB}::test_a") == unit_of(f"{HUB}::test_b[x::y]")
+    assert unit_of("tests/sim/test_sim_physics.py::test_a") == "tests/sim/test_sim_physics.py"
     assert unit_of("tests/unit/test_cli.py::test_a") == "tests/unit/test_cli.py::test_a"
 
 
