@@ -245,8 +245,14 @@ def run_program(main: Callable[[], int | None]) -> None:
         signal.signal(sig, interrupt_outside_imports)
     spin_threads_end_quietly()
     code: int | None = 0
-    with stopped_quietly():
-        code = main()
+    try:
+        with stopped_quietly():
+            code = main()
+    finally:
+        # Ending: a late signal (a retry, a supervisor's second SIGTERM) must not raise
+        # in the interpreter's own shutdown, which prints it as a traceback.
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, signal.SIG_IGN)
     sys.exit(code)
 
 
@@ -260,7 +266,11 @@ def interrupt_outside_imports(signum: int, frame: FrameType | None) -> None:
     the node joins the graph, or its module-lock clean-up running in garbage
     collection) it is printed as "Exception ignored ... KeyboardInterrupt"
     with a traceback and lost. There the signal is sent again a moment later.
+    Raised once: a later signal would interrupt the program's own clean-up (a
+    supervisor that must stop a hung one sends SIGKILL next).
     """
+    if _interrupted.is_set():
+        return  # the program is ending already: one KeyboardInterrupt is enough
     at = frame
     while at is not None:
         if at.f_code.co_filename.startswith("<frozen importlib"):
@@ -269,7 +279,11 @@ def interrupt_outside_imports(signum: int, frame: FrameType | None) -> None:
             retry.start()
             return
         at = at.f_back
+    _interrupted.set()
     raise KeyboardInterrupt
+
+
+_interrupted = threading.Event()  # interrupt_outside_imports has raised its one interrupt
 
 
 def _make_executor(factory: type[Executor] | Callable[[NodeT], Executor], node: NodeT) -> Executor:

@@ -14,7 +14,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 from app.scene.image_codec import rgb_to_image_msg
 from nodes.common.pointcloud import xyz_to_pointcloud2
-from tests.browser.helpers import open_tab
+from tests.browser.helpers import choose_when_listed, open_tab
 from tests.browser.scene_helpers import (
     Repeater,
     now_stamp,
@@ -40,16 +40,7 @@ CAMERA_IMAGE_SRC_JS = """() => {
 
 def pick(page, label: str, topic: str) -> None:
     """Choose ``topic`` once the dashboard has discovered it (the graph refreshes at 5 Hz)."""
-    page.get_by_label(label).click()
-    option = page.get_by_role("option", name=topic, exact=True)
-    for _ in range(60):
-        if option.count():
-            option.click()
-            return
-        page.keyboard.press("Escape")
-        page.wait_for_timeout(500)
-        page.get_by_label(label).click()
-    raise AssertionError(f"{topic} never appeared in {label}")
+    choose_when_listed(page, label, topic, timeout=30.0)
 
 
 def test_point_cloud_image_and_arm_show_up_live(page, probe):

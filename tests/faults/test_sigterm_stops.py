@@ -67,6 +67,8 @@ LEARNER_ARGS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
         ("-r", "__node:=static_transform_publisher"),  # upstream's name has a random tail
     ),
     "static_turtle_tf2_broadcaster": (("mystaticturtle", "0", "0", "1", "0", "0", "0"), ()),
+    # Without a robot description it ends at once by itself, as upstream's does.
+    "robot_state_publisher": (("nodes/robots/arm/robot.urdf",), ()),
 }
 
 

@@ -20,7 +20,8 @@ from app import PROJECT_ROOT
 from app.catalog import lookup_group
 from tests.outside_report import part, private_dds_env, run_outside_client
 
-pytestmark = pytest.mark.ros
+# The module fixture runs every scenario at once (tests/outside_report.py: CLIENT_TIMEOUT_SEC).
+pytestmark = [pytest.mark.ros, pytest.mark.timeout(420)]
 
 CLIENT = Path(__file__).with_name("sim_client.py")
 ROOM_HALF = 2.0  # inner faces of the room's walls at x, y = +-2 m

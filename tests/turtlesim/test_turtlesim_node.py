@@ -18,7 +18,8 @@ import pytest
 
 from tests.outside_report import part, private_dds_env, run_outside_client
 
-pytestmark = pytest.mark.ros
+# The module fixture runs every scenario at once (tests/outside_report.py: CLIENT_TIMEOUT_SEC).
+pytestmark = [pytest.mark.ros, pytest.mark.timeout(420)]
 
 CLIENT = Path(__file__).with_name("turtlesim_client.py")
 WORLD = (500 - 1) / 45
