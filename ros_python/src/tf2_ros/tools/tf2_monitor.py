@@ -138,6 +138,7 @@ def main(argv: list[str] | None = None) -> int:
     rclpy.init(args=argv)
     node = Node("tf2_monitor_main")
     executor = SingleThreadedExecutor()
+    spinner: threading.Thread | None = None
     try:
         if len(args) not in (1, 3):
             node.get_logger().info("TF_Monitor: usage: tf2_monitor framea frameb")
@@ -153,6 +154,8 @@ def main(argv: list[str] | None = None) -> int:
         pass
     finally:
         executor.shutdown(timeout_sec=2.0)
+        if spinner is not None:  # the node is destroyed only once nothing spins it
+            spinner.join(timeout=2.0)
         node.destroy_node()
         rclpy.try_shutdown()
     return 0
