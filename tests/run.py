@@ -60,6 +60,7 @@ DEFAULT_WORKERS = 3
 FORWARDED = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 LOADED = "loaded"  # the mark of tests that take the cores on purpose (tests/conftest.py)
 NO_TESTS = 5  # pytest's exit code when it selected no test
+GO_ON = (0, 1, NO_TESTS)  # a phase that ended so (passed, tests failed, none) lets the next run
 
 
 def interfaces() -> list[str]:
@@ -200,15 +201,17 @@ def pytest_phases(args: list[str]) -> list[list[str]]:
 
 
 def run_phases(commands: list[list[str]], keeper: bool) -> int:
-    """Each phase in turn (all of them, whatever one says); the first failure's code.
+    """Each phase in turn (after failed tests too); the first failure's code.
 
     pytest says 5 when a phase selected no test (a run of only loaded tests, or
     none): that is a failure only when no phase ran any.
     """
     if not keeper and len(commands) == 1:
         os.execv(sys.executable, commands[0])
-    codes = []
+    codes: list[int] = []
     for number, command in enumerate(commands):
+        if codes and codes[-1] not in GO_ON:
+            break  # interrupted (Ctrl+C), or pytest could not run: stop here
         if number:
             print(f"\ntests/run.py: the tests marked {LOADED}, alone, one at a time", flush=True)
         codes.append(keep(command) if keeper else subprocess.call(command))
