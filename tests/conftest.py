@@ -245,6 +245,9 @@ BUSY_LOOP = "while True: pass"
 
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", f"{LOADED}: takes the cores on purpose; runs alone")
+    config.addinivalue_line(
+        "markers", "alone: needs the machine's real time to itself (tests/run.py runs it alone)"
+    )
 
 
 @pytest.fixture

@@ -22,8 +22,9 @@ domain ids and ports need no coordination between them. A worker notes its
 namespace in a file the keeper reads, so the keeper ends what is left in
 every namespace of the run.
 
-Tests marked ``loaded`` take both cores on purpose; they run after the rest,
-one at a time, in a second pytest session (``pytest_phases``).
+Tests marked ``loaded`` take both cores on purpose, and tests marked
+``alone`` need the machine's real time to themselves; they run after the
+rest, one at a time, in a second pytest session (``pytest_phases``).
 
 Usage: ``python tests/run.py [--workers N] [pytest args]`` (``make test`` does
 this; ``--workers 1`` runs pytest in one process, as before); ``--bench
@@ -59,6 +60,8 @@ NAMESPACES = "CLASSROOM_RUN_NAMESPACES"  # the file where workers note their nam
 DEFAULT_WORKERS = 3
 FORWARDED = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 LOADED = "loaded"  # the mark of tests that take the cores on purpose (tests/conftest.py)
+ALONE = "alone"  # ...and of tests that need the machine's real time to themselves
+SECOND_PHASE = f"{LOADED} or {ALONE}"
 NO_TESTS = 5  # pytest's exit code when it selected no test
 GO_ON = (0, 1, NO_TESTS)  # a phase that ended so (passed, tests failed, none) lets the next run
 
@@ -195,8 +198,8 @@ def pytest_phases(args: list[str]) -> list[list[str]]:
         at = alone.index("--workers")
         del alone[at : at + 2]
     return [
-        pytest_command([*args, "-m", f"not {LOADED}"]),
-        pytest_command([*alone, "--workers", "1", "-m", LOADED]),
+        pytest_command([*args, "-m", f"not ({SECOND_PHASE})"]),
+        pytest_command([*alone, "--workers", "1", "-m", SECOND_PHASE]),
     ]
 
 
@@ -213,7 +216,7 @@ def run_phases(commands: list[list[str]], keeper: bool) -> int:
         if codes and codes[-1] not in GO_ON:
             break  # interrupted (Ctrl+C), or pytest could not run: stop here
         if number:
-            print(f"\ntests/run.py: the tests marked {LOADED}, alone, one at a time", flush=True)
+            print(f"\ntests/run.py: the tests marked {SECOND_PHASE}: one at a time", flush=True)
         codes.append(keep(command) if keeper else subprocess.call(command))
     failed = [code for code in codes if code not in (0, NO_TESTS)]
     if failed:

@@ -52,7 +52,10 @@ PROBE = Spec(
 
 @pytest.mark.parametrize(
     "loaded",
-    [pytest.param(False, id="idle"), pytest.param(True, id="loaded", marks=pytest.mark.loaded)],
+    [
+        pytest.param(False, id="idle", marks=pytest.mark.alone),  # "idle": nothing beside it
+        pytest.param(True, id="loaded", marks=pytest.mark.loaded),
+    ],
 )
 def test_the_rate_after_a_change_is_within_one_percent_of_the_timer(
     probe, supervisor, loaded, request
