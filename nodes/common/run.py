@@ -248,9 +248,13 @@ def run_program(main: Callable[[], int | None]) -> None:
     try:
         with stopped_quietly():
             code = main()
+            # Ending (rclpy's own handler may have ended main): a signal from now on,
+            # however late its Python handler runs, must not raise outside this block.
+            _interrupted.set()
     finally:
-        # Ending: a late signal (a retry, a supervisor's second SIGTERM) must not raise
-        # in the interpreter's own shutdown, which prints it as a traceback.
+        _interrupted.set()
+        # A late signal (a retry, a supervisor's second SIGTERM) must not raise in the
+        # interpreter's own shutdown, which prints it as a traceback.
         for sig in (signal.SIGINT, signal.SIGTERM):
             signal.signal(sig, signal.SIG_IGN)
     sys.exit(code)
