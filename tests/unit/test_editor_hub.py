@@ -70,7 +70,11 @@ class Editor:
             self.seen.append(message)
 
 
-def run_with_editor(hub: EditorHub, test: Any, slug: str = "heartbeat_logger") -> None:
+def run_with_editor(
+    hub: EditorHub, test: Any, slug: str = "heartbeat_logger", *, first_load: bool = True
+) -> None:
+    """``test(editor, url)`` with an editor connected; by default after its first load."""
+
     async def main() -> None:
         async def refuse(connection: Any) -> None:
             raise AssertionError("only the editor's socket is used here")
@@ -80,7 +84,8 @@ def run_with_editor(hub: EditorHub, test: Any, slug: str = "heartbeat_logger") -
             url = f"ws://127.0.0.1:{port}{SOCKET_PATH}?slug={slug}"
             async with connect(url) as socket:
                 editor = Editor(socket)
-                await editor.expect("load", file=None)  # the exercise's code, as before
+                if first_load:
+                    await editor.expect("load", file=None)  # the exercise's code, as before
                 await test(editor, url)
 
     # Its own thread: the session's Playwright (browser tests) keeps an asyncio loop
@@ -296,25 +301,16 @@ def test_an_editor_that_connects_before_the_panel_is_built_loses_no_save(tmp_pat
         hub.attach(lambda slug: saved.get(slug, "print('starter')\n"), saved.__setitem__,
                    scratch=tmp_path)  # fmt: skip
 
-    async def main() -> None:
-        async def refuse(connection: Any) -> None:
-            raise AssertionError("only the editor's socket is used here")
-
-        async with serve(hub.wrap_handler(refuse), "127.0.0.1", 0) as server:
-            port = server.sockets[0].getsockname()[1]
-            url = f"ws://127.0.0.1:{port}{SOCKET_PATH}?slug=heartbeat_logger"
-            async with connect(url) as socket:
-                attaching = asyncio.create_task(attach_later())
-                editor = Editor(socket)
-                await editor.send(type="save", code="print('mine')\n", rev=1)
-                loaded = await editor.expect("load", file=None)
-                assert loaded["code"] == "print('starter')\n"  # the exercise's, not ""
-                await editor.expect("saved", rev=1)
-                assert saved == {"heartbeat_logger": "print('mine')\n"}
-                await attaching
+    async def test(editor: Editor, url: str) -> None:
+        attaching = asyncio.create_task(attach_later())
+        await editor.send(type="save", code="print('mine')\n", rev=1)
+        loaded = await editor.expect("load", file=None)
+        assert loaded["code"] == "print('starter')\n"  # the exercise's, not ""
+        await editor.expect("saved", rev=1)
+        assert saved == {"heartbeat_logger": "print('mine')\n"}
+        await attaching
 
     try:
-        with concurrent.futures.ThreadPoolExecutor(1) as pool:
-            pool.submit(asyncio.run, main()).result()
+        run_with_editor(hub, test, first_load=False)
     finally:
         hub.close()
