@@ -67,8 +67,8 @@ def _thinned(samples: list[Sample]) -> list[Sample]:
     words="resets the world with the robot at a random start beside a wall (on `side`) and "
     "lets your node drive for `duration` simulated seconds: after `settle` s, the nearest "
     "obstacle on that side must stay between `band_min` and `band_max` m away for at least "
-    "`in_band` of the time, the robot must drive at least `min_travel` m and never touch "
-    "anything",
+    "`in_band` of the time, the robot must drive at least `min_travel` m, never stand still "
+    f"for {STUCK:g} s and never touch anything",
     draws="a start pose (x, y, yaw from the ranges, redrawn until a wall (a box 1.5 m long or "
     "more) runs along the robot's side at a distance in `wall_at`, with 1 m free ahead)",
 )
@@ -120,8 +120,13 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
     if touch.distance <= TOUCH:
         problems.append(touch_text(touch))
     if travel < min_travel:
-        still = f", and stood still for the last {STUCK:g} s" if at_rest(samples, STUCK) else ""
-        problems.append(f"it drove only {travel:.2f} m ({min_travel:g} m needed){still}")
+        problems.append(f"it drove only {travel:.2f} m ({min_travel:g} m needed)")
+    # A follower that halts at a corner may already have covered the travel: halting fails alone.
+    if spent >= settle + STUCK and at_rest(samples, STUCK):
+        problems.append(
+            f"it stood still for the last {STUCK:g} s (a wall follower keeps going: at a "
+            "corner it turns)"
+        )
     if distances and share < in_band:
         problems.append(
             f"the wall was in the band only {share:.0%} of the time ({in_band:.0%} needed)"
