@@ -106,7 +106,7 @@ test: setup browser sandbox lint
 SMOKE := tests/unit \
 	tests/browser/test_first_smoke.py::test_start_watch_and_stop_talker_and_listener \
 	tests/integration/test_ros2cli_graph.py::test_node_topic_service_and_action_verbs \
-	"tests/integration/test_lessons_walk.py::test_every_step_of_the_lesson_passes_on_real_nodes[03_topics]" \
+	"tests/integration/test_lessons_walk.py::test_every_step_of_the_lesson_passes_on_real_nodes[05_topics]" \
 	"tests/exercises/test_grading.py::test_grading[counter_publisher-reference]" \
 	"tests/exercises/test_grading.py::test_grading[counter_publisher-never_increments]"
 check: setup browser sandbox lint

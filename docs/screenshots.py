@@ -90,7 +90,7 @@ def _lesson(page: Page, unit: int | str, step: int) -> None:
 def topics_lesson(page: Page) -> None:
     """The opening picture: mid-way through the topics unit, its checks ticking green."""
     for step, label in ((1, "Start talker"), (3, "Start listener"), (4, "Start listener2")):
-        _lesson(page, 3, step)
+        _lesson(page, "05_topics", step)
         page.get_by_role("button", name=label, exact=True).click()
     expect(page.get_by_text("✓ step done").first).to_be_visible(timeout=60_000)
     page.wait_for_timeout(800)
@@ -126,7 +126,7 @@ def stage_graph(page: Page) -> None:
 
 def stage_turtlesim(page: Page) -> None:
     """The turtlesim lesson: turtlesim's window on stage, the trail it drew, the step beside."""
-    _lesson(page, "01_turtlesim_cli", 3)
+    _lesson(page, "02_turtlesim_cli", 3)
     _stage_shot(page, "turtlesim")
 
 
@@ -135,7 +135,7 @@ def stage_tf(page: Page) -> None:
     _tool(page, "Nodes")
     _choose(page, "Launch group", "turtle_tf2_demo")
     page.get_by_role("button", name="Start group", exact=True).click()
-    _lesson(page, "13_tf2_turtlesim", 4)
+    _lesson(page, "16_tf2_turtlesim", 4)
     expect(page.locator("div.stage-tf").get_by_text("turtle2").first).to_be_visible(timeout=60_000)
     _stage_shot(page, "tf", settle_ms=4000)  # rates and buffer lengths settle
     _tool(page, "Nodes")  # a clean world for the pictures that follow
@@ -176,7 +176,7 @@ def arm_scene(page: Page) -> None:
         page.wait_for_timeout(150)
     page.wait_for_timeout(4000)  # the arm on its way to the target
     page.screenshot(path=str(IMAGES / "scene.png"))
-    _lesson(page, "13_frames_and_arm", 4)  # a unit whose stage is the 3D scene
+    _lesson(page, "15_frames_and_arm", 4)  # a unit whose stage is the 3D scene
     _stage_shot(page, "scene", settle_ms=4000)
 
 

@@ -24,7 +24,7 @@ def cmd_list(_slug: str | None, _file: Path | None, _seed: int | None = None) ->
     book = load_exercises()
     width = max((len(e.slug) for e in book.exercises), default=4)
     for exercise in book.exercises:
-        print(f"{exercise.slug:<{width}}  unit {exercise.unit:>2}  {exercise.title}")
+        print(f"{exercise.slug:<{width}}  lesson {exercise.unit:>2}  {exercise.title}")
     for error in book.errors:
         print(f"broken exercise: {error}", file=sys.stderr)
     return 0

@@ -371,7 +371,7 @@ class ExercisePanel:
         passed = "passed_at" in record
         attempts = record.get("attempts", 0)
         self._header.show(
-            f"### {exercise.title}\nUnit {exercise.unit} · your node: `{exercise.node}` · "
+            f"### {exercise.title}\nLesson {exercise.unit} · your node: `{exercise.node}` · "
             + ("✓ **done**" if passed else f"{attempts} check{'s' if attempts != 1 else ''} so far")
         )
         status = runner.status(self._supervisor, exercise)

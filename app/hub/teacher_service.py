@@ -200,7 +200,7 @@ class LearnerHandler(_TeacherBase):
         self.finish(
             {
                 "key": record.key,
-                "where": f"Unit {record.unit} · {record.lesson_title} · step "
+                "where": f"Lesson {record.unit} · {record.lesson_title} · step "
                 f"{record.step}/{record.steps}: {record.step_title}",
                 "checks": checks_text(record),
                 "reasons": [

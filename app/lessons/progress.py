@@ -21,6 +21,62 @@ from typing import Any
 from app import PROJECT_ROOT
 
 DEFAULT_DIR = PROJECT_ROOT / "var" / "progress"
+VERSION = 2
+# Version 2 numbered the lessons 1..N in course order and split two long ones. Old id ->
+# (first old step, new id, step shift) per part: a saved step moves with the part it is in.
+RENUMBERED_IN_V2: dict[str, tuple[tuple[int, str, int], ...]] = {
+    **{
+        old: ((0, new, 0),)
+        for old, new in (
+            ("02_first_node", "04_first_node"),
+            ("03_topics", "05_topics"),
+            ("04_qos", "06_qos"),
+            ("05_services", "07_services"),
+            ("06_interfaces", "08_interfaces"),
+            ("07_actions", "09_actions"),
+            ("08_parameters", "10_parameters"),
+            ("09_lifecycle", "11_lifecycle"),
+            ("10_launch", "12_launch"),
+            ("11_executors", "13_executors"),
+            ("12_images_opencv", "14_images_opencv"),
+            ("13_frames_and_arm", "15_frames_and_arm"),
+            ("13_urdf_robot", "18_urdf_robot"),
+            ("13_wheeled_robot", "19_wheeled_robot"),
+            ("15_workspaces_packages", "20_workspaces_packages"),
+            ("16_bags", "21_bags"),
+            ("14_slam_capstone", "22_slam_capstone"),
+        )
+    },  # fmt: skip
+    "01_turtlesim_cli": ((0, "02_turtlesim_cli", 0), (6, "03_turtlesim_record_launch", -5)),
+    "13_tf2_turtlesim": ((0, "16_tf2_turtlesim", 0), (12, "17_tf2_time", -12)),
+}
+
+
+def _renumbered(lesson_id: str, step: int) -> tuple[str, int]:
+    parts = RENUMBERED_IN_V2.get(lesson_id, ((0, lesson_id, 0),))
+    first, new_id, shift = max(part for part in parts if part[0] <= max(step, 0))
+    return new_id, step + shift
+
+
+def migrate(data: dict[str, Any]) -> dict[str, Any]:
+    """A version-1 record, its lesson ids and steps moved to where those steps are now."""
+    if data.get("version", 1) >= VERSION:
+        return data
+    lessons: dict[str, dict[str, Any]] = {}
+    for old_id, entry in data["lessons"].items():
+        for step in sorted(int(s) for s in entry.get("passed", [])):
+            new_id, new_step = _renumbered(old_id, step)
+            moved = lessons.setdefault(new_id, {"step": 0, "passed": []})
+            moved["passed"] = sorted({*moved["passed"], new_step})
+        new_id, new_step = _renumbered(old_id, int(entry.get("step", 0)))
+        lessons.setdefault(new_id, {"step": 0, "passed": []})["step"] = new_step
+    current = data.get("current")
+    if isinstance(current, str):
+        step = int(data["lessons"].get(current, {}).get("step", 0))
+        data["current"] = _renumbered(current, step)[0]
+    return {**data, "version": VERSION, "lessons": lessons}
+
+
 _NAME = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
 
 
@@ -45,14 +101,14 @@ class ProgressStore:
             data = json.loads(self.path.read_text(encoding="utf-8"))
             if not isinstance(data, dict) or not isinstance(data.get("lessons"), dict):
                 raise ValueError("unexpected layout")
-            return data
+            return migrate(data)
         except FileNotFoundError:
-            return {"version": 1, "lessons": {}}
-        except (ValueError, UnicodeDecodeError) as exc:
+            return {"version": VERSION, "lessons": {}}
+        except (ValueError, TypeError, UnicodeDecodeError) as exc:
             aside = self.path.with_suffix(f".corrupt-{int(time.time())}.json")
             os.replace(self.path, aside)
             self.warning = f"Progress file was unreadable ({exc}); kept it as {aside.name}."
-            return {"version": 1, "lessons": {}}
+            return {"version": VERSION, "lessons": {}}
 
     def lesson(self, lesson_id: str) -> dict[str, Any]:
         with self._lock:
@@ -101,7 +157,7 @@ class ProgressStore:
 
     def reset(self) -> None:
         with self._lock:
-            self._data = {"version": 1, "lessons": {}}
+            self._data = {"version": VERSION, "lessons": {}}
             self._save()
 
     def _save(self) -> None:

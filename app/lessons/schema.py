@@ -74,8 +74,8 @@ class Step:
 
 @dataclass(frozen=True)
 class Lesson:
-    id: str  # directory name, e.g. "02_first_node"
-    unit: int
+    id: str  # directory name, e.g. "04_first_node"
+    unit: int  # its number in course order (1..N): the folder's prefix
     title: str
     summary: str
     goals: tuple[str, ...]
@@ -212,7 +212,10 @@ def load_lesson(directory: Path) -> Lesson:
         raise LessonError(f"{where}: file missing") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise LessonError(f"{where}: not valid TOML ({exc})") from None
-    unit = _require(data, "unit", int, where)
+    if "unit" in data:
+        raise LessonError(f"{where}: 'unit' is gone: a lesson's number is its folder's prefix")
+    match = _DIR_PATTERN.match(directory.name)
+    unit = int(match.group(1)) if match else 0
     title = _require(data, "title", str, where)
     summary = _require(data, "summary", str, where)
     goals = _require(data, "goals", list, where)
@@ -273,11 +276,15 @@ def load_course(root: Path = LESSONS_DIR) -> Course:
     """Every valid lesson under ``root``, sorted by directory; errors for the rest."""
     lessons: list[Lesson] = []
     errors: list[str] = []
-    for directory in sorted(p for p in root.iterdir() if p.is_dir()) if root.is_dir() else []:
-        if not _DIR_PATTERN.match(directory.name):
-            continue
+    folders = sorted(p for p in root.iterdir() if p.is_dir()) if root.is_dir() else []
+    folders = [p for p in folders if _DIR_PATTERN.match(p.name)]
+    for directory in folders:
         try:
             lessons.append(load_lesson(directory))
         except LessonError as exc:
             errors.append(str(exc))
+    numbers = [int(p.name[:2]) for p in folders]
+    if numbers != list(range(1, len(numbers) + 1)):
+        # The picker, the position line and the teacher's view all show this number.
+        errors.append(f"lesson folders must be numbered 01..{len(numbers):02d} in course order")
     return Course(tuple(lessons), tuple(errors))

@@ -81,7 +81,7 @@ def learner_detail(record: LearnerRecord) -> str:
     )
     parts = [
         f"### {record.learner} ({record.site}, ROS domain {record.domain_id})",
-        f"Unit {record.unit} · {record.lesson_title} · step {record.step}/{record.steps}: "
+        f"Lesson {record.unit} · {record.lesson_title} · step {record.step}/{record.steps}: "
         f"{record.step_title}",
         f"**Checks** {checks_text(record)}\n\n{reasons}" if reasons else "**Checks** none",
     ]

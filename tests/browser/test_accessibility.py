@@ -37,7 +37,7 @@ AXE = Path(__file__).parent / "axe" / "node_modules" / "axe-core" / "axe.min.js"
 COURSE = load_course()
 ZOOM_125 = {"viewport": {"width": 1093, "height": 614}, "device_scale_factor": 1.25}  # 1366x768
 # The steps with the most controls (buttons + answers + checks): they must fit too.
-CROWDED = [("15_workspaces_packages", 9), ("16_bags", 3), ("01_turtlesim_cli", 12)]
+CROWDED = [("20_workspaces_packages", 9), ("21_bags", 3), ("03_turtlesim_record_launch", 7)]
 
 
 @pytest.fixture(scope="module")

@@ -59,9 +59,9 @@ def test_a_new_lesson_starts_clean_and_names_what_is_left(browser, dashboard, si
     try:
         page.goto(dashboard.url)
         page.get_by_role("tab", name="Lessons").wait_for()
-        _open_lesson(page, "03_topics")
+        _open_lesson(page, "05_topics")
         total = len(COURSE.lessons)
-        number = [lesson.id for lesson in COURSE.lessons].index("03_topics") + 1
+        number = [lesson.id for lesson in COURSE.lessons].index("05_topics") + 1
         expect_text(page, f"Lesson {number} of {total} · Step 1 of 6")
         # Next says it would skip: the talker is not running yet.
         skip = page.get_by_role("button", name="Skip (3 checks not passed)", exact=True)
@@ -83,7 +83,7 @@ def test_a_new_lesson_starts_clean_and_names_what_is_left(browser, dashboard, si
 
         # The next lesson names both and stops them with one click; a still published
         # frame stays in view.
-        _open_lesson(page, "04_qos")
+        _open_lesson(page, "06_qos")
         leftover = page.get_by_role(
             "button",
             name=re.compile(r"^Stop 2 nodes left from earlier lessons: "),
@@ -101,7 +101,7 @@ def test_a_new_lesson_starts_clean_and_names_what_is_left(browser, dashboard, si
         expect_text(page, "publisher gone", timeout=60_000)
 
         # Another lesson: the frame nobody sends any more is gone from the 3D view.
-        _open_lesson(page, "05_services")
+        _open_lesson(page, "07_services")
         _wait_in_view(page, LAMP, False, 10.0)
         choose(page, "On stage", "3D scene")
         expect(page.get_by_text("lamp", exact=True).filter(visible=True)).to_have_count(0)
@@ -118,8 +118,8 @@ def test_a_stop_with_nothing_to_stop_is_greyed(browser, dashboard):
     try:
         page.goto(dashboard.url)
         page.get_by_role("tab", name="Lessons").wait_for()
-        _open_lesson(page, "03_topics")
-        lesson = COURSE.lesson("03_topics")
+        _open_lesson(page, "05_topics")
+        lesson = COURSE.lesson("05_topics")
         assert lesson is not None
         last = lesson.steps[-1]
         for at in range(len(lesson.steps) - 1):

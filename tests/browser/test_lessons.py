@@ -41,7 +41,7 @@ def done_cells(page):
     return page.get_by_role("cell", name="✓", exact=True)
 
 
-@pytest.mark.parametrize("lesson_id", ["02_first_node", "03_topics"])
+@pytest.mark.parametrize("lesson_id", ["04_first_node", "05_topics"])
 def test_complete_a_lesson_and_keep_progress(page, dashboard, ros_env, progress_dir, lesson_id):
     lesson = COURSE.lesson(lesson_id)
     complete_by_clicking(page, lesson)
@@ -66,12 +66,12 @@ def test_complete_a_lesson_and_keep_progress(page, dashboard, ros_env, progress_
 
 
 def test_complete_the_lifecycle_lesson_by_clicking_transitions(page):
-    complete_by_clicking(page, COURSE.lesson("09_lifecycle"))
+    complete_by_clicking(page, COURSE.lesson("11_lifecycle"))
 
 
 def test_complete_the_bags_lesson_whose_buttons_type_into_the_console(page):
     """Record, replay with no talker, replay looping at double rate: the Console runs them."""
-    complete_by_clicking(page, COURSE.lesson("16_bags"))
+    complete_by_clicking(page, COURSE.lesson("21_bags"))
     open_tab(page, "Console")  # shows the last command, still looping
     expect_text(page, "$ ros2 bag play talker_bag -r 2 -l")
 
@@ -83,6 +83,6 @@ def test_complete_the_workspace_lesson_building_and_running_the_learners_own_pac
     """Unit 15 by clicking: pkg create, files written, colcon build, source, ros2 run,
     'No executable found', the fix, a launch file, an interface package; real colcon."""
     # An interface package's build (CMake, rosidl, a compiler) takes 10-60 s on 2 busy cores.
-    complete_by_clicking(page, COURSE.lesson("15_workspaces_packages"), done_within_ms=180_000)
+    complete_by_clicking(page, COURSE.lesson("20_workspaces_packages"), done_within_ms=180_000)
     open_tab(page, "Console")
     expect_text(page, "$ ros2 run py_pubsub num_talker")

@@ -18,6 +18,6 @@ COURSE = load_course()
 
 def test_complete_the_urdf_unit_by_clicking(page):
     """robot_state_publisher, state_publisher, the latched description, a slider value."""
-    complete_by_clicking(page, COURSE.lesson("13_urdf_robot"))
+    complete_by_clicking(page, COURSE.lesson("18_urdf_robot"))
     open_tab(page, "Console")
     expect_text(page, "$ ros2 topic pub --once /joint_state_sliders")

@@ -275,7 +275,7 @@ def test_teacher_follows_three_learners_on_two_hosts(ros_env, two_hosts, tmp_pat
         assert "3 learners." in printed.stdout
 
         # -- an exercise: learner1 on A saves code, runs and checks it -----------------
-        reference = PROJECT_ROOT / "lessons/02_first_node/exercises/heartbeat_logger/reference.py"
+        reference = PROJECT_ROOT / "lessons/04_first_node/exercises/heartbeat_logger/reference.py"
         code_dir = progress_a / "learner1" / "learner1.code"
         code_dir.mkdir(parents=True, exist_ok=True)
         (code_dir / "heartbeat_logger.py").write_text(reference.read_text())  # as the editor saves

@@ -28,7 +28,7 @@ RATE = re.compile(r"at ([\d.]+) Hz over")
 
 
 def test_the_rate_after_the_button_is_the_new_one_only(probe, supervisor):
-    lesson = next(each for each in load_course().lessons if each.id == "08_parameters")
+    lesson = next(each for each in load_course().lessons if each.id == "10_parameters")
     change, measure = lesson.steps[1], lesson.steps[2]
     (button,) = change.actions
     (check,) = measure.checks

@@ -33,7 +33,7 @@ def test_drive_steps_pass_on_a_world_slower_than_real_time_and_say_so(
     busy_cores,
 ):
     course = load_course()
-    lesson = next(each for each in course.lessons if each.id == "13_wheeled_robot")
+    lesson = next(each for each in course.lessons if each.id == "19_wheeled_robot")
     commands: list[tuple[CallContext, threading.Thread]] = []
 
     def console(text: str) -> None:  # as the Console tab runs a lesson's command

@@ -50,7 +50,7 @@ def lesson_copy(tmp_path) -> tuple[Path, dict]:
     return target, tomllib.loads((target / "lesson.toml").read_text())
 
 
-TOP_LEVEL = ["unit", "title", "summary", "goals", "steps"]
+TOP_LEVEL = ["title", "summary", "goals", "steps"]
 
 
 @pytest.mark.parametrize("field", TOP_LEVEL)
@@ -60,7 +60,7 @@ def test_each_top_level_field_corrupted_names_file_and_field(lesson_copy, field,
     if damage == "missing":
         del data[field]
     else:
-        data[field] = {"unit": "seven", "title": 3, "summary": [], "goals": 5, "steps": "x"}[field]
+        data[field] = {"title": 3, "summary": [], "goals": 5, "steps": "x"}[field]
     _dump(data, directory / "lesson.toml")
     with pytest.raises(LessonError) as error:
         load_lesson(directory)
@@ -136,7 +136,7 @@ def test_a_check_naming_a_node_nobody_starts_is_an_error(lesson_copy):
 
 
 def test_a_broken_lesson_is_listed_in_the_outline_errors(tmp_path):
-    source = LESSONS_DIR / "03_topics"
+    source = LESSONS_DIR / "05_topics"
     shutil.copytree(source, tmp_path / source.name)
     toml = tmp_path / source.name / "lesson.toml"
     assert 'catalog_node = "' in toml.read_text()

@@ -15,14 +15,14 @@ from app.lessons.progress import ProgressStore
 
 def test_round_trip_and_reset(tmp_path):
     store = ProgressStore("ada", tmp_path)
-    store.set_position("02_first_node", 2)
-    assert store.mark_passed("02_first_node", 1)
-    assert not store.mark_passed("02_first_node", 1)
+    store.set_position("04_first_node", 2)
+    assert store.mark_passed("04_first_node", 1)
+    assert not store.mark_passed("04_first_node", 1)
     again = ProgressStore("ada", tmp_path)
-    assert again.lesson("02_first_node") == {"step": 2, "passed": [1]}
-    assert again.current_lesson() == "02_first_node"
+    assert again.lesson("04_first_node") == {"step": 2, "passed": [1]}
+    assert again.current_lesson() == "04_first_node"
     again.reset()
-    assert ProgressStore("ada", tmp_path).lesson("02_first_node") == {"step": 0, "passed": []}
+    assert ProgressStore("ada", tmp_path).lesson("04_first_node") == {"step": 0, "passed": []}
 
 
 def test_sigkill_during_writes_never_leaves_a_broken_file(tmp_path):
@@ -67,3 +67,31 @@ def test_learner_name_cannot_be_a_path(tmp_path):
 
     with pytest.raises(ValueError, match="learner names"):
         ProgressStore("../../etc/passwd", tmp_path)
+
+
+def test_a_version_1_file_follows_its_lessons_to_their_new_numbers(tmp_path):
+    """Lessons were renumbered 1..N and two were split: saved steps move with their part."""
+    old = {
+        "version": 1,
+        "current": "13_tf2_turtlesim",
+        "lessons": {
+            "02_first_node": {"step": 3, "passed": [0, 1, 2]},
+            "01_turtlesim_cli": {"step": 8, "passed": [0, 5, 6, 8]},
+            "13_tf2_turtlesim": {"step": 14, "passed": [11, 12, 13]},
+        },
+        "exercises": {"talker": {"attempts": 2}},
+    }
+    (tmp_path / "ada.json").write_text(json.dumps(old), encoding="utf-8")
+    store = ProgressStore("ada", tmp_path)
+    assert store.warning == ""
+    assert store.lesson("04_first_node") == {"step": 3, "passed": [0, 1, 2]}
+    assert store.lesson("02_turtlesim_cli") == {"step": 0, "passed": [0, 5]}
+    # The second half starts with a new step 0 (start turtlesim again): old step 6 is 1.
+    assert store.lesson("03_turtlesim_record_launch") == {"step": 3, "passed": [1, 3]}
+    assert store.lesson("16_tf2_turtlesim") == {"step": 0, "passed": [11]}
+    assert store.lesson("17_tf2_time") == {"step": 2, "passed": [0, 1]}
+    assert store.current_lesson() == "17_tf2_time"
+    assert store.exercise("talker") == {"attempts": 2}
+    assert store.lesson("02_first_node") == {"step": 0, "passed": []}  # the old id is gone
+    store.set_position("04_first_node", 4)
+    assert json.loads((tmp_path / "ada.json").read_text(encoding="utf-8"))["version"] == 2

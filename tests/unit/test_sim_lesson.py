@@ -1,7 +1,6 @@
-"""The "Drive a robot" unit and what its checks and probes measure with: the world's floor plan.
+"""The "Drive a robot" lesson and what its checks and probes measure with: the world's floor plan.
 
-The unit sorts right after the URDF unit (no older lesson id, the progress key,
-changes). The floor plan is read from the same MJCF file the simulation
+The floor plan is read from the same MJCF file the simulation
 loads; its distances are checked here against the room's known geometry
 (nodes/worlds/room/world.xml: inner wall faces at +-2 m).
 """
@@ -23,14 +22,8 @@ from app.lessons.schema import LessonError, load_course, parse_spec
 SIM_KINDS = {"robot_moved", "odom_drift", "scan_nearest", "sim_time_stamps", "sim_paused"}
 
 
-def test_the_unit_comes_after_the_urdf_unit_and_before_slam():
-    ids = [lesson.id for lesson in load_course().lessons]
-    at = ids.index("13_urdf_robot")
-    assert ids[at + 1 : at + 3] == ["13_wheeled_robot", "14_slam_capstone"]
-
-
 def test_the_unit_uses_every_simulation_check_kind():
-    lesson = load_course().lesson("13_wheeled_robot")
+    lesson = load_course().lesson("19_wheeled_robot")
     assert lesson is not None
     used = {check.kind for step in lesson.steps for check in step.checks}
     assert SIM_KINDS <= used and SIM_KINDS <= set(CHECK_KINDS)

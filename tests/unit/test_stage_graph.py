@@ -26,12 +26,12 @@ def test_every_lesson_names_a_known_stage():
 
 
 def _copy(tmp_path: Path, stage_line: str, step_stage: str = "") -> Path:
-    source = LESSONS_DIR / "03_topics"
+    source = LESSONS_DIR / "05_topics"
     target = tmp_path / source.name
     shutil.copytree(source, target)
     toml = target / "lesson.toml"
     text = re.sub(r'^stage = "\w+"\n', "", toml.read_text(encoding="utf-8"), flags=re.MULTILINE)
-    text = text.replace("unit = 3\n", f"unit = 3\n{stage_line}", 1)
+    text = stage_line + text
     if step_stage:
         text = text.replace("[[steps]]\n", f"[[steps]]\n{step_stage}", 1)
     toml.write_text(text, encoding="utf-8")

@@ -88,7 +88,7 @@ def test_each_diagram_is_accessible_svg_sized_for_the_side_panel(name):
 
 @pytest.fixture
 def lesson_copy(tmp_path) -> Path:
-    source = LESSONS_DIR / "03_topics"
+    source = LESSONS_DIR / "05_topics"
     target = tmp_path / source.name
     shutil.copytree(source, target)
     return target
@@ -126,7 +126,7 @@ def test_a_broken_picture_field_names_the_step_and_field(lesson_copy, lines, mes
     _with_picture(lesson_copy, lines)
     with pytest.raises(LessonError, match=message) as error:
         load_lesson(lesson_copy)
-    assert "03_topics/lesson.toml: steps[0]" in str(error.value)
+    assert "05_topics/lesson.toml: steps[0]" in str(error.value)
 
 
 # -- the panel -------------------------------------------------------------------
@@ -162,7 +162,7 @@ class _RecordingHandle(FakeHandle):
 
 
 def test_the_panel_shows_a_steps_picture_under_its_text_and_only_there(tmp_path):
-    lesson = COURSE.lesson("09_lifecycle")
+    lesson = COURSE.lesson("11_lifecycle")
     assert lesson is not None
     assert lesson.steps[0].image and not lesson.steps[1].image and not lesson.steps[2].image
     progress = ProgressStore(directory=tmp_path)
