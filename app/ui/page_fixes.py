@@ -32,6 +32,11 @@ _CSS = (
     ":root[data-mantine-color-scheme=light]{--mantine-color-dimmed:#5c636a!important}"
     ":root[data-mantine-color-scheme=dark]{--mantine-color-dimmed:#b1b5b9!important}"
     ".mantine-Notification-description{color:var(--mantine-color-dimmed)!important}"
+    # A long button label (a quiz answer, "Stop 3 nodes left from earlier lessons: ...")
+    # wraps onto more lines instead of being cut off at the column's edge.
+    ".mantine-Button-root{height:auto!important;min-height:var(--button-height)}"
+    ".mantine-Button-label{white-space:normal!important;overflow:visible!important;"
+    "line-height:1.3;padding:5px 0}"
 )
 
 _NAME_BUTTONS = """
