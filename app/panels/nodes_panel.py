@@ -131,7 +131,9 @@ class NodesPanel:
 
     def _do_start(self, name: str) -> str:
         status = self._supervisor.start(name)
-        return f"Started **{name}** (pid {status.pid})."
+        program = self._supervisor.program(name)
+        node = f": node `{program.node_name}`" if program is not None else ""
+        return f"Started **{name}**{node} (pid {status.pid})."
 
     def _do_stop(self, name: str) -> str:
         self._supervisor.stop(name)  # escalates in the supervisor's own thread

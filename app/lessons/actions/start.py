@@ -13,5 +13,9 @@ if TYPE_CHECKING:
 
 @register_action("start", required="catalog_node", optional="label", words="start a catalog node")
 def perform(rt: LessonRuntime, action: Spec) -> str:
-    status = rt.supervisor.start(action["catalog_node"])
-    return f"Started {action['catalog_node']} (pid {status.pid})."
+    name = action["catalog_node"]
+    status = rt.supervisor.start(name)
+    program = rt.supervisor.program(name)
+    # The button says what was run, the checks the node it made: the message ties the two.
+    node = f": node {program.node_name}" if program is not None else ""
+    return f"Started {name}{node} (pid {status.pid})."
