@@ -9,7 +9,6 @@ from __future__ import annotations
 import base64
 import html
 from collections.abc import Callable
-from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
 
@@ -28,18 +27,6 @@ from app.ui.loop import UiLoop
 from app.ui.starting import StartRequests
 
 _MARKS = {PASS: "✓", FAIL: "✗", "waiting": "…"}
-_QUIZ_VERDICTS = {PASS: "Right.", "waiting": "Pick the answer you think is right."}
-
-
-@dataclass
-class _Quiz:
-    """A quiz on screen: its check, a button per answer, and the verdict under them."""
-
-    check: Spec
-    answers: dict[str, Any]
-    verdict: Any
-
-
 # A step button's icon says what it does; the label says it in words.
 _ACTION_ICONS = {
     "open_panel": viser.Icon.EXTERNAL_LINK,
@@ -55,7 +42,7 @@ _ACTION_ICONS = {
     "publish": viser.Icon.SEND,
     "set_param": viser.Icon.ADJUSTMENTS,
 }
-_UNCHOSEN = (222, 226, 230)  # a light gray: an answer not (yet) chosen
+_CHOOSE = "(choose an answer)"
 # How the screen works, said once, on the first step of the course.
 FIRST_SCREEN = (
     "_New here?_ The **stage** on the left shows what the current step is about. The "
@@ -181,7 +168,6 @@ class LessonsPanel:
         self._leftovers: list[str] = []  # nodes running when this lesson was opened
         self._stop_buttons: list[tuple[Any, list[str]]] = []  # (button, what it stops)
         self._dynamic: list[Any] = []
-        self._quizzes: list[_Quiz] = []
         by_label = {_label(lesson): lesson for lesson in course.lessons}
         self._by_label = by_label
         if not course.lessons:
@@ -293,7 +279,6 @@ class LessonsPanel:
             handle.remove()
         self._dynamic = []
         self._stop_buttons = []
-        self._quizzes = []
         step = self._lesson.steps[self._step]
         statuses = self._statuses()
         with self._actions:
@@ -312,8 +297,14 @@ class LessonsPanel:
                 if stops:
                     self._stop_buttons.append((button, stops))
             for check in step.checks:
-                if check.kind == "quiz":
-                    self._add_quiz(check)
+                if check.kind != "quiz":
+                    continue
+                chosen = self._live.quiz_answers.get(check.key, _CHOOSE)
+                quiz = self._gui.add_dropdown(
+                    check["question"], [_CHOOSE, *check["options"]], initial_value=chosen
+                )
+                quiz.on_update(self._ui.callback(self._answer, check, quiz))
+                self._dynamic.append(quiz)
             if not self._dynamic:
                 self._dynamic.append(self._gui.add_markdown("_Nothing to click: read on._"))
 
@@ -344,37 +335,12 @@ class LessonsPanel:
             self._live.supervisor.stop(name)  # returns at once; the process ends on its own
         self._message.show(f"Stopping {', '.join(_ros_names(self._live, names))}.")
 
-    def _add_quiz(self, check: Spec) -> None:
-        """The question at full width, each answer a full-width button whose whole text shows
-        (the chosen one filled, as a radio button), and the verdict right under them."""
-        self._dynamic.append(self._gui.add_markdown(f"**Question:** {check['question']}"))
-        answers = {}
-        for option in check["options"]:
-            button = self._gui.add_button(option, icon=viser.Icon.CIRCLE, color=_UNCHOSEN)
-            button.on_click(self._ui.callback(self._answer, check, option))
-            answers[option] = button
-            self._dynamic.append(button)
-        verdict = self._gui.add_markdown("")
-        self._dynamic.append(verdict)
-        self._quizzes.append(_Quiz(check, answers, verdict))
-        self._mark_answers(self._quizzes[-1])
-
-    def _answer(self, check: Spec, option: str) -> None:
-        self._live.quiz_answers[check.key] = option
-        for quiz in self._quizzes:
-            if quiz.check is check:
-                self._mark_answers(quiz)
-
-    def _mark_answers(self, quiz: _Quiz) -> None:
-        chosen = self._live.quiz_answers.get(quiz.check.key)
-        for option, button in quiz.answers.items():
-            icon, color = (
-                (viser.Icon.CIRCLE_DOT, "blue")
-                if option == chosen
-                else (viser.Icon.CIRCLE, _UNCHOSEN)
-            )
-            if button.icon != icon:
-                button.icon, button.color = icon, color
+    def _answer(self, check: Spec, quiz: viser.GuiDropdownHandle) -> None:
+        value = quiz.value
+        if value == _CHOOSE:
+            self._live.quiz_answers.pop(check.key, None)
+        else:
+            self._live.quiz_answers[check.key] = value
 
     # -- live part ---------------------------------------------------------
 
@@ -391,16 +357,6 @@ class LessonsPanel:
         lines = [
             f"- {_MARKS[result.state]} **{result.state}**: {result.reason}" for _, result in ordered
         ]
-        verdicts = {check.key: result for check, result in results}
-        for quiz in self._quizzes:
-            found = verdicts.get(quiz.check.key)
-            text = (
-                f"{_MARKS[found.state]} {_QUIZ_VERDICTS.get(found.state, found.reason)}"
-                if found
-                else ""
-            )
-            if quiz.verdict.content != text:
-                quiz.verdict.content = text
         passed = set(self._progress.lesson(lesson.id)["passed"])
         status = "✓ step done" if index in passed else ""
         not_passed = sum(result.state != PASS for _, result in results)

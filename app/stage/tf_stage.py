@@ -27,6 +27,7 @@ from rclpy.subscription import Subscription
 from tf2_msgs.msg import TFMessage
 from tf2_tools.frames_svg import render
 
+from app.ros.graph import GraphSnapshot
 from app.ui import MarkdownView
 
 TF_QOS = QoSProfile(depth=100)
@@ -165,7 +166,7 @@ class TfStage:
             self._subs = []
             self.recorder.clear()  # a later look starts afresh, as view_frames does
 
-    def refresh(self) -> None:
+    def refresh(self, graph: GraphSnapshot) -> None:
         if not self._subs:
             return
         now = time.monotonic()

@@ -152,8 +152,9 @@ def step_controls(page: Page, lesson, index: int) -> dict[str, Locator]:
     expect(checks).to_have_count(len(step.checks))
     for i, check in enumerate(step.checks):
         if check.kind == "quiz":
-            for option in check["options"]:
-                controls[f"answer {option!r}"] = page.get_by_role("button", name=option, exact=True)
+            controls[f"answer to {check['question']!r}"] = page.get_by_label(
+                check["question"], exact=True
+            )
         controls[f"check {i + 1}"] = checks.nth(i)
     controls["Back"] = page.get_by_role("button", name="Back", exact=True)
     controls["Next"] = page.get_by_role("button", name=NEXT_OR_SKIP)

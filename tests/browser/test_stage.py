@@ -185,7 +185,7 @@ def test_the_graph_grows_and_messages_move_on_chatter(browser, dashboard, probe,
         expect(page.get_by_text("publishers: /talker").filter(visible=True)).to_be_visible()
         expect(page.get_by_text("subscribers: /listener").filter(visible=True)).to_be_visible()
         page.locator('svg.stage-graph g.sg-vertex[data-name="/listener"] a').click()
-        expect(page.get_by_text("Node /listener").filter(visible=True)).to_be_visible()
+        expect(page.get_by_text("Node /listener", exact=True).filter(visible=True)).to_be_visible()
         open_tab(page, "Nodes")  # the stage stays while the learner uses the tools
         expect(talker).to_be_visible()
     finally:

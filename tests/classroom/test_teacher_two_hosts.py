@@ -41,8 +41,7 @@ _in = two_host_setup._in
 FOLLOW_SEC = 2.0
 PORT_A, PORT_B = 8180, 8280  # each host has a loopback of its own
 STUCK_MINUTES = "Stuck: minutes without progress while a check fails"
-# Lesson 1, step 2 asks how a new node learns which other nodes exist; a wrong answer:
-WRONG_ANSWER = "It asks the roscore master over XML-RPC"
+QUIZ = "In ROS 2, how does a new node learn which other nodes exist?"  # unit 1, step 2
 
 # Reads one JSON command a line, answers one JSON line; times are time.monotonic(),
 # which every namespace of this kernel shares.
@@ -246,7 +245,7 @@ def test_teacher_follows_three_learners_on_two_hosts(ros_env, two_hosts, tmp_pat
         latencies["step on host A -> teacher page"] = seen["t"] - clicked
         # ...where learner2 answers the quiz wrong: a failing check (stuck, further down).
         a("set", page="teacher", label=STUCK_MINUTES, value=0.1)  # 6 s, for the test
-        a("click", page="a2", label=WRONG_ANSWER)  # each answer is a button
+        a("set", page="a2", label=QUIZ, value="It asks the roscore master over XML-RPC")
         seen = a("wait_regex", page="teacher", regex=_row("learner2", "A", 41, "1 · 2/5 \\| ✓✗"))
         assert seen["ok"], seen["markdown"]
 
