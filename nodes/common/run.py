@@ -96,6 +96,8 @@ def stopped_quietly() -> Iterator[None]:
         if rclpy.ok():
             raise
     finally:
+        global _ending
+        _ending = True  # first, in one store: a late signal in what follows raises nothing
         _start.end()  # a signal during the teardown is ignored, not raised
 
 
@@ -245,13 +247,16 @@ def run_program(main: Callable[[], int | None]) -> None:
         signal.signal(sig, interrupt_outside_imports)
     spin_threads_end_quietly()
     code: int | None = 0
+    global _ending
     try:
         with stopped_quietly():
             code = main()
             # Ending (rclpy's own handler may have ended main): a signal from now on,
             # however late its Python handler runs, must not raise outside this block.
-            _interrupted.set()
+            # One store, not Event.set(): a handler can run inside a Python-level call.
+            _ending = True
     finally:
+        _ending = True
         _interrupted.set()
         # A late signal (a retry, a supervisor's second SIGTERM) must not raise in the
         # interpreter's own shutdown, which prints it as a traceback.
@@ -273,7 +278,7 @@ def interrupt_outside_imports(signum: int, frame: FrameType | None) -> None:
     Raised once: a later signal would interrupt the program's own clean-up (a
     supervisor that must stop a hung one sends SIGKILL next).
     """
-    if _interrupted.is_set():
+    if _ending or _interrupted.is_set():
         return  # the program is ending already: one KeyboardInterrupt is enough
     at = frame
     while at is not None:
@@ -288,6 +293,7 @@ def interrupt_outside_imports(signum: int, frame: FrameType | None) -> None:
 
 
 _interrupted = threading.Event()  # interrupt_outside_imports has raised its one interrupt
+_ending = False  # main has returned or its block has ended: signals raise nothing now
 
 
 def _make_executor(factory: type[Executor] | Callable[[NodeT], Executor], node: NodeT) -> Executor:

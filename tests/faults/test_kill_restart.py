@@ -420,15 +420,16 @@ class Round:
 
     def page_choose(self, label: str, option: str) -> None:
         self.alive()
-        self.page.get_by_label(label, exact=True).filter(visible=True).first.click(timeout=5_000)
-        self.page.get_by_role("option", name=option, exact=True).click(timeout=5_000)
+        self.page.get_by_label(label, exact=True).filter(visible=True).first.click(timeout=15_000)
+        self.page.get_by_role("option", name=option, exact=True).click(timeout=15_000)
 
     def page_edit(self, code: str) -> None:
         """Type into the editor in the side window; it saves a moment after each change."""
         if self.frame is None:
             self.page_tool("Exercise")
             self.page_choose("Exercise", self.exercise_label)
-            self.page.get_by_role("tab", name="Your code").click(timeout=5_000)
+            # The tab opens once the server has sent the exercise: slower on a busy machine.
+            self.page.get_by_role("tab", name="Your code").click(timeout=30_000)
             editor = self.page.frame_locator(f"iframe[src*='slug={SLUG}']")
             self.page_wait(editor.locator("#status").filter(has_text=re.compile("saved|connected")))
             self.frame = self.page.frame(url=re.compile(rf"editor\.html\?slug={SLUG}"))
