@@ -127,6 +127,11 @@ def _skip_label(not_passed: int) -> str:
     return f"Skip ({not_passed} check{'s' if not_passed > 1 else ''} not passed)"
 
 
+def quiz_label(index: int, count: int) -> str:
+    """'Question', or 'Question 2' when a step asks several; its field is 'Answer 2'."""
+    return "Question" if count == 1 else f"Question {index + 1}"
+
+
 def _label(lesson: Lesson) -> str:
     return f"{lesson.unit:02d} · {lesson.title}"
 
@@ -296,15 +301,20 @@ class LessonsPanel:
                 self._dynamic.append(button)
                 if stops:
                     self._stop_buttons.append((button, stops))
-            for check in step.checks:
-                if check.kind != "quiz":
-                    continue
+            quizzes = [check for check in step.checks if check.kind == "quiz"]
+            for index, check in enumerate(quizzes):
+                # The question at full width (a field's label column is ~80 px: a question
+                # there ran to 11 lines), the answers in the field under it.
+                label = quiz_label(index, len(quizzes))
+                question = self._gui.add_markdown(f"**{label}:** {check['question']}")
                 chosen = self._live.quiz_answers.get(check.key, _CHOOSE)
                 quiz = self._gui.add_dropdown(
-                    check["question"], [_CHOOSE, *check["options"]], initial_value=chosen
+                    label.replace("Question", "Answer"),
+                    [_CHOOSE, *check["options"]],
+                    initial_value=chosen,
                 )
                 quiz.on_update(self._ui.callback(self._answer, check, quiz))
-                self._dynamic.append(quiz)
+                self._dynamic += [question, quiz]
             if not self._dynamic:
                 self._dynamic.append(self._gui.add_markdown("_Nothing to click: read on._"))
 

@@ -9,6 +9,7 @@ import pytest
 from playwright.sync_api import Locator, Page, expect
 from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
+from app.lessons.panel import quiz_label
 from bench._common import open_tool
 from tests.wire_client import NEXT_OR_SKIP
 
@@ -150,12 +151,18 @@ def step_controls(page: Page, lesson, index: int) -> dict[str, Locator]:
         controls[f"button {label!r}"] = page.get_by_role("button", name=label, exact=True)
     checks = page.locator("li").filter(has_text=CHECK_LINE).filter(visible=True)
     expect(checks).to_have_count(len(step.checks))
+    quizzes = [check for check in step.checks if check.kind == "quiz"]
     for i, check in enumerate(step.checks):
         if check.kind == "quiz":
             controls[f"answer to {check['question']!r}"] = page.get_by_label(
-                check["question"], exact=True
+                answer_label(quizzes, check), exact=True
             )
         controls[f"check {i + 1}"] = checks.nth(i)
     controls["Back"] = page.get_by_role("button", name="Back", exact=True)
     controls["Next"] = page.get_by_role("button", name=NEXT_OR_SKIP)
     return controls
+
+
+def answer_label(quizzes: list, check) -> str:
+    """The label of a quiz's answer field: 'Answer', or 'Answer 2' in a step with several."""
+    return quiz_label(quizzes.index(check), len(quizzes)).replace("Question", "Answer")
