@@ -5,7 +5,9 @@ A page asks for one with a marker on a line of its own:
 - ``<!-- generated: architecture -->``: the packages of ``app`` and their
   imports (``tools/architecture.py``), and the circles among them;
 - ``<!-- generated: contracts -->``: the import-linter contracts of
-  ``pyproject.toml``, the rules ``make lint`` enforces.
+  ``pyproject.toml``, the rules ``make lint`` enforces;
+- ``<!-- generated: course -->``: the lessons in course order, from their
+  ``lesson.toml`` files (number, title, steps, exercises).
 
 So the developers' pages cannot drift from the code they describe.
 """
@@ -45,6 +47,19 @@ def _contracts() -> str:
     return "\n".join(rows)
 
 
+def _course() -> str:
+    rows = ["| # | lesson | steps | exercises |", "|---|---|---|---|"]
+    for folder in sorted(p for p in (ROOT / "lessons").iterdir() if (p / "lesson.toml").is_file()):
+        lesson = tomllib.loads((folder / "lesson.toml").read_text(encoding="utf-8"))
+        exercises = folder / "exercises"
+        count = sum(1 for e in exercises.iterdir() if e.is_dir()) if exercises.is_dir() else 0
+        rows.append(
+            f"| {int(folder.name[:2])} | {lesson['title']} | {len(lesson['steps'])} | "
+            f"{count or '–'} |"
+        )
+    return "\n".join(rows)
+
+
 def on_page_markdown(markdown: str, **_: Any) -> str:
     if "<!-- generated: architecture -->" in markdown:
         house = read_house()
@@ -54,4 +69,6 @@ def on_page_markdown(markdown: str, **_: Any) -> str:
         )
     if "<!-- generated: contracts -->" in markdown:
         markdown = markdown.replace("<!-- generated: contracts -->", _contracts())
+    if "<!-- generated: course -->" in markdown:
+        markdown = markdown.replace("<!-- generated: course -->", _course())
     return markdown
