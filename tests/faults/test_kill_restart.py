@@ -428,7 +428,9 @@ class Round:
         if self.frame is None:
             self.page_tool("Exercise")
             self.page_choose("Exercise", self.exercise_label)
-            # The tab opens once the server has sent the exercise: slower on a busy machine.
+            # Picking the exercise already shown changes nothing: the learner's way to the
+            # editor is then "Open my code" (it puts the code window on stage).
+            self.page.get_by_role("button", name="Open my code").click(timeout=15_000)
             self.page.get_by_role("tab", name="Your code").click(timeout=30_000)
             editor = self.page.frame_locator(f"iframe[src*='slug={SLUG}']")
             self.page_wait(editor.locator("#status").filter(has_text=re.compile("saved|connected")))

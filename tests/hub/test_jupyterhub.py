@@ -191,7 +191,8 @@ def test_each_learner_sees_only_their_own_nodes_and_the_teacher_sees_rows_move(h
     # A box on the stage is a page link (classroom/act/...): through the hub's proxy too.
     alice = room.classrooms["alice"]
     vertex(alice, OWN_NODE["alice"]).locator("a").click()
-    expect(alice.get_by_text(f"Node /{OWN_NODE['alice']}").filter(visible=True)).to_be_visible()
+    inspected = alice.get_by_text(f"Node /{OWN_NODE['alice']}", exact=True)
+    expect(inspected.filter(visible=True)).to_be_visible()
 
 
 def _type_code(page: Page, frame_locator, code: str) -> None:
