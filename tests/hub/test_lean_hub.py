@@ -139,7 +139,7 @@ def test_each_learner_lands_in_their_own_dashboard_through_the_hubs_oauth(hub, r
         expect(vertex(page, theirs)).to_have_count(0)
     # A stage box is a page link (classroom/act/...): it works under the hub's base path.
     vertex(dora, "talker").locator("a").click()
-    expect(dora.get_by_text("Node /talker").filter(visible=True)).to_be_visible()
+    expect(dora.get_by_text("Node /talker", exact=True).filter(visible=True)).to_be_visible()
 
     # Progress reaches the teacher service as in the lab mode (HTTP with the hub's token).
     teacher = room.pages[TEACHER]
