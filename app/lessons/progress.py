@@ -46,7 +46,7 @@ RENUMBERED_IN_V2: dict[str, tuple[tuple[int, str, int], ...]] = {
             ("16_bags", "21_bags"),
             ("14_slam_capstone", "22_slam_capstone"),
         )
-    },  # fmt: skip
+    },
     "01_turtlesim_cli": ((0, "02_turtlesim_cli", 0), (6, "03_turtlesim_record_launch", -5)),
     "13_tf2_turtlesim": ((0, "16_tf2_turtlesim", 0), (12, "17_tf2_time", -12)),
 }
@@ -54,7 +54,7 @@ RENUMBERED_IN_V2: dict[str, tuple[tuple[int, str, int], ...]] = {
 
 def _renumbered(lesson_id: str, step: int) -> tuple[str, int]:
     parts = RENUMBERED_IN_V2.get(lesson_id, ((0, lesson_id, 0),))
-    first, new_id, shift = max(part for part in parts if part[0] <= max(step, 0))
+    _first, new_id, shift = max(part for part in parts if part[0] <= max(step, 0))
     return new_id, step + shift
 
 
