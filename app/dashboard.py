@@ -137,7 +137,7 @@ class Dashboard:
             ui,
             node,
             side_window,
-            self._rates.client(),
+            self._rates,
             self.page_links,
             starting=self._starting_nodes,
             program_output=self._program_output,

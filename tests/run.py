@@ -212,16 +212,42 @@ def run_phases(commands: list[list[str]], keeper: bool) -> int:
     if not keeper and len(commands) == 1:
         os.execv(sys.executable, commands[0])
     codes: list[int] = []
-    for number, command in enumerate(commands):
-        if codes and codes[-1] not in GO_ON:
-            break  # interrupted (Ctrl+C), or pytest could not run: stop here
-        if number:
-            print(f"\ntests/run.py: the tests marked {SECOND_PHASE}: one at a time", flush=True)
-        codes.append(keep(command) if keeper else subprocess.call(command))
+    with tempfile.TemporaryDirectory(prefix="classroom-run-") as reports:
+        for number, command in enumerate(commands):
+            if codes and codes[-1] not in GO_ON:
+                break  # interrupted (Ctrl+C), or pytest could not run: stop here
+            if number:
+                print(f"\ntests/run.py: the tests marked {SECOND_PHASE}: one at a time", flush=True)
+            command = [*command, f"--junitxml={reports}/phase{number}.xml"]
+            codes.append(keep(command) if keeper else subprocess.call(command))
+        print_failures(sorted(Path(reports).glob("phase*.xml")))
     failed = [code for code in codes if code not in (0, NO_TESTS)]
     if failed:
         return failed[0]
     return NO_TESTS if all(code == NO_TESTS for code in codes) else 0
+
+
+DIGEST_CHARS = 1200  # of each failure's message: the reason, not the whole traceback
+
+
+def print_failures(reports: list[Path]) -> None:
+    """Every phase's failures once more, at the very end, each with its reason: a CI log
+    shown by its head and tail still says what failed and why."""
+    import xml.etree.ElementTree as ET
+
+    lines: list[str] = []
+    for report in reports:
+        try:
+            cases = ET.parse(report).getroot().iter("testcase")
+        except (OSError, ET.ParseError):
+            continue
+        for case in cases:
+            for bad in [*case.findall("failure"), *case.findall("error")]:
+                name = f"{case.get('classname', '')}::{case.get('name', '')}"
+                reason = (bad.get("message") or "").strip() or (bad.text or "").strip()
+                lines.append(f"{bad.tag.upper()} {name}\n    {reason[:DIGEST_CHARS]}")
+    if lines:
+        print("\ntests/run.py: what failed, and why", *lines, sep="\n", flush=True)
 
 
 def main() -> int:

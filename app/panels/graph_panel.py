@@ -11,13 +11,14 @@ from __future__ import annotations
 
 import threading
 import time
+from typing import Any
 
 import viser
 from rclpy.node import Node
 
 from app.panels.graph_svg import graph_picture, legend_html, render_svg, topics_to_measure
 from app.ros.graph import GraphSnapshot, node_endpoints
-from app.ros.rates import RateBoard, rate_text
+from app.ros.rates import RATE_WINDOW_SEC, RateBoard, rate_text
 from app.ui import MarkdownView, topic_item
 
 PICTURE_PERIOD_SEC = 1.0
@@ -52,8 +53,11 @@ class SharedRates:
                 union.update(wish)
         self._board.watch(union)
 
-    def rate(self, topic: str) -> float | None:
-        return self._board.rate(topic)
+    def rate(self, topic: str, window_sec: float = RATE_WINDOW_SEC) -> float | None:
+        return self._board.rate(topic, window_sec)
+
+    def latest(self, topic: str) -> tuple[float, Any] | None:
+        return self._board.latest(topic)
 
     def watched(self) -> list[str]:
         return self._board.watched()
@@ -73,8 +77,11 @@ class SharedRatesClient:
         self._wanted = set(topics)
         self._shared._watch(self._key, topics)
 
-    def rate(self, topic: str) -> float | None:
-        return self._shared.rate(topic)
+    def rate(self, topic: str, window_sec: float = RATE_WINDOW_SEC) -> float | None:
+        return self._shared.rate(topic, window_sec)
+
+    def latest(self, topic: str) -> tuple[float, Any] | None:
+        return self._shared.latest(topic)
 
     def watched(self) -> list[str]:
         """What this drawing asked for and is measured."""

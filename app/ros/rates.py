@@ -12,6 +12,7 @@ import logging
 import threading
 import time
 from collections.abc import Callable
+from typing import Any
 
 from rclpy.node import Node
 
@@ -117,6 +118,12 @@ class RateBoard:
         if entry is None:
             return None
         return steady_rate(entry[1].rate_hz, window_sec)  # as published, not as received
+
+    def latest(self, topic: str) -> tuple[float, Any] | None:
+        """The newest message of a watched topic with its arrival time (monotonic), or None."""
+        with self._lock:
+            entry = self._monitors.get(topic)
+        return None if entry is None else entry[1].message()
 
     def close(self) -> None:
         with self._lock:

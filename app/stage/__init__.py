@@ -9,6 +9,7 @@ from __future__ import annotations
 # What can be on stage, as lesson.toml names it -> the label a learner picks.
 STAGES: dict[str, str] = {
     "graph": "Live ROS graph",
+    "plot": "Live plot",  # topic rates, and the values of number topics, over time
     "turtlesim": "Turtlesim",
     "scene": "3D scene",
     "tf": "TF tree",

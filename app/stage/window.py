@@ -17,11 +17,12 @@ from typing import Any, Protocol
 import viser
 from rclpy.node import Node
 
-from app.panels.graph_panel import SharedRatesClient
+from app.panels.graph_panel import SharedRates
 from app.ros.graph import GraphSnapshot
 from app.stage import DEFAULT_STAGE, STAGES
 from app.stage.code_stage import CodeStage
 from app.stage.graph_stage import GraphStage
+from app.stage.plot_stage import PlotStage
 from app.stage.tf_stage import TfStage
 from app.stage.turtlesim_stage import TurtlesimStage
 from app.ui import assign
@@ -49,7 +50,7 @@ const onResize = () => { clearTimeout(timer); timer = setTimeout(report, 150); }
     + listen_on_page("__stageWidthOff", "resize", "onResize")
     + "report();\n"
 )
-_IN_WINDOW = ("graph", "turtlesim", "tf")  # stages drawn in the stage window
+_IN_WINDOW = ("graph", "plot", "turtlesim", "tf")  # stages drawn in the stage window
 
 _TOAST_STYLE = (
     "<style>.mantine-Notifications-root{top:auto!important;bottom:12px!important;"
@@ -74,18 +75,22 @@ class Stage:
         ui: UiLoop,
         node: Node,
         code_window: Any,
-        rates: SharedRatesClient | None = None,
+        rates: SharedRates | None = None,
         links: PageLinks | None = None,
         starting: Callable[[], list[str]] = lambda: [],
         program_output: Callable[[], tuple[str, list[str]]] = lambda: ("", []),
         inspect: Callable[[str, str, str], None] = lambda _kind, _name, _type: None,
         open_tool: Callable[[str], None] = lambda _tool: None,
     ) -> None:
-        """``starting``, ``inspect`` and ``open_tool``: see ``GraphStage``;
+        """``rates``: measured once for the graph, the plot and the Graph tool;
+        ``starting``, ``inspect`` and ``open_tool``: see ``GraphStage``;
         ``program_output``: see ``CodeStage``."""
         self._ui = ui
         self._links = links
         self._code_window = code_window
+        self._own_rates = rates is None  # a stage alone (no Graph tool): it measures itself
+        rates = rates or SharedRates(node)
+        self._rates = rates
         self.width = STAGE_WIDTH
         self._fitted = False
         self._widths_due = 0.0
@@ -107,14 +112,16 @@ class Stage:
         self._window.set_width(STAGE_WIDTH)
         with self._window.add_tab("Stage", viser.Icon.PRESENTATION):
             self.graph = GraphStage(
-                gui, ui, node, STAGE_WIDTH, rates, links, starting, inspect, open_tool
+                gui, ui, node, STAGE_WIDTH, rates.client(), links, starting, inspect, open_tool
             )
+            self.plot = PlotStage(gui, rates.client())
             self.turtlesim = TurtlesimStage(gui, ui, node, links)
             self.tf = TfStage(gui, node)
         # Under the code: what the learner's program printed (the exercise's output).
         self.code = CodeStage(gui, code_window, program_output)
         self.parts: dict[str, StagePart] = {
             "graph": self.graph,
+            "plot": self.plot,
             "turtlesim": self.turtlesim,
             "tf": self.tf,
             "code": self.code,
@@ -204,3 +211,5 @@ class Stage:
     def close(self) -> None:
         for part in self.parts.values():
             part.close()
+        if self._own_rates:
+            self._rates.close()

@@ -40,6 +40,10 @@ def _node_names(node) -> list[str]:
     return [ns.rstrip("/") + "/" + name for name, ns in node.get_node_names_and_namespaces()]
 
 
+# The plot stage's first line: with topics to plot, and without.
+_PLOT_NOTE = re.compile(r"^(Messages a second on each topic,|No topic has a publisher yet)")
+
+
 def _on_stage(page: Page) -> list[str]:
     """Which stages the page shows, read from what is visible ([] is the 3D scene)."""
 
@@ -48,6 +52,7 @@ def _on_stage(page: Page) -> list[str]:
 
     seen = {
         "graph": shown(page.locator("svg.stage-graph")),
+        "plot": shown(page.get_by_text(_PLOT_NOTE)),
         "code": shown(page.get_by_role("tab", name="Code of this lesson"))
         and shown(page.get_by_role("tab", name="Output of my node")),
         "turtlesim": shown(page.get_by_text("Arrow keys drive turtle1 while this window")),
@@ -92,7 +97,7 @@ def test_every_lesson_puts_its_stage_on_and_the_learner_can_switch(browser, dash
         # The course as the dashboard loaded it (lessons are being written in this tree).
         for lesson in load_course().lessons:
             choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
-            _wait_stage(page, lesson.stage)
+            _wait_stage(page, lesson.steps[0].stage or lesson.stage)
             # Every control of the step is in view without scrolling: title, buttons,
             # answers, checks, Back and Next.
             controls = step_controls(page, lesson, 0)
@@ -282,3 +287,47 @@ def test_a_click_on_a_box_sets_the_tools_to_it(browser, dashboard):
     finally:
         page.screenshot(path=str(ARTIFACTS / "stage-inspect.png"))
         page.context.close()
+
+
+def test_the_plot_stage_shows_the_executor_demo_starved_then_not(browser, dashboard, probe):
+    """Lesson 13 puts its measured rates on stage: the single-threaded demo's fast timer
+    near 3 Hz, the multi-threaded one's near 10, as lines and as the table's last values."""
+    page = _open(browser, dashboard, (1366, 768))
+    try:
+        lesson = next(x for x in load_course().lessons if x.id.endswith("executors"))
+        choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
+        _wait_stage(page, "plot")
+        expect_text(page, "No topic has a publisher yet")
+        page.get_by_role("button", name="Start executor_demo (single-threaded)").click()
+        next_button = page.get_by_role("button", name="Next", exact=True)
+        next_button.wait_for(timeout=60_000)  # the step's checks passed
+        next_button.click()
+        _wait_stage(page, "plot")
+        page.get_by_role("button", name="Start executor_demo_multi").click()
+        values: dict[str, float] = {}
+
+        def both_settled() -> bool:
+            for topic in ("/executor_demo/fast_rate", "/executor_demo_multi/fast_rate"):
+                # The table's row (the charts' legends are tables too).
+                row = page.locator("tr", has_text=topic).filter(has_text="last value")
+                text = row.first.inner_text() if row.count() else ""
+                found = re.search(r"last value ([0-9.]+)", text)
+                if not found:
+                    return False
+                values[topic] = float(found.group(1))
+            return (
+                1.5 < values["/executor_demo/fast_rate"] < 6
+                and values["/executor_demo_multi/fast_rate"] > 8
+            )
+
+        wait_until(both_settled, timeout=60, what=f"both rates on the plot's table ({values})")
+        # The two charts are drawn (uPlot canvases) in the stage's window, left of the panel.
+        charts = page.locator(".uplot canvas").filter(visible=True)
+        expect(charts).to_have_count(2)
+        picker = page.get_by_label("On stage").bounding_box()
+        for i in range(2):
+            box = charts.nth(i).bounding_box()
+            assert box and picker and box["width"] > 300 and box["x"] + box["width"] < picker["x"]
+    finally:
+        page.screenshot(path=str(ARTIFACTS / "stage-plot-executors.png"))
+        page.context.close()  # the dashboard ends its nodes with it

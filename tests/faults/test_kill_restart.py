@@ -418,6 +418,22 @@ class Round:
                 if time.monotonic() > deadline:
                     raise
 
+    def page_exercise_tool(self) -> None:
+        """The Exercise tool, open until its dropdown shows: a Next clicked over the wire a
+        moment before may bring the lesson's text forward after the tool's tab was clicked."""
+        from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+        deadline = time.monotonic() + 30
+        while True:
+            self.page_tool("Exercise")
+            try:
+                select = self.page.get_by_label("Exercise", exact=True).filter(visible=True)
+                select.first.wait_for(timeout=3_000)
+                return
+            except PlaywrightTimeout:
+                if time.monotonic() > deadline:
+                    raise
+
     def page_choose(self, label: str, option: str) -> None:
         self.alive()
         self.page.get_by_label(label, exact=True).filter(visible=True).first.click(timeout=15_000)
@@ -426,7 +442,7 @@ class Round:
     def page_edit(self, code: str) -> None:
         """Type into the editor in the side window; it saves a moment after each change."""
         if self.frame is None:
-            self.page_tool("Exercise")
+            self.page_exercise_tool()
             self.page_choose("Exercise", self.exercise_label)
             # Picking the exercise already shown changes nothing: the learner's way to the
             # editor is then "Open my code" (it puts the code window on stage).
