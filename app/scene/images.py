@@ -31,9 +31,9 @@ class ImageLayer(OneTopicLayer):
         self,
         node: Node,
         gui: viser.GuiApi,
-        frames: FrameTree,
+        frames: FrameTree | None,
         *,
-        label: str = "Camera image",
+        label: str | None = "Camera image",
         tf_camera: TfCamera | None = None,
     ) -> None:
         self._frames = frames
@@ -52,8 +52,9 @@ class ImageLayer(OneTopicLayer):
             self.tf_camera.follow(None if topic == NONE else topic)
 
     def show_on_frustum(self, enabled: bool) -> None:
-        self.on_frustum = enabled
-        if not enabled:
+        """On the lesson camera's frustum too (a layer made without the 3D frames: never)."""
+        self.on_frustum = enabled and self._frames is not None
+        if not enabled and self._frames is not None:
             self._frames.frustum.image = None
 
     def _draw(self, msg: Image) -> None:
@@ -66,7 +67,7 @@ class ImageLayer(OneTopicLayer):
         small = np.ascontiguousarray(downscale(rgb, FRUSTUM_WIDTH))
         camera, frame = self.tf_camera, msg.header.frame_id
         on_tf = camera is not None and camera.show(frame, small, msg.width, msg.height)
-        if self.on_frustum and not on_tf:
+        if self.on_frustum and not on_tf and self._frames is not None:
             frustum = self._frames.frustum
             frustum.aspect = msg.width / max(1, msg.height)
             frustum.image = small

@@ -10,6 +10,7 @@ from __future__ import annotations
 STAGES: dict[str, str] = {
     "graph": "Live ROS graph",
     "plot": "Live plot",  # topic rates, and the values of number topics, over time
+    "image": "Camera images",  # the camera's pictures and a node's output beside
     "turtlesim": "Turtlesim",
     "scene": "3D scene",
     "tf": "TF tree",

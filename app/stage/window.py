@@ -22,6 +22,7 @@ from app.ros.graph import GraphSnapshot
 from app.stage import DEFAULT_STAGE, STAGES
 from app.stage.code_stage import CodeStage
 from app.stage.graph_stage import GraphStage
+from app.stage.image_stage import ImageStage
 from app.stage.plot_stage import PlotStage
 from app.stage.tf_stage import TfStage
 from app.stage.turtlesim_stage import TurtlesimStage
@@ -50,7 +51,7 @@ const onResize = () => { clearTimeout(timer); timer = setTimeout(report, 150); }
     + listen_on_page("__stageWidthOff", "resize", "onResize")
     + "report();\n"
 )
-_IN_WINDOW = ("graph", "plot", "turtlesim", "tf")  # stages drawn in the stage window
+_IN_WINDOW = ("graph", "plot", "image", "turtlesim", "tf")  # stages drawn in the stage window
 
 _TOAST_STYLE = (
     "<style>.mantine-Notifications-root{top:auto!important;bottom:12px!important;"
@@ -115,6 +116,7 @@ class Stage:
                 gui, ui, node, STAGE_WIDTH, rates.client(), links, starting, inspect, open_tool
             )
             self.plot = PlotStage(gui, rates.client())
+            self.image = ImageStage(gui, node)
             self.turtlesim = TurtlesimStage(gui, ui, node, links)
             self.tf = TfStage(gui, node)
         # Under the code: what the learner's program printed (the exercise's output).
@@ -122,6 +124,7 @@ class Stage:
         self.parts: dict[str, StagePart] = {
             "graph": self.graph,
             "plot": self.plot,
+            "image": self.image,
             "turtlesim": self.turtlesim,
             "tf": self.tf,
             "code": self.code,

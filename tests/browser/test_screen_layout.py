@@ -17,8 +17,11 @@ pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
 # A school laptop, a desk screen, and the laptop at 125 % browser zoom (its CSS pixels).
 SIZES = [(1366, 768, 1.0), (1920, 1080, 1.0), (1093, 614, 1.25), (2560, 1440, 1.0)]
-# The graph, then the code (lesson 2), the graph again, the 3D scene, the graph again.
-WALK = ("01_ros2_and_dds", "04_first_node", "05_topics", "14_images_opencv", "06_qos")
+# The graph, the code, the graph again, camera images, the 3D scene, the graph again.
+WALK = (
+    "01_ros2_and_dds", "04_first_node", "05_topics", "14_images_opencv", "15_frames_and_arm",
+    "06_qos",
+)  # fmt: skip
 MIN_TEXT_PX = 11
 
 # Where the stage and the column are, as drawn: the left dock (graph, code, turtlesim, TF)

@@ -44,6 +44,9 @@ def _node_names(node) -> list[str]:
 _PLOT_NOTE = re.compile(r"^(Messages a second on each topic,|No topic has a publisher yet)")
 
 
+_IMAGE_NOTE = re.compile(r"^(What the camera sends, and what a node|No camera image on the graph)")
+
+
 def _on_stage(page: Page) -> list[str]:
     """Which stages the page shows, read from what is visible ([] is the 3D scene)."""
 
@@ -53,6 +56,7 @@ def _on_stage(page: Page) -> list[str]:
     seen = {
         "graph": shown(page.locator("svg.stage-graph")),
         "plot": shown(page.get_by_text(_PLOT_NOTE)),
+        "image": shown(page.get_by_text(_IMAGE_NOTE)),
         "code": shown(page.get_by_role("tab", name="Code of this lesson"))
         and shown(page.get_by_role("tab", name="Output of my node")),
         "turtlesim": shown(page.get_by_text("Arrow keys drive turtle1 while this window")),
@@ -331,3 +335,29 @@ def test_the_plot_stage_shows_the_executor_demo_starved_then_not(browser, dashbo
     finally:
         page.screenshot(path=str(ARTIFACTS / "stage-plot-executors.png"))
         page.context.close()  # the dashboard ends its nodes with it
+
+
+def test_the_image_stage_shows_the_camera_and_the_detectors_picture(browser, dashboard):
+    """Lesson 14 puts the camera's pictures on stage, then the detector's beside them."""
+    page = _open(browser, dashboard, (1366, 768))
+    try:
+        lesson = next(x for x in load_course().lessons if x.id.endswith("images_opencv"))
+        choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
+        _wait_stage(page, "image")
+        page.get_by_role("button", name="Start image_publisher").click()
+        expect_text(page, re.compile(r"/camera/image_raw.*640×480 `?bgr8"), timeout=60_000)
+        for _ in range(3):  # to the detector's step, past the fields and the code
+            page.get_by_role("button", name=NEXT_OR_SKIP).click()
+        _wait_stage(page, "image")
+        page.get_by_role("button", name="Start object_detector").click()
+        expect_text(page, re.compile(r"/object_detection/output.*Hz"), timeout=60_000)
+        expect_text(page, re.compile(r"/camera/image_raw.*Hz"))
+        # Two pictures, side by side in the stage's window (left of the control column).
+        images = page.locator("img").filter(visible=True)
+        picker = page.get_by_label("On stage").bounding_box()
+        boxes = [images.nth(i).bounding_box() for i in range(images.count())]
+        on_stage = [b for b in boxes if b and picker and b["x"] + b["width"] < picker["x"]]
+        assert len(on_stage) == 2 and all(b["width"] > 300 for b in on_stage), boxes
+    finally:
+        page.screenshot(path=str(ARTIFACTS / "stage-image-detector.png"))
+        page.context.close()
