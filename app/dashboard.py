@@ -139,6 +139,7 @@ class Dashboard:
             side_window,
             self._rates,
             self.page_links,
+            self.rosout,
             starting=self._starting_nodes,
             program_output=self._program_output,
             inspect=self._inspect,

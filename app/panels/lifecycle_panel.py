@@ -31,9 +31,21 @@ POLL_SEC = 2.0
 
 class LifecyclePanel:
     def __init__(
-        self, gui: viser.GuiApi, ui: UiLoop, node: Node, rosout: RosoutLog, links: PageLinks
+        self,
+        gui: viser.GuiApi,
+        ui: UiLoop,
+        node: Node,
+        rosout: RosoutLog,
+        links: PageLinks,
+        *,
+        link_prefix: str = "lifecycle",
+        buttons: bool = True,
     ) -> None:
+        """``link_prefix``: the page links its drawing's edges use (one per drawing);
+        ``buttons``: a button per transition under the drawing (the stage has only the
+        drawing's edges, the tool both)."""
         self._ui = ui
+        self._link_prefix = link_prefix
         self._links = links
         self._node = node
         self._rosout = rosout
@@ -52,11 +64,12 @@ class LifecyclePanel:
         self._diagram_html = ""
         self._buttons = {}
         for label in lc.TRANSITION_LABELS:
-            button = gui.add_button(label, disabled=True)
-            button.on_click(ui.callback(self._transition, label))
-            self._buttons[label] = button
+            if buttons:
+                button = gui.add_button(label, disabled=True)
+                button.on_click(ui.callback(self._transition, label))
+                self._buttons[label] = button
             # The drawing's edges act as these buttons do (see app/ui/page_links.py).
-            links.register(f"lifecycle.{label}", self._poster(label))
+            links.register(f"{link_prefix}.{label}", self._poster(label))
         self._result = MarkdownView(gui, "")
         self._log = MarkdownView(gui, "")
         self._selector.on_update(ui.callback(lambda: self._select(self._selector.value)))
@@ -65,7 +78,7 @@ class LifecyclePanel:
         return lambda: self._ui.post(lambda: self._transition(label))
 
     def _edge_link(self, label: str, svg: str, title: str) -> str:
-        return self._links.anchor(f"lifecycle.{label}", svg, title)
+        return self._links.anchor(f"{self._link_prefix}.{label}", svg, title)
 
     # --- selection and state (UI thread) -------------------------------------------
 
@@ -182,6 +195,11 @@ class LifecyclePanel:
             for topic in self._rates.watched()
         ]
         return "Publishing: " + (" · ".join(parts) if parts else "no topics yet")
+
+    def release(self) -> None:
+        """Follow no node until the next refresh (the stage while it is not shown)."""
+        self._nodes = []
+        self._select(NONE)
 
     def close(self) -> None:
         self._rates.close()

@@ -11,6 +11,7 @@ STAGES: dict[str, str] = {
     "graph": "Live ROS graph",
     "plot": "Live plot",  # topic rates, and the values of number topics, over time
     "image": "Camera images",  # the camera's pictures and a node's output beside
+    "lifecycle": "Lifecycle states",  # a managed node's state machine, its state lit
     "turtlesim": "Turtlesim",
     "scene": "3D scene",
     "tf": "TF tree",

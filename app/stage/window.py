@@ -19,10 +19,12 @@ from rclpy.node import Node
 
 from app.panels.graph_panel import SharedRates
 from app.ros.graph import GraphSnapshot
+from app.ros.rosout import RosoutLog
 from app.stage import DEFAULT_STAGE, STAGES
 from app.stage.code_stage import CodeStage
 from app.stage.graph_stage import GraphStage
 from app.stage.image_stage import ImageStage
+from app.stage.lifecycle_stage import LifecycleStage
 from app.stage.plot_stage import PlotStage
 from app.stage.tf_stage import TfStage
 from app.stage.turtlesim_stage import TurtlesimStage
@@ -51,7 +53,8 @@ const onResize = () => { clearTimeout(timer); timer = setTimeout(report, 150); }
     + listen_on_page("__stageWidthOff", "resize", "onResize")
     + "report();\n"
 )
-_IN_WINDOW = ("graph", "plot", "image", "turtlesim", "tf")  # stages drawn in the stage window
+# Drawn in the stage window: all but the code (its own windows) and the 3D scene (the canvas).
+_IN_WINDOW = tuple(name for name in STAGES if name not in ("code", "scene"))
 
 _TOAST_STYLE = (
     "<style>.mantine-Notifications-root{top:auto!important;bottom:12px!important;"
@@ -76,14 +79,16 @@ class Stage:
         ui: UiLoop,
         node: Node,
         code_window: Any,
-        rates: SharedRates | None = None,
-        links: PageLinks | None = None,
+        rates: SharedRates | None,
+        links: PageLinks,
+        rosout: RosoutLog,
         starting: Callable[[], list[str]] = lambda: [],
         program_output: Callable[[], tuple[str, list[str]]] = lambda: ("", []),
         inspect: Callable[[str, str, str], None] = lambda _kind, _name, _type: None,
         open_tool: Callable[[str], None] = lambda _tool: None,
     ) -> None:
-        """``rates``: measured once for the graph, the plot and the Graph tool;
+        """``rates``: measured once for the graph, the plot and the Graph tool (None: the
+        stage measures its own); ``rosout``: the lifecycle drawing's log;
         ``starting``, ``inspect`` and ``open_tool``: see ``GraphStage``;
         ``program_output``: see ``CodeStage``."""
         self._ui = ui
@@ -117,6 +122,7 @@ class Stage:
             )
             self.plot = PlotStage(gui, rates.client())
             self.image = ImageStage(gui, node)
+            self.lifecycle = LifecycleStage(gui, ui, node, rosout, links)
             self.turtlesim = TurtlesimStage(gui, ui, node, links)
             self.tf = TfStage(gui, node)
         # Under the code: what the learner's program printed (the exercise's output).
@@ -125,6 +131,7 @@ class Stage:
             "graph": self.graph,
             "plot": self.plot,
             "image": self.image,
+            "lifecycle": self.lifecycle,
             "turtlesim": self.turtlesim,
             "tf": self.tf,
             "code": self.code,
@@ -140,8 +147,6 @@ class Stage:
         """
         self._main_panel = server.gui.main_panel
         self._place_control_panel()
-        if self._links is None:
-            return
         href = self._links.register_value("stage.window", self._on_window_width)
         server.gui.add_html(page_script(_REPORT_WIDTH % json.dumps(href), "window width"))
 

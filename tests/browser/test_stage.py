@@ -47,6 +47,9 @@ _PLOT_NOTE = re.compile(r"^(Messages a second on each topic,|No topic has a publ
 _IMAGE_NOTE = re.compile(r"^(What the camera sends, and what a node|No camera image on the graph)")
 
 
+_LIFECYCLE_NOTE = re.compile(r"^(Current state of /|Start lifecycle_talker in the Nodes tab)")
+
+
 def _on_stage(page: Page) -> list[str]:
     """Which stages the page shows, read from what is visible ([] is the 3D scene)."""
 
@@ -57,6 +60,7 @@ def _on_stage(page: Page) -> list[str]:
         "graph": shown(page.locator("svg.stage-graph")),
         "plot": shown(page.get_by_text(_PLOT_NOTE)),
         "image": shown(page.get_by_text(_IMAGE_NOTE)),
+        "lifecycle": shown(page.get_by_text(_LIFECYCLE_NOTE)),
         "code": shown(page.get_by_role("tab", name="Code of this lesson"))
         and shown(page.get_by_role("tab", name="Output of my node")),
         "turtlesim": shown(page.get_by_text("Arrow keys drive turtle1 while this window")),
@@ -360,4 +364,30 @@ def test_the_image_stage_shows_the_camera_and_the_detectors_picture(browser, das
         assert len(on_stage) == 2 and all(b["width"] > 300 for b in on_stage), boxes
     finally:
         page.screenshot(path=str(ARTIFACTS / "stage-image-detector.png"))
+        page.context.close()
+
+
+def test_the_lifecycle_stage_lights_the_state_and_its_edges_change_it(browser, dashboard):
+    """Lesson 11 draws the node's state machine on stage; a step's button and a click on a
+    blue edge of the drawing both move the node, and the lit state follows."""
+    page = _open(browser, dashboard, (1366, 768))
+    try:
+        lesson = next(x for x in load_course().lessons if x.id.endswith("lifecycle"))
+        choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
+        _wait_stage(page, "lifecycle")
+        page.get_by_role("button", name="Start lifecycle_talker").click()
+        expect_text(page, re.compile(r"Current state of /lifecycle_talker: unconfigured"), 60_000)
+        page.get_by_role("button", name=NEXT_OR_SKIP).click()
+        page.get_by_role("button", name="Configure lifecycle_talker").click()  # the step's
+        expect_text(page, re.compile(r"Current state of /lifecycle_talker: inactive"))
+        edge = page.locator('g.live-edge a[aria-label^="activate:"]').filter(visible=True)
+        expect(edge).to_have_count(1, timeout=20_000)
+        box = edge.bounding_box()
+        picker = page.get_by_label("On stage").bounding_box()
+        assert box and picker and box["x"] + box["width"] < picker["x"]  # on the stage
+        edge.locator("text").click()  # the drawing's own edge, as a learner would
+        expect_text(page, re.compile(r"Current state of /lifecycle_talker: active\b"))
+        expect_text(page, re.compile(r"/lifecycle_chatter: \d+\.\d Hz"))
+    finally:
+        page.screenshot(path=str(ARTIFACTS / "stage-lifecycle.png"))
         page.context.close()
