@@ -12,6 +12,7 @@ STAGES: dict[str, str] = {
     "plot": "Live plot",  # topic rates, and the values of number topics, over time
     "image": "Camera images",  # the camera's pictures and a node's output beside
     "lifecycle": "Lifecycle states",  # a managed node's state machine, its state lit
+    "bag": "Newest bag",  # what the newest recording holds, and when each message came
     "turtlesim": "Turtlesim",
     "scene": "3D scene",
     "tf": "TF tree",

@@ -21,6 +21,7 @@ from app.panels.graph_panel import SharedRates
 from app.ros.graph import GraphSnapshot
 from app.ros.rosout import RosoutLog
 from app.stage import DEFAULT_STAGE, STAGES
+from app.stage.bag_stage import BagStage
 from app.stage.code_stage import CodeStage
 from app.stage.graph_stage import GraphStage
 from app.stage.image_stage import ImageStage
@@ -123,6 +124,7 @@ class Stage:
             self.plot = PlotStage(gui, rates.client())
             self.image = ImageStage(gui, node)
             self.lifecycle = LifecycleStage(gui, ui, node, rosout, links)
+            self.bag = BagStage(gui, ui)
             self.turtlesim = TurtlesimStage(gui, ui, node, links)
             self.tf = TfStage(gui, node)
         # Under the code: what the learner's program printed (the exercise's output).
@@ -132,6 +134,7 @@ class Stage:
             "plot": self.plot,
             "image": self.image,
             "lifecycle": self.lifecycle,
+            "bag": self.bag,
             "turtlesim": self.turtlesim,
             "tf": self.tf,
             "code": self.code,

@@ -20,7 +20,7 @@ from tests.browser.helpers import (
     start_node,
     step_controls,
 )
-from tests.conftest import ARTIFACTS, wait_until
+from tests.conftest import ARTIFACTS, DashboardProcess, free_port, wait_until
 from tests.integration.core_helpers import DISCOVERY_TIMEOUT
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -61,6 +61,7 @@ def _on_stage(page: Page) -> list[str]:
         "plot": shown(page.get_by_text(_PLOT_NOTE)),
         "image": shown(page.get_by_text(_IMAGE_NOTE)),
         "lifecycle": shown(page.get_by_text(_LIFECYCLE_NOTE)),
+        "bag": shown(page.get_by_text("Newest bag", exact=True)),  # its folder's title
         "code": shown(page.get_by_role("tab", name="Code of this lesson"))
         and shown(page.get_by_role("tab", name="Output of my node")),
         "turtlesim": shown(page.get_by_text("Arrow keys drive turtle1 while this window")),
@@ -391,3 +392,28 @@ def test_the_lifecycle_stage_lights_the_state_and_its_edges_change_it(browser, d
     finally:
         page.screenshot(path=str(ARTIFACTS / "stage-lifecycle.png"))
         page.context.close()
+
+
+def test_the_bag_stage_shows_a_recording_as_it_ends(browser, ros_env, tmp_path):
+    """Lesson 21: the recording the step's button starts shows on stage when it ends, a
+    tick per message over its 12 s, with `ros2 bag info`'s summary under it."""
+    env = {**ros_env, "ROS2_CLASSROOM_BAGS": str(tmp_path / "bags")}  # no other test's bags
+    dashboard = DashboardProcess(env, free_port(), ["--progress-dir", str(tmp_path / "p")])
+    page = _open(browser, dashboard, (1366, 768))
+    try:
+        lesson = next(x for x in load_course().lessons if x.id.endswith("bags"))
+        choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
+        page.get_by_role("button", name="Start the talker").click()
+        page.get_by_role("button", name="Next", exact=True).click(timeout=60_000)
+        _wait_stage(page, "bag")
+        expect_text(page, "No bag in your bags folder yet")
+        page.get_by_role("button", name="Record 12 s of /chatter").click()
+        expect_text(page, re.compile(r"talker_bag.*being recorded"), 30_000)
+        expect_text(page, re.compile(r"talker_bag.* (2[0-9]) messages in 1[12]\.\d s"), 60_000)
+        ticks = page.locator("svg.stage-bag g line")
+        assert 20 <= ticks.count() <= 30, ticks.count()
+        expect_text(page, re.compile(r"Topic information:.*Topic: /chatter"))
+    finally:
+        page.screenshot(path=str(ARTIFACTS / "stage-bag.png"))
+        page.context.close()
+        dashboard.stop()
