@@ -120,11 +120,17 @@ def _stopped_by(action: Spec) -> list[str]:
     return []
 
 
-def _skip_label(not_passed: int) -> str:
-    """Next's label: it moves on either way, but says when that skips checks."""
-    if not not_passed:
-        return "Next"
-    return f"Skip ({not_passed} check{'s' if not_passed > 1 else ''} not passed)"
+COURSE_END = "End of the course"
+
+
+def _next_label(not_passed: int, following: Lesson | None, last_step: bool) -> str:
+    """Next's label: it moves on either way, but says when that skips checks; on a
+    lesson's last step it names the lesson it opens, on the course's last it ends."""
+    if last_step and following is None:
+        return COURSE_END
+    if not_passed:
+        return f"Skip ({not_passed} check{'s' if not_passed > 1 else ''} not passed)"
+    return f"Next lesson: {_label(following)}" if last_step and following else "Next"
 
 
 def quiz_label(index: int, count: int) -> str:
@@ -225,13 +231,17 @@ class LessonsPanel:
         if lesson is not None and lesson is not self._lesson:
             self._select(lesson, 0)
 
+    def _following(self, lesson: Lesson) -> Lesson | None:
+        """The lesson after ``lesson`` in the course, None after the last."""
+        index = self._course.lessons.index(lesson)
+        return self._course.lessons[index + 1] if index + 1 < len(self._course.lessons) else None
+
     def _go_next(self) -> None:
         if self._step + 1 < len(self._lesson.steps):
             self._select(self._lesson, self._step + 1)
             return
-        index = self._course.lessons.index(self._lesson)
-        if index + 1 < len(self._course.lessons):
-            following = self._course.lessons[index + 1]
+        following = self._following(self._lesson)
+        if following is not None:
             assign(self._selector, _label(following))
             self._select(following, 0)
 
@@ -370,10 +380,12 @@ class LessonsPanel:
         passed = set(self._progress.lesson(lesson.id)["passed"])
         status = "✓ step done" if index in passed else ""
         not_passed = sum(result.state != PASS for _, result in results)
-        label = _skip_label(not_passed)
+        last_step = index + 1 == len(lesson.steps)
+        label = _next_label(not_passed, self._following(lesson), last_step)
         if self._next.label != label:
             self._next.label = label
-            self._next.color = "orange" if not_passed else "blue"
+            self._next.color = "orange" if not_passed and label != COURSE_END else "blue"
+            self._next.disabled = label == COURSE_END
         self._show_stops()
         self._checks.show(("**Checks** " + status + "\n\n" + "\n".join(lines)) if lines else status)
         self._outline.show(self._outline_text(lesson))

@@ -11,7 +11,7 @@ import pytest
 from playwright.sync_api import Page, expect
 
 from app.lessons.schema import load_course
-from tests.browser.helpers import choose, expect_text, open_tab, start_node
+from tests.browser.helpers import NEXT_OR_SKIP, choose, expect_text, open_tab, start_node
 from tests.conftest import ARTIFACTS
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -124,7 +124,7 @@ def test_a_stop_with_nothing_to_stop_is_greyed(browser, dashboard):
         last = lesson.steps[-1]
         for at in range(len(lesson.steps) - 1):
             expect_text(page, f"Step {at + 1} of {len(lesson.steps)}")
-            page.get_by_role("button", name=re.compile(r"^(Next|Skip \(.*\))$")).click()
+            page.get_by_role("button", name=NEXT_OR_SKIP).click()
         expect_text(page, f"Step {len(lesson.steps)} of {len(lesson.steps)}: {last.title}")
         stops = [a.get("label") for a in last.actions if a.kind.startswith("stop")]
         assert stops, "the last step of the topics lesson stops its nodes"
