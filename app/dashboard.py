@@ -147,9 +147,9 @@ class Dashboard:
         )
         stage.follow_window(self.server)
         self._stage = stage
-        # The current step's title, buttons, checks and Back/Next: above the tools, so they
-        # stay in view whichever tool is open (the step's text is in Learn › Lessons).
-        position = MarkdownView(gui)  # "Lesson 4 of 20 · Step 1 of 6", above the card
+        # The current step, read top to bottom: its text, buttons, checks, Back and Next;
+        # above the tools, so it stays where it is whichever tool is open.
+        position = MarkdownView(gui)  # "Lesson 4 of 22 · Step 1 of 6", above the card
         step_card = gui.add_folder("This step")
         builders: dict[str, Callable[[], Panel]] = {
             "Lessons": lambda: LessonsPanel(
@@ -166,6 +166,8 @@ class Dashboard:
                 start_requests=self.start_requests,
                 new_lesson=self._new_lesson,
                 position=position,
+                # The column's top: any tab always in it finds the column (the first group).
+                to_top=lambda: opener.scroll_to_top(next(iter(TOOL_GROUPS))),
             ),
             "Exercise": lambda: ExercisePanel(
                 gui,

@@ -26,6 +26,7 @@ from playwright.sync_api import Browser, Locator, Page, expect, sync_playwright 
 
 from app.dds import configure_dds_env  # noqa: E402
 from app.exercises.model import load_exercises  # noqa: E402
+from app.lessons.panel import NEXT_LABEL  # noqa: E402
 from app.lessons.schema import load_course  # noqa: E402
 from app.ui import GROUP_OF  # noqa: E402
 
@@ -34,8 +35,7 @@ LAPTOP = {"width": 1366, "height": 768}  # a school laptop: each stage is shown 
 DESK = {"width": 1500, "height": 900}
 PORT = 8193
 CLASS_PORT = 8311  # the teacher page one below
-# Next says "Skip (N checks not passed)" until the step's checks pass.
-NEXT = re.compile(r"^(Next|Skip \(\d+ checks? not passed\))$")
+NEXT = NEXT_LABEL  # "Skip (N checks not passed)" until the step's checks pass
 
 
 def _wait_ready(log: Path, proc: subprocess.Popen, ready: str) -> None:

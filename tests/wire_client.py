@@ -21,8 +21,10 @@ import zstandard
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import ClientConnection, connect
 
+from app.lessons.panel import NEXT_LABEL
+
 # The step card's Next: until the step's checks pass it says what it would skip.
-NEXT_OR_SKIP = re.compile(r"^(Next|Next lesson: .+|Skip \(\d+ checks? not passed\))$")
+NEXT_OR_SKIP = NEXT_LABEL
 # What a rendering page reports about its camera (viser waits for one before it counts
 # the client as connected).
 CAMERA_REPORT = {

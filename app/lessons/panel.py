@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import base64
 import html
+import re
 from collections.abc import Callable
 from functools import lru_cache
 from typing import Any
@@ -121,6 +122,9 @@ def _stopped_by(action: Spec) -> list[str]:
 
 
 COURSE_END = "End of the course"
+# Every label Next takes but the course's end (browser tests and docs/screenshots.py find
+# the button by it).
+NEXT_LABEL = re.compile(r"^(Next|Next lesson: .+|Skip \(\d+ checks? not passed\))$")
 
 
 def _next_label(not_passed: int, following: Lesson | None, last_step: bool) -> str:
@@ -159,13 +163,15 @@ class LessonsPanel:
         start_requests: StartRequests | None = None,
         new_lesson: Callable[[], None] = lambda: None,
         position: MarkdownView | None = None,
+        to_top: Callable[[], None] = lambda: None,
     ) -> None:
         """``step_card``: a folder for the step's title, buttons, checks and Back/Next (the
         dashboard puts it above its tools, so they stay in view); made here when None.
         ``open_tool(name)`` brings a tool's tab into view (a step's `open_panel` button).
         ``new_lesson()``: another lesson was opened (the dashboard clears what the last one
         left in the views). ``position``: where the "Lesson i of n · Step j of m" line goes
-        (the dashboard puts it above the step card); made in the card when None."""
+        (the dashboard puts it above the step card); made in the card when None.
+        ``to_top()``: the column back to its top, where a new step's text begins."""
         self._gui = gui
         self._ui = ui
         self._course = course
@@ -174,6 +180,7 @@ class LessonsPanel:
         self._exercise_marks = exercise_marks
         self._show_stage = show_stage  # the stage shows what each step names
         self._open_tool = open_tool
+        self._to_top = to_top
         self._requests = start_requests or StartRequests()  # the stage shows a Start at once
         self._new_lesson = new_lesson
         self._leftovers: list[str] = []  # nodes running when this lesson was opened
@@ -185,18 +192,16 @@ class LessonsPanel:
             gui.add_markdown("No lessons could be loaded.\n\n" + "\n".join(course.errors))
             return
         current = course.lesson(progress.current_lesson() or "") or course.lessons[0]
-        # The reading column: which lesson, its title, the step's text and picture.
+        # The Lessons tab: which lesson, its title and summary, its goals, the outline.
         self._selector = gui.add_dropdown("Lesson", list(by_label), initial_value=_label(current))
         self._header = MarkdownView(gui)
-        self._text = MarkdownView(gui)
-        self._picture = _HtmlView(gui)
-        self._command = MarkdownView(gui)
         with gui.add_folder("Goals of this lesson", expand_by_default=False):
             self._goals = MarkdownView(gui)
         with gui.add_folder("Course outline", expand_by_default=False):
             self._outline = MarkdownView(gui)
             self._reset = gui.add_button("Reset my progress", color="gray")
-        # What the learner does: the step card (title, buttons, checks, Back/Next).
+        # The step card reads top to bottom: the step's text (and picture, and the terminal
+        # command), then what to do (buttons, questions), its checks, then Back and Next.
         self._card = step_card if step_card is not None else gui.add_folder("This step")
         with self._card:
             # Where am I: lesson i of n, step j of m.
@@ -204,6 +209,9 @@ class LessonsPanel:
             self._stop_leftovers = gui.add_button(
                 "", icon=viser.Icon.PLAYER_STOP, color="red", visible=False
             )
+            self._text = MarkdownView(gui)
+            self._picture = _HtmlView(gui)
+            self._command = MarkdownView(gui)
             self._actions = gui.add_folder(None)  # the step's own buttons, rebuilt per step
             self._checks = MarkdownView(gui)
             self._message = MarkdownView(gui)
@@ -252,7 +260,7 @@ class LessonsPanel:
 
     def _select(self, lesson: Lesson, step: int, reading: bool = True) -> None:
         """Show ``step`` of ``lesson``; ``reading``: bring its text into view (a new step is
-        read first, even if the learner had a tool open for the last one)."""
+        read first; the tool the learner has open stays open under the card)."""
         step = max(0, min(step, len(lesson.steps) - 1))
         if lesson is not self._lesson:  # a lesson starts clean: nothing of the last one
             self._leftovers = sorted(
@@ -280,7 +288,7 @@ class LessonsPanel:
         self._rebuild_step_widgets()
         self._back.disabled = step == 0
         if reading:
-            self._open_tool("Lessons")
+            self._to_top()
 
     def _source_listing(self, lesson: Lesson) -> str:
         parts = [

@@ -48,6 +48,21 @@ tick();
 """
 
 
+# The column back to its top (a new step: its text is read first), the tools as they are.
+_TOP_SCRIPT = """
+const anchor = [...parent.document.querySelectorAll('[role=tab][data-dock-tab]')]
+  .find((t) => t.title === %s);
+for (let box = anchor && anchor.parentElement; box; box = box.parentElement)
+  if (/(auto|scroll)/.test(parent.getComputedStyle(box).overflowY)) box.scrollTop = 0;
+"""
+
+
+def top_html(anchor_tab: str, nonce: int) -> str:
+    """The widget's content that scrolls the column holding ``anchor_tab`` to its top."""
+    script = _TOP_SCRIPT % json.dumps(anchor_tab)
+    return page_script(script, "column to its top", nonce=nonce)
+
+
 def opener_html(path: list[str], nonce: int) -> str:
     """The widget's content that opens the tabs ``path`` (outermost first) once."""
     script = _SCRIPT % (json.dumps(path), TIMEOUT_MS)
@@ -69,3 +84,8 @@ class TabOpener:
     def open(self, name: str) -> None:
         self._nonce += 1  # the same tab again is new content: the page presses it again
         self._handle.content = opener_html(self.path(name), self._nonce)
+
+    def scroll_to_top(self, anchor_tab: str) -> None:
+        """The column that holds ``anchor_tab`` (a tab always there) back to its top."""
+        self._nonce += 1
+        self._handle.content = top_html(anchor_tab, self._nonce)

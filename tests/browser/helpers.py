@@ -46,6 +46,17 @@ def choose_when_listed(
             page.wait_for_timeout(500)
 
 
+def open_lesson(page: Page, lesson) -> None:
+    """Pick ``lesson`` in Learn › Lessons, as a learner does (another tool may be open);
+    nothing when it is the lesson on screen (picking it again changes nothing)."""
+    label = f"{lesson.unit:02d} · {lesson.title}"
+    dropdown = page.get_by_label("Lesson", exact=True)
+    if dropdown.count() == 1 and dropdown.input_value() == label:
+        return
+    open_tab(page, "Lessons")
+    choose(page, "Lesson", label)
+
+
 def click(page: Page, button: str) -> None:
     page.get_by_role("button", name=button, exact=True).click()
 
@@ -103,7 +114,8 @@ def cut_off_at_panel_edge(page: Page, selector: str, text: str) -> list[str]:
 
 # Why an element is not fully in view: outside the window, clipped by a scrolling box
 # (the control panel scrolled), or covered by something else; '' when the learner sees it.
-_OUT_OF_VIEW_JS = """(elements) => elements.map((el) => {
+_OUT_OF_VIEW_JS = """([elements, scroll]) => elements.map((el) => {
+  if (scroll) el.scrollIntoView({block: 'nearest'});
   const r = el.getBoundingClientRect();
   const at = (b) => `${Math.round(b.top)}..${Math.round(b.bottom)} x ${Math.round(b.left)}..`
     + `${Math.round(b.right)}`;
@@ -125,14 +137,41 @@ _OUT_OF_VIEW_JS = """(elements) => elements.map((el) => {
 })"""
 
 
-def out_of_view(page: Page, controls: dict[str, Locator]) -> list[str]:
-    """Each control (name -> locator) the learner cannot see whole without scrolling.
+def out_of_view(page: Page, controls: dict[str, Locator], scroll: bool = False) -> list[str]:
+    """Each control (name -> locator) the learner cannot see whole without scrolling
+    (``scroll``: once scrolled to, as a learner reading down the column does).
 
     Waits for each to be on the page (up to 10 s), then looks at all of them at once.
     """
     handles = [locator.first.element_handle(timeout=10_000) for locator in controls.values()]
-    reasons = page.evaluate(_OUT_OF_VIEW_JS, handles)
+    reasons = page.evaluate(_OUT_OF_VIEW_JS, [handles, scroll])
     return [f"{name}: {why}" for name, why in zip(controls, reasons, strict=True) if why]
+
+
+def step_reads_top_down(page: Page, lesson, index: int) -> list[str]:
+    """What is wrong with step ``index``'s card as a learner reads it (none: []): its title
+    and text in view as the step opens, the text above its first button and answer, and
+    every control whole, uncovered and inside the window once scrolled to."""
+    controls = step_controls(page, lesson, index)
+    head = {"title": controls["title"], "text": controls["text"]}
+    wrong = out_of_view(page, head)
+    text_box = controls["text"].first.bounding_box()
+    for name, locator in controls.items():
+        if name.startswith(("button", "answer")):
+            box = locator.first.bounding_box()
+            if text_box and box and box["y"] < text_box["y"]:
+                wrong.append(f"{name} comes before the step's text")
+            break
+    wrong += out_of_view(page, controls, scroll=True)
+    return wrong
+
+
+def first_words(markdown: str, count: int = 5) -> str:
+    """The first words of a step's text as the page shows them (no title, no markup)."""
+    body = [p for p in markdown.split("\n\n") if p.strip()[:1].isalpha()]  # prose
+    plain = re.sub(r"\[([^\]]*)\]\([^)]*\)", r"\1", body[0] if body else "")
+    plain = re.sub(r"[*`]|(?<!\w)_|_(?!\w)", "", plain)  # emphasis, not snake_case
+    return " ".join(plain.split()[:count])
 
 
 CHECK_LINE = re.compile(r"^(✓|✗|…) (pass|fail|waiting)")
@@ -146,6 +185,7 @@ def step_controls(page: Page, lesson, index: int) -> dict[str, Locator]:
     title = f"Step {index + 1} of {len(lesson.steps)}: {step.title}"
     controls = {"title": page.get_by_text(title, exact=True)}
     expect(controls["title"]).to_be_visible()
+    controls["text"] = page.get_by_text(first_words(step.text)).filter(visible=True)
     for action in step.actions:
         label = action.get("label") or action.kind.replace("_", " ")
         controls[f"button {label!r}"] = page.get_by_role("button", name=label, exact=True)

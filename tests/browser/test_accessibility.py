@@ -20,13 +20,12 @@ from app.lessons.schema import load_course
 from app.supervisor import Supervisor
 from tests.browser.helpers import (
     NEXT_OR_SKIP,
-    choose,
     click,
     click_next,
     expect_text,
+    open_lesson,
     open_tab,
-    out_of_view,
-    step_controls,
+    step_reads_top_down,
 )
 from tests.conftest import ARTIFACTS, DashboardProcess, fail_on_leftover_nodes, free_port
 from tests.outside_report import private_dds_env
@@ -111,13 +110,15 @@ def test_axe_finds_nothing_serious_in_the_lesson_exercise_and_graph_views(
 
 
 def _go_to_step(page: Page, lesson, index: int) -> None:
-    choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
+    open_lesson(page, lesson)
     for at in range(index):
         expect_text(page, f"Step {at + 1} of {len(lesson.steps)}")
         click_next(page)
 
 
-def test_at_125_percent_zoom_the_steps_controls_stay_in_view(browser, dashboard_with_chatter):
+def test_at_125_percent_zoom_each_step_reads_top_down_and_every_control_is_reachable(
+    browser, dashboard_with_chatter
+):
     page = _page(browser, dashboard_with_chatter.url, **ZOOM_125)
     try:
         places = [(lesson, 0) for lesson in COURSE.lessons]
@@ -127,7 +128,7 @@ def test_at_125_percent_zoom_the_steps_controls_stay_in_view(browser, dashboard_
             _go_to_step(page, lesson, index)
             hidden += [
                 f"{lesson.id} step {index + 1}: {why}"
-                for why in out_of_view(page, step_controls(page, lesson, index))
+                for why in step_reads_top_down(page, lesson, index)
             ]
         assert not hidden, "; ".join(hidden)
     finally:

@@ -6,14 +6,10 @@ import pytest
 from playwright.sync_api import expect
 
 from app.lessons.schema import load_course
-from tests.browser.helpers import choose, click_next, expect_text, open_tab
+from tests.browser.helpers import click_next, expect_text, open_lesson, open_tab
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 COURSE = load_course()
-
-
-def _label(lesson) -> str:
-    return f"{lesson.unit:02d} · {lesson.title}"
 
 
 def _picture_steps():
@@ -39,7 +35,7 @@ def _picture_steps():
 def test_a_step_shows_its_picture_and_the_next_step_does_not(page, lesson, index):
     step = lesson.steps[index]
     open_tab(page, "Lessons")
-    choose(page, "Lesson", _label(lesson))
+    open_lesson(page, lesson)
     for _ in range(index):
         click_next(page)
     expect_text(page, f"Step {index + 1} of {len(lesson.steps)}: {step.title}")

@@ -11,7 +11,14 @@ import pytest
 from playwright.sync_api import Page, expect
 
 from app.lessons.schema import load_course
-from tests.browser.helpers import NEXT_OR_SKIP, choose, expect_text, open_tab, start_node
+from tests.browser.helpers import (
+    NEXT_OR_SKIP,
+    choose,
+    expect_text,
+    open_lesson,
+    open_tab,
+    start_node,
+)
 from tests.conftest import ARTIFACTS
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -27,7 +34,7 @@ def _open_lesson(page: Page, lesson_id: str) -> None:
     lesson = COURSE.lesson(lesson_id)
     assert lesson is not None
     open_tab(page, "Lessons")
-    choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
+    open_lesson(page, lesson)
     expect_text(page, f"Step 1 of {len(lesson.steps)}: {lesson.steps[0].title}")
 
 

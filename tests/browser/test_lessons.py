@@ -8,20 +8,24 @@ import pytest
 from playwright.sync_api import expect
 
 from app.lessons.schema import load_course
-from tests.browser.helpers import answer_label, choose, click, click_next, expect_text, open_tab
+from tests.browser.helpers import (
+    answer_label,
+    choose,
+    click,
+    click_next,
+    expect_text,
+    open_lesson,
+    open_tab,
+)
 from tests.conftest import DashboardProcess, free_port
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 COURSE = load_course()
 
 
-def lesson_label(lesson) -> str:
-    return f"{lesson.unit:02d} · {lesson.title}"
-
-
 def complete_by_clicking(page, lesson, done_within_ms: int = 45_000) -> None:
     open_tab(page, "Lessons")
-    choose(page, "Lesson", lesson_label(lesson))
+    open_lesson(page, lesson)
     for index, step in enumerate(lesson.steps):
         expect_text(page, f"Step {index + 1} of {len(lesson.steps)}: {step.title}")
         for action in step.actions:
@@ -37,6 +41,7 @@ def complete_by_clicking(page, lesson, done_within_ms: int = 45_000) -> None:
 
 def done_cells(page):
     """The outline's done marks (the outline folder starts collapsed)."""
+    open_tab(page, "Lessons")
     page.get_by_text("Course outline", exact=True).click()
     return page.get_by_role("cell", name="✓", exact=True)
 

@@ -10,7 +10,14 @@ import pytest
 from playwright.sync_api import Page, expect
 
 from app.lessons.schema import load_course
-from tests.browser.helpers import NEXT_OR_SKIP, choose, expect_text, out_of_view, step_controls
+from tests.browser.helpers import (
+    NEXT_OR_SKIP,
+    expect_text,
+    open_lesson,
+    out_of_view,
+    step_controls,
+    step_reads_top_down,
+)
 from tests.conftest import ARTIFACTS
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -93,7 +100,7 @@ def test_the_stage_is_all_the_room_left_of_the_column_in_every_lesson(browser, d
         page.get_by_role("tab", name="Lessons").wait_for()
         for lesson_id in WALK:
             lesson = course[lesson_id]
-            choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
+            open_lesson(page, lesson)
             stage = lesson.steps[0].stage or lesson.stage
             layout = _settled(page, stage)
             off = _fills(layout, stage)
@@ -145,11 +152,11 @@ def test_the_first_screen_says_how_it_works_and_shows_the_dashboards_node(browse
         own = page.locator('svg.stage-graph g.sg-vertex[data-name="/classroom_dashboard"]')
         expect(own).to_be_visible()
         expect(page.get_by_text("Nothing on the graph yet").filter(visible=True)).to_have_count(0)
-        # The intro pushes none of the step's controls out of view.
+        # The intro, the step's title and its text are in view as the page opens, and the
+        # card reads top to bottom.
         controls = step_controls(page, first, 0)
-        controls["Next"] = page.get_by_role("button", name=NEXT_OR_SKIP)
-        controls["intro"] = intro
-        hidden = out_of_view(page, controls)
+        hidden = out_of_view(page, {"intro": intro, "title": controls["title"]})
+        hidden += step_reads_top_down(page, first, 0)
         assert not hidden, "; ".join(hidden)
         # Only the first screen carries it.
         page.get_by_role("button", name=NEXT_OR_SKIP).click()

@@ -15,10 +15,10 @@ from tests.browser.helpers import (
     NEXT_OR_SKIP,
     choose,
     expect_text,
+    open_lesson,
     open_tab,
-    out_of_view,
     start_node,
-    step_controls,
+    step_reads_top_down,
 )
 from tests.conftest import ARTIFACTS, DashboardProcess, free_port, wait_until
 from tests.integration.core_helpers import DISCOVERY_TIMEOUT
@@ -105,15 +105,12 @@ def test_every_lesson_puts_its_stage_on_and_the_learner_can_switch(browser, dash
         _wait_side_by_side(page, size)
         # The course as the dashboard loaded it (lessons are being written in this tree).
         for lesson in load_course().lessons:
-            choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
+            open_lesson(page, lesson)
             _wait_stage(page, lesson.steps[0].stage or lesson.stage)
-            # Every control of the step is in view without scrolling: title, buttons,
-            # answers, checks, Back and Next.
-            controls = step_controls(page, lesson, 0)
-            # Next says "Skip (N checks not passed)" until the step's checks pass.
-            controls["Next"] = page.get_by_role("button", name=NEXT_OR_SKIP)
-            hidden = out_of_view(page, controls)
-            assert not hidden, f"{lesson.id} at {size}: " + "; ".join(hidden)
+            # The card reads top to bottom: title and text in view, the text before the
+            # buttons and answers, every control whole once scrolled to.
+            wrong = step_reads_top_down(page, lesson, 0)
+            assert not wrong, f"{lesson.id} at {size}: " + "; ".join(wrong)
         for name, label in STAGES.items():  # the learner's own choice
             choose(page, "On stage", label)
             _wait_stage(page, name)
@@ -304,7 +301,7 @@ def test_the_plot_stage_shows_the_executor_demo_starved_then_not(browser, dashbo
     page = _open(browser, dashboard, (1366, 768))
     try:
         lesson = next(x for x in load_course().lessons if x.id.endswith("executors"))
-        choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
+        open_lesson(page, lesson)
         _wait_stage(page, "plot")
         expect_text(page, "No topic has a publisher yet")
         page.get_by_role("button", name="Start executor_demo (single-threaded)").click()
@@ -347,7 +344,7 @@ def test_the_image_stage_shows_the_camera_and_the_detectors_picture(browser, das
     page = _open(browser, dashboard, (1366, 768))
     try:
         lesson = next(x for x in load_course().lessons if x.id.endswith("images_opencv"))
-        choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
+        open_lesson(page, lesson)
         _wait_stage(page, "image")
         page.get_by_role("button", name="Start image_publisher").click()
         expect_text(page, re.compile(r"/camera/image_raw.*640×480 `?bgr8"), timeout=60_000)
@@ -374,7 +371,7 @@ def test_the_lifecycle_stage_lights_the_state_and_its_edges_change_it(browser, d
     page = _open(browser, dashboard, (1366, 768))
     try:
         lesson = next(x for x in load_course().lessons if x.id.endswith("lifecycle"))
-        choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
+        open_lesson(page, lesson)
         _wait_stage(page, "lifecycle")
         page.get_by_role("button", name="Start lifecycle_talker").click()
         expect_text(page, re.compile(r"Current state of /lifecycle_talker: unconfigured"), 60_000)
@@ -402,7 +399,7 @@ def test_the_bag_stage_shows_a_recording_as_it_ends(browser, ros_env, tmp_path):
     page = _open(browser, dashboard, (1366, 768))
     try:
         lesson = next(x for x in load_course().lessons if x.id.endswith("bags"))
-        choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
+        open_lesson(page, lesson)
         page.get_by_role("button", name="Start the talker").click()
         page.get_by_role("button", name="Next", exact=True).click(timeout=60_000)
         _wait_stage(page, "bag")

@@ -30,7 +30,15 @@ from app.dds import configure_dds_env
 from app.lessons.schema import load_course
 from app.teacher.http_report import to_json
 from app.teacher.record import LearnerRecord
-from tests.browser.helpers import answer_label, choose, click, click_next, expect_text, open_tab
+from tests.browser.helpers import (
+    answer_label,
+    choose,
+    click,
+    click_next,
+    expect_text,
+    open_lesson,
+    open_tab,
+)
 from tests.browser.test_exercise import EXERCISE, _open_editor
 from tests.conftest import ARTIFACTS, fail_on_leftover_nodes, in_private_netns, wait_until
 from tests.hub.local_hub import PASSWORD, LocalHub
@@ -210,7 +218,7 @@ def test_each_learner_passes_a_lesson_step_and_an_exercise(hub, room):
     for user in LEARNERS:
         page = room.classrooms[user]
         open_tab(page, "Lessons")
-        choose(page, "Lesson", f"{lesson.unit:02d} · {lesson.title}")
+        open_lesson(page, lesson)
         quizzes = [check for check in lesson.steps[0].checks if check.kind == "quiz"]
         for check in quizzes:
             choose(page, answer_label(quizzes, check), check["answer"])

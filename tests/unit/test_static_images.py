@@ -181,7 +181,9 @@ def test_the_panel_shows_a_steps_picture_under_its_text_and_only_there(tmp_path)
     gui.add_html = add_html  # type: ignore[method-assign]
     LessonsPanel(gui, ui, COURSE, _Live(), progress, _SideWindow())  # type: ignore[arg-type]
     kinds = [h.kind for h in gui.handles]
-    assert kinds[:5] == ["dropdown", "markdown", "markdown", "html", "markdown"], (
+    at = gui.handles.index(picture)
+    assert kinds[at - 1 : at + 2] == ["markdown", "html", "markdown"], kinds
+    assert gui.handles[at - 1].content.startswith(lesson.steps[0].text.split("\n\n")[1][:40]), (
         "the picture sits right under the step text, above the command"
     )
     alt = f'alt="{lesson.steps[0].image_alt}"'
