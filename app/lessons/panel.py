@@ -47,8 +47,8 @@ _CHOOSE = "(choose an answer)"
 # How the screen works, said once, on the first step of the course.
 FIRST_SCREEN = (
     "_New here?_ The **stage** on the left shows what the current step is about. The "
-    "**step card** below says what to do, with its buttons and live checks (✓ when "
-    "done); the tools are in the tabs under it, and the step's text in Learn › Lessons."
+    "**step card** below explains the step, then gives its buttons and live checks (✓ "
+    "when done); the tools are in the tabs under it."
 )
 
 
