@@ -26,7 +26,7 @@ from playwright.sync_api import Browser, Locator, Page, expect, sync_playwright 
 
 from app.dds import configure_dds_env  # noqa: E402
 from app.exercises.model import load_exercises  # noqa: E402
-from app.lessons.panel import NEXT_LABEL  # noqa: E402
+from app.lessons.panel import NEXT_LABEL, quiz_label  # noqa: E402
 from app.lessons.schema import load_course  # noqa: E402
 from app.ui import GROUP_OF  # noqa: E402
 
@@ -287,6 +287,23 @@ def _on_failure_keep(page: Page, tmp: str) -> None:
     shutil.copy(Path(tmp) / "failed.png", ROOT / "test-artifacts")
 
 
+def walked_gallery(browser: Browser, env: dict[str, str], tmp: str) -> None:
+    """The lessons' gallery, on a dashboard of its own (a fresh learner), 1366x768."""
+    argv = ["serve", "--port", str(PORT + 1), "--progress-dir", str(Path(tmp) / "walk")]
+    with _running(argv, env, Path(tmp) / "walk.log", "is ready"):
+        page = browser.new_page(viewport=LAPTOP)
+        page.goto(f"http://127.0.0.1:{PORT + 1}/")
+        page.get_by_role("tab").first.wait_for()
+        _dismiss_toasts(page)
+        try:
+            undone = lesson_gallery(page)
+        except Exception:
+            _on_failure_keep(page, tmp)
+            raise
+        page.close()
+    print(f"{len(undone)} steps left undone by a learner who only clicks:", *undone, sep="\n  ")
+
+
 def learner_dashboard(browser: Browser, env: dict[str, str], tmp: str) -> None:
     argv = ["serve", "--port", str(PORT), "--progress-dir", str(Path(tmp) / "progress")]
     with _running(argv, env, Path(tmp) / "dashboard.log", "is ready"):
@@ -300,6 +317,69 @@ def learner_dashboard(browser: Browser, env: dict[str, str], tmp: str) -> None:
             _on_failure_keep(page, tmp)
             raise
         page.close()
+
+
+GALLERY = IMAGES / "lessons"
+STEP_DONE_MS = 20_000  # a step that needs typing (the learner's own code) is left undone
+
+
+def _walk_step(page: Page, step) -> bool:
+    """Do a step as a learner who only clicks: its buttons, then the right answers; True
+    when its checks passed within STEP_DONE_MS."""
+    for action in step.actions:
+        if action.kind == "open_panel":
+            continue  # the tools stay as they are: the pictures show the card and the stage
+        label = action.get("label") or action.kind.replace("_", " ")
+        button = page.get_by_role("button", name=label, exact=True)
+        if button.is_enabled(timeout=10_000):  # a Stop with nothing to stop is greyed
+            button.click()
+            page.wait_for_timeout(400)
+    quizzes = [check for check in step.checks if check.kind == "quiz"]
+    for index, check in enumerate(quizzes):
+        field = quiz_label(index, len(quizzes)).replace("Question", "Answer")
+        page.get_by_label(field, exact=True).filter(visible=True).first.click()
+        page.get_by_role("option", name=check["answer"], exact=True).click()
+    try:
+        expect(_shown(page, "✓ step done")).to_be_visible(timeout=STEP_DONE_MS)
+        return True
+    except AssertionError:
+        return False
+
+
+def lesson_gallery(page: Page) -> list[str]:
+    """Every lesson from its first step to its last, in order and without reloading, as a
+    learner who clicks the buttons walks it: a picture of each lesson's first and last step
+    (docs/images/lessons/, the README's gallery). Returns the steps left undone."""
+    GALLERY.mkdir(parents=True, exist_ok=True)
+    undone: list[str] = []
+    for lesson in load_course().lessons:
+        _lesson(page, lesson.id, 1)
+        for index, step in enumerate(lesson.steps):
+            last = index + 1 == len(lesson.steps)
+            if last and len(lesson.steps) > 1:  # what was built, before its stops are pressed
+                page.wait_for_timeout(1500)
+                page.screenshot(path=str(GALLERY / f"{lesson.unit:02d}-last.jpg"), quality=70)
+            if not _walk_step(page, step):
+                undone.append(f"{lesson.id} step {index + 1}: {step.title}")
+            if index == 0:
+                page.wait_for_timeout(1500)  # the stage settles (a node joins the graph)
+                page.screenshot(path=str(GALLERY / f"{lesson.unit:02d}-first.jpg"), quality=70)
+            if not last:
+                page.get_by_role("button", name=NEXT).click()
+        print(f"{lesson.id}: walked", flush=True)
+    return undone
+
+
+def gallery_markdown() -> str:
+    """The README's gallery: a row per lesson, its first and last step."""
+    rows = ["| Lesson | First step | Last step |", "|---|---|---|"]
+    for lesson in load_course().lessons:
+        pictures = [
+            f"![{lesson.title}, {which} step](docs/images/lessons/{lesson.unit:02d}-{which}.jpg)"
+            for which in ("first", "last")
+        ]
+        rows.append(f"| {lesson.unit} · {lesson.title} | {pictures[0]} | {pictures[1]} |")
+    return "\n".join(rows)
 
 
 def teacher_page(browser: Browser, env: dict[str, str], tmp: str) -> None:
@@ -335,8 +415,11 @@ def main() -> int:
         browser = playwright.chromium.launch(
             executable_path="/usr/bin/chromium", args=["--no-sandbox", "--disable-dev-shm-usage"]
         )
-        learner_dashboard(browser, env, tmp)
-        teacher_page(browser, env, tmp)
+        only = sys.argv[1:]  # e.g. "gallery": one part; none: every picture
+        parts = {"dashboard": learner_dashboard, "teacher": teacher_page, "gallery": walked_gallery}
+        for name, take in parts.items():
+            if not only or name in only:
+                take(browser, env, tmp)
         browser.close()
     for image in sorted(IMAGES.glob("*.png")):
         print(f"wrote {image.relative_to(ROOT)}")
