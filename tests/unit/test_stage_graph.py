@@ -46,7 +46,7 @@ def test_a_unit_without_stage_gets_the_default_and_a_step_can_override(tmp_path)
 
 
 def test_an_unknown_stage_is_a_clear_error(tmp_path):
-    with pytest.raises(LessonError, match=r"unknown stage 'movie' \(stages: graph, turtlesim"):
+    with pytest.raises(LessonError, match=r"unknown stage 'movie' \(stages: graph, plot, image"):
         load_lesson(_copy(tmp_path, 'stage = "movie"\n'))
     with pytest.raises(LessonError, match=r"steps\[0\]: unknown stage 'film'"):
         load_lesson(_copy(tmp_path / "b", 'stage = "graph"\n', 'stage = "film"\n'))
