@@ -88,15 +88,19 @@ def stopped_quietly() -> Iterator[None]:
     (ValueError), or using one already destroyed (InvalidHandle). With ROS
     still up, those are real errors and go on.
     """
+    global _ending
     try:
         yield
     except (KeyboardInterrupt, ExternalShutdownException):
-        pass
+        _ending = True
     except (RCLError, ValueError, InvalidHandle):
+        # Ending before asking rclpy: the SIGTERM that shut the context down may have its
+        # Python handler run inside rclpy.ok(), where its KeyboardInterrupt would escape
+        # this clause (seen: view_frames stopped while creating its node).
+        _ending = True
         if rclpy.ok():
             raise
     finally:
-        global _ending
         _ending = True  # first, in one store: a late signal in what follows raises nothing
         _start.end()  # a signal during the teardown is ignored, not raised
 
