@@ -99,6 +99,7 @@ def _left_in_namespace() -> list[tuple[int, str]]:
             not entry.name.isdigit()
             or int(entry.name) == me
             or _net_namespace(entry.name) not in ours
+            or _another_run(entry)
         ):
             continue
         try:
@@ -109,6 +110,19 @@ def _left_in_namespace() -> list[tuple[int, str]]:
             continue
         found.append((int(entry.name), cmd.strip()[:160]))
     return found
+
+
+def _another_run(proc: Path) -> bool:
+    """A process of another run whose namespace got a number this run's had: the kernel
+    reuses a namespace's number once it is gone (seen: a run's keeper ended the workers
+    of a run started beside it). A run's processes inherit its NAMESPACES file's name."""
+    try:
+        environ = (proc / "environ").read_bytes().split(b"\0")
+    except OSError:
+        return False
+    prefix = f"{NAMESPACES}=".encode()
+    theirs = next((v[len(prefix) :] for v in environ if v.startswith(prefix)), None)
+    return theirs is not None and theirs.decode(errors="replace") != os.environ.get(NAMESPACES)
 
 
 def keep(command: list[str]) -> int:
