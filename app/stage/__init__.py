@@ -10,7 +10,7 @@ from __future__ import annotations
 STAGES: dict[str, str] = {
     "graph": "Live ROS graph",
     "plot": "Live plot",  # topic rates, and the values of number topics, over time
-    "image": "Camera images",  # the camera's pictures and a node's output beside
+    "image": "Camera images",  # the camera's pictures and a node's output under them
     "lifecycle": "Lifecycle states",  # a managed node's state machine, its state lit
     "bag": "Newest bag",  # what the newest recording holds, and when each message came
     "turtlesim": "Turtlesim",

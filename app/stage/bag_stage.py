@@ -105,6 +105,7 @@ class BagStage:
         with self._box:
             self._heading = MarkdownView(gui, NO_BAG)
             self._timeline = gui.add_html("")
+            self._timeline_svg = ""
             self._info = MarkdownView(gui, "")
 
     def set_active(self, active: bool) -> None:
@@ -127,7 +128,7 @@ class BagStage:
             return
         if not (newest / "metadata.yaml").exists():  # rosbag2 writes it when a recording ends
             self._heading.show(f"**`{newest.name}`** · {BEING_RECORDED}")
-            self._timeline.content = ""
+            self._set_timeline("")
             self._info.show("")
             return
         self._reading = True
@@ -140,7 +141,7 @@ class BagStage:
         def failed(text: str) -> None:  # being recorded (no summary yet), or damaged
             self._reading = False
             self._heading.show(f"**`{newest.name}`** · {text}")
-            self._timeline.content = ""
+            self._set_timeline("")
             self._info.show("")
 
         self._ui.run_job(lambda: read_bag(newest), done, failed)
@@ -148,7 +149,7 @@ class BagStage:
     def _show_nothing(self) -> None:
         self._shown = None
         self._heading.show(NO_BAG)
-        self._timeline.content = ""
+        self._set_timeline("")
         self._info.show("")
 
     def _show(self, picture: BagPicture) -> None:
@@ -158,8 +159,14 @@ class BagStage:
             f"{info.duration_ns / 1e9:.1f} s · {human_size(info.size)} · "
             f"`ros2 bag info {info.path.name}`"
         )
-        self._timeline.content = timeline_svg(picture)
+        self._set_timeline(timeline_svg(picture))
         self._info.show(code_block(info_lines(info)))
+
+    def _set_timeline(self, svg: str) -> None:
+        """Sent to the page only when it changes (the folder is looked at every 2 s)."""
+        if svg != self._timeline_svg:
+            self._timeline_svg = svg
+            self._timeline.content = svg
 
     def close(self) -> None:
         pass

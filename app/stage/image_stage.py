@@ -1,4 +1,4 @@
-"""Camera images on stage: what the camera sends, and beside it what a node made of it.
+"""Camera images on stage: what the camera sends, and under it what a node made of it.
 
 The images lesson's evidence: ``/camera/image_raw`` as ``image_publisher`` draws
 it, and ``object_detector``'s picture with the ball it found circled
@@ -22,7 +22,7 @@ IMAGE_TYPE = "sensor_msgs/msg/Image"
 PANES = 2
 NOTHING = (
     "_No camera image on the graph yet._ Start `image_publisher` from the step's button: "
-    "its pictures show here, and what `object_detector` finds in them beside."
+    "its pictures show here, and under them what `object_detector` finds in them."
 )
 
 

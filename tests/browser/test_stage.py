@@ -36,6 +36,11 @@ def _open(browser, dashboard, size: tuple[int, int]) -> Page:
     return page
 
 
+def _open_lesson_ending(page: Page, suffix: str) -> None:
+    """Open the lesson whose id ends with ``suffix`` (numbers change, names stay)."""
+    open_lesson(page, next(x for x in load_course().lessons if x.id.endswith(suffix)))
+
+
 def _node_names(node) -> list[str]:
     return [ns.rstrip("/") + "/" + name for name, ns in node.get_node_names_and_namespaces()]
 
@@ -300,8 +305,7 @@ def test_the_plot_stage_shows_the_executor_demo_starved_then_not(browser, dashbo
     near 3 Hz, the multi-threaded one's near 10, as lines and as the table's last values."""
     page = _open(browser, dashboard, (1366, 768))
     try:
-        lesson = next(x for x in load_course().lessons if x.id.endswith("executors"))
-        open_lesson(page, lesson)
+        _open_lesson_ending(page, "executors")
         _wait_stage(page, "plot")
         expect_text(page, "No topic has a publisher yet")
         page.get_by_role("button", name="Start executor_demo (single-threaded)").click()
@@ -343,8 +347,7 @@ def test_the_image_stage_shows_the_camera_and_the_detectors_picture(browser, das
     """Lesson 14 puts the camera's pictures on stage, then the detector's beside them."""
     page = _open(browser, dashboard, (1366, 768))
     try:
-        lesson = next(x for x in load_course().lessons if x.id.endswith("images_opencv"))
-        open_lesson(page, lesson)
+        _open_lesson_ending(page, "images_opencv")
         _wait_stage(page, "image")
         page.get_by_role("button", name="Start image_publisher").click()
         expect_text(page, re.compile(r"/camera/image_raw.*640×480 `?bgr8"), timeout=60_000)
@@ -354,7 +357,7 @@ def test_the_image_stage_shows_the_camera_and_the_detectors_picture(browser, das
         page.get_by_role("button", name="Start object_detector").click()
         expect_text(page, re.compile(r"/object_detection/output.*Hz"), timeout=60_000)
         expect_text(page, re.compile(r"/camera/image_raw.*Hz"))
-        # Two pictures, side by side in the stage's window (left of the control column).
+        # Two pictures, one under the other in the stage's window (left of the column).
         images = page.locator("img").filter(visible=True)
         picker = page.get_by_label("On stage").bounding_box()
         boxes = [images.nth(i).bounding_box() for i in range(images.count())]
@@ -370,8 +373,7 @@ def test_the_lifecycle_stage_lights_the_state_and_its_edges_change_it(browser, d
     blue edge of the drawing both move the node, and the lit state follows."""
     page = _open(browser, dashboard, (1366, 768))
     try:
-        lesson = next(x for x in load_course().lessons if x.id.endswith("lifecycle"))
-        open_lesson(page, lesson)
+        _open_lesson_ending(page, "lifecycle")
         _wait_stage(page, "lifecycle")
         page.get_by_role("button", name="Start lifecycle_talker").click()
         expect_text(page, re.compile(r"Current state of /lifecycle_talker: unconfigured"), 60_000)
@@ -398,8 +400,7 @@ def test_the_bag_stage_shows_a_recording_as_it_ends(browser, ros_env, tmp_path):
     dashboard = DashboardProcess(env, free_port(), ["--progress-dir", str(tmp_path / "p")])
     page = _open(browser, dashboard, (1366, 768))
     try:
-        lesson = next(x for x in load_course().lessons if x.id.endswith("bags"))
-        open_lesson(page, lesson)
+        _open_lesson_ending(page, "bags")
         page.get_by_role("button", name="Start the talker").click()
         page.get_by_role("button", name="Next", exact=True).click(timeout=60_000)
         _wait_stage(page, "bag")
