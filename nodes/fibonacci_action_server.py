@@ -61,6 +61,7 @@ class FibonacciActionServer(Node):
         self.goal_lock = threading.Lock()  # guards current_goal and goal state changes
         self.current_goal: ServerGoalHandle | None = None
         self.shutting_down = threading.Event()  # set by stop_goals() on Ctrl+C or SIGTERM
+        self.context.on_shutdown(self.stop_goals)  # wakes a sleeping goal as ROS shuts down
         self.action_server = ActionServer(
             self,
             Fibonacci,
@@ -101,8 +102,20 @@ class FibonacciActionServer(Node):
         return CancelResponse.ACCEPT
 
     def execute_goal(self, goal_handle: ServerGoalHandle) -> Fibonacci.Result:
+        sequence: list[int] = []
+        try:
+            return self.compute(goal_handle, sequence)
+        except Exception:
+            if self.context.ok():
+                raise
+            # Ctrl+C or SIGTERM shut ROS down in the middle of a step (while publishing
+            # feedback, say): the node is ending, so the goal ends quietly with it.
+            return self.abandon_goal(goal_handle, sequence)
+
+    def compute(self, goal_handle: ServerGoalHandle, sequence: list[int]) -> Fibonacci.Result:
+        """Grow ``sequence`` one number per step, with feedback, to the goal's order."""
         order = goal_handle.request.order
-        sequence = [0, 1][: order + 1]
+        sequence += [0, 1][: order + 1]
         self.get_logger().info(f"Executing goal: order {order}")
         self.send_feedback(goal_handle, sequence)
         while len(sequence) < order + 1:

@@ -166,7 +166,9 @@ def test_fibonacci_feedback_result_rejection_cancel_and_preemption(supervisor, p
     wait_until(lambda: len(running.feedback) >= 2, what="a goal running before the stop")
     stopped = supervisor.stop("fibonacci_action_server").result(timeout=20)
     assert stopped.exit_code == 0, supervisor.output("fibonacci_action_server", last=20)
-    assert not output_has(supervisor, "fibonacci_action_server", "Traceback")
+    assert not output_has(supervisor, "fibonacci_action_server", "Traceback"), "\n".join(
+        supervisor.output("fibonacci_action_server", last=30)
+    )
 
 
 # -- lifecycle -----------------------------------------------------------------
