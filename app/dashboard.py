@@ -29,7 +29,7 @@ from app.lessons.schema import load_course
 from app.panels.actions_panel import ActionsPanel
 from app.panels.bags_panel import BagsPanel
 from app.panels.echo_panel import EchoPanel
-from app.panels.graph_panel import GraphPanel, SharedRates
+from app.panels.graph_panel import GraphPanel
 from app.panels.lifecycle_panel import LifecyclePanel
 from app.panels.logs_panel import LogsPanel
 from app.panels.nodes_panel import NodesPanel
@@ -40,13 +40,14 @@ from app.panels.tf_panel import TfPanel
 from app.panels.topics_panel import TopicsPanel
 from app.panels.turtlesim_panel import TurtlesimPanel
 from app.ros.graph import GraphSnapshot, snapshot
+from app.ros.rates import SharedRates
 from app.ros.rosout import RosoutLog
 from app.ros.runtime import RosRuntime
 from app.ros2cli.console_panel import ConsolePanel
 from app.scene.grid import add_floor_grid
 from app.stage.window import Stage
 from app.supervisor import NodeState, Supervisor
-from app.ui import GROUP_OF, TAB_NAMES, TOOL_GROUPS, MarkdownView, Panel
+from app.ui import GROUP_OF, TAB_NAMES, TOOL_GROUPS, TOOLS, MarkdownView, Panel
 from app.ui.loop import UiLoop
 from app.ui.page_fixes import page_fixes_html
 from app.ui.page_links import PageLinks
@@ -57,21 +58,6 @@ log = logging.getLogger(__name__)
 
 UI_PERIOD_SEC = 0.2  # panels refresh at 5 Hz
 GRAPH_CHECK_SEC = 0.02  # ...and within 20 ms of a node joining/leaving or an intent
-
-_ICONS = {
-    "Lessons": viser.Icon.SCHOOL, "Exercise": viser.Icon.PENCIL, "Nodes": viser.Icon.CPU,
-    "Turtlesim": viser.Icon.PAW,
-    "Graph": viser.Icon.SITEMAP,
-    "Echo": viser.Icon.MESSAGE, "3D view": viser.Icon.CUBE, "TF": viser.Icon.BINARY_TREE,
-    "Topics": viser.Icon.LIST_DETAILS,
-    "Parameters": viser.Icon.ADJUSTMENTS, "Console": viser.Icon.TERMINAL,
-    "Services": viser.Icon.ARROWS_EXCHANGE, "Actions": viser.Icon.ROCKET,
-    "Lifecycle": viser.Icon.PROGRESS, "Logs": viser.Icon.FILE_TEXT, "Bags": viser.Icon.DATABASE,
-}  # fmt: skip
-_GROUP_ICONS = {
-    "Learn": viser.Icon.SCHOOL, "Run": viser.Icon.PLAYER_PLAY, "Inspect": viser.Icon.ZOOM_IN,
-    "Interact": viser.Icon.HAND_CLICK, "See": viser.Icon.EYE, "Record": viser.Icon.PLAYER_RECORD,
-}  # fmt: skip
 
 
 class Dashboard:
@@ -200,11 +186,11 @@ class Dashboard:
         # Tools grouped as a learner thinks of them: a tab per group, a tab per tool inside.
         groups = gui.add_tab_group()
         built: dict[str, Panel] = {}
-        for group, names in TOOL_GROUPS.items():
-            with groups.add_tab(group, _GROUP_ICONS[group]):
+        for group, declared in TOOLS.items():
+            with groups.add_tab(group, declared.icon):
                 tools = gui.add_tab_group()
-                for name in names:
-                    with tools.add_tab(name, _ICONS[name]):
+                for name, icon in declared.tools.items():
+                    with tools.add_tab(name, icon):
                         built[name] = builders[name]()
         panels = [built[name] for name in TAB_NAMES]
         self._tools = built

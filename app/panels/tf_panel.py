@@ -6,7 +6,7 @@ publisher node, rate, age, static or dynamic, and stale frames said in words;
 a tf2_echo readout (a real tf2 lookup) for two frames the learner picks;
 and the picture the last ``ros2 run tf2_tools view_frames`` drew.
 
-Data comes from ``app.scene.tf_sources`` (its own thread); this panel reads
+Data comes from ``app.ros.tf_sources`` (its own thread); this panel reads
 copies on the UI thread and never waits on ROS.
 """
 
@@ -23,9 +23,9 @@ from rclpy.time import Time
 from tf2_ros import TransformException
 from tf2_ros.tools.tf2_echo import format_transform
 
+from app.ros import tf_sources
 from app.ros.graph import GraphSnapshot
-from app.scene import tf_sources
-from app.scene.tf_sources import FrameInfo, TfSources
+from app.ros.tf_sources import FrameInfo, TfSources
 from app.supervisor import Supervisor
 from app.ui import MarkdownView, assign, code_block, set_options
 from app.ui.loop import UiLoop

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.topic_endpoint_info import TopicEndpointInfo
 
 # Measuring (hz, bw, rates) subscribes best effort: it must never slow a
 # reliable publisher, and it hears best-effort and reliable ones alike.
@@ -17,21 +19,35 @@ MEASURE_QOS = QoSProfile(
 )
 
 
-def matching_qos(node: Node, topic: str, depth: int = 10) -> QoSProfile:
-    """A subscription QoS every current publisher is compatible with (as ros2 echo picks it)."""
-    publishers = node.get_publishers_info_by_topic(topic)
-    reliable = bool(publishers) and all(
+def matching_qos(node: Node, topic: str, depth: int = 10, *, latched: bool = True) -> QoSProfile:
+    """A subscription QoS every current publisher is compatible with (as ros2 echo picks it).
+
+    ``latched=False``: volatile even when every publisher keeps its last message
+    for late joiners (a view that wants only what is new).
+    """
+    qos = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth)
+    return suit_publishers(qos, node.get_publishers_info_by_topic(topic), latched=latched)
+
+
+def suit_publishers(
+    qos: QoSProfile, publishers: Sequence[TopicEndpointInfo], *, latched: bool = True
+) -> QoSProfile:
+    """``qos`` made reliable only when every publisher offers reliable delivery (a
+    reliable reader cannot hear a best-effort writer), and transient local only when
+    every one keeps its last messages for late joiners (a volatile writer cannot
+    serve a transient-local reader). No publishers: best effort and volatile."""
+    every = bool(publishers)
+    reliable = every and all(
         p.qos_profile.reliability == ReliabilityPolicy.RELIABLE for p in publishers
     )
-    transient = bool(publishers) and all(
-        p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for p in publishers
+    transient = (
+        latched
+        and every
+        and all(p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for p in publishers)
     )
-    return QoSProfile(
-        history=HistoryPolicy.KEEP_LAST,
-        depth=depth,
-        reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
-        durability=DurabilityPolicy.TRANSIENT_LOCAL if transient else DurabilityPolicy.VOLATILE,
-    )
+    qos.reliability = ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT
+    qos.durability = DurabilityPolicy.TRANSIENT_LOCAL if transient else DurabilityPolicy.VOLATILE
+    return qos
 
 
 def qos_lines(qos: QoSProfile) -> list[str]:

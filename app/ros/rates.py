@@ -133,6 +133,73 @@ class RateBoard:
             monitor.close()
 
 
+class SharedRates:
+    """One ``RateBoard`` for several views of the graph (the Graph tab, the stage's graph and plot).
+
+    Each drawing says which topics it wants; the board measures their union, so
+    a topic two drawings show is subscribed once (a 1 kHz topic costs per
+    subscription).
+    """
+
+    def __init__(self, node: Node) -> None:
+        self._board = RateBoard(node)
+        self._lock = threading.Lock()
+        self._wishes: dict[int, dict[str, str]] = {}
+
+    def client(self) -> SharedRatesClient:
+        with self._lock:
+            key = len(self._wishes)
+            self._wishes[key] = {}
+        return SharedRatesClient(self, key)
+
+    def _watch(self, key: int, topics: dict[str, str]) -> None:
+        with self._lock:
+            if self._wishes.get(key) == topics:
+                return
+            self._wishes[key] = dict(topics)
+            union: dict[str, str] = {}
+            for wish in self._wishes.values():
+                union.update(wish)
+        self._board.watch(union)
+
+    def rate(self, topic: str, window_sec: float = RATE_WINDOW_SEC) -> float | None:
+        return self._board.rate(topic, window_sec)
+
+    def latest(self, topic: str) -> tuple[float, Any] | None:
+        return self._board.latest(topic)
+
+    def watched(self) -> list[str]:
+        return self._board.watched()
+
+    def close(self) -> None:
+        self._board.close()
+
+
+class SharedRatesClient:
+    """One drawing's view of ``SharedRates``: the RateBoard calls it uses."""
+
+    def __init__(self, shared: SharedRates, key: int) -> None:
+        self._shared, self._key = shared, key
+        self._wanted: set[str] = set()
+
+    def watch(self, topics: dict[str, str]) -> None:
+        self._wanted = set(topics)
+        self._shared._watch(self._key, topics)
+
+    def rate(self, topic: str, window_sec: float = RATE_WINDOW_SEC) -> float | None:
+        return self._shared.rate(topic, window_sec)
+
+    def latest(self, topic: str) -> tuple[float, Any] | None:
+        return self._shared.latest(topic)
+
+    def watched(self) -> list[str]:
+        """What this drawing asked for and is measured."""
+        return [t for t in self._shared.watched() if t in self._wanted]
+
+    def close(self) -> None:
+        self.watch({})
+
+
 def rate_text(rate: float | None) -> str:
     """'2.0 Hz', 'silent', or '' when not measured."""
     if rate is None:

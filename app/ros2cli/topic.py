@@ -35,7 +35,7 @@ from app.ros.convert import (
 from app.ros.errors import Ros2Error
 from app.ros.graph import topic_types
 from app.ros.monitor import TopicMonitor
-from app.ros.qos import MEASURE_QOS
+from app.ros.qos import MEASURE_QOS, suit_publishers
 from app.ros2cli.common import (
     Ros2cliMessage,
     SilentFailure,
@@ -202,14 +202,7 @@ def _echo_qos(ctx: CallContext, topic: str, options: QosOptions) -> QoSProfile |
     if options.profile == ECHO_QOS.profile:
         return None  # the same choice, made by app.ros.qos.matching_qos
     qos = QoSPresetProfiles.get_from_short_key(options.profile)
-    if publishers:
-        reliable = all(p.qos_profile.reliability == ReliabilityPolicy.RELIABLE for p in publishers)
-        latched = all(
-            p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for p in publishers
-        )
-        qos.reliability = ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT
-        qos.durability = DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE
-    return qos
+    return suit_publishers(qos, publishers) if publishers else qos
 
 
 def _full_topic_name(ctx: CallContext, topic: str) -> str:

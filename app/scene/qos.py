@@ -11,19 +11,13 @@ from __future__ import annotations
 
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import QoSProfile
+
+from app.ros.qos import matching_qos
 
 
 def newest_only_qos(node: Node, topic: str) -> QoSProfile:
-    infos = node.get_publishers_info_by_topic(topic)
-    reliable = bool(infos) and all(
-        info.qos_profile.reliability == ReliabilityPolicy.RELIABLE for info in infos
-    )
-    return QoSProfile(
-        depth=1,
-        reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
-        durability=DurabilityPolicy.VOLATILE,
-    )
+    return matching_qos(node, topic, depth=1, latched=False)
 
 
 # The scene's callbacks only drop a message into a box, so they may run

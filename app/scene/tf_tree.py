@@ -20,8 +20,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-STALE_MIN_SEC = 1.0  # a dynamic frame is stale after this long without news...
-STALE_PERIODS = 5.0  # ...or after this many of its own periods, if that is longer
+from app.ros.tf_sources import STALE_MIN_SEC, STALE_PERIODS
+
 QUATERNION_TOLERANCE = 10e-3  # tf2 ignores a rotation whose squared length is further from 1
 
 

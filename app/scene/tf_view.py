@@ -10,7 +10,7 @@ NaN or zero-length quaternion, a loop of frames) is one line in the status
 and in the log; nothing is drawn from it and nothing stops.
 
 Threads: /tf and /tf_static come from the dashboard's one TF reader
-(``app.scene.tf_sources``, shared with the TF panel), whose thread only
+(``app.ros.tf_sources``, shared with the TF panel), whose thread only
 stores the transforms; the /robot_description callback (executor) drops the
 text into a one-slot box; a drawing thread of this layer parses
 descriptions and moves scene nodes, at most ``MAX_HZ`` times a second.
@@ -31,7 +31,7 @@ from robot_state_publisher.urdf_tree import UrdfError
 from std_msgs.msg import String
 from tf2_ros._wire import Entry
 
-from app.scene import tf_sources
+from app.ros import tf_sources
 from app.scene import transforms as tf
 from app.scene.qos import SCENE_CALLBACK_GROUP
 from app.scene.robot_model import RobotDrawing, SliderJoint, build_drawing

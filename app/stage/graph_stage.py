@@ -12,10 +12,9 @@ from collections.abc import Callable
 import viser
 from rclpy.node import Node
 
-from app.panels.graph_panel import SharedRatesClient
 from app.panels.graph_svg import Edge, Vertex, graph_picture, topics_to_measure
 from app.ros.graph import GraphSnapshot, NodeEndpoints, node_endpoints
-from app.ros.rates import RateBoard, RateHold, rate_text
+from app.ros.rates import RateBoard, RateHold, SharedRatesClient, rate_text
 from app.stage.graph_view import (
     PER_ROW,
     STARTING,

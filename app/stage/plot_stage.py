@@ -17,11 +17,10 @@ import numpy as np
 import viser
 import viser.uplot as uplot
 
-from app.panels.graph_panel import SharedRatesClient
 from app.panels.graph_svg import HEAVY_TYPES
 from app.ros.graph import GraphSnapshot
 from app.ros.names import QUIET_TOPICS, is_internal_topic
-from app.ros.rates import MAX_RATE_WINDOW_SEC, rate_text
+from app.ros.rates import MAX_RATE_WINDOW_SEC, SharedRatesClient, rate_text
 from app.ui import MarkdownView
 
 WINDOW_SEC = 60.0

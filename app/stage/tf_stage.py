@@ -2,13 +2,14 @@
 
 ``ros2 run tf2_tools view_frames`` listens to ``/tf`` and ``/tf_static`` for a
 few seconds and draws the tree with, on each edge, who broadcasts it, how
-often and how much of it is buffered. The stage listens the same way, all the
-time it is shown, and redraws the same picture (tf2_tools' own drawing) each
-second when the tree changed: a learner who starts a broadcaster sees its
-frame join the tree.
+often and how much of it is buffered. The stage listens all the time it is
+shown, through the dashboard's one TF reader (``app.ros.tf_sources``, which
+the TF tool and the 3D view read too), and redraws the same picture
+(tf2_tools' own drawing) each second when the tree changed: a learner who
+starts a broadcaster sees its frame join the tree.
 
-Threads: the subscriptions (executor thread) record under a lock; the stage
-(UI thread) subscribes, unsubscribes and reads.
+Threads: the TF reader's thread records under a lock; the stage (UI thread)
+starts and stops listening, and reads.
 """
 
 from __future__ import annotations
@@ -22,16 +23,13 @@ from typing import Any
 
 import viser
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile
-from rclpy.subscription import Subscription
-from tf2_msgs.msg import TFMessage
+from tf2_ros._wire import Entry
 from tf2_tools.frames_svg import render
 
+from app.ros import tf_sources
 from app.ros.graph import GraphSnapshot
 from app.ui import MarkdownView
 
-TF_QOS = QoSProfile(depth=100)
-STATIC_QOS = QoSProfile(depth=100, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 BUFFER_SEC = 10.0  # tf2's default cache: transforms older than this are dropped
 STATIC_RATE = 10000.0  # what view_frames reports for a static transform
 REDRAW_SEC = 1.0
@@ -59,12 +57,13 @@ class TfRecorder:
         self._frames: dict[str, _Frame] = {}
         self.version = 0
 
-    def add(self, msg: TFMessage, static: bool, now: float | None = None) -> None:
+    def add(self, transforms: list[Entry], static: bool, now: float | None = None) -> None:
+        """One /tf or /tf_static message's transforms, as the TF reader decodes them."""
         now = time.monotonic() if now is None else now
         with self._lock:
-            for t in msg.transforms:
-                parent = t.header.frame_id.strip().lstrip("/")
-                child = t.child_frame_id.strip().lstrip("/")
+            for frame_id, child_frame_id, stamp_ns, _translation, _rotation in transforms:
+                parent = frame_id.strip().lstrip("/")
+                child = child_frame_id.strip().lstrip("/")
                 if not parent or not child or parent == child:
                     continue  # tf2 ignores these too
                 frame = self._frames.get(child)
@@ -75,7 +74,7 @@ class TfRecorder:
                 if frame.parent != parent or frame.static != static:
                     self.version += 1  # the tree changed shape
                 frame.parent, frame.static = parent, static
-                frame.stamps.append(t.header.stamp.sec + t.header.stamp.nanosec * 1e-9)
+                frame.stamps.append(stamp_ns * 1e-9)
                 frame.arrivals.append(now)
 
     def clear(self) -> None:
@@ -138,7 +137,7 @@ class TfStage:
     def __init__(self, gui: viser.GuiApi, node: Node) -> None:
         self._node = node
         self.recorder = TfRecorder()
-        self._subs: list[Subscription] = []
+        self._sources: tf_sources.TfSources | None = None  # while shown
         self._drawn = (-1, 0.0)
         self._html = ""
         self._box = gui.add_folder(None, visible=False)
@@ -149,25 +148,28 @@ class TfStage:
 
     def set_active(self, active: bool) -> None:
         self._box.visible = active
-        if active and not self._subs:
-            record = self.recorder.add
-            self._subs = [
-                self._node.create_subscription(
-                    TFMessage, "/tf", lambda m: record(m, False), TF_QOS
-                ),
-                self._node.create_subscription(
-                    TFMessage, "/tf_static", lambda m: record(m, True), STATIC_QOS
-                ),
-            ]
+        if active and self._sources is None:
+            sources = self._sources = tf_sources.shared(self._node)
+            # A fresh /tf_static subscription hears every latched frame again; the shared
+            # reader heard them already: those whose broadcaster is still here join now.
+            self.recorder.add(
+                [
+                    (f.parent, f.frame, 0, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
+                    for f in sources.frames()
+                    if f.static and f.parent and f.publisher_here
+                ],
+                static=True,
+            )
+            sources.on_transforms(self.recorder.add)
             self._drawn = (-1, 0.0)
-        elif not active and self._subs:
-            for sub in self._subs:
-                self._node.destroy_subscription(sub)
-            self._subs = []
+        elif not active and self._sources is not None:
+            self._sources.remove_sink(self.recorder.add)
+            tf_sources.release(self._sources)
+            self._sources = None
             self.recorder.clear()  # a later look starts afresh, as view_frames does
 
     def refresh(self, graph: GraphSnapshot) -> None:
-        if not self._subs:
+        if self._sources is None:
             return
         now = time.monotonic()
         version, drawn_at = self._drawn

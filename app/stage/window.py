@@ -17,8 +17,8 @@ from typing import Any, Protocol
 import viser
 from rclpy.node import Node
 
-from app.panels.graph_panel import SharedRates
 from app.ros.graph import GraphSnapshot
+from app.ros.rates import SharedRates
 from app.ros.rosout import RosoutLog
 from app.stage import DEFAULT_STAGE, STAGES
 from app.stage.bag_stage import BagStage

@@ -39,21 +39,55 @@ viser (1.1.1) from each thread:
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any, Protocol
 
+import viser
+
 from app.ros.graph import GraphSnapshot
+
 
 # The dashboard's tools, grouped as a learner thinks of them: what I learn with, what I
 # run, what I watch flowing through the running system, how I ask its nodes to do or
 # change something, what I see in 3D, what I record. Each group is a tab holding its
-# tools' tabs, one row each. A new tool joins the group it belongs to.
+# tools' tabs, one row each. A new tool joins the group it belongs to, here, with its
+# icon; the dashboard says how to build it (``app/dashboard.py``, keyed by its name).
+@dataclass(frozen=True)
+class ToolGroup:
+    icon: viser.IconName
+    tools: dict[str, viser.IconName]  # each tool's tab name -> its icon, in tab order
+
+
+Icon = viser.Icon
+TOOLS: dict[str, ToolGroup] = {
+    "Learn": ToolGroup(Icon.SCHOOL, {"Lessons": Icon.SCHOOL, "Exercise": Icon.PENCIL}),
+    "Run": ToolGroup(
+        Icon.PLAYER_PLAY, {"Nodes": Icon.CPU, "Console": Icon.TERMINAL, "Turtlesim": Icon.PAW}
+    ),
+    "Inspect": ToolGroup(
+        Icon.ZOOM_IN,
+        {
+            "Graph": Icon.SITEMAP,
+            "TF": Icon.BINARY_TREE,
+            "Topics": Icon.LIST_DETAILS,
+            "Echo": Icon.MESSAGE,
+            "Logs": Icon.FILE_TEXT,
+        },
+    ),
+    "Interact": ToolGroup(
+        Icon.HAND_CLICK,
+        {
+            "Services": Icon.ARROWS_EXCHANGE,
+            "Actions": Icon.ROCKET,
+            "Parameters": Icon.ADJUSTMENTS,
+            "Lifecycle": Icon.PROGRESS,
+        },
+    ),
+    "See": ToolGroup(Icon.EYE, {"3D view": Icon.CUBE}),
+    "Record": ToolGroup(Icon.PLAYER_RECORD, {"Bags": Icon.DATABASE}),
+}
 TOOL_GROUPS: dict[str, tuple[str, ...]] = {
-    "Learn": ("Lessons", "Exercise"),
-    "Run": ("Nodes", "Console", "Turtlesim"),
-    "Inspect": ("Graph", "TF", "Topics", "Echo", "Logs"),
-    "Interact": ("Services", "Actions", "Parameters", "Lifecycle"),
-    "See": ("3D view",),
-    "Record": ("Bags",),
+    group: tuple(declared.tools) for group, declared in TOOLS.items()
 }
 # Every tool tab, in order. Lessons name them ("Open the Lifecycle tool") and are
 # checked against this list when they load.

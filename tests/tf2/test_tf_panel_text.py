@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from app.panels.tf_panel import default_pair, describe, picture_path, stale_between, tree_markdown
-from app.scene.tf_sources import RATE_MIN_ARRIVALS, RATE_WINDOW, FrameInfo, _Record
+from app.ros.tf_sources import RATE_MIN_ARRIVALS, RATE_WINDOW, FrameInfo, _Record
 
 WORLD = FrameInfo("world", "")
 BASE = FrameInfo("base_link", "world", rate=50.0, age=0.01, publisher="/robot_state_publisher")

@@ -14,8 +14,8 @@ from geometry_msgs.msg import TransformStamped
 from tf2_msgs.msg import TFMessage
 from tf2_ros import StaticTransformBroadcaster
 
-from app.scene import tf_sources
-from app.scene.tf_sources import RATE_WINDOW, FrameInfo, TfSources
+from app.ros import tf_sources
+from app.ros.tf_sources import RATE_WINDOW, FrameInfo, TfSources
 from tests.conftest import wait_until
 from tests.integration.core_helpers import DISCOVERY_TIMEOUT
 

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 from pytransform3d import rotations as pr
 
-from app.exercises.probes.tf import angle_between, expected_joint_pose, yaw_of
-from app.lessons.checks._tf_watch import quaternion_from_rpy, rotation_angle, rpy_of
+from app.exercises.probes.tf import expected_joint_pose
+from app.ros.rotations import angle_between, quaternion_from_rpy, rotation_angle, rpy_of, yaw_of
 
 RNG = random.Random(23)
 

@@ -14,9 +14,10 @@ from sensor_msgs.msg import JointState
 from tf2_ros import Buffer, TransformException, TransformListener
 
 from app.exercises.probes.base import ProbeContext, register_probe
-from app.exercises.probes.tf import expected_joint_pose, quat_angle
+from app.exercises.probes.tf import expected_joint_pose
 from app.exercises.report import Result
 from app.lessons.schema import Spec
+from app.ros.rotations import rotation_angle as quat_angle
 
 
 def _vec3(value: Any) -> tuple[float, float, float]:

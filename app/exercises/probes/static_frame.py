@@ -8,11 +8,12 @@ import math
 import time
 
 from app.exercises.probes.base import ProbeContext, draw, register_probe
-from app.exercises.probes.tf import FrameTap, Seen, angle_between
+from app.exercises.probes.tf import FrameTap, Seen
 from app.exercises.report import Result
 from app.lessons.schema import Spec
 from app.ros import params
 from app.ros.errors import Ros2Error
+from app.ros.rotations import angle_between
 
 CHILD_WORDS = ("lidar", "camera", "imu", "gps", "sonar", "bumper", "antenna")
 PARENT_WORDS = ("world", "map", "odom", "base_link")

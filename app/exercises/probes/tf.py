@@ -9,17 +9,15 @@ import threading
 import time
 from dataclasses import dataclass
 
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from tf2_msgs.msg import TFMessage
 from turtlesim.srv import TeleportAbsolute
 
 from app.exercises.probes.base import ProbeContext
 from app.ros.calls import call_service
+from app.ros.rotations import yaw_of
+from app.ros.tf_sources import STATIC_QOS, TF_QOS
 
 WORLD_MIN, WORLD_MAX = 1.5, 9.5  # teleport targets: inside turtlesim's 11 m world, off the walls
-STATIC_QOS = QoSProfile(
-    depth=100, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
-)
 
 
 @dataclass(frozen=True)
@@ -36,17 +34,6 @@ class Seen:
     static: bool = False  # came on /tf_static
 
 
-def yaw_of(x: float, y: float, z: float, w: float) -> float:
-    """Yaw of a quaternion (normalised first, so a wrong length cannot hide a wrong angle)."""
-    n = math.sqrt(x * x + y * y + z * z + w * w) or 1.0
-    x, y, z, w = x / n, y / n, z / n, w / n
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
-def angle_between(a: float, b: float) -> float:
-    return abs(math.atan2(math.sin(a - b), math.cos(a - b)))
-
-
 class FrameTap:
     """Every transform on /tf and /tf_static, newest per child frame (executor thread writes)."""
 
@@ -58,7 +45,7 @@ class FrameTap:
             self._node.create_subscription(TFMessage, "/tf_static", self._on_static, STATIC_QOS)
         ]
         if not static_only:
-            self._subs.append(self._node.create_subscription(TFMessage, "/tf", self._on_tf, 100))
+            self._subs.append(self._node.create_subscription(TFMessage, "/tf", self._on_tf, TF_QOS))
 
     def _on_static(self, msg: TFMessage) -> None:
         self._on_tf(msg, static=True)
@@ -123,11 +110,6 @@ def _rotate(q: tuple[float, ...], v: tuple[float, float, float]) -> tuple[float,
     cx, cy, cz = y * v[2] - z * v[1], z * v[0] - x * v[2], x * v[1] - y * v[0]
     dx, dy, dz = y * cz - z * cy, z * cx - x * cz, x * cy - y * cx
     return (v[0] + 2 * (w * cx + dx), v[1] + 2 * (w * cy + dy), v[2] + 2 * (w * cz + dz))
-
-
-def quat_angle(a: tuple[float, ...], b: tuple[float, ...]) -> float:
-    dot = abs(sum(p * q for p, q in zip(a, b, strict=True)))
-    return 2.0 * math.acos(min(1.0, dot))
 
 
 def expected_joint_pose(

@@ -13,13 +13,13 @@ from app.exercises.probes.tf import (
     WORLD_MIN,
     FrameTap,
     Seen,
-    angle_between,
     pose_text,
     teleport,
 )
 from app.exercises.report import Result
 from app.lessons.schema import Spec
 from app.ros.errors import Ros2Error
+from app.ros.rotations import angle_between
 
 
 def _frame_mistake(seen: Seen, x: float, y: float, theta: float, tol: float) -> str:

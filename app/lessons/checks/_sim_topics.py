@@ -13,6 +13,7 @@ from functools import lru_cache
 from typing import TYPE_CHECKING, Any
 
 from app.lessons.checks._world_map import WorldMap, load_world_map
+from app.ros import rotations
 
 if TYPE_CHECKING:
     from app.lessons.runtime import LessonRuntime
@@ -43,7 +44,8 @@ def seconds(stamp: Any) -> float:
 
 
 def yaw_of(q: Any) -> float:
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    """Yaw of a geometry_msgs Quaternion."""
+    return rotations.yaw_of(q.x, q.y, q.z, q.w)
 
 
 def wrap(angle: float) -> float:

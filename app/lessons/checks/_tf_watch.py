@@ -13,29 +13,23 @@ executor thread and only store; checks read under the lock and never block.
 
 from __future__ import annotations
 
-import math
 import threading
 import time
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from tf2_msgs.msg import TFMessage
 from tf2_ros import Buffer
+
+from app.ros.tf_sources import STATIC_QOS, TF_QOS
 
 if TYPE_CHECKING:
     from app.lessons.runtime import LessonRuntime
 
-TF_QOS = QoSProfile(depth=100)
-# As tf2_ros.TransformListener: /tf_static is reliable and transient local.
-STATIC_QOS = QoSProfile(
-    depth=100, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
-)
-
 
 @dataclass
-class FrameInfo:
+class HeardFrame:
     """One child frame as the watch last heard it."""
 
     parent: str
@@ -51,7 +45,7 @@ class TfWatch:
         self.node = node
         self.buffer = Buffer()
         self.lock = threading.Lock()
-        self.frames: dict[str, FrameInfo] = {}
+        self.frames: dict[str, HeardFrame] = {}
         self.memory: dict[str, Any] = {}  # per check key: what a check remembers between calls
         self._subscriptions = [
             node.create_subscription(TFMessage, "/tf", self._on_tf, TF_QOS),
@@ -67,7 +61,7 @@ class TfWatch:
             with self.lock:
                 info = self.frames.get(t.child_frame_id)
                 if info is None or info.parent != t.header.frame_id or info.static != static:
-                    info = self.frames[t.child_frame_id] = FrameInfo(t.header.frame_id, static)
+                    info = self.frames[t.child_frame_id] = HeardFrame(t.header.frame_id, static)
                 info.updates += 1
                 info.last_seen = time.monotonic()
 
@@ -77,10 +71,10 @@ class TfWatch:
     def _on_static(self, msg: TFMessage) -> None:
         self._store(msg, static=True)
 
-    def frame(self, name: str) -> FrameInfo | None:
+    def frame(self, name: str) -> HeardFrame | None:
         with self.lock:
             info = self.frames.get(name)
-            return None if info is None else FrameInfo(**vars(info))
+            return None if info is None else HeardFrame(**vars(info))
 
     def known(self) -> list[str]:
         with self.lock:
@@ -133,34 +127,3 @@ def known_text(watch: TfWatch) -> str:
         return "no frames heard yet"
     shown = ", ".join(names[:12]) + (", ..." if len(names) > 12 else "")
     return f"frames heard: {shown}"
-
-
-def yaw_of(x: float, y: float, z: float, w: float) -> float:
-    """The yaw (rotation about z) of a quaternion, as tf2_echo's RPY shows it."""
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
-def rpy_of(x: float, y: float, z: float, w: float) -> tuple[float, float, float]:
-    """Roll, pitch, yaw (fixed axes, ROS convention) of a quaternion."""
-    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
-    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
-    return roll, pitch, yaw_of(x, y, z, w)
-
-
-def quaternion_from_rpy(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
-    """x, y, z, w of R = Rz(yaw) Ry(pitch) Rx(roll), as the tf2 tutorials compute it."""
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return (
-        sr * cp * cy - cr * sp * sy,
-        cr * sp * cy + sr * cp * sy,
-        cr * cp * sy - sr * sp * cy,
-        cr * cp * cy + sr * sp * sy,
-    )
-
-
-def rotation_angle(a: tuple[float, ...], b: tuple[float, ...]) -> float:
-    """The angle (rad) of the rotation between two unit quaternions (x, y, z, w)."""
-    dot = abs(sum(p * q for p, q in zip(a, b, strict=True)))
-    return 2.0 * math.acos(min(1.0, dot))

@@ -18,8 +18,9 @@ from typing import TYPE_CHECKING, Any
 
 from tf2_msgs.msg import TFMessage
 
-from app.lessons.checks._tf_watch import STATIC_QOS, watch_of
+from app.lessons.checks._tf_watch import watch_of
 from app.lessons.registry import FAIL, PASS, WAITING, CheckResult, register_check
+from app.ros.tf_sources import STATIC_QOS
 
 if TYPE_CHECKING:
     from app.lessons.runtime import LessonRuntime

@@ -8,8 +8,9 @@ from typing import TYPE_CHECKING
 from rclpy.time import Time
 from tf2_ros import TransformException
 
-from app.lessons.checks._tf_watch import known_text, nobody_publishes, rotation_angle, watch_of
+from app.lessons.checks._tf_watch import known_text, nobody_publishes, watch_of
 from app.lessons.registry import FAIL, PASS, WAITING, CheckResult, register_check
+from app.ros.rotations import rotation_angle
 
 if TYPE_CHECKING:
     from app.lessons.runtime import LessonRuntime

@@ -8,14 +8,9 @@ from typing import TYPE_CHECKING
 from rclpy.time import Time
 from tf2_ros import TransformException
 
-from app.lessons.checks._tf_watch import (
-    nobody_publishes,
-    quaternion_from_rpy,
-    rotation_angle,
-    rpy_of,
-    watch_of,
-)
+from app.lessons.checks._tf_watch import nobody_publishes, watch_of
 from app.lessons.registry import FAIL, PASS, WAITING, CheckResult, register_check
+from app.ros.rotations import quaternion_from_rpy, rotation_angle, rpy_of
 
 if TYPE_CHECKING:
     from app.lessons.runtime import LessonRuntime

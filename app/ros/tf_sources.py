@@ -1,6 +1,12 @@
-"""Who publishes each TF frame, how often, how long ago, and a tf2 Buffer fed from the same data.
+"""The dashboard's one reader of /tf and /tf_static: who publishes each frame, how often,
+how long ago, and a tf2 Buffer fed from the same data.
 
-The TF panel needs, per frame, the node that broadcasts it. A /tf message
+The TF tool, the 3D view's TF layer and the stage's TF tree read it
+(``shared(node)``): /tf is taken and decoded once per dashboard, whichever
+of them are open. It is also the home of how every /tf reader of ours
+subscribes (``TF_QOS``, ``STATIC_QOS``) and when a frame counts as stale.
+
+The TF tool needs, per frame, the node that broadcasts it. A /tf message
 names frames, never its sender; the middleware knows the sender (each
 received sample carries its writer's GID, ``rmw_message_info_t.publisher_gid``)
 and the graph maps every writer's GID to its node
@@ -40,7 +46,6 @@ from tf2_ros._wire import Entry, decode_tf_message
 from tf2_ros.buffer import Buffer
 
 from app.ros.names import node_fqn
-from app.scene.tf_tree import STALE_MIN_SEC, STALE_PERIODS
 
 log = logging.getLogger(__name__)
 
@@ -56,6 +61,10 @@ RATE_WINDOW = 20  # arrivals a frame's rate is measured over...
 RATE_MIN_ARRIVALS = 5  # ...and the fewest that give one: from 2 or 3, one late sample skews it
 RCL_RET_OK = 0
 RCL_RET_SUBSCRIPTION_TAKE_FAILED = 401  # nothing to take
+STALE_MIN_SEC = 1.0  # a dynamic frame is stale after this long without news...
+STALE_PERIODS = 5.0  # ...or after this many of its own periods, if that is longer
+# As tf2_ros.TransformListener subscribes (every /tf reader of ours does the same):
+# /tf keeps 100, /tf_static is reliable and transient local, so a late joiner hears it.
 TF_QOS = QoSProfile(depth=100, history=HistoryPolicy.KEEP_LAST)
 STATIC_QOS = QoSProfile(
     depth=100,
