@@ -47,7 +47,7 @@ from app.ros2cli.console_panel import ConsolePanel
 from app.scene.grid import add_floor_grid
 from app.stage.window import Stage
 from app.supervisor import NodeState, Supervisor
-from app.ui import GROUP_OF, TAB_NAMES, TOOL_GROUPS, TOOLS, MarkdownView, Panel
+from app.ui import GROUP_OF, TAB_NAMES, TOOL_GROUPS, TOOLS, Inspector, MarkdownView, Panel
 from app.ui.loop import UiLoop
 from app.ui.page_fixes import page_fixes_html
 from app.ui.page_links import PageLinks
@@ -225,18 +225,11 @@ class Dashboard:
         return found
 
     def _inspect(self, kind: str, name: str, type_text: str) -> None:
-        """A box clicked on the stage: the tools that show more of it pick it (UI thread)."""
-        tools = self._tools
-        if kind == "topic":
-            cast(TopicsPanel, tools["Topics"]).preselect(name)
-            cast(EchoPanel, tools["Echo"]).show_topic(name, type_text)
-        elif kind == "node":
-            cast(ParametersPanel, tools["Parameters"]).preselect(name)
-            cast(NodesPanel, tools["Nodes"]).preselect(name)
-        elif kind == "service":
-            cast(ServicesPanel, tools["Services"]).preselect(name)
-        elif kind == "action":
-            cast(ActionsPanel, tools["Actions"]).preselect(name)
+        """A box clicked on the stage: every tool that shows more of such a thing picks
+        it (UI thread); each tool says which kinds it shows."""
+        for tool in self._tools.values():
+            if isinstance(tool, Inspector):
+                tool.inspect(kind, name, type_text)
 
     def _program_output(self) -> tuple[str, list[str]]:
         """The learner's most recently started program (not a catalog node): its name and

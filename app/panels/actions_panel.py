@@ -36,9 +36,9 @@ class ActionsPanel:
         self._cancel.on_click(ui.callback(self._do_cancel))
         self._selector.on_update(ui.callback(self._rebuild_form))
 
-    def preselect(self, name: str) -> None:
-        """Pick ``name`` (a click on the stage graph; UI thread); one not listed is left."""
-        if name in self._selector.options and name != self._selector.value:
+    def inspect(self, kind: str, name: str, type_text: str) -> None:
+        """An action clicked on the stage graph (UI thread): pick it; one not listed is left."""
+        if kind == "action" and name in self._selector.options and name != self._selector.value:
             assign(self._selector, name)
             self._rebuild_form()
 

@@ -41,9 +41,9 @@ class EchoPanel:
         self._tap = TopicMonitor(node, TOPIC, String, keep=50, qos=10)
         self._view = MarkdownView(gui)
 
-    def show_topic(self, topic: str, type_text: str) -> None:
-        """Echo ``topic`` instead (a click on the stage graph; UI thread)."""
-        if topic == self._topic or not type_text:
+    def inspect(self, kind: str, topic: str, type_text: str) -> None:
+        """A topic clicked on the stage graph (UI thread): echo it instead."""
+        if kind != "topic" or topic == self._topic or not type_text:
             return
         if type_text in HEAVY_TYPES:
             self._note = f"`{topic}` carries {type_text}: see it in **See › 3D view**."

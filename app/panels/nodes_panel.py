@@ -145,8 +145,10 @@ class NodesPanel:
 
     # -- UI thread -------------------------------------------------------------
 
-    def preselect(self, node_name: str) -> None:
-        """Pick the catalog entry that makes ROS node ``node_name`` (a stage click)."""
+    def inspect(self, kind: str, node_name: str, type_text: str) -> None:
+        """A node clicked on the stage graph: pick the catalog entry that makes it."""
+        if kind != "node":
+            return
         entry = next((e for e in ENTRIES if e.node_name == node_name), None)
         if entry is not None:
             assign(self._selector, entry.name)

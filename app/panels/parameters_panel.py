@@ -149,9 +149,9 @@ class ParametersPanel:
 
     # --- loading ---------------------------------------------------------------
 
-    def preselect(self, node: str) -> None:
-        """Show ``node``'s parameters (a click on the stage graph; UI thread)."""
-        if node in self._nodes and node != self._selector.value:
+    def inspect(self, kind: str, node: str, type_text: str) -> None:
+        """A node clicked on the stage graph (UI thread): show its parameters."""
+        if kind == "node" and node in self._nodes and node != self._selector.value:
             assign(self._selector, node)
             self._select(node)
 

@@ -142,9 +142,9 @@ class TopicsPanel:
 
     # --- selection -------------------------------------------------------------
 
-    def preselect(self, topic: str) -> None:
-        """Follow ``topic`` (a click on the stage graph; UI thread)."""
-        if topic not in self._types:
+    def inspect(self, kind: str, topic: str, type_text: str) -> None:
+        """A topic clicked on the stage graph (UI thread): follow it."""
+        if kind != "topic" or topic not in self._types:
             return  # not on the graph (yet): the list would not keep it
         if topic != self._selector.value:
             set_options(self._selector, [NONE, *sorted(self._types)])

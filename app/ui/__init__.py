@@ -40,7 +40,7 @@ viser (1.1.1) from each thread:
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any, Protocol, runtime_checkable
 
 import viser
 
@@ -99,6 +99,14 @@ class Panel(Protocol):
     def refresh(self, graph: GraphSnapshot) -> None: ...
 
     def close(self) -> None: ...
+
+
+@runtime_checkable
+class Inspector(Protocol):
+    """A tool that shows more of a box clicked on the stage's graph: ``kind`` is node,
+    topic, service or action; a tool ignores the kinds it does not show."""
+
+    def inspect(self, kind: str, name: str, type_text: str) -> None: ...
 
 
 class MarkdownView:
