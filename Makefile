@@ -83,7 +83,7 @@ render:
 		SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
 		$$SUDO apt-get update -q && $$SUDO apt-get install -y -q libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6; }
 
-# Contained learner code runs under uids of its own (app/exercises/contain.py).
+# Contained learner code runs under uids of its own (app/containment/contain.py).
 # When Python lives under a private /root, those uids must be able to pass
 # through it: o+x lets them reach the interpreter, not list or read /root.
 sandbox: setup

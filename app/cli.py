@@ -87,7 +87,7 @@ def _access_token(args: argparse.Namespace) -> str | None:
 
 def _run_policy(args: argparse.Namespace, progress_dir: Path, workspace: Any) -> Any:
     """Learner code: as the user on loopback; served to others, only contained and allowed."""
-    from app.exercises.runner import RunPolicy
+    from app.containment.policy import RunPolicy
 
     if _is_loopback(args.host):
         return RunPolicy()
@@ -152,7 +152,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     # Behind the hub's login (serve --jupyterhub) only the learner reaches the dashboard.
     remote = hub_login is None and not _is_loopback(args.host)
     if remote:
-        from app.exercises.contain import SANDBOX_GID
+        from app.containment.contain import SANDBOX_GID
 
         setup_workspace(
             progress.path, remote=True, home=scratch_root / progress.path.stem, group=SANDBOX_GID
@@ -200,7 +200,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
 
 def _containment_line(allowed: bool) -> str:
     """What happens to learner code on a dashboard served to others, said at start."""
-    from app.exercises.sandbox import sandbox_available
+    from app.containment.sandbox import sandbox_available
 
     missing = sandbox_available()
     if missing is None:
@@ -250,7 +250,7 @@ def _hub_run_policy() -> Any:
     """Behind the hub's login only the learner (or an admin the hub lets in) reaches the
     dashboard, which runs as the learner, in their own container under a container
     spawner: their code runs as in their own terminal, as in the Jupyter mode."""
-    from app.exercises.runner import LOOPBACK_POLICY
+    from app.containment.policy import LOOPBACK_POLICY
 
     return LOOPBACK_POLICY
 

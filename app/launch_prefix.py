@@ -27,12 +27,13 @@ import sys
 import tempfile
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Protocol
 
 import ros2launch
 
 from app.ament_prefix import write_prefix
 from app.catalog import ENTRIES, GROUPS, CatalogEntry
+from app.containment import sandbox
+from app.containment.policy import RunPolicy
 from app.launch import PACKAGE, launch_file_text
 from app.supervisor import LearnerProgram
 from app.tf2_launch_files import LAUNCH_FILES as TF2_LAUNCH_FILES
@@ -225,27 +226,12 @@ class LaunchRefused(RuntimeError):
     """A learner's launch file may not run here (the same rule as their other code)."""
 
 
-class Policy(Protocol):
-    """How learner code may run (app.exercises.runner.RunPolicy has these)."""
-
-    @property
-    def allowed(self) -> bool: ...
-
-    @property
-    def contained(self) -> bool: ...
-
-    @property
-    def hidden(self) -> tuple[Path, ...]: ...
-
-    def refusal(self) -> str: ...
-
-
 def launch_program(
     name: str,
     node_name: str,
     words: list[str],
     cwd: Path,
-    policy: Policy | None,
+    policy: RunPolicy | None,
     *,
     trusted: bool,
 ) -> LearnerProgram:
@@ -265,11 +251,7 @@ def launch_program(
     assert policy is not None
     if not policy.allowed:
         raise LaunchRefused(policy.refusal())
-    from app.exercises import sandbox
-
-    missing = sandbox.sandbox_available()
-    if missing:
-        raise LaunchRefused(f"learner code must run contained here, and cannot: {missing}")
+    sandbox.require_sandbox("learner code", LaunchRefused)
     argv = sandbox.contained_argv(ROS2LAUNCH_MAIN, cwd, policy.hidden) + words
     return LearnerProgram(
         name, node_name, tuple(argv), cwd, after_exit=sandbox.kill_leftovers, env=env

@@ -34,6 +34,7 @@ from pathlib import Path
 
 from app import PROJECT_ROOT
 from app.catalog import CatalogEntry, lookup
+from app.containment.policy import RunPolicy
 
 _PR_SET_PDEATHSIG = 1
 _libc = ctypes.CDLL(None, use_errno=True)
@@ -190,9 +191,9 @@ class Supervisor:
         self._ended: deque[NodeStatus] = deque(maxlen=500)  # who ended, newest last
         self._spawner = ThreadPoolExecutor(max_workers=1, thread_name_prefix="supervisor-spawn")
         self._closed = False
-        # How learner code may run (app.exercises.runner.RunPolicy), set by whoever serves the
+        # How learner code may run (app.containment.policy), set by whoever serves the
         # page; None refuses it. `ros2 launch` of a learner's launch file reads it.
-        self.learner_policy: object | None = None
+        self.learner_policy: RunPolicy | None = None
 
     # -- queries -----------------------------------------------------------
 

@@ -27,7 +27,7 @@ PACKAGE = "app"
 BOX_W, BOX_H, GAP_X, GAP_Y, MARGIN = 128, 30, 14, 56, 16
 # What each home is for, shown as the box's tooltip.
 ROLES = {
-    "ros": "the ROS layer: runtime, graph, monitor, calls, parameters, lifecycle, QoS",
+    "ros": "the ROS layer: runtime, graph, monitor, rates, TF, calls, parameters, QoS",
     "bags": "rosbag2 files: record, info, play, repair",
     "ui": "what the browser front ends share: the UI thread, widgets, page links",
     "panels": "the tools: rqt- and rviz-like tabs",
@@ -37,6 +37,7 @@ ROLES = {
     "exercises": "exercises: files, runner, grader, probes, editor",
     "ros2cli": "the ros2 verbs (command line and Console)",
     "learner_ws": "the learner's colcon workspace",
+    "containment": "learner code's rule (RunPolicy) and its sandbox",
     "teacher": "the teacher's view",
     "hub": "JupyterHub spawner and proxy",
     "dashboard": "wires server, runtime, supervisor, lessons",

@@ -8,7 +8,7 @@
   (``assist_worker.py``). Jedi imports the compiled modules it finds on its
   path to read them, and the learner's sourced install space is on that
   path; so on a dashboard served to other machines the worker runs contained,
-  exactly like learner code (``app.exercises.sandbox``), or not at all.
+  exactly like learner code (``app.containment.sandbox``), or not at all.
 
 Everything here is called from worker threads (``asyncio.to_thread``) or
 returns futures: nothing blocks the web server's event loop.
@@ -26,8 +26,10 @@ import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future
 from pathlib import Path
-from typing import IO, Any, Protocol
+from typing import IO, Any
 
+from app.containment import sandbox
+from app.containment.policy import RunPolicy
 from app.exercises.lint import Problem, lint
 from app.supervisor import die_with
 
@@ -97,28 +99,11 @@ def format_code(code: str, filename: str) -> str:
     return done.stdout
 
 
-class Policy(Protocol):
-    """How learner code may run (app.exercises.runner.RunPolicy has these)."""
-
-    @property
-    def allowed(self) -> bool: ...
-
-    @property
-    def contained(self) -> bool: ...
-
-    @property
-    def hidden(self) -> tuple[Path, ...]: ...
-
-
-def worker_argv(policy: Policy | None, scratch: Path | None) -> list[str]:
+def worker_argv(policy: RunPolicy | None, scratch: Path | None) -> list[str]:
     """How to start the worker: as the user, or contained; ValueError when it may not run."""
     if policy is None or not policy.contained:
         return [sys.executable, str(WORKER)]
-    from app.exercises import sandbox
-
-    missing = sandbox.sandbox_available()
-    if missing:
-        raise ValueError(f"completion runs contained on a served dashboard, and cannot: {missing}")
+    sandbox.require_sandbox("completion", ValueError)
     if scratch is None:
         raise ValueError("completion needs the learner's scratch folder here")
     limits = sandbox.SandboxLimits(

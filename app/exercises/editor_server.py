@@ -47,8 +47,9 @@ from websockets.datastructures import Headers
 from websockets.exceptions import ConnectionClosed
 from websockets.http11 import Request, Response
 
+from app.containment.policy import RunPolicy
 from app.exercises import code_assist
-from app.exercises.code_assist import AssistProcess, FormatError, Policy
+from app.exercises.code_assist import AssistProcess, FormatError
 from app.learner_ws import files, folder, overlay
 from app.ros.errors import Ros2Error
 
@@ -129,7 +130,7 @@ class EditorHub:
         self._known: dict[str, tuple[int, int] | None] = {}
         self._watcher: asyncio.Task[None] | None = None
         self._tasks: set[asyncio.Task[Any]] = set()
-        self._policy: Policy | None = None
+        self._policy: RunPolicy | None = None
         self._scratch: Path | None = None
         self._assist: AssistProcess | None = None
         self._newest: dict[tuple[ServerConnection, str], Any] = {}  # the latest question asked
@@ -140,7 +141,7 @@ class EditorHub:
         load: Callable[[str], str],
         save: Callable[[str, str], None],
         *,
-        policy: Policy | None = None,
+        policy: RunPolicy | None = None,
         scratch: Path | None = None,
     ) -> None:
         """Where code comes from and goes to (the dashboard's exercise workspace), and the

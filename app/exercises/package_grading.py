@@ -27,11 +27,11 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+from app.containment.policy import LOOPBACK_POLICY, RunPolicy, RunRefused
 from app.exercises import runner
 from app.exercises.grader import Grader
 from app.exercises.model import Exercise, package_files
 from app.exercises.report import Report, Result
-from app.exercises.runner import RunPolicy, RunRefused
 from app.learner_ws import build, folder, served
 from app.learner_ws.folder import BuildLimits, LearnerWorkspace
 from app.ros.errors import Ros2Error
@@ -175,7 +175,7 @@ def grade_package(
     source: Path,
     scratch: Path,
     *,
-    policy: RunPolicy = runner.LOOPBACK_POLICY,
+    policy: RunPolicy = LOOPBACK_POLICY,
     on_result: Callable[[Result], None] | None = None,
     seed: int | None = None,
 ) -> Report:
@@ -196,7 +196,7 @@ def grade_package(
     limits = BuildLimits(seconds=BUILD_SECONDS, disk_bytes=DISK_BYTES)
     group = None
     if policy.contained:  # served: built and run like the learner's other code, contained
-        from app.exercises.contain import SANDBOX_GID
+        from app.containment.contain import SANDBOX_GID
 
         group = SANDBOX_GID
     workspace = LearnerWorkspace(

@@ -18,6 +18,7 @@ from typing import Any
 
 import viser
 
+from app.containment.policy import RunPolicy
 from app.exercises import code_assist, package_grading, runner
 from app.exercises.editor_server import EditorHub, editor_url
 from app.exercises.explain import panel_line
@@ -25,7 +26,6 @@ from app.exercises.grader import Grader
 from app.exercises.lint import Problem, lint, refuses_to_run
 from app.exercises.model import Exercise, ExerciseBook
 from app.exercises.report import Report, Result
-from app.exercises.runner import RunPolicy
 from app.exercises.workspace import Workspace
 from app.ros.graph import GraphSnapshot
 from app.supervisor import NodeState, NodeStatus, Supervisor

@@ -3,7 +3,7 @@
 Same DDS profile and domain, same start/stop/crash handling as a catalog
 node: the supervisor owns the process. Stop is Ctrl+C (SIGINT first). When
 the dashboard serves other machines, the file runs contained
-(``app.exercises.sandbox``) or, unless the teacher allowed learner code, not
+(``app.containment``) or, unless the teacher allowed learner code, not
 at all.
 """
 
@@ -14,32 +14,12 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
+from app.containment import sandbox
+from app.containment.policy import LOOPBACK_POLICY, RunPolicy, RunRefused
 from app.exercises.model import Exercise
 from app.supervisor import LearnerProgram, NodeStatus, Supervisor
 
 _FILE_LINE = re.compile(r'^\s*File "(?P<file>[^"]+)", line (?P<line>\d+)')
-
-
-class RunRefused(RuntimeError):
-    """Learner code may not run here (remote dashboard without the teacher's consent)."""
-
-
-@dataclass(frozen=True)
-class RunPolicy:
-    """Where and how learner code may run."""
-
-    allowed: bool = True
-    contained: bool = False
-    hidden: tuple[Path, ...] = ()  # directories contained code must not read
-
-    def refusal(self) -> str:
-        return (
-            "This dashboard serves other machines, so learner code runs only when the "
-            "teacher starts it with --allow-learner-code (it then runs contained)."
-        )
-
-
-LOOPBACK_POLICY = RunPolicy()
 
 
 def is_launch_file(script: Path) -> bool:
@@ -67,11 +47,7 @@ def program_for(exercise: Exercise, script: Path, policy: RunPolicy) -> LearnerP
     if not policy.contained:
         argv = [sys.executable, str(script)]
         return LearnerProgram(exercise.program_name, exercise.node, tuple(argv), scratch)
-    from app.exercises import sandbox
-
-    missing = sandbox.sandbox_available()
-    if missing:
-        raise RunRefused(f"learner code must run contained here, and cannot: {missing}")
+    sandbox.require_sandbox("learner code")
     argv = sandbox.contained_argv(script, scratch, policy.hidden)
     return LearnerProgram(
         exercise.program_name,

@@ -44,7 +44,7 @@ class LearnerWorkspace:
     # allowed by the teacher and contained; see app.learner_ws.build.
     remote: bool = False
     limits: BuildLimits = BuildLimits()
-    # Served: the group contained builds and nodes run in (app.exercises.contain's
+    # Served: the group contained builds and nodes run in (app.containment.contain's
     # SANDBOX_GID). They read src/ through it and write only build/, install/, log/.
     group: int | None = None
 
@@ -113,7 +113,7 @@ def _to_group(folder: Path, group: int, mode: int) -> None:
     Where the group cannot be given, the folder stays the user's alone: not
     root (EPERM), or a user namespace that does not map the sandbox's ids
     (EINVAL: rootless Podman/Docker, Kubernetes user namespaces). No sandbox
-    runs there either (app.exercises.contain.missing says why), so contained
+    runs there either (app.containment.contain.missing says why), so contained
     builds are refused; the group bits would only open it to the user's group.
     """
     fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC)

@@ -5,7 +5,7 @@ their package runs their node: learner code. On the learner's own machine it
 runs as they would run it in a terminal (``app.learner_ws.build``). On a
 dashboard served to other machines it runs only when the teacher allows
 learner code, and then contained exactly like exercise code
-(``app.exercises.contain``):
+(``app.containment.contain``):
 
 * a build reads src/ and writes only build/, install/ and log/ (and its own
   temporary folder in build/); the learner's node writes only their scratch
@@ -25,8 +25,9 @@ from __future__ import annotations
 
 import dataclasses
 from pathlib import Path
-from typing import Protocol
 
+from app.containment import sandbox
+from app.containment.policy import RunPolicy
 from app.learner_ws import build
 from app.learner_ws.folder import LearnerWorkspace
 from app.ros.errors import Ros2Error
@@ -41,22 +42,7 @@ MEMORY_BYTES = 3 * 1024**3
 OPEN_FILES = 1024
 
 
-class Policy(Protocol):
-    """How learner code may run (app.exercises.runner.RunPolicy has these)."""
-
-    @property
-    def allowed(self) -> bool: ...
-
-    @property
-    def contained(self) -> bool: ...
-
-    @property
-    def hidden(self) -> tuple[Path, ...]: ...
-
-    def refusal(self) -> str: ...
-
-
-def _allowed(policy: Policy | None, what: str) -> Policy:
+def _allowed(policy: RunPolicy | None, what: str) -> RunPolicy:
     if policy is None or not policy.allowed:
         why = policy.refusal() if policy is not None else "No rule for learner code was given."
         raise build.BuildRefused(f"{what} runs your own code. {why}")
@@ -64,18 +50,14 @@ def _allowed(policy: Policy | None, what: str) -> Policy:
 
 
 def colcon_program(
-    workspace: LearnerWorkspace, words: list[str], policy: Policy | None
+    workspace: LearnerWorkspace, words: list[str], policy: RunPolicy | None
 ) -> LearnerProgram:
     """``colcon WORDS`` in the workspace: as the learner's user, or (served) contained."""
     if not workspace.remote:
         return build.colcon_program(workspace, words)
     words = build.check_words(words)
     policy = _allowed(policy, "colcon runs your setup.py and CMakeLists.txt, i.e. it")
-    from app.exercises import sandbox
-
-    missing = sandbox.sandbox_available()
-    if missing:
-        raise build.BuildRefused(f"builds must run contained here, and cannot: {missing}")
+    sandbox.require_sandbox("builds", build.BuildRefused)
     workspace.ensure()
     build_dir, install, log = workspace.colcon_folders()
     limits = sandbox.SandboxLimits(
@@ -99,18 +81,14 @@ def colcon_program(
 
 
 def node_program(
-    workspace: LearnerWorkspace, program: LearnerProgram, policy: Policy | None
+    workspace: LearnerWorkspace, program: LearnerProgram, policy: RunPolicy | None
 ) -> LearnerProgram:
     """The learner's installed executable (``argv[0]``) as ``program`` starts it, or (served)
     contained, writing only the folder the workspace lives in."""
     if not workspace.remote:
         return program
     policy = _allowed(policy, "your package's executable")
-    from app.exercises import sandbox
-
-    missing = sandbox.sandbox_available()
-    if missing:
-        raise Ros2Error(f"your node must run contained here, and cannot: {missing}")
+    sandbox.require_sandbox("your node", Ros2Error)
     script, *tail = program.argv
     argv = sandbox.contained_argv(Path(script), workspace.home, policy.hidden) + tail
     return dataclasses.replace(

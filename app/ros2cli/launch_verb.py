@@ -80,7 +80,7 @@ def launch(ctx: CallContext, package: str, launch_file: str, arguments: list[str
         )
     from app.launch_prefix import LaunchRefused, is_ours, launch_program
 
-    policy = getattr(programs, "learner_policy", None)  # the supervisor's (app.supervisor)
+    policy = programs.learner_policy
     try:
         program = launch_program(
             key, "", [str(path), *arguments], path.parent, policy, trusted=is_ours(path)

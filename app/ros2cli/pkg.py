@@ -222,7 +222,7 @@ def _colcon(ctx: CallContext, args: argparse.Namespace) -> int:
     programs = run.programs_of(ctx)
     words = list(args.words)
     # The rule for learner code (app.supervisor's learner_policy): builds run setup.py.
-    program = served.colcon_program(ws, words, getattr(programs, "learner_policy", None))
+    program = served.colcon_program(ws, words, programs.learner_policy)
     if _active(programs, program.name):
         raise Ros2Error(f"`colcon {words[0]}` is already running in this workspace")
     programs.start_program(program)
@@ -365,7 +365,7 @@ def run_own(ctx: CallContext, package: str, executable: str, words: list[str]) -
         env=overlay.child_env(),
     )  # fmt: skip
     if ws is not None:  # served to other machines: contained, or refused
-        program = served.node_program(ws, program, getattr(programs, "learner_policy", None))
+        program = served.node_program(ws, program, programs.learner_policy)
     nodes_before = _node_names(ctx)
     programs.start_program(program)
     return _show_own_start(ctx, programs, key, nodes_before)

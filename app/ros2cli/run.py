@@ -36,6 +36,7 @@ from typing import Any, Protocol
 import yaml
 
 from app.catalog import ENTRIES, CatalogEntry, UnknownNodeError, lookup
+from app.containment.policy import RunPolicy
 from app.ros.context import CallContext
 from app.ros.errors import Ros2Error
 from app.ros2cli import tool_args
@@ -113,6 +114,8 @@ _LOG_LEVEL = re.compile(rf"^(?:[A-Za-z_][\w.]*:=)?(?:{'|'.join(_LEVELS)})$", re.
 
 class Programs(Protocol):
     """What the verb needs of the supervisor (app.supervisor.Supervisor has it)."""
+
+    learner_policy: RunPolicy | None  # how learner code may run here (None: it may not)
 
     def start_program(self, entry: Any, extra_ros_args: Iterable[str] = ()) -> Any: ...
 

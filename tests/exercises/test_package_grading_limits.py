@@ -9,10 +9,10 @@ import time
 
 import pytest
 
+from app.containment.policy import RunPolicy
 from app.exercises import package_grading
 from app.exercises.grader import Grader
 from app.exercises.model import load_exercises
-from app.exercises.runner import RunPolicy
 from app.supervisor import Supervisor
 
 EXERCISE = load_exercises().get("package_doubler")

@@ -256,7 +256,7 @@ def test_tutorial_run_needs_source_then_prints_hi(built, probe):
 
 def test_launch_file_of_the_learners_package_runs_its_nodes(built, probe):
     """ros2 launch of an own package: the nodes find the package and its own interfaces."""
-    from app.exercises.runner import RunPolicy
+    from app.containment.policy import RunPolicy
 
     _ws, console, _log = built
     console.node = probe.node

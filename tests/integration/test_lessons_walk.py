@@ -87,7 +87,7 @@ WORKSPACE_KINDS = {
 @pytest.fixture
 def learner_workspace(tmp_path, supervisor):
     """The dashboard's learner workspace (app.ros2cli.pkg.setup_workspace), undone after."""
-    from app.exercises.runner import RunPolicy
+    from app.containment.policy import RunPolicy
     from app.ros2cli.pkg import setup_workspace
 
     saved, underlay = os.environ.get(overlay.PREFIX_ENV), overlay.underlay()

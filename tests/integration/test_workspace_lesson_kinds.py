@@ -15,9 +15,9 @@ from pathlib import Path
 
 import pytest
 
+from app.containment.policy import RunPolicy
 from app.exercises.model import load_exercises
 from app.exercises.package_grading import grade_learner_package
-from app.exercises.runner import RunPolicy
 from app.learner_ws import build, folder, overlay
 from app.learner_ws.folder import LearnerWorkspace, OutsideWorkspace
 from app.lessons.kinds import ACTIONS, CHECKS

@@ -15,7 +15,7 @@ import textwrap
 
 import pytest
 
-from app.exercises.runner import RunPolicy
+from app.containment.policy import RunPolicy
 from tests.launch.helpers import ament_prefix, group_members, python_child
 from tests.turtlesim.test_ros2_run import console  # noqa: F401  (the Console fixture)
 

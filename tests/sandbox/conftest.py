@@ -22,8 +22,8 @@ from pathlib import Path
 
 import pytest
 
-from app.exercises.contain import sandbox_processes
-from app.exercises.sandbox import SandboxLimits, contained_argv, kill_leftovers, sandbox_available
+from app.containment.contain import sandbox_processes
+from app.containment.sandbox import SandboxLimits, contained_argv, kill_leftovers, sandbox_available
 
 SECRET = "bob-progress-secret"
 DEFAULT = SandboxLimits()

@@ -18,8 +18,8 @@ from pathlib import Path
 
 import pytest
 
-from app.exercises.contain import SANDBOX_GID, UID_BASE, sandbox_processes
-from app.exercises.runner import RunPolicy
+from app.containment.contain import SANDBOX_GID, UID_BASE, sandbox_processes
+from app.containment.policy import RunPolicy
 from app.learner_ws import build, overlay, served
 from app.learner_ws.folder import LearnerWorkspace
 from app.ros.errors import Ros2Error

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import pytest
 
+from app.containment.policy import RunPolicy, RunRefused
 from app.exercises import runner
 from app.exercises.grader import Grader
 from app.exercises.model import load_exercises
-from app.exercises.runner import RunPolicy, RunRefused
 from tests.sandbox.conftest import Classroom
 
 pytestmark = pytest.mark.ros

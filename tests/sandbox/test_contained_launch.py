@@ -11,10 +11,10 @@ from pathlib import Path
 
 import pytest
 
+from app.containment.policy import RunPolicy, RunRefused
+from app.containment.sandbox import sandbox_available
 from app.exercises import runner
 from app.exercises.model import load_exercises
-from app.exercises.runner import RunPolicy, RunRefused
-from app.exercises.sandbox import sandbox_available
 from app.launch_prefix import LaunchRefused, find_launch_file, launch_program
 
 EXERCISE = load_exercises().get("launch_pair")

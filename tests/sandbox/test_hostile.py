@@ -22,8 +22,8 @@ from dataclasses import replace
 import pytest
 from std_msgs.msg import String
 
-from app.exercises.contain import UID_BASE, sandbox_processes
-from app.exercises.sandbox import SandboxLimits, kill_leftovers
+from app.containment.contain import UID_BASE, sandbox_processes
+from app.containment.sandbox import SandboxLimits, kill_leftovers
 from app.ros.monitor import TopicMonitor
 from tests.conftest import in_private_netns, wait_until
 from tests.sandbox.conftest import SECRET, Classroom

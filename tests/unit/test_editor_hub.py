@@ -272,7 +272,7 @@ def test_the_worker_starts_again_after_it_died(ws):
 
 
 def test_served_dashboards_run_the_worker_contained_or_not_at_all(tmp_path):
-    from app.exercises.runner import RunPolicy
+    from app.containment.policy import RunPolicy
 
     policy = RunPolicy(allowed=False, contained=True, hidden=(tmp_path / "others",))
     argv = code_assist.worker_argv(policy, tmp_path)

@@ -1,6 +1,6 @@
 """colcon's own entry point, run by path in a workspace: ``colcon_main.py WORKSPACE WORDS...``.
 
-A dashboard served to other machines runs colcon contained (app.exercises.contain
+A dashboard served to other machines runs colcon contained (app.containment.contain
 runs a script by path, in its own process): this is that script. It has a
 folder of its own because the folder of a script run by path comes first on
 ``sys.path``, and app/learner_ws holds a ``build`` module.

@@ -22,12 +22,13 @@ ends it even after the launcher was SIGKILLed.
 from __future__ import annotations
 
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from app.containment import contain
+from app.containment.policy import RunRefused
 from app.dds import LOOPBACK_PROFILE
-from app.exercises import contain
 
 LAUNCHER = Path(contain.__file__).resolve()
 
@@ -79,6 +80,14 @@ def contained_argv(
         str(script),
     ]
     return argv
+
+
+def require_sandbox(what: str, refused: Callable[[str], Exception] = RunRefused) -> None:
+    """Raise ``refused("<what> must run contained here, and cannot: <what is missing>")``
+    when this machine cannot contain a program (each runner raises its own kind)."""
+    missing = sandbox_available()
+    if missing:
+        raise refused(f"{what} must run contained here, and cannot: {missing}")
 
 
 def sandbox_available() -> str | None:
