@@ -443,6 +443,7 @@ def _join_ros_graph(argv: list[str]) -> None:
     if importlib.util.find_spec("rclpy") is None:
         return  # no ROS here: nothing to join
     import rclpy
+    import rclpy.utilities
 
     rclpy.init(args=[*argv, "--ros-args", "--disable-external-lib-logs"])
     _bootstrap_node = rclpy.create_node(
@@ -452,7 +453,7 @@ def _join_ros_graph(argv: list[str]) -> None:
         start_parameter_services=False,
     )
     real_init = rclpy.init
-    default_context = rclpy.get_default_context()
+    default_context = rclpy.utilities.get_default_context()
 
     def init(**kwargs: object) -> None:
         """The sandbox already initialised ROS (with these arguments); a no-op then."""

@@ -94,7 +94,7 @@ class Course:
         return next((lesson for lesson in self.lessons if lesson.id == lesson_id), None)
 
 
-def _require(table: dict, key: str, kind: type | tuple[type, ...], where: str) -> Any:
+def _require(table: dict[str, Any], key: str, kind: type | tuple[type, ...], where: str) -> Any:
     if key not in table:
         raise LessonError(f"{where}: missing field '{key}'")
     value = table[key]
@@ -175,7 +175,7 @@ def inside(base: Path, relative: str, where: str) -> Path:
     return candidate
 
 
-def _step_image(raw: dict, where: str) -> tuple[str, str]:
+def _step_image(raw: dict[str, Any], where: str) -> tuple[str, str]:
     """A step's optional picture: a file in static/ and the alt text it needs."""
     if "image" not in raw:
         if "image_alt" in raw:
@@ -193,14 +193,14 @@ def _step_image(raw: dict, where: str) -> tuple[str, str]:
     return image, alt.strip()
 
 
-def _stage(table: dict, where: str, default: str) -> str:
+def _stage(table: dict[str, Any], where: str, default: str) -> str:
     """The optional ``stage`` field: one of the names the stage knows."""
     if "stage" not in table:
         return default
     stage = _require(table, "stage", str, where)
     if stage not in STAGES:
         raise LessonError(f"{where}: unknown stage '{stage}' (stages: {', '.join(STAGES)})")
-    return stage
+    return str(stage)
 
 
 def load_lesson(directory: Path) -> Lesson:

@@ -15,8 +15,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from action_msgs.msg import GoalStatus
-from rclpy.action import ActionClient, get_action_names_and_types
-from rclpy.action.client import ClientGoalHandle
+from rclpy.action.client import ActionClient, ClientGoalHandle
+from rclpy.action.graph import get_action_names_and_types
 from rclpy.node import Node
 from rclpy.task import Future
 

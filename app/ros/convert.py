@@ -150,11 +150,11 @@ def to_yaml(msg: Any, *, max_items: int | None = 32) -> str:
     return dump_yaml(plain)
 
 
-class _Dumper(yaml.SafeDumper):
+class _Dumper(yaml.SafeDumper):  # type: ignore[misc]  # PyYAML ships no types
     """Block-style mappings (as ros2 prints them), lists of plain values on one line."""
 
 
-def _represent_list(dumper: yaml.SafeDumper, data: list) -> Any:
+def _represent_list(dumper: yaml.SafeDumper, data: list[Any]) -> Any:
     flat = all(not isinstance(v, dict | list) for v in data)
     return dumper.represent_sequence("tag:yaml.org,2002:seq", data, flow_style=flat)
 
@@ -163,9 +163,8 @@ _Dumper.add_representer(list, _represent_list)
 
 
 def dump_yaml(value: Any) -> str:
-    return yaml.dump(
-        value, Dumper=_Dumper, sort_keys=False, default_flow_style=False, width=100
-    ).rstrip()
+    text = yaml.dump(value, Dumper=_Dumper, sort_keys=False, default_flow_style=False, width=100)
+    return str(text).rstrip()
 
 
 def field_value(msg: Any, path: str) -> Any:
@@ -467,5 +466,5 @@ def message_repr(msg: Any) -> str:
 
 def yaml_inline(msg: Any) -> str:
     """A message as '{a: 1, b: 2}', quoted for the equivalent ros2 command line."""
-    text = yaml.safe_dump(to_plain(msg), default_flow_style=True, width=10_000).strip()
+    text = str(yaml.safe_dump(to_plain(msg), default_flow_style=True, width=10_000)).strip()
     return "'" + text.replace("'", "'\"'\"'") + "'"

@@ -12,14 +12,14 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from rclpy.action import (
+from rclpy.action.graph import (
     get_action_client_names_and_types_by_node,
     get_action_server_names_and_types_by_node,
 )
 from rclpy.node import Node
 
 from app.ros.context import CallContext
-from app.ros.convert import import_type
+from app.ros.convert import RosType, import_type
 from app.ros.errors import Ros2Error
 from app.ros.names import (
     ACTION_MARKER,
@@ -220,7 +220,7 @@ def require_node(ctx: CallContext, fqn: str) -> str:
     return fqn
 
 
-def resolve_topic_type(ctx: CallContext, topic: str, given: str | None) -> type:
+def resolve_topic_type(ctx: CallContext, topic: str, given: str | None) -> RosType:
     """The message class for ``topic``: the given type, else the one on the graph."""
     if given:
         return import_type(given, "msg")

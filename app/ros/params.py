@@ -154,7 +154,7 @@ def same_value(actual: Any, expected: Any) -> bool:
     """Equality as a learner means it: 5 equals 5.0, floats compare with a tolerance."""
     numbers = (int, float)
     if isinstance(actual, bool) or isinstance(expected, bool):
-        return actual == expected
+        return bool(actual == expected)
     if isinstance(actual, numbers) and isinstance(expected, numbers):
         return math.isclose(actual, expected, rel_tol=1e-9, abs_tol=1e-12)
     return bool(actual == expected)

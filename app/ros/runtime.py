@@ -28,6 +28,7 @@ from rclpy.exceptions import InvalidHandle
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
+from rclpy.utilities import try_shutdown
 
 from nodes.common.parameter_guard import guard_parameter_services
 
@@ -98,7 +99,7 @@ class RosRuntime:
         with process_watchdog(teardown_sec, f"ROS teardown of /{self.node.get_name()}"):
             if not self._thread.is_alive():
                 self.node.destroy_node()
-            rclpy.try_shutdown(context=self.context)
+            try_shutdown(context=self.context)
 
 
 @contextmanager
