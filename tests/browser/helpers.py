@@ -152,16 +152,8 @@ def step_reads_top_down(page: Page, lesson, index: int) -> list[str]:
     """What is wrong with step ``index``'s card as a learner reads it (none: []): its title
     and text in view as the step opens, the text above its first button and answer, and
     every control whole, uncovered and inside the window once scrolled to."""
-    # A stage change re-mounts the column (3D scene: docked right) and its panel slides
-    # into place (seen: the title 20 px wide at x -287 mid-slide): a learner reads the
-    # card once it has settled, so the head is judged after up to 5 s of settling.
-    for _ in range(10):
-        controls = step_controls(page, lesson, index)
-        head = {"title": controls["title"], "text": controls["text"]}
-        wrong = out_of_view(page, head)
-        if not wrong:
-            break
-        page.wait_for_timeout(500)
+    wrong = step_head_in_view(page, lesson, index)
+    controls = step_controls(page, lesson, index)
     text_box = controls["text"].first.bounding_box()
     for name, locator in controls.items():
         if name.startswith(("button", "answer")):
@@ -170,6 +162,26 @@ def step_reads_top_down(page: Page, lesson, index: int) -> list[str]:
                 wrong.append(f"{name} comes before the step's text")
             break
     wrong += out_of_view(page, controls, scroll=True)
+    return wrong
+
+
+def step_head_in_view(page: Page, lesson, index: int) -> list[str]:
+    """What keeps a learner from reading step ``index``'s title and the start of its text
+    as the step opens (none: [])."""
+    step = lesson.steps[index]
+    title = f"Step {index + 1} of {len(lesson.steps)}: {step.title}"
+    head = {
+        "title": page.get_by_text(title, exact=True),
+        "text": page.get_by_text(first_words(step.text)).filter(visible=True),
+    }
+    # A stage change re-mounts the column (3D scene: docked right) and its panel slides
+    # into place (seen: the title 20 px wide at x -287 mid-slide): a learner reads the
+    # card once it has settled, so the head is judged after up to 5 s of settling.
+    for _ in range(10):
+        wrong = out_of_view(page, head)
+        if not wrong:
+            break
+        page.wait_for_timeout(500)
     return wrong
 
 

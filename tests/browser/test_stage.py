@@ -14,10 +14,12 @@ from app.stage import STAGES
 from tests.browser.helpers import (
     NEXT_OR_SKIP,
     choose,
+    click_next,
     expect_text,
     open_lesson,
     open_tab,
     start_node,
+    step_head_in_view,
     step_reads_top_down,
 )
 from tests.conftest import ARTIFACTS, DashboardProcess, free_port, wait_until
@@ -121,6 +123,36 @@ def test_every_lesson_puts_its_stage_on_and_the_learner_can_switch(browser, dash
             _wait_stage(page, name)
     finally:
         page.screenshot(path=str(ARTIFACTS / f"stage-lessons-{size[0]}.png"))
+        page.context.close()
+
+
+@pytest.mark.timeout(900)
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
+def test_every_step_in_course_order_puts_its_stage_on_with_its_text_in_view(
+    browser, dashboard, size
+):
+    """The whole course as a learner walks it, Next after Next, without a reload: each
+    step shows the stage its data names, and its title and text open in view."""
+    page = _open(browser, dashboard, size)
+    lessons = load_course().lessons
+    wrong: list[str] = []
+    try:
+        open_lesson(page, lessons[0])
+        for lesson in lessons:
+            for index, step in enumerate(lesson.steps):
+                where = f"{lesson.id} step {index + 1}"
+                title = f"Step {index + 1} of {len(lesson.steps)}: {step.title}"
+                expect(page.get_by_text(title, exact=True)).to_be_visible(timeout=15_000)
+                try:
+                    _wait_stage(page, step.stage or lesson.stage)
+                except AssertionError as exc:
+                    wrong.append(f"{where}: {exc}")
+                wrong += [f"{where}: {why}" for why in step_head_in_view(page, lesson, index)]
+                if (lesson, index) != (lessons[-1], len(lesson.steps) - 1):
+                    click_next(page)  # on a lesson's last step: "Next lesson: ..."
+        assert not wrong, f"at {size}: " + "; ".join(wrong)
+    finally:
+        page.screenshot(path=str(ARTIFACTS / f"stage-every-step-{size[0]}.png"))
         page.context.close()
 
 
