@@ -100,7 +100,9 @@ class ProbeGoal:
             feedback_callback=lambda msg: self.feedback.append(list(msg.feedback.partial_sequence)),
         )
         self.handle = wait_until(
-            lambda: self._send.done() and self._send.result(), what=f"goal {order} response"
+            lambda: self._send.done() and self._send.result(),
+            timeout=30,  # a loaded machine answered after more than 15 s
+            what=f"goal {order} response",
         )
         self._result = self.handle.get_result_async() if self.handle.accepted else None
 
