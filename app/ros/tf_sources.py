@@ -63,6 +63,16 @@ RCL_RET_OK = 0
 RCL_RET_SUBSCRIPTION_TAKE_FAILED = 401  # nothing to take
 STALE_MIN_SEC = 1.0  # a dynamic frame is stale after this long without news...
 STALE_PERIODS = 5.0  # ...or after this many of its own periods, if that is longer
+
+
+def is_stale(static: bool, rate: float | None, received: float, now: float) -> bool:
+    """A dynamic frame silent longer than its rate allows (static frames never are)."""
+    if static:
+        return False
+    limit = max(STALE_MIN_SEC, STALE_PERIODS / rate) if rate else STALE_MIN_SEC * 2
+    return now - received > limit
+
+
 # As tf2_ros.TransformListener subscribes (every /tf reader of ours does the same):
 # /tf keeps 100, /tf_static is reliable and transient local, so a late joiner hears it.
 TF_QOS = QoSProfile(depth=100, history=HistoryPolicy.KEEP_LAST)
@@ -247,11 +257,7 @@ class _Record:
         return (len(self.arrivals) - 1) / (self.arrivals[-1] - self.arrivals[0])
 
     def stale(self, now: float) -> bool:
-        if self.static:
-            return False
-        rate = self.rate()
-        limit = max(STALE_MIN_SEC, STALE_PERIODS / rate) if rate else STALE_MIN_SEC * 2
-        return now - self.received > limit
+        return is_stale(self.static, self.rate(), self.received, now)
 
 
 class TfSources:

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from app.ros.tf_sources import STALE_MIN_SEC, STALE_PERIODS
+from app.ros.tf_sources import is_stale
 
 QUATERNION_TOLERANCE = 10e-3  # tf2 ignores a rotation whose squared length is further from 1
 
@@ -39,11 +39,7 @@ class FrameRecord:
         return (len(self.arrivals) - 1) / (self.arrivals[-1] - self.arrivals[0])
 
     def stale(self, now: float) -> bool:
-        if self.static:
-            return False
-        rate = self.rate()
-        limit = max(STALE_MIN_SEC, STALE_PERIODS / rate) if rate else STALE_MIN_SEC * 2
-        return now - self.received > limit
+        return is_stale(self.static, self.rate(), self.received, now)
 
 
 def transform_matrix(
