@@ -69,6 +69,14 @@ class LearnerProgram:
 
 Program = CatalogEntry | LearnerProgram
 
+# The key of a program of the learner's own workspace (`ros2 run <package> <executable>`).
+OWN_PROGRAM = "own:/"
+
+
+def own_program_key(package: str, executable: str) -> str:
+    return f"{OWN_PROGRAM}{package}/{executable}"
+
+
 ACTIVE_STATES = frozenset({NodeState.STARTING, NodeState.RUNNING, NodeState.STOPPING})
 
 

@@ -346,6 +346,22 @@ def _walk_step(page: Page, step) -> bool:
         return False
 
 
+# The column scrolled back to its top: the picture shows the lesson's and the step's head
+# as a learner opening the step sees them (doing the step scrolled down to its checks).
+_COLUMN_TO_TOP = """() => {
+  const title = [...document.querySelectorAll('*')].find((e) => e.children.length === 0
+    && /^Lesson \\d+ of \\d+/.test(e.textContent.trim()) && e.getBoundingClientRect().width);
+  for (let box = title && title.parentElement; box; box = box.parentElement)
+    if (/(auto|scroll)/.test(getComputedStyle(box).overflowY)) box.scrollTop = 0;
+}"""
+
+
+def _shoot_step(page: Page, path: Path) -> None:
+    page.evaluate(_COLUMN_TO_TOP)
+    page.wait_for_timeout(300)
+    page.screenshot(path=str(path), quality=70)
+
+
 def lesson_gallery(page: Page) -> list[str]:
     """Every lesson from its first step to its last, in order and without reloading, as a
     learner who clicks the buttons walks it: a picture of each lesson's first and last step
@@ -358,12 +374,12 @@ def lesson_gallery(page: Page) -> list[str]:
             last = index + 1 == len(lesson.steps)
             if last and len(lesson.steps) > 1:  # what was built, before its stops are pressed
                 page.wait_for_timeout(1500)
-                page.screenshot(path=str(GALLERY / f"{lesson.unit:02d}-last.jpg"), quality=70)
+                _shoot_step(page, GALLERY / f"{lesson.unit:02d}-last.jpg")
             if not _walk_step(page, step):
                 undone.append(f"{lesson.id} step {index + 1}: {step.title}")
             if index == 0:
                 page.wait_for_timeout(1500)  # the stage settles (a node joins the graph)
-                page.screenshot(path=str(GALLERY / f"{lesson.unit:02d}-first.jpg"), quality=70)
+                _shoot_step(page, GALLERY / f"{lesson.unit:02d}-first.jpg")
             if not last:
                 page.get_by_role("button", name=NEXT).click()
         print(f"{lesson.id}: walked", flush=True)

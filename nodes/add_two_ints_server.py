@@ -17,8 +17,8 @@ ROS concepts shown
   ``/add_two_ints/_service_event`` (here only that they happened, not their
   contents), so tools can show calls as they happen.
 
-Try it: ``ros2-classroom run add_two_ints_server``, then
-``ros2-classroom run add_two_ints_client`` (adds 2 and 3), or from a full ROS
+Try it: ``ros2 run tutorial_nodes add_two_ints_server``, then
+``ros2 run tutorial_nodes add_two_ints_client`` (adds 2 and 3), or from a full ROS
 install ``ros2 service call /add_two_ints tutorial_interfaces/srv/AddTwoInts
 "{a: 2, b: 3}"``.
 """

@@ -18,7 +18,7 @@ z straight out of the lens (the depth). The default camera pose in
 ``coordinate_transform`` looks straight down at the table from 0.7 m, so the
 object sits about 0.62 m in front of the lens.
 
-Try it: ``ros2-classroom run camera_publisher`` then echo ``/pos_in_cam_frame``.
+Try it: ``ros2 run tutorial_nodes camera_publisher`` then echo ``/pos_in_cam_frame``.
 """
 
 import numpy as np

@@ -29,8 +29,9 @@ ROS concepts shown
 - callback groups passed as ``callback_group=`` to ``create_timer``;
 - why a long callback hurts everything else on the same thread.
 
-Try it: ``ros2-classroom run executor_demo`` and
-``ros2-classroom run executor_demo_multi`` (``-p executor:=multi``).
+Try it: ``ros2 run tutorial_nodes executor_demo`` and
+``ros2 run tutorial_nodes executor_demo --ros-args -r __node:=executor_demo_multi
+-p executor:=multi``.
 """
 
 import time

@@ -10,7 +10,7 @@ ROS concepts shown
 Parameters: ``rate_hz`` (messages a second, default 2000), ``topic``
 (default ``chatter``), ``log_every`` (log one line per N messages, default 1).
 
-Try it: ``ros2-classroom run flood_node --ros-args -p rate_hz:=5000``.
+Try it: ``ros2 run tutorial_nodes flood_node --ros-args -p rate_hz:=5000``.
 """
 
 from rclpy.node import Node

@@ -36,7 +36,7 @@ ROS concepts shown
 - ``create_lifecycle_publisher``; ``TransitionCallbackReturn``;
 - a parameter whose allowed values are checked by a set-parameters callback.
 
-Try it: ``ros2-classroom run lifecycle_talker``, then from a full ROS install
+Try it: ``ros2 run tutorial_nodes lifecycle_talker``, then from a full ROS install
 ``ros2 lifecycle set /lifecycle_talker configure`` and ``... activate``.
 """
 

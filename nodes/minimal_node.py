@@ -19,7 +19,7 @@ ROS concepts shown
 The other nodes of the course hand steps 1, 3 and 4 to ``spin_node``
 (nodes/common/run.py), which does exactly what ``main`` below spells out.
 Compare it with ``minimal_node_procedural``, the same node without a class.
-Try it: ``ros2-classroom run minimal_node`` and ``ros2 node list``.
+Try it: ``ros2 run tutorial_nodes minimal_node`` and ``ros2 node list``.
 """
 
 import rclpy

@@ -22,7 +22,7 @@ ROS concepts shown
 - ``add_post_set_parameters_callback``: react to accepted changes;
 - overriding a default at start-up: ``--ros-args -p publish_rate_hz:=5.0``.
 
-Try it: ``ros2-classroom run parameters_node``, then from a full ROS install
+Try it: ``ros2 run tutorial_nodes parameters_node``, then from a full ROS install
 ``ros2 param set /parameters_node publish_rate_hz 10.0`` (accepted) or
 ``ros2 param set /parameters_node publish_rate_hz 100.0`` (refused).
 """

@@ -21,7 +21,7 @@ ROS concepts shown
   (declared in ``qos_settings.declare_qos_parameters``).
 
 Try it: ``ros2-classroom launch qos_mismatch`` (a best-effort talker and a
-reliable listener), or ``ros2-classroom run qos_talker --ros-args -p
+reliable listener), or ``ros2 run tutorial_nodes qos_talker --ros-args -p
 reliability:=best_effort``.
 """
 

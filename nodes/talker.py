@@ -8,8 +8,8 @@ ROS concepts shown
   node spins;
 - ``get_logger().info`` prints a log line that also goes to /rosout.
 
-Try it: ``ros2-classroom run talker`` and, in another terminal,
-``ros2-classroom run listener``.
+Try it: ``ros2 run tutorial_nodes talker`` and, in another terminal,
+``ros2 run tutorial_nodes listener``.
 """
 
 from rclpy.node import Node

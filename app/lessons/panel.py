@@ -21,7 +21,7 @@ from app.lessons.progress import ProgressStore
 from app.lessons.runtime import FAIL, PASS, LessonRuntime
 from app.lessons.schema import IMAGE_TYPES, STATIC_DIR, Course, Lesson, Spec
 from app.ros.graph import GraphSnapshot
-from app.supervisor import NodeStatus
+from app.supervisor import OWN_PROGRAM, NodeStatus, own_program_key
 from app.ui import MarkdownView, assign
 from app.ui.code_view import python_listing
 from app.ui.loop import UiLoop
@@ -117,7 +117,7 @@ def _stopped_by(action: Spec) -> list[str]:
         except UnknownNodeError:
             return []
     if action.kind == "stop_own":  # app.ros2cli.pkg's program key
-        return [f"own:/{action['package']}/{action['executable']}"]
+        return [own_program_key(action["package"], action["executable"])]
     return []
 
 
@@ -446,9 +446,17 @@ def _any_active(statuses: dict[str, NodeStatus], names: list[str]) -> bool:
 
 
 def _ros_names(live: LessonRuntime, names: list[str]) -> list[str]:
-    """The supervisor's names as the ROS graph calls those nodes (/talker, /num_publisher)."""
+    """The supervisor's names as the ROS graph calls those nodes (/talker, /num_publisher).
+
+    A program of the learner's own workspace is named as it was started ("py_pubsub
+    talker, your program"): its node's name is in the learner's code, not known here
+    (its key's "/py_pubsub/talker" read as a node the graph did not show).
+    """
     shown = []
     for name in names:
         program = live.supervisor.program(name)
-        shown.append(program.node_name if program is not None else name)
+        if name.startswith(OWN_PROGRAM):
+            shown.append(" ".join(name.removeprefix(OWN_PROGRAM).split("/")) + ", your program")
+        else:
+            shown.append(program.node_name if program is not None else name)
     return shown

@@ -12,7 +12,7 @@ wider than the panel wraps onto extra rows, so 15 nodes stay readable.
 from __future__ import annotations
 
 from collections import defaultdict
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from html import escape
 from typing import Literal
 
@@ -359,6 +359,12 @@ def graph_picture(
                 edges.append(Edge(me, add("service", service, _short_type(kind)), dashed=True))
         for action, kind in sorted(node.action_clients.items()):
             edges.append(Edge(me, add("action", action, _short_type(kind)), dashed=True))
+    # A client waiting for a server that is not there: its box says so (drawn plain, it
+    # read as a service that exists).
+    served = {edge.target for edge in edges if not edge.dashed}
+    for key, vertex in vertices.items():
+        if vertex.kind in ("service", "action") and key not in served:
+            vertices[key] = replace(vertex, detail=" · ".join(("no server", vertex.detail)))
     return list(vertices.values()), edges
 
 

@@ -303,10 +303,12 @@ class ScenePanel:
         self._on_frame_display()
 
     def _follow_desk(self, graph: GraphSnapshot) -> None:
-        """The lesson-13 desk gives way to what ROS describes in its place.
+        """The lesson-13 desk shows while a node feeds it, and gives way to what ROS
+        describes in its place.
 
         The desk is the view's own base_link and camera marks (axes, names, the
-        frustum) and the arm drawn straight from joint angles. Once a simulated
+        frustum) and the arm drawn straight from joint angles; it shows while a
+        node publishes joint angles or a stamped point or pose. Once a simulated
         world, or a robot from a running robot_state_publisher (a publisher of
         /robot_description), is drawn, TF draws those frames and links where
         they really are, as rviz would; the desk's copies would only stand on
@@ -315,7 +317,7 @@ class ScenePanel:
         frustum stays while the learner shows the camera image on it.
         """
         robot = self.tf_view.robot_drawn and graph.publishers("/robot_description") > 0
-        desk = not (self._world_shown or robot)
+        desk = picker.desk_in_use(graph) and not (self._world_shown or robot)
         frustum = desk or self._image_on_frustum.value is True
         if (desk, frustum) == self._desk_shown:
             return

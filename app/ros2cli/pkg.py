@@ -35,7 +35,7 @@ from app.ros.context import CallContext
 from app.ros.errors import Cancelled, Ros2Error
 from app.ros2cli import run
 from app.ros2cli.common import Ros2cliMessage
-from app.supervisor import LearnerProgram
+from app.supervisor import LearnerProgram, own_program_key
 
 NO_DDS = {("pkg", v) for v in ("create", "list", "executables", "prefix")}
 FIRST_WORDS_WITHOUT_DDS = ("colcon", "source")
@@ -352,7 +352,7 @@ def run_own(ctx: CallContext, package: str, executable: str, words: list[str]) -
         )
     programs = run.programs_of(ctx)
     before, ros_args = run.split_ros_args(words)
-    key = f"own:/{package}/{executable}"
+    key = own_program_key(package, executable)
     if _active(programs, key):
         raise Ros2Error(
             f"{package} {executable} is already running; stop it with "

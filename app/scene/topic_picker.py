@@ -19,6 +19,21 @@ POSE_TYPES = ("geometry_msgs/msg/PoseStamped",)
 
 STALE_AFTER_SEC = 3.0
 
+# What the desk (the camera lesson's base_link and camera marks, and its arm) draws.
+DESK_TYPES = JOINT_TYPES + POINT_TYPES + POSE_TYPES
+
+
+def desk_in_use(graph: GraphSnapshot | None) -> bool:
+    """Whether another node publishes something the desk draws (joint angles, a stamped
+    point or pose): without one, its frames would stand for a camera and arm that are not
+    there (they stayed on the 3D view of every later lesson)."""
+    if graph is None:
+        return False
+    return any(
+        t.publishers > t.own_publishers and any(ty in DESK_TYPES for ty in t.types)
+        for t in graph.topics
+    )
+
 
 def drawable_topics(graph: GraphSnapshot | None, types: tuple[str, ...]) -> list[str]:
     """Topics whose advertised type is one of ``types``, sorted by name."""

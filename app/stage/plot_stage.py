@@ -40,7 +40,8 @@ NOTHING = (
     "publishes gets a line here, the number of messages a second (`ros2 topic hz`)."
 )
 NOTE = (
-    "Messages a second on each topic, over the last minute (`ros2 topic hz <topic>`), "
+    "Messages a second on each topic, since it appeared and up to the last minute "
+    "(`ros2 topic hz <topic>`), "
     "and the numbers that number topics carry (`ros2 topic echo <topic>`)."
 )
 

@@ -42,6 +42,7 @@ PANEL_MARGIN = 14  # the floating control panel's gap to the window's edges
 CONTROL_PANEL_ROOM = CONTROL_WIDTH + 28  # and its margins
 MIN_WIDTH, MAX_WIDTH = 400, 3000  # up to the panel: no 3D scene peeks out between
 REFIT_PX = 24  # a smaller change of the window is not worth moving the stage
+WIDTH_RESENDS = (0.05, 0.5, 1.5)  # s after a stage change: its width again
 # Runs in the page (app.ui.page_script): report the window's width now and after resizes.
 _REPORT_WIDTH = (
     """
@@ -100,7 +101,7 @@ class Stage:
         self._rates = rates
         self.width = STAGE_WIDTH
         self._fitted = False
-        self._widths_due = 0.0
+        self._widths_due: list[float] = []  # when to say the stage's width again
         self._main_panel: viser.MainPanelHandle | None = None  # placed by follow_window
         self.current = DEFAULT_STAGE
         by_label = {label: name for name, label in STAGES.items()}
@@ -202,9 +203,13 @@ class Stage:
             window.visible = on
         for name, part in self.parts.items():
             part.set_active(name == stage)
-        # A window docked again takes the client's default width: give it the stage's.
+        # A window docked again takes the client's default width: give it the stage's,
+        # and again a little later. The client applies a width only to a panel it has
+        # placed, and a window just re-shown is placed a few frames on (seen once at
+        # 2560 px: the graph left at the client's 300 px default after the code stage).
         self._set_widths()
-        self._widths_due = time.monotonic() + 0.05
+        now = time.monotonic()
+        self._widths_due = [now + delay for delay in WIDTH_RESENDS]
         self._place_control_panel()
 
     def forget(self) -> None:
@@ -212,8 +217,8 @@ class Stage:
         self.graph.forget()
 
     def refresh(self, graph: GraphSnapshot) -> None:
-        if self._widths_due and time.monotonic() > self._widths_due:
-            self._widths_due = 0.0
+        if self._widths_due and time.monotonic() > self._widths_due[0]:
+            self._widths_due.pop(0)
             self._set_widths()
         part = self.parts.get(self.current)
         if part is not None:

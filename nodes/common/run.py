@@ -278,7 +278,10 @@ def interrupt_outside_imports(signum: int, frame: FrameType | None) -> None:
     Raised inside Python's import machinery (an import still under way as
     the node joins the graph, or its module-lock clean-up running in garbage
     collection) it is printed as "Exception ignored ... KeyboardInterrupt"
-    with a traceback and lost. There the signal is sent again a moment later.
+    with a traceback and lost. Raised inside an rclpy constructor it leaves a
+    half-made object whose ``__del__`` prints a traceback (seen: "Exception
+    ignored in Executor.__del__ ... '_sigint_gc'"). In both the signal is sent
+    again a moment later.
     Raised once: a later signal would interrupt the program's own clean-up (a
     supervisor that must stop a hung one sends SIGKILL next).
     """
@@ -286,7 +289,7 @@ def interrupt_outside_imports(signum: int, frame: FrameType | None) -> None:
         return  # the program is ending already: one KeyboardInterrupt is enough
     at = frame
     while at is not None:
-        if at.f_code.co_filename.startswith("<frozen importlib"):
+        if _unsafe_to_interrupt(at):
             retry = threading.Timer(RETRY_SIGNAL_SEC, os.kill, (os.getpid(), signum))
             retry.daemon = True
             retry.start()
@@ -294,6 +297,14 @@ def interrupt_outside_imports(signum: int, frame: FrameType | None) -> None:
         at = at.f_back
     _interrupted.set()
     raise KeyboardInterrupt
+
+
+def _unsafe_to_interrupt(frame: FrameType) -> bool:
+    """Inside an import, or inside the ``__init__`` of one of rclpy's classes."""
+    code = frame.f_code
+    if code.co_filename.startswith("<frozen importlib"):
+        return True
+    return code.co_name == "__init__" and f"{os.sep}rclpy{os.sep}" in code.co_filename
 
 
 _interrupted = threading.Event()  # interrupt_outside_imports has raised its one interrupt

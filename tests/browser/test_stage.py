@@ -19,9 +19,9 @@ from tests.browser.helpers import (
     open_lesson,
     open_tab,
     start_node,
-    step_head_in_view,
     step_reads_top_down,
 )
+from tests.browser.stage_layout import settled_layout, stage_fills
 from tests.conftest import ARTIFACTS, DashboardProcess, free_port, wait_until
 from tests.integration.core_helpers import DISCOVERY_TIMEOUT
 
@@ -132,7 +132,8 @@ def test_every_step_in_course_order_puts_its_stage_on_with_its_text_in_view(
     browser, dashboard, size
 ):
     """The whole course as a learner walks it, Next after Next, without a reload: each
-    step shows the stage its data names, and its title and text open in view."""
+    step shows the stage its data names, filling the room left of the column; its title
+    and text open in view, above its buttons; and every control is whole and uncovered."""
     page = _open(browser, dashboard, size)
     lessons = load_course().lessons
     wrong: list[str] = []
@@ -143,11 +144,14 @@ def test_every_step_in_course_order_puts_its_stage_on_with_its_text_in_view(
                 where = f"{lesson.id} step {index + 1}"
                 title = f"Step {index + 1} of {len(lesson.steps)}: {step.title}"
                 expect(page.get_by_text(title, exact=True)).to_be_visible(timeout=15_000)
+                stage = step.stage or lesson.stage
                 try:
-                    _wait_stage(page, step.stage or lesson.stage)
+                    _wait_stage(page, stage)
                 except AssertionError as exc:
                     wrong.append(f"{where}: {exc}")
-                wrong += [f"{where}: {why}" for why in step_head_in_view(page, lesson, index)]
+                if off := stage_fills(settled_layout(page, stage), stage):
+                    wrong.append(f"{where} ({stage}): {off}")
+                wrong += [f"{where}: {why}" for why in step_reads_top_down(page, lesson, index)]
                 if (lesson, index) != (lessons[-1], len(lesson.steps) - 1):
                     click_next(page)  # on a lesson's last step: "Next lesson: ..."
         assert not wrong, f"at {size}: " + "; ".join(wrong)

@@ -147,3 +147,23 @@ def test_picker_offers_only_drawable_topics_and_explains_silence():
     assert "waiting" in picker.liveness_note(graph, "/cloud", 0, None)
     assert "stopped publishing" in picker.liveness_note(graph, "/cloud", 5, 10.0)
     assert picker.liveness_note(graph, "/cloud", 5, 0.1) == ""
+
+
+def test_the_desk_shows_only_while_another_node_feeds_it():
+    def graph(*topics: TopicInfo) -> GraphSnapshot:
+        return GraphSnapshot(topics=topics)
+
+    assert not picker.desk_in_use(None)
+    assert not picker.desk_in_use(graph(TopicInfo("/chatter", ("std_msgs/msg/String",), 1, 0)))
+    joints = TopicInfo("/joint_states", ("sensor_msgs/msg/JointState",), 1, 1)
+    assert picker.desk_in_use(graph(joints))
+    point = TopicInfo("/pos_in_cam_frame", ("geometry_msgs/msg/PointStamped",), 1, 0)
+    assert picker.desk_in_use(graph(point))
+    # The dashboard's own publisher (a learner's Publish form) feeds nothing of the desk's.
+    own = TopicInfo("/pose", ("geometry_msgs/msg/PoseStamped",), 1, 0, own_publishers=1)
+    assert not picker.desk_in_use(graph(own))
+    # A topic only subscribed to (nobody publishes it) does not either.
+    assert not picker.desk_in_use(graph(TopicInfo("/joint_states", JOINTS_TYPE, 0, 2)))
+
+
+JOINTS_TYPE = ("sensor_msgs/msg/JointState",)

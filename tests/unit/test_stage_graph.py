@@ -196,3 +196,14 @@ def test_a_started_node_is_drawn_dashed_until_the_graph_lists_it():
     assert 'data-name="/talker" data-state="starting"' in svg and "stroke-dasharray" in svg
     svg = stage_svg(StablePlaces().place([Vertex("node", "/talker")], []), [], {})
     assert 'data-state="on-graph"' in svg and "stroke-dasharray" not in svg
+
+
+def test_a_service_with_only_a_client_says_no_server():
+    """Lesson 7's client waiting for its server: the service box must not read as served."""
+    types = {"/add_two_ints": "example_interfaces/srv/AddTwoInts"}
+    client = NodeEndpoints("/add_two_ints_client", {}, {}, {}, types, {}, {})
+    details = {v.name: v.detail for v in graph_picture([client])[0]}
+    assert details["/add_two_ints"] == "no server · example_interfaces/AddTwoInts"
+    server = NodeEndpoints("/add_two_ints_server", {}, {}, types, {}, {}, {})
+    details = {v.name: v.detail for v in graph_picture([client, server])[0]}
+    assert details["/add_two_ints"] == "example_interfaces/AddTwoInts"

@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from app.lessons.registry import register_action
+from app.supervisor import own_program_key
 
 if TYPE_CHECKING:
     from app.lessons.runtime import LessonRuntime
@@ -20,7 +21,7 @@ STOP_WAIT_SEC = 20.0  # above the supervisor's SIGINT -> SIGTERM -> SIGKILL esca
     words="stop a node of yours that `ros2 run PACKAGE EXECUTABLE` started (Ctrl+C first)",
 )
 def perform(rt: LessonRuntime, action: Spec) -> str:
-    key = f"own:/{action['package']}/{action['executable']}"  # app.ros2cli.pkg's program key
+    key = own_program_key(action["package"], action["executable"])
     shown = f"{action['package']} {action['executable']}"
     status = rt.supervisor.statuses().get(key)
     if status is None or not status.active:
