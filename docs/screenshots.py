@@ -26,7 +26,7 @@ from playwright.sync_api import Browser, Locator, Page, expect, sync_playwright 
 
 from app.dds import configure_dds_env  # noqa: E402
 from app.exercises.model import load_exercises  # noqa: E402
-from app.lessons.panel import NEXT_LABEL, quiz_label  # noqa: E402
+from app.lessons.panel import NEXT_LABEL, answer_button_label  # noqa: E402
 from app.lessons.schema import load_course  # noqa: E402
 from app.ui import GROUP_OF  # noqa: E402
 
@@ -51,7 +51,7 @@ def _choose(page: Page, label: str, option: str) -> None:
     page.get_by_role("option", name=option, exact=True).click()
 
 
-def _shown(page: Page, text: str) -> Locator:
+def _shown(page: Page, text: str | re.Pattern[str]) -> Locator:
     """``text`` where it is on screen (other tabs keep hidden copies)."""
     return page.get_by_text(text).filter(visible=True).first
 
@@ -335,11 +335,10 @@ def _walk_step(page: Page, step) -> bool:
         if button.is_enabled(timeout=10_000):  # a Stop with nothing to stop is greyed
             button.click()
             page.wait_for_timeout(400)
-    quizzes = [check for check in step.checks if check.kind == "quiz"]
-    for index, check in enumerate(quizzes):
-        field = quiz_label(index, len(quizzes)).replace("Question", "Answer")
-        page.get_by_label(field, exact=True).filter(visible=True).first.click()
-        page.get_by_role("option", name=check["answer"], exact=True).click()
+    for check in step.checks:
+        if check.kind == "quiz":
+            answer = answer_button_label(check["answer"], chosen=False)
+            page.get_by_role("button", name=answer, exact=True).click()
     try:
         expect(_shown(page, "✓ step done")).to_be_visible(timeout=STEP_DONE_MS)
         return True

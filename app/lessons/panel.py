@@ -18,7 +18,7 @@ import viser
 from app import PROJECT_ROOT
 from app.catalog import UnknownNodeError, lookup_group
 from app.lessons.progress import ProgressStore
-from app.lessons.runtime import FAIL, PASS, LessonRuntime
+from app.lessons.runtime import FAIL, PASS, WAITING, LessonRuntime
 from app.lessons.schema import IMAGE_TYPES, STATIC_DIR, Course, Lesson, Spec
 from app.ros.graph import GraphSnapshot
 from app.supervisor import OWN_PROGRAM, NodeStatus, own_program_key
@@ -27,7 +27,10 @@ from app.ui.code_view import python_listing
 from app.ui.loop import UiLoop
 from app.ui.starting import StartRequests
 
-_MARKS = {PASS: "✓", FAIL: "✗", "waiting": "…"}
+# How a check reads on the card. Not passed yet is "to do", not "fail": most steps open
+# with their checks unmet, and a learner who has not acted yet has failed nothing.
+_MARKS = {PASS: "✓", FAIL: "○", WAITING: "…"}
+_WORDS = {PASS: "pass", FAIL: "to do", WAITING: "waiting"}
 # A step button's icon says what it does; the label says it in words.
 _ACTION_ICONS = {
     "open_panel": viser.Icon.EXTERNAL_LINK,
@@ -43,7 +46,14 @@ _ACTION_ICONS = {
     "publish": viser.Icon.SEND,
     "set_param": viser.Icon.ADJUSTMENTS,
 }
-_CHOOSE = "(choose an answer)"
+_ANSWER_COLOUR, _CHOSEN_COLOUR = "gray", "blue"
+
+
+def answer_button_label(option: str, chosen: bool) -> str:
+    """A quiz answer's button: a radio mark, then the answer's whole text."""
+    return f"{'●' if chosen else '○'} {option}"
+
+
 # How the screen works, said once, on the first step of the course.
 FIRST_SCREEN = (
     "_New here?_ The **stage** on the left shows what the current step is about. The "
@@ -138,7 +148,7 @@ def _next_label(not_passed: int, following: Lesson | None, last_step: bool) -> s
 
 
 def quiz_label(index: int, count: int) -> str:
-    """'Question', or 'Question 2' when a step asks several; its field is 'Answer 2'."""
+    """'Question', or 'Question 2' when a step asks several."""
     return "Question" if count == 1 else f"Question {index + 1}"
 
 
@@ -322,17 +332,23 @@ class LessonsPanel:
             quizzes = [check for check in step.checks if check.kind == "quiz"]
             for index, check in enumerate(quizzes):
                 # The question at full width (a field's label column is ~80 px: a question
-                # there ran to 11 lines), the answers in the field under it.
+                # there ran to 11 lines), then each answer as a button with its whole text
+                # (in a dropdown the chosen answer was cut off, and its open list covered
+                # the checks): one choice at a time, as radio buttons.
                 label = quiz_label(index, len(quizzes))
                 question = self._gui.add_markdown(f"**{label}:** {check['question']}")
-                chosen = self._live.quiz_answers.get(check.key, _CHOOSE)
-                quiz = self._gui.add_dropdown(
-                    label.replace("Question", "Answer"),
-                    [_CHOOSE, *check["options"]],
-                    initial_value=chosen,
-                )
-                quiz.on_update(self._ui.callback(self._answer, check, quiz))
-                self._dynamic += [question, quiz]
+                self._dynamic.append(question)
+                chosen = self._live.quiz_answers.get(check.key)
+                answers = []
+                for option in check["options"]:
+                    answer = self._gui.add_button(
+                        answer_button_label(option, option == chosen),
+                        color=_CHOSEN_COLOUR if option == chosen else _ANSWER_COLOUR,
+                    )
+                    answers.append((option, answer))
+                    self._dynamic.append(answer)
+                for option, answer in answers:
+                    answer.on_click(self._ui.callback(self._answer, check, option, answers))
             if not self._dynamic:
                 self._dynamic.append(self._gui.add_markdown("_Nothing to click: read on._"))
 
@@ -363,12 +379,14 @@ class LessonsPanel:
             self._live.supervisor.stop(name)  # returns at once; the process ends on its own
         self._message.show(f"Stopping {', '.join(_ros_names(self._live, names))}.")
 
-    def _answer(self, check: Spec, quiz: viser.GuiDropdownHandle) -> None:
-        value = quiz.value
-        if value == _CHOOSE:
-            self._live.quiz_answers.pop(check.key, None)
-        else:
-            self._live.quiz_answers[check.key] = value
+    def _answer(
+        self, check: Spec, chosen: str, answers: list[tuple[str, viser.GuiButtonHandle]]
+    ) -> None:
+        self._live.quiz_answers[check.key] = chosen
+        for option, answer in answers:
+            picked = option == chosen
+            answer.label = answer_button_label(option, picked)
+            answer.color = _CHOSEN_COLOUR if picked else _ANSWER_COLOUR
 
     # -- live part ---------------------------------------------------------
 
@@ -383,7 +401,8 @@ class LessonsPanel:
         # What is left to do comes first; each line keeps its full reason.
         ordered = sorted(results, key=lambda pair: pair[1].state == PASS)
         lines = [
-            f"- {_MARKS[result.state]} **{result.state}**: {result.reason}" for _, result in ordered
+            f"- {_MARKS[result.state]} **{_WORDS[result.state]}**: {result.reason}"
+            for _, result in ordered
         ]
         passed = set(self._progress.lesson(lesson.id)["passed"])
         status = "✓ step done" if index in passed else ""

@@ -86,11 +86,18 @@ const onKey = (event) => {{
 
 
 def pose_topics(graph: GraphSnapshot, sim_fqn: str) -> dict[str, str]:
-    """The sim's turtles by name -> pose topic: ``<sim namespace>/<name>/pose``."""
+    """The sim's turtles by name -> pose topic: ``<sim namespace>/<name>/pose``.
+
+    Only topics a node publishes: a turtle's pose topic stays on the graph while we
+    still subscribe to it, so a killed turtle (or one of a sim since restarted) was
+    listed as there.
+    """
     namespace = sim_fqn.rsplit("/", 1)[0]  # '' for a node at the root
     found = {}
     for topic in graph.topics:
         if POSE_TYPE not in topic.types or not topic.name.startswith(namespace + "/"):
+            continue
+        if topic.publishers <= topic.own_publishers:
             continue
         name, _, tail = topic.name[len(namespace) + 1 :].partition("/")
         if tail == "pose" and name:

@@ -21,8 +21,9 @@ from app.ui import MarkdownView
 IMAGE_TYPE = "sensor_msgs/msg/Image"
 PANES = 2
 NOTHING = (
-    "_No camera image on the graph yet._ Start `image_publisher` from the step's button: "
-    "its pictures show here, and under them what `object_detector` finds in them."
+    "_No camera image on the graph yet._ Start the step's camera node from its button "
+    "(`image_publisher`, `video_publisher`): its pictures show here, and under them what "
+    "a detector finds in them."
 )
 
 

@@ -9,7 +9,7 @@ import pytest
 from playwright.sync_api import Locator, Page, expect
 from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
-from app.lessons.panel import COURSE_END, quiz_label
+from app.lessons.panel import COURSE_END, answer_button_label
 from bench._common import open_tool
 from tests.wire_client import NEXT_OR_SKIP
 
@@ -196,7 +196,7 @@ def first_words(markdown: str, count: int = 5) -> str:
     return " ".join(plain.split()[:count])
 
 
-CHECK_LINE = re.compile(r"^(✓|✗|…) (pass|fail|waiting)")
+CHECK_LINE = re.compile(r"^(✓|○|…) (pass|to do|waiting)")
 
 
 def step_controls(page: Page, lesson, index: int) -> dict[str, Locator]:
@@ -213,12 +213,10 @@ def step_controls(page: Page, lesson, index: int) -> dict[str, Locator]:
         controls[f"button {label!r}"] = page.get_by_role("button", name=label, exact=True)
     checks = page.locator("li").filter(has_text=CHECK_LINE).filter(visible=True)
     expect(checks).to_have_count(len(step.checks))
-    quizzes = [check for check in step.checks if check.kind == "quiz"]
     for i, check in enumerate(step.checks):
         if check.kind == "quiz":
-            controls[f"answer to {check['question']!r}"] = page.get_by_label(
-                answer_label(quizzes, check), exact=True
-            )
+            for option in check["options"]:
+                controls[f"answer {option[:30]!r}"] = answer_button(page, option)
         controls[f"check {i + 1}"] = checks.nth(i)
     controls["Back"] = page.get_by_role("button", name="Back", exact=True)
     last = page.get_by_role("button", name=COURSE_END, exact=True)  # the course's last step
@@ -226,6 +224,17 @@ def step_controls(page: Page, lesson, index: int) -> dict[str, Locator]:
     return controls
 
 
-def answer_label(quizzes: list, check) -> str:
-    """The label of a quiz's answer field: 'Answer', or 'Answer 2' in a step with several."""
-    return quiz_label(quizzes.index(check), len(quizzes)).replace("Question", "Answer")
+def answer_button(page: Page, option: str) -> Locator:
+    """A quiz answer's button (its radio mark chosen or not)."""
+    def button(chosen: bool) -> Locator:
+        label = answer_button_label(option, chosen)
+        return page.get_by_role("button", name=label, exact=True)
+
+    return button(False).or_(button(True))
+
+
+def answer_quiz(page: Page, check) -> None:
+    """Click a quiz's right answer, as a learner does, and see it marked chosen."""
+    answer_button(page, check["answer"]).click()
+    chosen = answer_button_label(check["answer"], chosen=True)
+    expect(page.get_by_role("button", name=chosen, exact=True)).to_be_visible()

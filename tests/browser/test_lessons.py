@@ -9,8 +9,7 @@ from playwright.sync_api import expect
 
 from app.lessons.schema import load_course
 from tests.browser.helpers import (
-    answer_label,
-    choose,
+    answer_quiz,
     click,
     click_next,
     expect_text,
@@ -31,9 +30,9 @@ def complete_by_clicking(page, lesson, done_within_ms: int = 45_000) -> None:
         for action in step.actions:
             click(page, action.get("label") or action.kind.replace("_", " "))
             page.wait_for_timeout(300)  # a learner reads the result before the next click
-        quizzes = [check for check in step.checks if check.kind == "quiz"]
-        for check in quizzes:
-            choose(page, answer_label(quizzes, check), check["answer"])
+        for check in step.checks:
+            if check.kind == "quiz":
+                answer_quiz(page, check)
         expect(page.get_by_text("✓ step done")).to_be_visible(timeout=done_within_ms)
         if index + 1 < len(lesson.steps):
             click_next(page)

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 from builtin_interfaces.msg import Time
-from geometry_msgs.msg import Point
+from geometry_msgs.msg import Point, PointStamped
 from playwright.sync_api import expect
 from sensor_msgs.msg import Image, JointState, PointCloud2
 from visualization_msgs.msg import Marker, MarkerArray
@@ -159,3 +159,35 @@ def test_markers_add_modify_and_delete(page, probe):
         assert page.evaluate(HAS_NODE_JS, "/base_link/markers/demo_0")
     finally:
         repeater.stop()
+
+
+# The camera lesson's desk: base_link and camera marks, drawn by the view itself.
+DESK_SHOWN_JS = (
+    "() => { const o = window.__viserMutable && window.__viserMutable.nodeRefFromName["
+    "'/base_link/camera/frustum']; return !!o && o.visible; }"
+)
+
+
+def test_the_desk_shows_only_while_a_node_feeds_it(page, probe):
+    """Lessons after the camera lesson showed its base_link and camera marks with nothing
+    running (under the URDF robot, the capstone's map): they show while a node publishes
+    what they draw, here a stamped point in the camera frame."""
+    open_tab(page, "3D view")
+    page.wait_for_function(HAS_NODE_JS, arg="/base_link/camera/frustum", timeout=30_000)
+    page.wait_for_timeout(2_000)  # a few graph refreshes
+    assert not page.evaluate(DESK_SHOWN_JS), "the desk shows with no node feeding it"
+    publisher = probe.node.create_publisher(PointStamped, "/pos_in_cam_frame", 10)
+
+    def point(i: int) -> PointStamped:
+        msg = PointStamped()
+        msg.header.frame_id = "camera"
+        msg.point.z = 0.5
+        return msg
+
+    repeater = Repeater(publisher, point, 0.1)
+    try:
+        page.wait_for_function(DESK_SHOWN_JS, polling=200, timeout=30_000)
+    finally:
+        repeater.stop()
+        probe.node.destroy_publisher(publisher)
+    page.wait_for_function(f"() => !({DESK_SHOWN_JS})()", polling=200, timeout=30_000)

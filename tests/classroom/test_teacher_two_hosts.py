@@ -30,6 +30,7 @@ import pytest
 import tests.classroom.test_two_hosts as two_host_setup
 from app import PROJECT_ROOT
 from app.dds import configure_dds_env
+from app.lessons.panel import answer_button_label
 from tests.conftest import ARTIFACTS
 from tests.faults.helpers import record
 
@@ -41,7 +42,8 @@ _in = two_host_setup._in
 FOLLOW_SEC = 2.0
 PORT_A, PORT_B = 8180, 8280  # each host has a loopback of its own
 STUCK_MINUTES = "Stuck: minutes without progress while a check fails"
-QUIZ = "Answer"  # lesson 1, step 2's one question: how does a new node find the others?
+# Lesson 1, step 2's one question (how does a new node find the others?), answered wrong.
+WRONG_ANSWER = answer_button_label("It asks the roscore master over XML-RPC", chosen=False)
 
 # Reads one JSON command a line, answers one JSON line; times are time.monotonic(),
 # which every namespace of this kernel shares.
@@ -245,7 +247,7 @@ def test_teacher_follows_three_learners_on_two_hosts(ros_env, two_hosts, tmp_pat
         latencies["step on host A -> teacher page"] = seen["t"] - clicked
         # ...where learner2 answers the quiz wrong: a failing check (stuck, further down).
         a("set", page="teacher", label=STUCK_MINUTES, value=0.1)  # 6 s, for the test
-        a("set", page="a2", label=QUIZ, value="It asks the roscore master over XML-RPC")
+        a("click", page="a2", label=WRONG_ANSWER)
         seen = a("wait_regex", page="teacher", regex=_row("learner2", "A", 41, "1 · 2/5 \\| ✓✗"))
         assert seen["ok"], seen["markdown"]
 
