@@ -226,6 +226,7 @@ def step_controls(page: Page, lesson, index: int) -> dict[str, Locator]:
 
 def answer_button(page: Page, option: str) -> Locator:
     """A quiz answer's button (its radio mark chosen or not)."""
+
     def button(chosen: bool) -> Locator:
         label = answer_button_label(option, chosen)
         return page.get_by_role("button", name=label, exact=True)
