@@ -11,7 +11,7 @@ import html
 import re
 from collections.abc import Callable
 from functools import lru_cache
-from typing import Any
+from typing import Any, Final
 
 import viser
 
@@ -46,7 +46,8 @@ _ACTION_ICONS = {
     "publish": viser.Icon.SEND,
     "set_param": viser.Icon.ADJUSTMENTS,
 }
-_ANSWER_COLOUR, _CHOSEN_COLOUR = "gray", "blue"
+_ANSWER_COLOUR: Final = "gray"
+_CHOSEN_COLOUR: Final = "blue"
 
 
 def answer_button_label(option: str, chosen: bool) -> str:
