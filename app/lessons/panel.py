@@ -474,9 +474,9 @@ def _ros_names(live: LessonRuntime, names: list[str]) -> list[str]:
     """
     shown = []
     for name in names:
-        program = live.supervisor.program(name)
         if name.startswith(OWN_PROGRAM):
             shown.append(" ".join(name.removeprefix(OWN_PROGRAM).split("/")) + ", your program")
-        else:
-            shown.append(program.node_name if program is not None else name)
+            continue
+        program = live.supervisor.program(name)
+        shown.append(program.node_name if program is not None else name)
     return shown

@@ -6,6 +6,7 @@ import re
 from typing import TYPE_CHECKING
 
 from app.lessons.registry import FAIL, PASS, WAITING, CheckResult, register_check
+from app.supervisor import OWN_PROGRAM
 
 if TYPE_CHECKING:
     from app.lessons.runtime import LessonRuntime
@@ -14,7 +15,7 @@ if TYPE_CHECKING:
 _NAME = re.compile(r"^(/[A-Za-z_][A-Za-z0-9_]*)+$")
 # The Console's programs for the learner's own code: `ros2 run` of a sourced
 # package ("own:/pkg/exe") and `ros2 launch` ("launch:pkg/file").
-OWN_PREFIXES = ("own:", "launch:")
+OWN_PREFIXES = (OWN_PROGRAM, "launch:")
 
 
 @register_check(
