@@ -106,7 +106,7 @@ class TeleopTurtle(Node):
             self.goal_handle.cancel_goal_async()
 
 
-def read_terminal_keys(node: TeleopTurtle) -> None:
+def read_terminal_keys(node: TeleopTurtle, executor: SingleThreadedExecutor) -> None:
     """Raw keys from the terminal until Q, Ctrl+C or shutdown (upstream's key loop)."""
     import termios
 
@@ -121,7 +121,9 @@ def read_terminal_keys(node: TeleopTurtle) -> None:
         while rclpy.ok() and not node.quit.is_set():
             byte = os.read(fd, 1).decode("latin-1")
             if byte:
-                node.handle_key(TERMINAL_KEYS.get(byte, byte))
+                # Handled in the spinning thread: rclpy's ActionClient drops a goal's
+                # answer if it arrives while another thread is still sending the goal.
+                executor.create_task(node.handle_key, TERMINAL_KEYS.get(byte, byte))
     finally:
         termios.tcsetattr(fd, termios.TCSANOW, cooked)
 
@@ -141,7 +143,7 @@ def main(args=None) -> None:
             if sys.stdin.isatty():
                 spinner = threading.Thread(target=executor.spin, daemon=True)
                 spinner.start()
-                read_terminal_keys(node)
+                read_terminal_keys(node, executor)
             else:
                 print(f"(no terminal: reading key names from {node.key_subscription.topic_name})")
                 while rclpy.ok() and not node.quit.is_set():

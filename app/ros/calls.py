@@ -15,11 +15,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from action_msgs.msg import GoalStatus
-from rclpy.action.client import ActionClient, ClientGoalHandle
+from rclpy.action.client import ClientGoalHandle
 from rclpy.action.graph import get_action_names_and_types
 from rclpy.node import Node
 from rclpy.task import Future
 
+from app.ros.action_client import ThreadSafeActionClient
 from app.ros.context import CallContext
 from app.ros.convert import import_type, type_name
 from app.ros.errors import Cancelled, NoAnswer, Ros2Error
@@ -162,7 +163,8 @@ def send_goal(
     known = action_type_of(ctx.node, run.action)
     if known and known != type_name(action_cls):
         raise Ros2Error(f"action '{run.action}' has type {known}, not {type_name(action_cls)}")
-    client = ActionClient(ctx.node, action_cls, run.action)
+    # Sent from this job's thread while the runtime spins in its own (see action_client).
+    client = ThreadSafeActionClient(ctx.node, action_cls, run.action)
 
     running_id: list[Any] = []  # the goal's id, once feedback proves it runs
 

@@ -45,6 +45,10 @@ STOP_TIMEOUT = 20.0
 # Exit codes that are the node's Ctrl+C codes too: view_frames stopped while it listens
 # reports that it wrote no picture (1), on SIGINT as on SIGTERM.
 CTRL_C_CODES = {"view_frames": (0, 1)}
+# Seven catalog entries are named /listener. A node that ends says goodbye to the
+# others; when that one UDP message is lost (busy cores), the probe still sees it until
+# its lease runs out: Fast DDS's default lease is 20 s.
+GRAPH_CLEAR_TIMEOUT = 25.0
 ABORT = "terminate called"
 
 
@@ -88,7 +92,9 @@ def _on_graph(probe, name: str) -> bool:
 def _stop_one(entry: catalog.CatalogEntry, env: dict[str, str], probe) -> Ending:
     """Start ``entry``, SIGTERM it as soon as it is up, and say how it ended."""
     wait_until(  # the previous node of this domain with the same name has left
-        lambda: not _on_graph(probe, entry.node_name), timeout=10, what="the graph to clear"
+        lambda: not _on_graph(probe, entry.node_name),
+        timeout=GRAPH_CLEAR_TIMEOUT,
+        what="the graph to clear",
     )
     proc = subprocess.Popen(
         [sys.executable, "-m", f"nodes.{entry.module}", *entry.argv_tail()],

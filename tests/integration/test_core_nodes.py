@@ -8,12 +8,12 @@ import pytest
 from action_msgs.msg import GoalStatus
 from lifecycle_msgs.msg import Transition
 from lifecycle_msgs.srv import ChangeState, GetState
-from rclpy.action import ActionClient
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64, String
 from tutorial_interfaces.action import Fibonacci
 from tutorial_interfaces.srv import AddTwoInts
 
+from app.ros.action_client import ThreadSafeActionClient
 from app.ros.monitor import TopicMonitor
 from app.supervisor import NodeState
 from tests.conftest import wait_until
@@ -92,7 +92,7 @@ def test_add_two_ints_client_waits_then_prints_the_sum(supervisor, probe):
 class ProbeGoal:
     """One Fibonacci goal sent from the probe, with its feedback and result."""
 
-    def __init__(self, client: ActionClient, order: int) -> None:
+    def __init__(self, client: ThreadSafeActionClient, order: int) -> None:
         self.order = order
         self.feedback: list[list[int]] = []
         self._send = client.send_goal_async(
@@ -115,7 +115,7 @@ class ProbeGoal:
 
 def test_fibonacci_feedback_result_rejection_cancel_and_preemption(supervisor, probe):
     supervisor.start("fibonacci_action_server", ["-p", "step_period:=0.1"])
-    client = ActionClient(probe.node, Fibonacci, "/fibonacci")
+    client = ThreadSafeActionClient(probe.node, Fibonacci, "/fibonacci")
     wait_until(client.server_is_ready, timeout=DISCOVERY_TIMEOUT, what="the /fibonacci server")
 
     # Feedback grows one number per step; the result has order + 1 numbers.

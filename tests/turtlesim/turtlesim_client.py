@@ -16,6 +16,7 @@ import math
 import sys
 import threading
 import time
+from collections.abc import Callable
 from typing import Any
 
 import rclpy
@@ -348,18 +349,32 @@ def scenario_reset(node: TurtleClient) -> dict:
     }
 
 
+def in_spin_thread(node: Node, request: Callable[[], Any]) -> Any:
+    """``request()`` run by the executor's own thread; its return value.
+
+    rclpy 7.1's ActionClient files a request's future after sending it: an answer
+    the spinning thread takes in between is dropped ("Ignoring unexpected goal
+    response"). Sent from the spinning thread, no answer can come in between.
+    """
+    task = node.executor.create_task(request)
+    return wait(lambda: task.done() and task.result(), what="the request to be sent")
+
+
 class Goal:
     """One rotate_absolute goal: feedback count, final status and result."""
 
-    def __init__(self, client: ActionClient, theta: float) -> None:
+    def __init__(self, node: Node, client: ActionClient, theta: float) -> None:
         self.feedback: list[float] = []
         self.sent = time.monotonic()
-        future = client.send_goal_async(
-            RotateAbsolute.Goal(theta=theta),
-            feedback_callback=lambda msg: self.feedback.append(msg.feedback.remaining),
+        future = in_spin_thread(
+            node,
+            lambda: client.send_goal_async(
+                RotateAbsolute.Goal(theta=theta),
+                feedback_callback=lambda msg: self.feedback.append(msg.feedback.remaining),
+            ),
         )
         self.handle = wait(lambda: future.done() and future.result(), what="goal accepted")
-        self.result_future = self.handle.get_result_async()
+        self.result_future = in_spin_thread(node, self.handle.get_result_async)
 
     def outcome(self) -> dict:
         wait(self.result_future.done, what="the goal's result")
@@ -377,19 +392,19 @@ def scenario_rotate(node: TurtleClient) -> dict:
     client = ActionClient(node, RotateAbsolute, "/turtle1/rotate_absolute")
     wait(client.server_is_ready, what="the rotate_absolute action")
     node.still("turtle1")
-    done = Goal(client, math.pi / 2).outcome()
+    done = Goal(node, client, math.pi / 2).outcome()
     reached = node.still("turtle1")
 
-    first = Goal(client, -math.pi / 2)
+    first = Goal(node, client, -math.pi / 2)
     time.sleep(0.3)
-    second = Goal(client, math.pi)
+    second = Goal(node, client, math.pi)
     replaced = first.outcome()
     newer = second.outcome()
     node.still("turtle1")
 
     node.teleport("turtle1", CENTRE, CENTRE, 0.0)
     node.still("turtle1")
-    third = Goal(client, math.pi)
+    third = Goal(node, client, math.pi)
     time.sleep(0.3)
     node.drive("turtle1", angular=0.5)
     by_cmd_vel = third.outcome()
@@ -397,9 +412,9 @@ def scenario_rotate(node: TurtleClient) -> dict:
 
     node.teleport("turtle1", CENTRE, CENTRE, 0.0)
     node.still("turtle1")
-    fourth = Goal(client, math.pi)
+    fourth = Goal(node, client, math.pi)
     time.sleep(0.3)
-    cancel = fourth.handle.cancel_goal_async()
+    cancel = in_spin_thread(node, fourth.handle.cancel_goal_async)
     wait(cancel.done, what="the cancel reply")
     canceled = fourth.outcome()
     after_cancel = node.fresh_pose("turtle1", 0.2)
