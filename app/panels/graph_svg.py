@@ -187,6 +187,24 @@ def short(text: str, limit: int = MAX_LABEL) -> str:
     return text if len(text) <= limit else text[: limit - 1] + "…"
 
 
+NAME_FONT, SMALLEST_NAME_FONT = 12.0, 9.0  # px; 9 px still reads at 1:1 scale
+
+
+def fitted_name(name: str) -> tuple[str, float]:
+    """A box's name and its font size: a long name is set smaller so it reads whole.
+
+    Only a name too long even at the smallest size is cut, in its middle: both its
+    namespace and its last part (the one a learner typed) stay.
+    """
+    if len(name) <= MAX_LABEL:
+        return name, NAME_FONT
+    fits = int(MAX_LABEL * NAME_FONT / SMALLEST_NAME_FONT)
+    if len(name) <= fits:
+        return name, round(NAME_FONT * MAX_LABEL / len(name), 1)
+    head = (fits - 1) // 2
+    return name[:head] + "…" + name[-(fits - 1 - head) :], SMALLEST_NAME_FONT
+
+
 def edge_path(a: Placed, b: Placed) -> tuple[str, float, float]:
     """A cubic curve from a's bottom to b's top (or around the side when b is not below)."""
     x0, y0 = a.x + BOX_W / 2, a.y + BOX_H
@@ -245,14 +263,15 @@ def render_svg(vertices: list[Vertex], edges: list[Edge], per_row: int = PER_ROW
         cx = p.x + BOX_W / 2
         title = f"{v.kind} {v.name}" + (f" ({v.detail})" if v.detail else "")
         name_y = p.y + (14 if v.detail else 21)
+        label, font = fitted_name(v.name)
         parts.append(
             f'<g class="rg-vertex" data-kind="{v.kind}" data-name="{escape(v.name)}">'
             # A tooltip only for cut names: a hidden title would shadow the visible text.
-            + (f"<title>{escape(title)}</title>" if short(v.name) != v.name else "")
+            + (f"<title>{escape(title)}</title>" if label != v.name else "")
             + f'<rect x="{p.x:.0f}" y="{p.y:.0f}" width="{BOX_W}" height="{BOX_H}" rx="{radius}" '
             f'fill="{fill}" stroke="{stroke}" stroke-width="1.5"/>'
-            f'<text x="{cx:.0f}" y="{name_y:.0f}" font-size="12" text-anchor="middle" '
-            f'fill="#111">{escape(short(v.name))}</text>'
+            f'<text x="{cx:.0f}" y="{name_y:.0f}" font-size="{font:g}" text-anchor="middle" '
+            f'fill="#111">{escape(label)}</text>'
         )
         if v.detail:
             parts.append(

@@ -22,6 +22,7 @@ from app.panels.graph_svg import (
     Placed,
     Vertex,
     edge_path,
+    fitted_name,
     layout,
     short,
 )
@@ -320,9 +321,10 @@ def stage_svg(
         cx = p.x + BOX_W / 2
         name_y = p.y + (14 if v.detail else 21)
         waiting = v.kind == "node" and v.name in starting
+        label, font = fitted_name(v.name)
         body = (
             f'{_shape(p, waiting)}<text class="sg-name" x="{cx:.0f}" y="{name_y:.0f}" '
-            f'font-size="12" text-anchor="middle">{escape(short(v.name))}</text>'
+            f'font-size="{font:g}" text-anchor="middle">{escape(label)}</text>'
         )
         if v.detail:
             body += (

@@ -10,6 +10,7 @@ from app.panels.graph_svg import (
     Edge,
     NodeEndpoints,
     Vertex,
+    fitted_name,
     graph_picture,
     layers,
     layout,
@@ -116,3 +117,19 @@ def test_rates_measured_only_for_drawn_topics_and_not_heavy_ones():
     assert topics_to_measure(picture, [TALKER, camera]) == {"/chatter": STRING}
     heavy = topics_to_measure(picture, [TALKER, camera], heavy_too=True)
     assert heavy == {"/chatter": STRING, "/image": "sensor_msgs/msg/Image"}
+
+
+def test_a_long_name_is_set_smaller_and_only_a_very_long_one_is_cut_in_its_middle():
+    assert fitted_name("/talker") == ("/talker", 12.0)
+    name, font = fitted_name("/fibonacci_action_server")  # 24 characters: as it is
+    assert (name, font) == ("/fibonacci_action_server", 12.0)
+    name, font = fitted_name("/turtlesim/describe_parameters")  # 30: whole, smaller
+    assert name == "/turtlesim/describe_parameters" and 9.0 <= font < 12.0
+    assert len(name) * font <= 25 * 12.0  # no wider than 25 characters at 12 px
+    very_long = "/classroom_dashboard/get_parameter_types_and_more"
+    name, font = fitted_name(very_long)
+    assert font == 9.0 and "…" in name and len(name) * font <= 25 * 12.0
+    head, tail = name.split("…")
+    assert very_long.startswith(head) and very_long.endswith(tail) and tail.endswith("_more")
+    svg = render_svg([Vertex("node", very_long)], [])
+    assert f"<title>node {very_long}</title>" in svg  # the whole name on hover
