@@ -256,7 +256,9 @@ class ScenePanel:
         Frames whose broadcaster left, a robot nobody describes any more, and
         the clouds, scans, images, markers, joints and stamped points of topics
         without a publisher; each row then follows by itself again, so what the
-        new lesson starts shows at once. What is still published stays.
+        new lesson starts shows at once. What is still published stays. The
+        cameras go back to the desk view (an earlier lesson may have left them far
+        out over a point cloud), unless the simulated world still runs.
         """
         rows = (
             (self._cloud_row, self.clouds.select),
@@ -273,6 +275,8 @@ class ScenePanel:
                 row.chosen_by_learner = False
         self.stamped.forget_unpublished(graph)
         self.tf_view.forget_unpublished(graph.publishers("/robot_description") > 0)
+        if not self._world_shown:
+            self.drive.move_cameras(*(np.asarray(v, dtype=float) for v in DESK_VIEW))
 
     def _frame_pose(self, frame: str) -> np.ndarray | None:
         """A TF frame's pose in the Fixed Frame, as the TF view last drew it (any thread)."""
