@@ -17,6 +17,7 @@ import viser
 
 from app.catalog import UnknownNodeError, lookup
 from app.catalog import names as catalog_names
+from app.exercises.attempts import AttemptStore, attempts_root
 from app.exercises.editor_server import EditorHub
 from app.exercises.grader import Grader
 from app.exercises.model import load_exercises
@@ -161,7 +162,7 @@ class Dashboard:
                 self.exercises,
                 self.workspace,
                 self.supervisor,
-                Grader(node, self.supervisor),
+                Grader(node, self.supervisor, AttemptStore(attempts_root())),
                 self.editor_hub,
                 side_window,
                 self.exercise_settings,

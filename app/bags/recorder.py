@@ -133,7 +133,10 @@ class Recorder:
         compression_mode: str = "none",
         compression_format: str = "zstd",
         flush_interval: float = 1.0,
+        skip_types: frozenset[str] = frozenset(),
     ) -> None:
+        """``skip_types``: message types ``all_topics`` leaves out (a topic named in
+        ``topics`` is recorded whatever its type)."""
         if storage not in STORAGES:
             raise BagError(f"unknown storage '{storage}' (choose {' or '.join(STORAGES)})")
         if compression_mode not in COMPRESSION_MODES:
@@ -146,6 +149,7 @@ class Recorder:
         self._node = node
         self._wanted = list(dict.fromkeys(topics or []))
         self._all = all_topics
+        self._skip_types = skip_types
         self._flush_interval = flush_interval
         self._queue: queue.SimpleQueue[_Item] = queue.SimpleQueue()
         self._subs: dict[str, Subscription] = {}
@@ -186,7 +190,12 @@ class Recorder:
         graph = dict(self._node.get_topic_names_and_types())
         candidates = self._wanted or []
         if self._all:
-            candidates = [t for t in sorted(graph) if not is_internal_topic(t) or t in QUIET_TOPICS]
+            candidates = [
+                t
+                for t in sorted(graph)
+                if (not is_internal_topic(t) or t in QUIET_TOPICS)
+                and not set(graph[t]) <= self._skip_types
+            ]
         for topic in candidates:
             if topic in self._subs or topic in self._skipped or topic not in graph:
                 continue
@@ -276,6 +285,10 @@ class Recorder:
     def failed(self) -> str | None:
         with self._lock:
             return self._failure
+
+    def set_custom_data(self, key: str, value: str) -> None:
+        """A key and value for ``metadata.yaml``'s ``custom_data`` (before ``stop``)."""
+        self._writer.set_custom_data(key, value)
 
     def stop(self, timeout: float = 30.0) -> RecordingStatus:
         """End the recording: no more messages, the writer drains and closes the bag."""

@@ -13,12 +13,13 @@ from __future__ import annotations
 import dataclasses
 import random
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 
 from rclpy.node import Node
 
 from app.exercises import runner
+from app.exercises.attempts import AttemptStore
 from app.exercises.model import Exercise
 from app.exercises.probes import ProbeContext, run_probe
 from app.exercises.report import Report, Result
@@ -93,9 +94,13 @@ class _Programs:
 
 
 class Grader:
-    def __init__(self, node: Node, supervisor: Supervisor) -> None:
+    def __init__(
+        self, node: Node, supervisor: Supervisor, attempts: AttemptStore | None = None
+    ) -> None:
+        """``attempts``: where each grading is recorded as a bag (None: not recorded)."""
         self.node = node
         self.supervisor = supervisor
+        self.attempts = attempts
 
     def grade(
         self,
@@ -110,31 +115,50 @@ class Grader:
         report = Report(exercise.slug, seed=seed)
         call = ctx or CallContext(self.node, limits=PROBE_LIMITS)
         lessons = LessonRuntime(self.node, self.supervisor)
+        recording = self.attempts.start(self.node, exercise.slug) if self.attempts else None
 
         def record(result: Result) -> None:
             report.results.append(result)
             if on_result is not None:
                 on_result(result)
 
-        def wait_check(spec: Spec, timeout: float) -> tuple[bool, str]:
+        def for_learner(spec: Spec) -> Spec:
             if spec.get("catalog_node") == LEARNER_PROGRAM:
-                spec = Spec(spec.kind, {**spec.fields, "catalog_node": exercise.program_name})
+                return Spec(spec.kind, {**spec.fields, "catalog_node": exercise.program_name})
+            return spec
+
+        def wait_checks(specs: Sequence[Spec], timeout: float) -> Iterator[tuple[bool, str]]:
+            """Each check's verdict, in order: passed as soon as it passes, failed once
+            ``timeout`` has gone by. All are watched at once, so a program that fails
+            several is told so after one wait, not one wait per check."""
+            pending = {i: for_learner(spec) for i, spec in enumerate(specs)}
+            verdicts: dict[int, tuple[bool, str]] = {}
             deadline = time.monotonic() + timeout
+            told = 0
             while True:
                 lessons.graph = snapshot(self.node)
-                outcome = lessons.evaluate(spec)
-                if outcome.state == PASS:
-                    return True, outcome.reason
-                if time.monotonic() > deadline:
-                    return False, outcome.reason
+                late = time.monotonic() > deadline
+                for index, spec in list(pending.items()):
+                    outcome = lessons.evaluate(spec)
+                    if outcome.state == PASS or late:
+                        verdicts[index] = (outcome.state == PASS, outcome.reason)
+                        del pending[index]
+                while told in verdicts:  # in the exercise's order, as soon as known
+                    yield verdicts[told]
+                    told += 1
+                if not pending:
+                    return
                 call.sleep(POLL_SEC)
+
+        def wait_check(spec: Spec, timeout: float) -> tuple[bool, str]:
+            return next(wait_checks([spec], timeout))
 
         try:
             report.problem = self._wait_for_learner(exercise, script, call)
             if report.problem:
                 return report
-            for check in exercise.checks:
-                passed, detail = wait_check(check, CHECK_WAIT_SEC)
+            verdicts = wait_checks(exercise.checks, CHECK_WAIT_SEC)
+            for check, (passed, detail) in zip(exercise.checks, verdicts, strict=True):
                 record(Result(_check_name(check), passed, detail))
             programs = _Programs(self.supervisor, exercise)
             probe_ctx = ProbeContext(
@@ -155,6 +179,10 @@ class Grader:
             report.problem = "grading was stopped"
         finally:
             lessons.close()
+            if recording is not None:
+                kept = recording.finish(report)
+                report.attempt = str(kept.path or "")
+                report.attempt_note = kept.note
         return report
 
     def _alive(self, exercise: Exercise) -> bool:

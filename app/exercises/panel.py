@@ -18,6 +18,7 @@ from typing import Any
 
 import viser
 
+from app.bags.folder import bags_dir
 from app.containment.policy import RunPolicy
 from app.exercises import code_assist, package_grading, runner
 from app.exercises.editor_server import EditorHub, editor_url
@@ -286,6 +287,7 @@ class ExercisePanel:
             self._verdict = (
                 f"**{report.summary()}** Read the ✗ lines, change your code, Run, Check."
             )
+        self._verdict += attempt_line(report)
         self._message = (
             "⚠ You changed the code after Run: these results are for the code that runs. "
             "Click **Run my node** again to check your edits."
@@ -417,3 +419,21 @@ class ExercisePanel:
 
     def close(self) -> None:
         """The learner's process belongs to the supervisor, which stops it on shutdown."""
+
+
+def attempt_line(report: Report) -> str:
+    """Where this grading's recording went, as the Console's `ros2 bag` commands take it."""
+    if report.attempt_note:
+        return f"\n\n_{report.attempt_note}_"
+    if not report.attempt:
+        return ""
+    name = Path(report.attempt)
+    try:
+        name = name.relative_to(bags_dir())
+    except ValueError:
+        pass
+    return (
+        "\n\nThis attempt was recorded: in the Console, `ros2 bag info "
+        f"{name}` lists what the grader sent and your node answered, and `ros2 bag play "
+        f"{name}` replays it (an MCAP file: Foxglove opens it too)."
+    )

@@ -25,6 +25,8 @@ class Report:
     results: list[Result] = field(default_factory=list)
     problem: str = ""  # why grading could not even start (no process, syntax error, ...)
     seed: int | None = None  # the probes' inputs were drawn from it: replays the grading
+    attempt: str = ""  # the bag this grading was recorded into (app/exercises/attempts.py)
+    attempt_note: str = ""  # why it was not kept, when it was not
 
     @property
     def passed(self) -> bool:

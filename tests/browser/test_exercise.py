@@ -10,6 +10,7 @@ from playwright.sync_api import Page, expect
 
 from app.exercises.model import load_exercises
 from tests.browser.helpers import choose, click, expect_text, open_tab
+from tests.browser.test_ros2_panels import expect_regex, field
 from tests.conftest import DashboardProcess, free_port
 
 EXERCISE = load_exercises().get("multiply_service")
@@ -56,6 +57,16 @@ def test_wrong_then_right_then_survives_reload_and_sigkill(page, dashboard, ros_
     click(page, "Check my node")
     expect_text(page, re.compile(r"/multiply answered sum=-?\d+ for a=-?\d+, b=-?\d+; expected"))
     expect_text(page, "1 of 2 checks passed")
+    # The attempt was recorded, and the Console's `ros2 bag info` reads it as shown.
+    told = page.get_by_text(re.compile(r"This attempt was recorded")).first
+    expect(told).to_be_visible(timeout=20_000)
+    found = re.search(r"ros2 bag info (attempts/\S+?-fail)\b", told.inner_text())
+    assert found, told.inner_text()
+    open_tab(page, "Console")
+    field(page, "Command").fill(f"ros2 bag info {found.group(1)}")
+    click(page, "Run")
+    expect_regex(page, r"Topic: /rosout \| Type: rcl_interfaces/msg/Log \| Count: [1-9]", 30_000)
+    open_tab(page, "Exercise")
 
     _type_code(page, frame_locator, EXERCISE.reference)
     click(page, "Run my node")

@@ -17,10 +17,12 @@ from pathlib import Path
 import pytest
 
 from app.exercises import runner
+from app.exercises.attempts import AttemptStore
 from app.exercises.grader import Grader
 from app.exercises.model import Exercise, load_exercises
 from app.exercises.package_grading import grade_package
 from app.exercises.report import Report
+from tests.bags.readers import mcap_messages
 from tests.conftest import fail_on_leftover_nodes
 from tests.exercises.cheats import EXEMPT, cheat_code
 
@@ -57,11 +59,27 @@ def grading_env(tmp_path_factory):
     configure_dds_env(os.environ, domain_id=77, network=False)
     runtime = RosRuntime("exercise_grader_test")
     supervisor = Supervisor(os.environ)
-    yield Grader(runtime.node, supervisor), supervisor, tmp_path_factory.mktemp("code")
+    # Every grading recorded, as the dashboard does: each attempt is read back below.
+    attempts = AttemptStore(tmp_path_factory.mktemp("attempts"))
+    yield Grader(runtime.node, supervisor, attempts), supervisor, tmp_path_factory.mktemp("code")
     supervisor.shutdown()
     runtime.shutdown()
     os.environ.clear()
     os.environ.update(saved)
+
+
+def _read_back(report: Report, ran: bool = True) -> Report:
+    """The grading's attempt is kept, and the independent MCAP reader reads all of it.
+
+    ``ran`` False: a package that may not have built, so never ran (nothing to record).
+    """
+    if not ran and not (report.attempt or report.attempt_note):
+        return report
+    assert report.attempt, f"the attempt was not kept: {report.attempt_note}"
+    verdict = "problem" if report.problem else ("pass" if report.passed else "fail")
+    assert report.attempt.endswith(f"-seed7-{verdict}"), report.attempt
+    mcap_messages(Path(report.attempt))  # raises on a damaged file or an undecodable message
+    return report
 
 
 def _grade(grading_env, exercise: Exercise, code: str) -> Report:
@@ -70,7 +88,7 @@ def _grade(grading_env, exercise: Exercise, code: str) -> Report:
     script.write_text(code, encoding="utf-8")
     runner.start(supervisor, exercise, script)
     try:
-        return grader.grade(exercise, script, seed=7)
+        return _read_back(grader.grade(exercise, script, seed=7))
     finally:
         runner.stop(supervisor, exercise)
         for name in exercise.setup:
@@ -82,7 +100,7 @@ def _grade_package(grading_env, exercise: Exercise, folder: Path) -> Report:
     """A package exercise: the grader builds the folder with colcon, then runs or launches it."""
     grader, _supervisor, scratch = grading_env
     try:
-        return grade_package(grader, exercise, folder, scratch, seed=7)
+        return _read_back(grade_package(grader, exercise, folder, scratch, seed=7), ran=False)
     finally:
         fail_on_leftover_nodes("this case")
 

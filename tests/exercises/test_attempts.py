@@ -1,0 +1,133 @@
+"""Every graded attempt is kept as a bag (app/exercises/attempts.py).
+
+A real grading of the services exercise, recorded: the bag is read by the
+independent ``mcap`` reader and holds the learner node's own log lines, its
+name and metadata carry the seed and the verdict. The store keeps the newest
+attempts of an exercise and stays under its size; a folder that cannot be
+written leaves the grading as it was, with the reason the attempt was not kept.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import pytest
+import yaml
+
+from app.exercises import runner
+from app.exercises.attempts import AttemptStore
+from app.exercises.grader import Grader
+from app.exercises.model import load_exercises
+from app.exercises.report import Report
+from tests.bags.readers import mcap_messages
+from tests.conftest import fail_on_leftover_nodes, in_private_netns
+
+SLUG = "multiply_service"
+EXERCISE = load_exercises().get(SLUG)
+
+
+def _attempt(root: Path, slug: str, name: str, size: int = 10) -> Path:
+    folder = root / slug / name
+    folder.mkdir(parents=True)
+    (folder / "bag_0.mcap").write_bytes(b"x" * size)
+    return folder
+
+
+def test_the_newest_attempts_of_an_exercise_stay(tmp_path):
+    store = AttemptStore(tmp_path, keep=2)
+    names = [
+        "20261129-100000-seed1-fail",
+        "20261129-100100-seed2-fail",
+        "20261129-100200-seed3-pass",
+    ]
+    made = [_attempt(tmp_path, SLUG, name) for name in names]
+    other = _attempt(tmp_path, "talker_rate", "20261129-090000-seed9-fail")
+    store.prune(SLUG, made[-1])
+    assert [p.name for p in store.attempts(SLUG)] == names[1:]
+    assert other.exists()  # another exercise's attempts are counted apart
+
+
+def test_the_oldest_attempts_of_all_exercises_go_first_over_the_size_cap(tmp_path):
+    store = AttemptStore(tmp_path, keep=10, cap_bytes=250)
+    oldest = _attempt(tmp_path, "talker_rate", "20261129-090000-seed9-fail", size=100)
+    middle = _attempt(tmp_path, SLUG, "20261129-100000-seed1-fail", size=100)
+    newest = _attempt(tmp_path, SLUG, "20261129-110000-seed2-fail", size=100)
+    store.prune(SLUG, newest)
+    assert not oldest.exists() and middle.exists() and newest.exists()
+    # One attempt alone over the cap is not kept either.
+    huge = _attempt(tmp_path, SLUG, "20261129-120000-seed3-fail", size=1000)
+    store.prune(SLUG, huge)
+    assert not huge.exists() and not middle.exists() and not newest.exists()
+
+
+@pytest.fixture(scope="module")
+def grading(tmp_path_factory):
+    if not in_private_netns():
+        pytest.fail("run through tests/run.py: DDS tests need the private network namespace")
+    from app.dds import configure_dds_env
+    from app.ros.runtime import RosRuntime
+    from app.supervisor import Supervisor
+
+    saved = dict(os.environ)
+    configure_dds_env(os.environ, domain_id=78, network=False)
+    runtime = RosRuntime("attempt_test_grader")
+    supervisor = Supervisor(os.environ)
+    yield runtime.node, supervisor, tmp_path_factory.mktemp("code")
+    supervisor.shutdown()
+    runtime.shutdown()
+    os.environ.clear()
+    os.environ.update(saved)
+
+
+def _grade(grading, store: AttemptStore, code: str, seed: int) -> Report:
+    node, supervisor, scratch = grading
+    script = scratch / f"{SLUG}.py"
+    script.write_text(code, encoding="utf-8")
+    runner.start(supervisor, EXERCISE, script)
+    try:
+        return Grader(node, supervisor, store).grade(EXERCISE, script, seed=seed)
+    finally:
+        runner.stop(supervisor, EXERCISE)
+        fail_on_leftover_nodes("this case")
+
+
+@pytest.mark.ros
+def test_a_graded_attempt_is_a_bag_with_the_learners_log_seed_and_verdict(grading, tmp_path):
+    store = AttemptStore(tmp_path / "attempts")
+    mistake = next(m for m in EXERCISE.mistakes if m.path.stem == "adds")
+    report = _grade(grading, store, mistake.path.read_text(encoding="utf-8"), seed=4242)
+    assert not report.passed and not report.problem, report.summary()
+    assert report.attempt and not report.attempt_note, report.attempt_note
+    bag = Path(report.attempt)
+    assert bag.parent == tmp_path / "attempts" / SLUG
+    assert bag.name.endswith("-seed4242-fail")
+
+    meta = yaml.safe_load((bag / "metadata.yaml").read_text(encoding="utf-8"))
+    custom = meta["rosbag2_bagfile_information"]["custom_data"]
+    assert custom["classroom.exercise"] == SLUG
+    assert custom["classroom.seed"] == "4242"
+    assert custom["classroom.verdict"] == "fail"
+    results = json.loads(custom["classroom.results"])
+    assert [r["detail"] for r in results] == [r.detail for r in report.results]
+
+    # The independent reader: the learner node's own lines, as it answered the probes.
+    messages = mcap_messages(bag)
+    logged = [m.msg for topic, _t, m in messages if topic == "/rosout" and m.name == "multiplier"]
+    assert logged, f"no log line of /multiplier in the attempt ({len(messages)} messages)"
+
+    # A second attempt: a pass, beside the first.
+    report = _grade(grading, store, EXERCISE.reference, seed=5)
+    assert report.passed, report.summary()
+    assert [p.name.split("-seed")[1] for p in store.attempts(SLUG)] == ["4242-fail", "5-pass"]
+
+
+@pytest.mark.ros
+def test_an_unwritable_attempts_folder_never_stops_the_grading(grading, tmp_path):
+    blocker = tmp_path / "not_a_folder"
+    blocker.write_text("a file where the attempts folder should be", encoding="utf-8")
+    report = _grade(grading, AttemptStore(blocker / "attempts"), EXERCISE.reference, seed=6)
+    assert report.passed, report.summary()
+    assert not report.attempt
+    assert report.attempt_note.startswith("attempt not kept: cannot record into")
