@@ -204,7 +204,8 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
     bag.add_verbs(group("bag", "Various rosbag related sub-commands"), verb)
     pkg.add_verbs(group("pkg", "Various package related sub-commands"), verb)  # issue 22
     pkg.add_commands(groups, write)  # `colcon ...` and `source install/setup.bash`
-    run.add_command(groups, write)  # `ros2 run PKG EXE`: a command, not a group of verbs
+    # `ros2 run PKG EXE`: a command, not a group of verbs; sourced workspaces come first.
+    run.add_command(groups, write, pkg.run_own)
     launch_verb.add_command(groups, write)  # `ros2 launch PKG FILE`: the same
     for g, verbs, name in groups_done:
         for missing, description in NOT_HERE_VERBS.get(name, {}).items():

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import argparse
 import re
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import replace
 from pathlib import Path
 from typing import Any, Protocol
@@ -42,7 +42,7 @@ from app.ros.errors import Ros2Error
 from app.ros2cli import tool_args
 
 # (package, executable) of the tutorials -> catalog name.
-_UPSTREAM: dict[tuple[str, str], str] = {
+UPSTREAM: dict[tuple[str, str], str] = {
     ("turtlesim", "turtlesim_node"): "turtlesim_node",
     ("turtlesim", "turtle_teleop_key"): "turtle_teleop_key",
     ("turtlesim", "mimic"): "turtle_mimic",
@@ -98,7 +98,7 @@ _UPSTREAM: dict[tuple[str, str], str] = {
 # ...and every catalog entry under its own package (`ros2 run tutorial_nodes talker`).
 EXECUTABLES: dict[tuple[str, str], str] = {
     **{(entry.package, entry.name): entry.name for entry in ENTRIES},
-    **_UPSTREAM,
+    **UPSTREAM,
 }
 
 STARTUP_WAIT_SEC = 5.0  # the longest the verb shows a starting node's output
@@ -160,9 +160,9 @@ def executables(package: str | None = None) -> list[tuple[str, str]]:
     An upstream package lists the tutorial names it maps (turtlesim: mimic,
     turtle_teleop_key, turtlesim_node), not the catalog's variants of them.
     """
-    upstream = {pkg for pkg, _exe in _UPSTREAM}
+    upstream = {pkg for pkg, _exe in UPSTREAM}
     pairs = [
-        (pkg, exe) for pkg, exe in EXECUTABLES if (pkg, exe) in _UPSTREAM or pkg not in upstream
+        (pkg, exe) for pkg, exe in EXECUTABLES if (pkg, exe) in UPSTREAM or pkg not in upstream
     ]
     if package is not None:
         pairs = [(pkg, exe) for pkg, exe in pairs if pkg == package]
@@ -364,7 +364,13 @@ def _show_start(ctx: CallContext, programs: Programs, key: str, fqn: str) -> int
     return 0
 
 
-def add_command(groups: Any, write: Any) -> None:
+# `ros2 run` of a package in a sourced workspace (app.ros2cli.pkg.run_own): its exit code,
+# or None when the package is not one of those. Given by the parser, so that this module
+# (which pkg builds on) does not import pkg back.
+OwnFirst = Callable[[CallContext, str, str, list[str]], int | None]
+
+
+def add_command(groups: Any, write: Any, own_packages_first: OwnFirst) -> None:
     """Register `run` on the parser's sub-command table (parser.build_parser)."""
     p = groups.add_parser(
         "run", help="start a node: ros2 run PACKAGE EXECUTABLE [--ros-args ...]", write=write
@@ -373,7 +379,7 @@ def add_command(groups: Any, write: Any) -> None:
     p.add_argument("package", nargs="?")
     p.add_argument("executable", nargs="?")
     p.add_argument("arguments", nargs=argparse.REMAINDER, help="program and --ros-args words")
-    p.set_defaults(handler=_handle)
+    p.set_defaults(handler=lambda ctx, args: _handle(ctx, args, own_packages_first))
 
 
 def pkg_executables(ctx: CallContext, package: str | None) -> int:
@@ -382,14 +388,13 @@ def pkg_executables(ctx: CallContext, package: str | None) -> int:
     return 0
 
 
-def _handle(ctx: CallContext, args: argparse.Namespace) -> int:
+def _handle(ctx: CallContext, args: argparse.Namespace, own_packages_first: OwnFirst) -> int:
     if args.stop:
         return stop(ctx, args.stop)
     if not args.package or not args.executable:
         raise Ros2Error("usage: ros2 run PACKAGE EXECUTABLE [args] [--ros-args ...]")
-    from app.ros2cli.pkg import run_own  # a sourced workspace's packages first (issue 22)
-
-    own = run_own(ctx, args.package, args.executable, list(args.arguments))
+    # A sourced workspace's packages first (issue 22), as a sourced overlay shadows.
+    own = own_packages_first(ctx, args.package, args.executable, list(args.arguments))
     if own is not None:
         return own
     return run(ctx, args.package, args.executable, list(args.arguments))

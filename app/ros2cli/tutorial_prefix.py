@@ -4,7 +4,7 @@
 executable='talker')`` find programs through the ament index:
 ``<prefix>/share/ament_index/resource_index/packages/<pkg>`` marks the
 package and ``<prefix>/lib/<pkg>/<exe>`` is the program. This prefix holds
-every ``(package, executable)`` of ``run._UPSTREAM`` whose package the
+every ``(package, executable)`` of ``run.UPSTREAM`` whose package the
 catalog prefix of ``app.launch_prefix`` (turtlesim, tutorial_nodes, ...)
 does not already hold, so the two never split one package. Each program is
 a two-line shell script that execs ``python -m nodes.<module>`` with the
@@ -25,7 +25,7 @@ from pathlib import Path
 from app import PROJECT_ROOT
 from app.ament_prefix import write_prefix
 from app.catalog import lookup
-from app.ros2cli.run import _UPSTREAM
+from app.ros2cli.run import UPSTREAM
 
 PARENT = PROJECT_ROOT / "var" / "ament"
 INDEX = "share/ament_index/resource_index/packages"
@@ -54,7 +54,7 @@ def files() -> dict[str, str]:
     """Relative path -> content of every file of the prefix."""
     taken = _taken_packages()
     out: dict[str, str] = {}
-    for (package, executable), name in sorted(_UPSTREAM.items()):
+    for (package, executable), name in sorted(UPSTREAM.items()):
         if package in taken:
             continue
         entry = lookup(name)
