@@ -462,6 +462,17 @@ def cmd_exercise(args: argparse.Namespace) -> int:
     return exercise_main(args.verb, args.slug, args.file, seed=args.seed)
 
 
+def cmd_lti(args: argparse.Namespace) -> int:
+    """What to paste into an LMS to add the tool (app/lti/lms_setup.py); makes the key once."""
+    from app.lti.keys import DEFAULT_DIR, ToolKeys
+    from app.lti.lms_setup import setup_text
+    from app.lti.routes import ToolUrls
+
+    urls = ToolUrls.from_base(args.base_url)
+    print(setup_text(urls, ToolKeys.load_or_create(args.keys_dir or DEFAULT_DIR)))
+    return 0
+
+
 ROS2_GROUPS = (
     "node", "topic", "service", "action", "param", "lifecycle", "interface", "bag", "pkg",
 )  # fmt: skip
@@ -643,6 +654,14 @@ def build_parser(prog: str = "ros2-classroom") -> argparse.ArgumentParser:
     exercise.add_argument("--seed", type=int, help="check: replay a grading's random inputs")
     dds_options(exercise)
     exercise.set_defaults(func=cmd_exercise)
+
+    lti = sub.add_parser("lti", help="LTI 1.3: the values to paste into Moodle, Canvas, Open edX")
+    lti.add_argument("verb", choices=("config",))
+    lti.add_argument("--base-url", required=True, help="where the LMS reaches this tool")
+    lti.add_argument(
+        "--keys-dir", type=Path, default=None, help="the tool key's folder (default var/lti/keys)"
+    )
+    lti.set_defaults(func=cmd_lti)
 
     # ros2-like verbs (app/ros2cli): `ros2-classroom topic list -t` is `ros2 topic list -t`.
     for group in ROS2_GROUPS:
