@@ -41,6 +41,7 @@ ONE_WORKER = frozenset(
 # worker, and whose tests gain from being shared out (the reason says why).
 SHARED_MODULE_FIXTURES = {
     "tests/exercises/test_grading.py": "one probe node and a supervisor; ~60 cases to share",
+    "tests/exercises/test_attempts.py": "one probe node and a supervisor, for two gradings",
     "tests/unit/test_slam_geometry.py": "synthetic frames rendered in memory in a second",
 }
 

@@ -57,6 +57,7 @@ COMPRESSION_MODES["message"] = CompressionMode.MESSAGE
 # Deep enough that a 1 kHz topic survives a slow writer moment without drops.
 SUBSCRIPTION_DEPTH = 1000
 BATCH_PAUSE_SEC = 0.02  # the writer lets messages gather this long between batches
+SUBSCRIBED = "Subscribed to topic"  # rosbag2's words, the line a learner waits for
 DRAIN_MAX = 100  # messages taken per callback beyond the one it was called with
 MAX_BATCH = 20_000
 BAG_VERSION: Literal[9] = 9  # Jazzy's rosbag2 metadata version
@@ -260,7 +261,7 @@ class Recorder:
             raw=True,
         )
         subscription.append(self._subs[topic])
-        return f"Subscribed to topic '{topic}'"
+        return f"{SUBSCRIBED} '{topic}'"
 
     def status(self) -> RecordingStatus:
         with self._lock:

@@ -5,7 +5,10 @@ are stopped: Ctrl+C on the command line, the Stop button in the Console.
 They do not obey the console's few-seconds limit for streams (a recording is
 meant to last), but in the browser they stop after ``CONSOLE_CAP_SEC`` at
 the latest, so a forgotten recording cannot fill the disk; ``--max-duration``
-(ours, not rosbag2's) stops a recording after a set time.
+(ours, not rosbag2's) stops a recording after a set time of recording: counted
+from its first subscription, since discovery may take a second or more on a
+busy machine and what comes before is not recorded (with nothing to subscribe
+to, from the start).
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ from app.bags.errors import BagError
 from app.bags.folder import existing_path, output_path
 from app.bags.info import human_size, info_lines, read_info
 from app.bags.player import Player, PlayOptions, parse_remap
-from app.bags.recorder import COMPRESSION_MODES, STORAGES, Recorder
+from app.bags.recorder import COMPRESSION_MODES, STORAGES, SUBSCRIBED, Recorder
 from app.bags.repair import reindex
 from app.ros.context import CallContext
 from app.ros.errors import Cancelled
@@ -92,9 +95,16 @@ def record(
     started = time.monotonic()
     next_progress = started + PROGRESS_EVERY_SEC
     announced = False
+    recording_since: float | None = None  # the first subscription: --max-duration counts from it
     try:
-        while limit is None or time.monotonic() - started < limit:
+        while limit is None or time.monotonic() - (recording_since or started) < limit:
             for line in recorder.poll():
+                if (
+                    recording_since is None
+                    and max_duration is not None
+                    and line.startswith(SUBSCRIBED)
+                ):
+                    recording_since = time.monotonic()
                 if line.startswith("[WARN]"):
                     ctx.write(line)
                 else:
@@ -224,7 +234,12 @@ def add_verbs(verbs: Any, verb: Verb) -> None:
     p.add_argument("-s", "--storage", choices=sorted(STORAGES), default="mcap")
     p.add_argument("--compression-mode", choices=sorted(COMPRESSION_MODES), default="none")
     p.add_argument("--compression-format", choices=["zstd"], default="zstd")
-    p.add_argument("--max-duration", type=float, default=None, help="stop after this many seconds")
+    p.add_argument(
+        "--max-duration",
+        type=float,
+        default=None,
+        help="stop after recording this many seconds (from the first subscription; ours)",
+    )
     p = verb(verbs, "info", "what a bag holds", lambda c, a: info(c, a.bag_path))
     p.add_argument("bag_path")
     p = verb(

@@ -49,7 +49,11 @@ def live(dashboard_node, supervisor, tmp_path, monkeypatch):
     def console(text: str) -> None:
         for earlier in commands:
             earlier.cancel.set()
-        ctx = CallContext(dashboard_node, limits=CONSOLE_LIMITS, programs=supervisor)
+        printed: list[str] = []  # what the Console shows, for a learner who waits for a line
+        runtime.console_printed = printed  # type: ignore[attr-defined]
+        ctx = CallContext(
+            dashboard_node, write=printed.append, limits=CONSOLE_LIMITS, programs=supervisor
+        )
         commands.append(ctx)
         threading.Thread(target=run_text, args=(ctx, text), daemon=True).start()
 
@@ -129,6 +133,14 @@ def test_every_step_of_the_lesson_passes_on_real_nodes(live, lesson, request):
                     what=f"the server for {action.key}",
                 )
             live.perform(action)
+            if action.kind == "console" and action["command"].startswith("ros2 bag record"):
+                # As the lesson says: drive once the recorder has subscribed (on busy
+                # cores that took over a second, and the first commands were not in the bag).
+                wait_until(
+                    lambda: any("Subscribed to topic" in line for line in live.console_printed),
+                    timeout=20,
+                    what=lambda: f"the recording to subscribe; the Console: {live.console_printed}",
+                )
         for check in step.checks:
             if check.kind == "quiz":
                 live.quiz_answers[check.key] = check["answer"]

@@ -158,7 +158,10 @@ def test_every_launch_group_is_a_tutorial_nodes_launch_file(console, supervisor)
     children = {int(line.rsplit("[", 1)[1].rstrip("]")) for line in out[2:4]}
     assert {os.getpgid(child) for child in children} == {pid}  # the launcher's group
     out = ok(console, "ros2 launch --stop tutorial_nodes minimal_nodes.launch.py")
-    assert len(out) == 3 and all("process has finished cleanly" in line for line in out[1:]), out
+    # The nodes' own lines ("[minimal_node-1] [INFO] ...") that came after the start
+    # command stopped showing output are shown here: on busy cores some do. Launch's own:
+    own = [line for line in out if not re.match(r"\[[\w.]+-\d+\] ", line)]
+    assert len(own) == 3 and all("process has finished cleanly" in line for line in own[1:]), out
     for child in children:  # reaped: no orphan left
         with pytest.raises(ProcessLookupError):
             os.kill(child, 0)
