@@ -7,7 +7,6 @@ clear line and exit non-zero; they never show a traceback.
 from __future__ import annotations
 
 import argparse
-import ipaddress
 import logging
 import os
 import socket
@@ -19,6 +18,7 @@ from typing import Any
 
 from app import catalog
 from app.dds import configure_this_process, validate_domain_id
+from app.hosts import is_loopback
 from app.stop_signals import set_on_signals
 
 EXIT_USAGE = 2
@@ -46,15 +46,6 @@ def _port(text: str) -> int:
     return port
 
 
-def _is_loopback(host: str) -> bool:
-    if host == "localhost":
-        return True
-    try:
-        return ipaddress.ip_address(host).is_loopback
-    except ValueError:
-        return False
-
-
 def _check_port_free(host: str, port: int) -> None:
     # viser silently moves to the next port when ours is taken; say so instead.
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
@@ -71,7 +62,7 @@ def _access_token(args: argparse.Namespace) -> str | None:
     """Beyond loopback only with --allow-remote, and then always with a token."""
     from app.access import AccessError, check_token, new_token
 
-    if not _is_loopback(args.host) and not args.allow_remote:
+    if not is_loopback(args.host) and not args.allow_remote:
         raise CliError(
             f"refusing to serve on {args.host}: the dashboard can start processes, so it "
             "only listens on this machine (127.0.0.1) unless you add --allow-remote "
@@ -89,7 +80,7 @@ def _run_policy(args: argparse.Namespace, progress_dir: Path, workspace: Any) ->
     """Learner code: as the user on loopback; served to others, only contained and allowed."""
     from app.containment.policy import RunPolicy
 
-    if _is_loopback(args.host):
+    if is_loopback(args.host):
         return RunPolicy()
     own = workspace.scratch.resolve()
 
@@ -150,7 +141,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
 
     scratch_root = args.scratch_dir or (args.progress_dir or DEFAULT_DIR).parent / "scratch"
     # Behind the hub's login (serve --jupyterhub) only the learner reaches the dashboard.
-    remote = hub_login is None and not _is_loopback(args.host)
+    remote = hub_login is None and not is_loopback(args.host)
     if remote:
         from app.containment.contain import SANDBOX_GID
 
@@ -313,7 +304,7 @@ def cmd_classroom(args: argparse.Namespace) -> int:
         return cmd_classroom_status(args)
     if args.learners is None:
         raise CliError("say how many learners: `ros2-classroom classroom --learners N`")
-    if not _is_loopback(args.host) and not args.allow_remote:
+    if not is_loopback(args.host) and not args.allow_remote:
         raise CliError(
             f"refusing to serve on {args.host}: add --allow-remote (each learner then gets "
             "an access token in their URL)"

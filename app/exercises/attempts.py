@@ -128,20 +128,24 @@ class AttemptRecording:
         except (OSError, BagError) as exc:
             self._failure = f"cannot record into {path.parent}: {exc}"
             return
-        self._poll()  # the topics already there, before the first probe sends anything
+        except Exception as exc:  # never a reason for the grading itself to fail
+            log.exception("attempt recording could not start")
+            self._failure = f"the recording could not start: {exc}"
+            return
+        self._poll_once()  # the topics already there, before the first probe sends anything
         self._poller = threading.Thread(target=self._poll_loop, name="attempt-poll", daemon=True)
         self._poller.start()
 
-    def _poll(self) -> None:
-        if self._recorder is not None:
-            self._recorder.poll()
+    def _poll_once(self) -> None:
+        try:
+            if self._recorder is not None:
+                self._recorder.poll()
+        except Exception:  # the graph changed under us: the next round sees it again
+            log.debug("attempt recording: poll failed", exc_info=True)
 
     def _poll_loop(self) -> None:
         while not self._stop.wait(POLL_SEC):
-            try:
-                self._poll()
-            except Exception:  # the graph changed under us: the next round sees it again
-                log.debug("attempt recording: poll failed", exc_info=True)
+            self._poll_once()
 
     def finish(self, report: Report) -> KeptAttempt:
         """Write the verdict into the bag's metadata, close it and give it its final name."""

@@ -6,23 +6,15 @@ A teacher pastes these into the LMS once, and the login step checks a
 
 from __future__ import annotations
 
-import ipaddress
 import urllib.parse
 from dataclasses import dataclass
+
+from app.hosts import is_loopback
 
 LOGIN_PATH = "/lti/login"
 LAUNCH_PATH = "/lti/launch"
 JWKS_PATH = "/lti/jwks"
 DEEP_LINK_PATH = "/lti/deep-link"
-
-
-def _is_loopback(host: str) -> bool:
-    if host == "localhost":
-        return True
-    try:
-        return ipaddress.ip_address(host).is_loopback
-    except ValueError:
-        return False
 
 
 @dataclass(frozen=True)
@@ -39,7 +31,7 @@ class ToolUrls:
             raise ValueError(f"the base URL must look like https://host/path, got {base_url!r}")
         if parts.query or parts.fragment:
             raise ValueError(f"the base URL must have no query or fragment, got {base_url!r}")
-        if parts.scheme == "http" and not _is_loopback(parts.hostname):
+        if parts.scheme == "http" and not is_loopback(parts.hostname):
             raise ValueError(
                 f"LMSes only talk to LTI tools over https; {base_url!r} is plain http "
                 "(http is allowed for localhost tests only)"

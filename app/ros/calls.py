@@ -223,6 +223,9 @@ def send_goal(
         client.destroy()
 
 
+LOST_AFTER_SEC = 3.0  # a request unanswered this long is asked again (a lost answer)
+
+
 class ServicePoller:
     """The latest answer of a service, re-asked at most once a period; never blocks.
 
@@ -252,6 +255,11 @@ class ServicePoller:
             future, result, sent_at = self._calls.get(key, (None, None, 0.0))
             if future is not None and future.done():
                 result = future.result() if future.exception() is None else None
+                future = None
+            elif future is not None and time.monotonic() - sent_at > LOST_AFTER_SEC:
+                # A server that answers before it has matched our fresh client's reader
+                # loses the answer (busy discovery); without this the check waited forever.
+                client.remove_pending_request(future)
                 future = None
             due = time.monotonic() - sent_at > self._period
             if future is None and due and client.service_is_ready():

@@ -10,7 +10,6 @@ written leaves the grading as it was, with the reason the attempt was not kept.
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 import pytest
@@ -22,7 +21,8 @@ from app.exercises.grader import Grader
 from app.exercises.model import load_exercises
 from app.exercises.report import Report
 from tests.bags.readers import mcap_messages
-from tests.conftest import fail_on_leftover_nodes, in_private_netns
+from tests.conftest import fail_on_leftover_nodes
+from tests.exercises.grading_participant import grading_participant
 
 SLUG = "multiply_service"
 EXERCISE = load_exercises().get(SLUG)
@@ -64,21 +64,8 @@ def test_the_oldest_attempts_of_all_exercises_go_first_over_the_size_cap(tmp_pat
 
 @pytest.fixture(scope="module")
 def grading(tmp_path_factory):
-    if not in_private_netns():
-        pytest.fail("run through tests/run.py: DDS tests need the private network namespace")
-    from app.dds import configure_dds_env
-    from app.ros.runtime import RosRuntime
-    from app.supervisor import Supervisor
-
-    saved = dict(os.environ)
-    configure_dds_env(os.environ, domain_id=78, network=False)
-    runtime = RosRuntime("attempt_test_grader")
-    supervisor = Supervisor(os.environ)
-    yield runtime.node, supervisor, tmp_path_factory.mktemp("code")
-    supervisor.shutdown()
-    runtime.shutdown()
-    os.environ.clear()
-    os.environ.update(saved)
+    with grading_participant("attempt_test_grader", domain_id=78) as (node, supervisor):
+        yield node, supervisor, tmp_path_factory.mktemp("code")
 
 
 def _grade(grading, store: AttemptStore, code: str, seed: int) -> Report:

@@ -10,7 +10,6 @@ node names, and every learner process is stopped after its case.
 
 from __future__ import annotations
 
-import os
 import shutil
 from pathlib import Path
 
@@ -25,6 +24,7 @@ from app.exercises.report import Report
 from tests.bags.readers import mcap_messages
 from tests.conftest import fail_on_leftover_nodes
 from tests.exercises.cheats import EXEMPT, cheat_code
+from tests.exercises.grading_participant import grading_participant
 
 BOOK = load_exercises()
 # Correct solutions written differently from the references: accepted/<slug>__<how>.py.
@@ -47,25 +47,10 @@ def _cases():
 
 @pytest.fixture(scope="module")
 def grading_env(tmp_path_factory):
-    from tests.conftest import in_private_netns
-
-    if not in_private_netns():
-        pytest.fail("run through tests/run.py: DDS tests need the private network namespace")
-    from app.dds import configure_dds_env
-    from app.ros.runtime import RosRuntime
-    from app.supervisor import Supervisor
-
-    saved = dict(os.environ)
-    configure_dds_env(os.environ, domain_id=77, network=False)
-    runtime = RosRuntime("exercise_grader_test")
-    supervisor = Supervisor(os.environ)
-    # Every grading recorded, as the dashboard does: each attempt is read back below.
-    attempts = AttemptStore(tmp_path_factory.mktemp("attempts"))
-    yield Grader(runtime.node, supervisor, attempts), supervisor, tmp_path_factory.mktemp("code")
-    supervisor.shutdown()
-    runtime.shutdown()
-    os.environ.clear()
-    os.environ.update(saved)
+    with grading_participant("exercise_grader_test", domain_id=77) as (node, supervisor):
+        # Every grading recorded, as the dashboard does: each attempt is read back below.
+        attempts = AttemptStore(tmp_path_factory.mktemp("attempts"))
+        yield Grader(node, supervisor, attempts), supervisor, tmp_path_factory.mktemp("code")
 
 
 def _read_back(report: Report, ran: bool = True) -> Report:

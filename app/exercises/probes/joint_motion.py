@@ -15,6 +15,7 @@ from tf2_ros import Buffer, TransformException, TransformListener
 
 from app.exercises.probes.base import ProbeContext, register_probe
 from app.exercises.probes.tf import expected_joint_pose
+from app.exercises.probes.topics import others_subscribed
 from app.exercises.report import Result
 from app.lessons.schema import Spec
 from app.ros.rotations import rotation_angle as quat_angle
@@ -97,7 +98,7 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
     tried: list[str] = []
     try:
         deadline = time.monotonic() + 5.0
-        while publisher.get_subscription_count() == 0:
+        while not others_subscribed(node, publisher, "/joint_states"):
             if time.monotonic() > deadline:
                 return Result(name, False, "nothing subscribes to /joint_states")
             ctx.call.sleep(0.1)

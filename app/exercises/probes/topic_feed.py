@@ -7,6 +7,7 @@ import time
 from rclpy.qos import QoSProfile
 
 from app.exercises.probes.base import ProbeContext, draw, expected_value, register_probe, same
+from app.exercises.probes.topics import others_subscribed
 from app.exercises.report import Result
 from app.lessons.schema import Spec
 from app.ros.convert import fill, import_type, to_plain
@@ -37,7 +38,7 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
     monitor = TopicMonitor(node, out_topic, out_type, keep=200, qos=50)
     try:
         deadline = time.monotonic() + 5.0
-        while publisher.get_subscription_count() == 0:
+        while not others_subscribed(node, publisher, in_topic):
             if time.monotonic() > deadline:
                 return Result(name, False, f"nothing subscribes to {in_topic}")
             ctx.call.sleep(0.05)

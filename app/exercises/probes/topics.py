@@ -33,10 +33,21 @@ def listen(ctx: ProbeContext, topic: str, msg_type: type) -> TopicMonitor:
     return TopicMonitor(ctx.call.node, topic, msg_type, keep=20, qos=qos)
 
 
+def others_subscribed(node: Any, publisher: Any, topic: str) -> int:
+    """Readers matched by ``publisher`` other than ``node``'s own (the grader's recording of
+    the attempt subscribes to every topic: it is not the learner's node listening)."""
+    ours = sum(
+        1
+        for info in node.get_subscriptions_info_by_topic(topic)
+        if info.node_name == node.get_name() and info.node_namespace == node.get_namespace()
+    )
+    return max(0, int(publisher.get_subscription_count()) - ours)
+
+
 def wait_subscribed(ctx: ProbeContext, publisher: Any, topic: str) -> str:
     """'' once someone subscribes to ``topic``, else why not."""
     deadline = time.monotonic() + MATCH_WAIT_SEC
-    while publisher.get_subscription_count() == 0:
+    while not others_subscribed(ctx.call.node, publisher, topic):
         if time.monotonic() > deadline:
             return f"nothing subscribes to {topic} (waited {MATCH_WAIT_SEC:g} s)"
         ctx.call.sleep(0.05)
