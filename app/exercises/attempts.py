@@ -104,11 +104,12 @@ class AttemptStore:
             (p for folder in _dirs(self.root) for p in _dirs(folder)),
             key=lambda p: (p == keeping, p.name),
         )
-        total = sum(_size(p) for p in every)
+        sizes = {p: _size(p) for p in every}  # each folder walked once
+        total = sum(sizes.values())
         for old in every:
             if total <= self.cap_bytes:
                 break
-            total -= _size(old)
+            total -= sizes[old]
             _remove(old)
 
 
