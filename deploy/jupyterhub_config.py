@@ -32,6 +32,9 @@ Settings through the environment (all optional):
   CLASSROOM_SAME_ACCOUNT=1    no system user per learner: every server runs as
                               the hub's account with its own HOME (trying it out)
   CLASSROOM_SINGLEUSER        dashboard (default) or lab, see above
+  CLASSROOM_LTI_URL, CLASSROOM_LTI_DIR
+                              the teacher service as the LMS's LTI tool; with
+                              deploy/lti_tool_config.py (docs/deploy/lti.md)
 """
 
 import os
@@ -46,6 +49,7 @@ TEACHERS = os.environ.get("CLASSROOM_TEACHERS_GROUP", "teachers")
 SERVICE_PORT = int(os.environ.get("CLASSROOM_TEACHER_PORT", "10101"))
 SERVICE_URL = f"http://127.0.0.1:{SERVICE_PORT}"
 SINGLEUSER = os.environ.get("CLASSROOM_SINGLEUSER", "dashboard")
+LTI_SETTINGS = ("CLASSROOM_LTI_URL", "CLASSROOM_LTI_DIR")  # passed on to the teacher service
 
 
 def _names(var):
@@ -97,5 +101,7 @@ c.JupyterHub.services = [
         "command": [sys.executable, "-m", "app.hub.teacher_service"],
         "oauth_no_confirm": True,
         "cwd": str(ROOT),
+        # The LMS's LTI tool, when deploy/lti_tool_config.py is loaded (docs/deploy/lti.md).
+        "environment": {k: v for k, v in os.environ.items() if k in LTI_SETTINGS},
     }
 ]

@@ -16,6 +16,12 @@ it. Two kinds of callers:
 
 All state lives on tornado's one thread: no locks. Rows, stuck marks and the
 CSV are those of ``classroom``'s teacher page (app.teacher.record).
+
+With ``CLASSROOM_LTI_URL`` set, the service is also the LTI 1.3 tool an LMS
+launches (app/hub/lti_service.py): its login, launch, deep-linking and JWKS
+addresses are under ``lti/``, it holds the tool's private key and the score
+outbox in ``CLASSROOM_LTI_DIR``, and a report that shows a finished lesson or a
+passed exercise of a learner who came from the LMS sends that grade back.
 """
 
 from __future__ import annotations
@@ -26,7 +32,7 @@ import logging
 import os
 import time
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 from urllib.parse import urlsplit
 
 from jupyterhub.services.auth import (
@@ -47,6 +53,9 @@ from app.teacher.record import (
     table,
     to_csv,
 )
+
+if TYPE_CHECKING:  # LTI needs PyJWT, which only a deployment with LTI installs
+    from app.hub.lti_service import LtiService
 
 log = logging.getLogger(__name__)
 
@@ -122,6 +131,12 @@ class ProgressReportHandler(_Base):
         record = replace(record, site=SITE)
         self.state.records[record.key] = record
         self.state.reports += 1
+        lti: LtiService | None = self.settings.get("lti")
+        if lti is not None:
+            try:
+                lti.on_record(record)  # a finished lesson or passed exercise: a grade for the LMS
+            except Exception:  # the report itself is accepted whatever grading does
+                log.exception("LTI: queueing %s's score failed", name)
         since = _int_arg(self.get_argument("since", "0"))
         self.finish(
             {
@@ -250,7 +265,15 @@ def _json_body(body: bytes) -> dict[str, Any]:
     return data
 
 
-def make_app(prefix: str, state: ClassState | None = None) -> web.Application:
+def make_app(
+    prefix: str,
+    state: ClassState | None = None,
+    *,
+    hub_auth: Any = None,
+    lti: LtiService | None = None,
+) -> web.Application:
+    """The service's tornado app. ``hub_auth`` answers whose token a report carries (the
+    hub's, unless a test gives its own); ``lti`` serves LTI and sends grades (None: off)."""
     state = state or ClassState()
     args = {"state": state}
     routes: list[Any] = [
@@ -263,26 +286,45 @@ def make_app(prefix: str, state: ClassState | None = None) -> web.Application:
         (url_path_join(prefix, "api/progress"), ProgressReportHandler, args),
         (url_path_join(prefix, "oauth_callback"), HubOAuthCallbackHandler),
     ]
+    if lti is not None:
+        routes += lti.routes(prefix)
     return web.Application(
         routes,
         cookie_secret=os.urandom(32),
         login_url=url_path_join(prefix, "oauth_start"),  # replaced by HubOAuth's redirect
-        hub_auth=HubAuth(),
+        hub_auth=hub_auth if hub_auth is not None else HubAuth(),
         xsrf_cookies=True,
+        lti=lti,
     )
+
+
+def _lti_from_environment(prefix: str) -> LtiService | None:
+    if not os.environ.get("CLASSROOM_LTI_URL", "").strip():
+        log.info("LTI is off: set CLASSROOM_LTI_URL to serve LMS launches and send grades")
+        return None
+    from app.hub.lti_service import from_environment
+
+    return from_environment(prefix)
 
 
 def main() -> None:
     logging.basicConfig(level=logging.INFO)
     prefix = os.environ.get("JUPYTERHUB_SERVICE_PREFIX", f"/services/{SERVICE_NAME}/")
     where = urlsplit(os.environ.get("JUPYTERHUB_SERVICE_URL", "http://127.0.0.1:10101"))
-    app = make_app(prefix)
+    lti = _lti_from_environment(prefix)
+    app = make_app(prefix, lti=lti)
     app.listen(where.port or 80, where.hostname or "127.0.0.1", xheaders=True)
     log.info("classroom teacher service on %s under %s", where.geturl(), prefix)
+    loop = ioloop.IOLoop.current()
+    if lti is not None:
+        loop.add_callback(lti.start)  # sends what a previous run left in the outbox
     try:
-        ioloop.IOLoop.current().start()
+        loop.start()
     except KeyboardInterrupt:  # the hub stops its services with SIGINT
         log.info("classroom teacher service stopped")
+    finally:
+        if lti is not None:
+            lti.stop()
 
 
 PAGE = """<!doctype html>

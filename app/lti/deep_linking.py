@@ -1,8 +1,8 @@
 """Deep Linking 2.0: the teacher picks lessons or exercises, we hand them to the LMS.
 
-Each picked activity becomes an ``ltiResourceLink`` whose custom parameter
-names the lesson or exercise, with a line item so the LMS makes the grade
-column at once. The response is a JWT signed by the tool key, carried back
+Each picked activity becomes an ``ltiResourceLink`` whose custom parameters
+name the lesson or exercise and its points, with a line item so the LMS makes
+the grade column at once. The response is a JWT signed by the tool key, carried back
 by the browser in an auto-submitting form.
 """
 
@@ -12,8 +12,8 @@ import html
 import secrets
 import time
 import urllib.parse
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, replace
 from typing import Any, Literal
 
 from app.lti import claims
@@ -22,6 +22,7 @@ from app.lti.launch import Launch
 
 RESPONSE_LIFE_SEC = 600
 RESOURCE_LINK_TYPE = "ltiResourceLink"
+SCORE_MAXIMUM_PARAM = "score_maximum"  # the custom parameter with the activity's points
 
 
 class DeepLinkingError(ValueError):
@@ -43,7 +44,8 @@ class Activity:
             "type": RESOURCE_LINK_TYPE,
             "title": self.title,
             "url": launch_url,
-            "custom": {self.kind: self.slug},
+            # The points ride along, so the learner's launch says what a score is out of.
+            "custom": {self.kind: self.slug, SCORE_MAXIMUM_PARAM: f"{self.score_maximum:g}"},
             "lineItem": {
                 "scoreMaximum": self.score_maximum,
                 "label": self.title,
@@ -54,6 +56,37 @@ class Activity:
         if self.text:
             item["text"] = self.text
         return item
+
+
+MAX_POINTS = 1000.0
+
+
+def picks_from_form(
+    form: Mapping[str, Sequence[str]], catalog: Sequence[Activity]
+) -> list[Activity]:
+    """What the teacher ticked on the picker (app/lti/pages.py), each with the points typed.
+
+    Only activities of ``catalog`` can be picked: a forged form names nothing else.
+    """
+    known = {f"{a.kind}:{a.slug}": a for a in catalog}
+    picked: list[Activity] = []
+    for value in form.get("pick", ()):
+        activity = known.get(value)
+        if activity is None:
+            raise DeepLinkingError(f"{value!r} is not a lesson or exercise of this course")
+        typed = (form.get(f"points-{value}") or [f"{activity.score_maximum:g}"])[0]
+        try:
+            points = float(typed)
+        except ValueError:
+            raise DeepLinkingError(f"the points for {activity.title!r} are not a number") from None
+        if not 0 < points <= MAX_POINTS:
+            raise DeepLinkingError(
+                f"the points for {activity.title!r} must be above 0 and at most {MAX_POINTS:g}"
+            )
+        picked.append(replace(activity, score_maximum=points))
+    if not picked:
+        raise DeepLinkingError("nothing was picked: tick a lesson or an exercise")
+    return picked
 
 
 def deep_linking_response(

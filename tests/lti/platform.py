@@ -61,6 +61,9 @@ class TestPlatform:
         self.scores: dict[str, list[dict[str, Any]]] = defaultdict(list)  # line item -> bodies
         self.score_requests: list[tuple[str, str, str]] = []  # (path, query, content type)
         self.scripted: dict[str, list[tuple[int, str]]] = defaultdict(list)  # next answers
+        # Deep linking: what came back from the tool, and the line items made from it.
+        self.deep_link_refusals: list[str] = []
+        self.links: list[dict[str, Any]] = []  # content items, each with its made line item
         self.lock = threading.Lock()
         self._server = ThreadingHTTPServer(("127.0.0.1", 0), self._handler())
         self._thread = threading.Thread(
@@ -176,6 +179,10 @@ class TestPlatform:
                     status, answer = platform._token(body)
                     self._answer(status, answer)
                     return
+                if parts.path == "/deep-link-return":
+                    status, answer = platform._deep_link_return(body)
+                    self._answer(status, answer)
+                    return
                 segments = parts.path.strip("/").split("/")
                 if len(segments) == 3 and segments[0] == "lineitems" and segments[2] == "scores":
                     status, answer = platform._score(
@@ -259,3 +266,39 @@ class TestPlatform:
                 return 409, {"error": "timestamp not newer than the stored score"}
             earlier.append(score)
         return 200, {}
+
+    def _deep_link_return(self, body: bytes) -> tuple[int, object]:
+        """Check the tool's signed answer as an LMS does, and make a line item per link."""
+        form = dict(urllib.parse.parse_qsl(body.decode()))
+
+        def refuse(why: str) -> tuple[int, object]:
+            with self.lock:
+                self.deep_link_refusals.append(why)
+            return 400, {"error": why}
+
+        if self.tool_jwks is None:
+            return refuse("no tool key registered")
+        try:
+            token = form["JWT"]
+            key = jwt.PyJWKSet.from_dict(self.tool_jwks)[jwt.get_unverified_header(token)["kid"]]
+            checked = jwt.decode(
+                token,
+                key,
+                algorithms=["RS256"],
+                audience=self.issuer,
+                issuer=CLIENT_ID,
+                options={"require": ["exp", "iat", "nonce"]},
+            )
+        except (jwt.PyJWTError, KeyError) as error:
+            return refuse(f"deep-linking response refused: {error}")
+        if checked.get(claims.MESSAGE_TYPE) != claims.DEEP_LINKING_RESPONSE:
+            return refuse("not a deep-linking response")
+        if checked.get(claims.DEPLOYMENT_ID) != DEPLOYMENT_ID:
+            return refuse("unknown deployment")
+        with self.lock:
+            for item in checked.get(claims.CONTENT_ITEMS, []):
+                number = f"dl-{len(self.links) + 1}"
+                self.links.append(
+                    {**item, "resource_link_id": f"link-{number}", "lineitem_id": number}
+                )
+        return 200, {"added": len(checked.get(claims.CONTENT_ITEMS, []))}

@@ -86,7 +86,7 @@ def test_the_response_verifies_with_the_tool_jwks_and_carries_the_picks(
             "type": "ltiResourceLink",
             "title": "Topics: publishers and subscribers",
             "url": "https://tool.example.edu/classroom/lti/launch",
-            "custom": {"lesson": "05_topics"},
+            "custom": {"lesson": "05_topics", "score_maximum": "10"},
             "lineItem": {
                 "scoreMaximum": 10,
                 "label": "Topics: publishers and subscribers",
@@ -97,7 +97,7 @@ def test_the_response_verifies_with_the_tool_jwks_and_carries_the_picks(
             "type": "ltiResourceLink",
             "title": "Exercise: talker & listener",
             "url": "https://tool.example.edu/classroom/lti/launch",
-            "custom": {"exercise": "talker_listener"},
+            "custom": {"exercise": "talker_listener", "score_maximum": "5"},
             "lineItem": {
                 "scoreMaximum": 5,
                 "label": "Exercise: talker & listener",

@@ -1,0 +1,390 @@
+"""LTI 1.3 in the teacher service: thin tornado handlers around ``app.lti``, and grade passback.
+
+Served under the service's prefix (``/services/classroom-teacher/``):
+
+- ``lti/login`` (GET or POST): the LMS's login initiation, answered with a
+  redirect to its auth endpoint;
+- ``lti/launch`` and ``lti/deep-link`` (POST): the signed launch. A learner
+  is sent through the hub's handoff page (app/hub/lti_login.py) to their own
+  server, a teacher to the teacher's page, and a deep-linking request gets
+  the activity picker;
+- ``lti/deep-link/return`` (POST): the picker's form; the answer posts the
+  signed picks back to the LMS;
+- ``lti/jwks`` (GET): the tool's public key set;
+- ``lti/handoff`` (POST): the hub trades a launch's one-time ticket for the
+  user to log in.
+
+Progress reports (``api/progress``) come through ``on_record``: a finished
+lesson or a passed exercise of a learner who launched it from an LMS becomes
+a score in the outbox, which a thread of its own empties, scheduled from
+tornado's loop. Checking a launch may fetch the LMS's keys, so it too runs
+off the loop. Everything else runs on the loop's thread.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+from asyncio import Future
+from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+from typing import Any
+from urllib.parse import quote, urlencode
+
+from tornado import ioloop, web
+
+from app import PROJECT_ROOT
+from app.hub.lti_catalog import course_activities
+from app.lti import claims
+from app.lti.deep_linking import Activity, DeepLinkingError
+from app.lti.handoff import Handoff, HandoffRefused, HandoffTickets
+from app.lti.launch import Launch
+from app.lti.learners import hub_user_name
+from app.lti.pages import picker_page, refusal_page
+from app.lti.rejection import LaunchRejected
+from app.lti.routes import DEEP_LINK_PATH, JWKS_PATH, LAUNCH_PATH, LOGIN_PATH, ToolUrls
+from app.lti.tool import GradedResult, LtiTool
+from app.teacher.record import LearnerRecord
+
+log = logging.getLogger(__name__)
+
+HANDOFF_PAGE = "lti-handoff"  # under the hub's /hub/: app/hub/lti_login.py serves it
+HANDOFF_API = "/lti/handoff"
+PICK_PATH = DEEP_LINK_PATH + "/return"
+OUTBOX_POLL_SEC = 1.0
+DEFAULT_DIR = PROJECT_ROOT / "var" / "lti"
+
+
+def results_in(record: LearnerRecord) -> list[GradedResult]:
+    """What a progress report proves done: its lesson's last step passed, its exercise passed.
+
+    A report shows one lesson (the learner's current one, at its current step,
+    with that step's checks) and one exercise (the one worked on last). A lesson
+    counts as done when the learner is on its last step and every check of that
+    step passes (the report says nothing of earlier steps, which Next lets a
+    learner skip); an exercise when the grader passed it in this learner's server.
+    """
+    found: list[GradedResult] = []
+    states = record.check_states
+    if (
+        record.lesson_id
+        and record.steps > 0
+        and record.step == record.steps
+        and states
+        and all(state == "pass" for state in states)
+    ):
+        checked = "; ".join(r for r in record.check_reasons if r)
+        found.append(
+            GradedResult(
+                "lesson",
+                record.lesson_id,
+                f"Lesson {record.unit} ({record.lesson_title or record.lesson_id}) done: "
+                f"all {record.steps} steps; the last step's {len(states)} check(s) passed on "
+                f"the learner's live ROS 2 graph: {checked}.",
+            )
+        )
+    if record.exercise and record.exercise_passed_here:
+        failed = record.exercise_failed_here
+        found.append(
+            GradedResult(
+                "exercise",
+                record.exercise,
+                f"Exercise {record.exercise} passed: the grader ran its checks and probes "
+                "against the learner's own node on a live ROS 2 graph "
+                f"({record.exercise_attempts_here} grading run(s), {failed} failed check(s) "
+                "before the pass).",
+            )
+        )
+    return found
+
+
+class OutboxPump:
+    """Empties the outbox on a thread of its own; tornado's loop decides when.
+
+    A round runs every ``poll_sec`` (the outbox itself holds back what is not yet
+    due: 5 s, 10 s, 20 s ... after a failure) and at once when a score is queued.
+    Rounds never overlap; a kick during a round asks for one more right after it.
+    """
+
+    def __init__(self, tool: LtiTool, poll_sec: float = OUTBOX_POLL_SEC) -> None:
+        self._tool, self._poll_sec = tool, poll_sec
+        self._executor = ThreadPoolExecutor(1, thread_name_prefix="lti-outbox")
+        self._periodic: ioloop.PeriodicCallback | None = None
+        self._running = self._again = False
+
+    def start(self) -> None:
+        """On the loop's thread: first round now (what a restart left waiting), then every poll."""
+        self._periodic = ioloop.PeriodicCallback(self.kick, self._poll_sec * 1000)
+        self._periodic.start()
+        self.kick()
+
+    def stop(self) -> None:
+        if self._periodic is not None:
+            self._periodic.stop()
+        self._executor.shutdown(wait=True)
+
+    def kick(self) -> None:
+        if self._running:
+            self._again = True
+            return
+        self._running = True
+        loop = ioloop.IOLoop.current()
+        future = loop.run_in_executor(self._executor, self._tool.outbox.deliver_due)
+        loop.add_future(future, self._done)
+
+    def _done(self, future: Future[int]) -> None:
+        self._running = False
+        try:
+            delivered = future.result()
+        except Exception:  # a bug or a full disk: the scores stay on disk for the next round
+            log.exception("sending scores to the LMS failed")
+        else:
+            if delivered:
+                log.info("LTI: %d score(s) delivered to the LMS", delivered)
+        if self._again:
+            self._again = False
+            self.kick()
+
+
+class LtiService:
+    """The teacher service's LTI side: the tool, the course's activities, the hub's paths."""
+
+    def __init__(
+        self,
+        tool: LtiTool,
+        *,
+        service_prefix: str,
+        hub_base: str = "/",
+        catalog: Sequence[Activity] | None = None,
+        poll_sec: float = OUTBOX_POLL_SEC,
+    ) -> None:
+        self.tool = tool
+        self.service_prefix = _slashed(service_prefix)
+        self.hub_base = _slashed(hub_base)
+        self.catalog = list(catalog) if catalog is not None else course_activities()
+        self.tickets = HandoffTickets()
+        self.pump = OutboxPump(tool, poll_sec)
+
+    def start(self) -> None:
+        self.pump.start()
+
+    def stop(self) -> None:
+        self.pump.stop()
+
+    # -- where people are sent ----------------------------------------------------------
+
+    def learner_url(self, name: str) -> str:
+        """The learner's own server. The dashboard has no parameter that opens a given
+        lesson or exercise yet, so the server's root: it opens where the learner left off."""
+        return f"{self.hub_base}user/{quote(name)}/"
+
+    def handoff_url(self, handoff: Handoff) -> str:
+        ticket = self.tickets.issue(handoff)
+        return f"{self.hub_base}hub/{HANDOFF_PAGE}?{urlencode({'ticket': ticket})}"
+
+    # -- what the handlers hand over ----------------------------------------------------
+
+    def after_launch(self, launch: Launch) -> str:
+        """Where a checked resource-link launch goes: the hub's handoff, with a ticket."""
+        if launch.is_instructor:
+            name = hub_user_name(launch.registration.issuer, launch.user_id)
+            log.info("LTI: teacher %s (%s) launched; to the teacher's page", name, launch.name)
+            return self.handoff_url(Handoff(name, self.service_prefix, teacher=True))
+        name, item = self.tool.record_launch(launch)
+        if item is None:
+            log.info("LTI: learner %s launched a link that names no lesson or exercise", name)
+        elif not self._known(item.kind, item.slug):
+            log.warning(
+                "LTI: %s's link names %s %r, not in this course", name, item.kind, item.slug
+            )
+        elif not item.graded:
+            log.info("LTI: %s launched %s %s; no score goes back", name, item.kind, item.slug)
+        else:
+            log.info("LTI: %s launched %s %s", name, item.kind, item.slug)
+        return self.handoff_url(Handoff(name, self.learner_url(name), teacher=False))
+
+    def on_record(self, record: LearnerRecord) -> int:
+        """A learner's progress report: queue the scores it earns; the number queued."""
+        if not self.tool.graded_items(record.learner):
+            return 0
+        queued = sum(self.tool.submit(record.learner, result) for result in results_in(record))
+        if queued:
+            log.info("LTI: %d score(s) queued for %s", queued, record.learner)
+            self.pump.kick()
+        return queued
+
+    def _known(self, kind: str, slug: str) -> bool:
+        return any((a.kind, a.slug) == (kind, slug) for a in self.catalog)
+
+    def routes(self, prefix: str) -> list[tuple[str, type[web.RequestHandler], dict[str, Any]]]:
+        args = {"lti": self}
+        base = _slashed(prefix).rstrip("/")
+        return [
+            (base + LOGIN_PATH, LoginHandler, args),
+            (base + LAUNCH_PATH, LaunchHandler, args),
+            (base + DEEP_LINK_PATH, LaunchHandler, args),
+            (base + PICK_PATH, PickHandler, args),
+            (base + JWKS_PATH, JwksHandler, args),
+            (base + HANDOFF_API, HandoffHandler, args),
+        ]
+
+
+def _slashed(path: str) -> str:
+    path = path if path.startswith("/") else "/" + path
+    return path if path.endswith("/") else path + "/"
+
+
+class _LtiPage(web.RequestHandler):
+    """LMS-facing pages: cross-site form posts (no XSRF cookie), HTML errors, no traceback."""
+
+    def initialize(self, lti: LtiService) -> None:
+        self.lti = lti
+
+    def check_xsrf_cookie(self) -> None:
+        return  # the LMS posts from its own site; the signed id_token or a one-time token guards
+
+    def refuse(self, sentence: str, *, what: str = "This launch from your course") -> None:
+        log.warning("LTI: %s refused: %s", what.lower(), sentence)
+        self.set_status(400)
+        self.set_header("Content-Type", "text/html; charset=utf-8")
+        self.set_header("Cache-Control", "no-store")
+        self.finish(refusal_page(sentence, what=what))
+
+    def write_error(self, status_code: int, **kwargs: Any) -> None:
+        error = kwargs.get("exc_info", (None, None, None))[1]
+        if isinstance(error, web.HTTPError) and error.log_message:
+            sentence = error.log_message
+        else:
+            sentence = (
+                f"the tool could not handle this request ({status_code} {self._reason}); "
+                "the service's log has the details"
+            )
+        self.set_header("Content-Type", "text/html; charset=utf-8")
+        self.finish(refusal_page(sentence))
+
+    def form(self) -> dict[str, str]:
+        """The request's query and form fields, the first value of each."""
+        return {k: self.get_argument(k) for k in self.request.arguments}
+
+
+class LoginHandler(_LtiPage):
+    def get(self) -> None:
+        self._login()
+
+    def post(self) -> None:
+        self._login()
+
+    def _login(self) -> None:
+        try:
+            redirect = self.lti.tool.login(self.form())
+        except LaunchRejected as rejected:
+            self.refuse(str(rejected), what="This login from your course")
+            return
+        self.set_header("Cache-Control", "no-store")
+        self.redirect(redirect.url, status=302)
+
+
+class LaunchHandler(_LtiPage):
+    async def post(self) -> None:
+        id_token = self.get_body_argument("id_token", "")
+        state = self.get_body_argument("state", "")
+        error = self.get_body_argument("error", "")
+        if error:  # the LMS's auth step said no (OIDC error response)
+            why = self.get_body_argument("error_description", "") or error
+            self.refuse(f"the LMS did not sign this launch: {why}")
+            return
+        if not id_token or not state:
+            self.refuse("the launch carries no id_token and state: start it from the LMS")
+            return
+        loop = ioloop.IOLoop.current()
+        try:
+            launch = await loop.run_in_executor(None, self.lti.tool.validate, id_token, state)
+        except LaunchRejected as rejected:
+            self.refuse(str(rejected))
+            return
+        self.set_header("Cache-Control", "no-store")
+        if launch.message_type == claims.DEEP_LINKING_REQUEST and launch.deep_linking:
+            token = self.lti.tool.open_picker(launch)
+            self.set_header("Content-Type", "text/html; charset=utf-8")
+            self.finish(
+                picker_page(
+                    self.lti.catalog,
+                    action=self.lti.tool.urls.base + PICK_PATH,
+                    token=token,
+                    multiple=launch.deep_linking.accept_multiple,
+                )
+            )
+            return
+        self.redirect(self.lti.after_launch(launch), status=303)
+
+
+class PickHandler(_LtiPage):
+    def post(self) -> None:
+        token = self.get_body_argument("token", "")
+        form = {
+            k: [v.decode("utf-8", "replace") for v in vs]
+            for k, vs in self.request.body_arguments.items()
+        }
+        try:
+            page = self.lti.tool.finish_picker(token, form, self.lti.catalog)
+        except DeepLinkingError as error:
+            self.refuse(str(error), what="Adding the activity")
+            return
+        log.info("LTI: deep-linking answer with %s", ", ".join(form.get("pick", [])))
+        self.set_header("Content-Type", "text/html; charset=utf-8")
+        self.set_header("Cache-Control", "no-store")
+        self.finish(page)
+
+
+class JwksHandler(_LtiPage):
+    def get(self) -> None:
+        self.set_header("Content-Type", "application/json")
+        self.set_header("Cache-Control", "public, max-age=300")
+        self.finish(json.dumps(self.lti.tool.keys.public_jwks()))
+
+
+class HandoffHandler(_LtiPage):
+    """The hub's authenticator trades a ticket for whom to log in and where to send them."""
+
+    def post(self) -> None:
+        try:
+            handoff = self.lti.tickets.redeem(self.get_body_argument("ticket", ""))
+        except HandoffRefused as refused:
+            log.warning("LTI: a hub login was refused: %s", refused)
+            self.set_status(403)
+            self.finish({"error": str(refused)})
+            return
+        self.finish({"name": handoff.name, "next": handoff.next_url, "teacher": handoff.teacher})
+
+
+def from_environment(service_prefix: str) -> LtiService | None:
+    """The service's LTI side as the deployment configures it; None when LTI is off.
+
+    CLASSROOM_LTI_URL is the address the LMS has for this service (what
+    ``ros2-classroom lti config --base-url`` printed); CLASSROOM_LTI_DIR the folder
+    with the key, platforms.toml, launches and the outbox (default var/lti).
+    """
+    base = os.environ.get("CLASSROOM_LTI_URL", "").strip()
+    if not base:
+        return None
+    urls = ToolUrls.from_base(base)
+    folder = Path(os.environ.get("CLASSROOM_LTI_DIR") or DEFAULT_DIR)
+    tool = LtiTool(folder, urls)
+    if not list(tool.registrations):
+        log.warning("LTI: no LMS registered in %s: every launch will be refused", folder)
+    service = LtiService(
+        tool,
+        service_prefix=service_prefix,
+        hub_base=os.environ.get("JUPYTERHUB_BASE_URL", "/"),
+    )
+    log.info(
+        "LTI: %s, %d platform(s), %d activities, key %s, data in %s",
+        urls.base,
+        len(list(tool.registrations)),
+        len(service.catalog),
+        tool.keys.kid,
+        folder,
+    )
+    return service
