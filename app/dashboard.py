@@ -6,11 +6,13 @@ applies posted intents, takes a graph snapshot, and refreshes every panel.
 
 from __future__ import annotations
 
+import json
 import logging
 import os
 import threading
 import time
 from collections.abc import Callable
+from functools import partial
 from typing import cast
 
 import viser
@@ -52,6 +54,7 @@ from app.ui import GROUP_OF, TAB_NAMES, TOOL_GROUPS, TOOLS, Inspector, MarkdownV
 from app.ui.loop import UiLoop
 from app.ui.page_fixes import page_fixes_html
 from app.ui.page_links import PageLinks
+from app.ui.page_script import page_script
 from app.ui.starting import StartRequests
 from app.ui.tab_opener import TabOpener
 
@@ -59,6 +62,19 @@ log = logging.getLogger(__name__)
 
 UI_PERIOD_SEC = 0.2  # panels refresh at 5 Hz
 GRAPH_CHECK_SEC = 0.02  # ...and within 20 ms of a node joining/leaving or an intent
+# Runs in the page (app.ui.page_script): what the address asks to open, reported once per
+# page load to the page link of its kind (values the links take: a-z, 0-9, '_', '.', '-').
+_OPEN_FROM_ADDRESS = """
+const links = %s;
+const asked = new URLSearchParams(parent.location.search);
+for (const [key, link] of Object.entries(links)) {
+  const value = asked.get(key);
+  if (value && /^[a-z0-9_.-]{1,80}$/.test(value)) {
+    fetch(new URL(link + '/' + value, parent.location.href).href, {cache: 'no-store'})
+      .catch(() => {});
+  }
+}
+"""
 
 
 class Dashboard:
@@ -167,6 +183,7 @@ class Dashboard:
                 side_window,
                 self.exercise_settings,
                 open_code=lambda: stage.show("code"),
+                watch=stage.watch,
             ),
             "Nodes": lambda: NodesPanel(gui, ui, self.supervisor, self.start_requests),
             "Turtlesim": lambda: TurtlesimPanel(gui, ui, node, self.supervisor, self.page_links),
@@ -198,7 +215,32 @@ class Dashboard:
         # A lesson's `console` buttons type their command into the Console tab.
         console = next(p for p in panels if isinstance(p, ConsolePanel))
         self.lessons.console = console.run_for_lesson
+        self._open_from_address(opener)
         return [stage, *panels]
+
+    def _open_from_address(self, opener: TabOpener) -> None:
+        """A link into the course opens where it points: ``?lesson=ID`` the lesson (Learn ›
+        Lessons), ``?exercise=SLUG`` the exercise (an LMS's launch lands there)."""
+        lessons = cast(LessonsPanel, self._tools["Lessons"])
+        exercises = cast(ExercisePanel, self._tools["Exercise"])
+        openers = {"lesson": lessons.open_lesson, "exercise": exercises.open_exercise}
+        tabs = {"lesson": "Lessons", "exercise": "Exercise"}
+
+        def opened(key: str, value: str) -> None:  # viser's asyncio thread: check and post
+            def open_it() -> None:
+                if openers[key](value):
+                    opener.open(tabs[key])
+                else:
+                    log.warning("the address asks for %s %r, which the course has not", key, value)
+
+            self.ui.post(open_it)
+
+        hrefs = {
+            key: self.page_links.register_value(f"open.{key}", partial(opened, key))
+            for key in openers
+        }
+        script = _OPEN_FROM_ADDRESS % json.dumps(hrefs)
+        self.server.gui.add_html(page_script(script, "open what the address names"))
 
     def _new_lesson(self) -> None:
         """Another lesson was opened (UI thread): the views forget what the last one left."""

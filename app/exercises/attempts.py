@@ -28,11 +28,13 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+import yaml
 from rclpy.node import Node
 
 from app.bags.errors import BagError
 from app.bags.folder import bags_dir
 from app.bags.recorder import Recorder
+from app.exercises import plots
 from app.exercises.report import Report
 
 log = logging.getLogger(__name__)
@@ -50,6 +52,7 @@ LEFT_OUT_TYPES = frozenset(
 ATTEMPTS_FOLDER = "attempts"
 UNFINISHED = ".recording"  # a folder's suffix until its grading ended
 CUSTOM_PREFIX = "classroom."
+TRACES_FILE = "traces.json"  # what the probes judged over time (app/exercises/trace.py)
 
 
 def attempts_root() -> Path:
@@ -63,6 +66,7 @@ class KeptAttempt:
 
     path: Path | None
     note: str = ""
+    plots: tuple[Path, ...] = ()  # the PNG plots of the results' traces, in the folder
 
 
 class AttemptStore:
@@ -170,6 +174,7 @@ class AttemptRecording:
             self._path.rename(final)
         except OSError as exc:
             return KeptAttempt(None, f"attempt not kept: cannot name {self._path}: {exc}")
+        drawn = _keep_traces(report, final)
         try:
             self._store.prune(final.parent.name, final)
         except OSError as exc:
@@ -177,7 +182,53 @@ class AttemptRecording:
         if not final.exists():
             return KeptAttempt(None, f"attempt not kept: larger than {self._store.cap_bytes} bytes")
         log.info("attempt kept in %s (%d messages)", final, status.count)
-        return KeptAttempt(final)
+        return KeptAttempt(final, plots=drawn)
+
+
+def _keep_traces(report: Report, folder: Path) -> tuple[Path, ...]:
+    """The results' traces as JSON and as PNG plots beside the bag (nothing if none)."""
+    traces = report.traces()
+    if not traces:
+        return ()
+    try:
+        text = json.dumps([trace.to_json() for trace in traces])
+        (folder / TRACES_FILE).write_text(text, encoding="utf-8")
+        return tuple(plots.save(traces, folder))
+    except OSError as exc:
+        log.warning("could not keep the plots of %s: %s", folder, exc)
+        return ()
+
+
+def attempt_label(path: Path) -> str:
+    """How a kept attempt is listed: "2026-11-29 10:15 UTC · fail · seed 4242", or damaged."""
+    name = path.name
+    stamp = name[:15]
+    try:
+        when = time.strftime("%Y-%m-%d %H:%M:%S UTC", time.strptime(stamp, "%Y%m%d-%H%M%S"))
+    except ValueError:
+        when = name
+    if name.endswith(UNFINISHED):
+        return f"{when} · damaged: its recording never ended (ros2 bag reindex repairs it)"
+    parts = name[15:].split("-")
+    verdict = parts[-1] if parts and parts[-1] in ("pass", "fail", "problem") else "?"
+    seed = next((part[4:] for part in parts if part.startswith("seed")), "")
+    return f"{when} · {verdict}" + (f" · seed {seed}" if seed else "")
+
+
+def attempt_heading(path: Path) -> str:
+    """What a replay of a kept attempt says first: its verdict and result lines, as kept in
+    the bag's metadata ('' when they cannot be read: the bag is damaged)."""
+    try:
+        meta = yaml.safe_load((path / "metadata.yaml").read_text(encoding="utf-8"))
+        custom = meta["rosbag2_bagfile_information"].get("custom_data") or {}
+        lines = [
+            f"- {'✓' if r.get('passed') else '✗'} **{r.get('name', '')}**: {r.get('detail', '')}"
+            for r in json.loads(custom.get(CUSTOM_PREFIX + "results", "[]"))
+        ]
+    except (OSError, ValueError, KeyError, TypeError, AttributeError, yaml.YAMLError):
+        return ""
+    summary = custom.get(CUSTOM_PREFIX + "summary", "")
+    return "\n\n".join(part for part in (f"**{summary}**", "\n".join(lines)) if part.strip("*"))
 
 
 def _custom_data(report: Report) -> dict[str, str]:

@@ -13,9 +13,13 @@ from __future__ import annotations
 import os
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from app.exercises.model import Exercise, ExerciseError, load_exercises
 from app.exercises.report import Report
+
+if TYPE_CHECKING:
+    from app.exercises.attempts import AttemptStore
 
 EXIT_FAILED = 1
 
@@ -72,7 +76,7 @@ def cmd_check(slug: str | None, file: Path | None, seed: int | None = None) -> i
     supervisor = Supervisor(os.environ)
     try:
         runner.start(supervisor, exercise, file.resolve())
-        report = Grader(runtime.node, supervisor).grade(
+        report = Grader(runtime.node, supervisor, _attempts()).grade(
             exercise, file.resolve(), on_result=lambda r: print(r.line(), flush=True), seed=seed
         )
     finally:
@@ -100,7 +104,7 @@ def _check_package(exercise: Exercise, folder: Path, seed: int | None) -> int:
     try:
         with tempfile.TemporaryDirectory(prefix="classroom_grading_") as scratch:
             report = grade_package(
-                Grader(runtime.node, supervisor),
+                Grader(runtime.node, supervisor, _attempts()),
                 exercise,
                 folder.resolve(),
                 Path(scratch),
@@ -113,11 +117,25 @@ def _check_package(exercise: Exercise, folder: Path, seed: int | None) -> int:
     return _print_verdict(exercise, report, folder)
 
 
+def _attempts() -> AttemptStore:
+    """Kept where the dashboard keeps them (imported here: it needs ROS)."""
+    from app.exercises.attempts import AttemptStore, attempts_root
+
+    return AttemptStore(attempts_root())
+
+
 def _print_verdict(exercise: Exercise, report: Report, graded: Path) -> int:
-    """The last lines of a check, and its exit status; a replay line for a seeded grading."""
+    """The last lines of a check, and its exit status; a replay line for a seeded grading;
+    where the attempt and the plots of what was judged were kept."""
     if report.problem:
         print(f"FAIL  {exercise.slug}: {report.problem}")
     print(report.summary())
+    if report.attempt:
+        print(f"recorded: {report.attempt}")
+    elif report.attempt_note:
+        print(report.attempt_note)
+    for plot in report.plots:
+        print(f"plot: {plot}")
     if report.seed is not None and not report.problem:
         print(f"replay: exercise check {exercise.slug} {graded} --seed {report.seed}")
     return 0 if report.passed else EXIT_FAILED

@@ -183,6 +183,7 @@ class Grader:
                 kept = recording.finish(report)
                 report.attempt = str(kept.path or "")
                 report.attempt_note = kept.note
+                report.plots = [str(path) for path in kept.plots]
         return report
 
     def _alive(self, exercise: Exercise) -> bool:

@@ -11,16 +11,19 @@ one by one, so a learner sees progress during a slow probe.
 from __future__ import annotations
 
 import html
+import logging
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import viser
 
 from app.bags.folder import bags_dir
 from app.containment.policy import RunPolicy
-from app.exercises import code_assist, package_grading, runner
+from app.exercises import code_assist, package_grading, plots, runner
+from app.exercises.attempts import attempt_heading, attempt_label
 from app.exercises.editor_server import EditorHub, editor_url
 from app.exercises.explain import panel_line
 from app.exercises.grader import Grader
@@ -33,8 +36,11 @@ from app.supervisor import NodeState, NodeStatus, Supervisor
 from app.ui import MarkdownView, assign
 from app.ui.loop import UiLoop
 
+log = logging.getLogger(__name__)
 LOG_LINES = 12
+NO_ATTEMPT = "(no attempt kept yet)"
 LANE = "exercise"
+MOST_PLOTS = 4  # plots shown under the results (a probe's trials; the attempt keeps all)
 
 
 @dataclass
@@ -48,6 +54,13 @@ class ExerciseSettings:
 
     policy: RunPolicy = RunPolicy()
     reveal_after: int | None = None  # None: each exercise's own number
+
+
+@dataclass(frozen=True)
+class CheckOutcome:
+    report: Report
+    edited_since_run: bool  # the code on screen is not the code that was graded
+    plots: list[np.ndarray]  # RGBA pictures of what the probes judged (app/exercises/plots)
 
 
 @dataclass(frozen=True)
@@ -87,10 +100,14 @@ class ExercisePanel:
         side_window: Any,
         settings: ExerciseSettings | None = None,
         open_code: Callable[[], None] | None = None,
+        watch: Callable[[Path, str], None] | None = None,
     ) -> None:
-        """``open_code``: put the code window on stage (the editor lives there)."""
+        """``open_code``: put the code window on stage (the editor lives there); ``watch``:
+        play a graded attempt's recording on stage, under a heading."""
         self._gui, self._ui, self._book = gui, ui, book
         self._open_code = open_code
+        self._watch = watch
+        self._attempt_paths: dict[str, Path] = {}  # the Attempt dropdown's labels
         self._workspace, self._supervisor, self._grader = workspace, supervisor, grader
         self._hub, self._settings = hub, settings or ExerciseSettings()
         hub.attach(
@@ -131,6 +148,14 @@ class ExercisePanel:
         self._check = gui.add_button("Check my node", icon=viser.Icon.CHECKLIST, color="blue")
         self._status = MarkdownView(gui)
         self._results_view = MarkdownView(gui)
+        # Every kept attempt of this exercise, newest first: watch any on stage.
+        self._attempt_pick = gui.add_dropdown("Attempt", [NO_ATTEMPT], visible=False)
+        self._watch_button = gui.add_button(
+            "Watch this attempt", icon=viser.Icon.PLAYER_PLAY, visible=False
+        )
+        # What the probes judged over time, drawn when a check ends (see app/exercises/plots).
+        blank = np.full((8, 8, 4), 255, dtype=np.uint8)
+        self._plots = [gui.add_image(blank, format="png", visible=False) for _ in range(MOST_PLOTS)]
         with gui.add_folder("Output of your node", expand_by_default=False):
             self._log = MarkdownView(gui)
         with gui.add_folder("Help", expand_by_default=False):
@@ -158,6 +183,7 @@ class ExercisePanel:
         self._cancel.on_click(ui.callback(self._ask_reset, False))
         self._confirm.on_click(ui.callback(self._on_reset))
         self._solution_button.on_click(ui.callback(self._on_solution))
+        self._watch_button.on_click(ui.callback(self._on_watch))
         if first is not None:
             self._show(first)
 
@@ -175,6 +201,16 @@ class ExercisePanel:
         self._labels = {_label(e, self._workspace.passed(e)): e for e in self._book.exercises}
         return list(self._labels)
 
+    def open_exercise(self, slug: str) -> bool:
+        """Show exercise ``slug`` (a link into the course, such as an LMS's launch); False
+        for a slug the book does not have."""
+        exercise = next((known for known in self._book.exercises if known.slug == slug), None)
+        if exercise is None or self._checking:
+            return exercise is not None
+        if exercise is not self._exercise:
+            self._show(exercise)
+        return True
+
     def _on_pick(self) -> None:
         exercise = self._labels.get(self._selector.value)
         if exercise is not None and exercise is not self._exercise:
@@ -186,6 +222,8 @@ class ExercisePanel:
         self._exercise = exercise
         self._hints_shown = 0
         self._results, self._verdict, self._problems, self._message = [], "", [], ""
+        self._show_plots([])
+        self._list_attempts()
         assign(self._selector, next(k for k, e in self._labels.items() if e is exercise))
         self._statement.show(f"{exercise.statement}\n\n*{panel_line(exercise)}*")
         self._hints.show("")
@@ -249,12 +287,13 @@ class ExercisePanel:
             return
         self._checking = True
         self._results, self._verdict = [], ""
+        self._show_plots([])
         self._message = "Checking… (results appear one by one)"
 
         def on_result(result: Result) -> None:
             self._ui.post(lambda: self._results.append(result))
 
-        def work() -> tuple[Report, bool]:
+        def work() -> CheckOutcome:
             if exercise.is_package:  # the package in the learner's ~/ros2_ws/src, built here
                 policy = self._settings.policy
                 scratch = self._workspace.scratch
@@ -263,19 +302,47 @@ class ExercisePanel:
                 )
                 if not report.problem:
                     self._workspace.record_check(exercise, report.passed)
-                return report, False
+                return CheckOutcome(report, False, _plot_images(report))
             self._hub.flush(exercise.slug)
             script = self._workspace.scratch / f"{exercise.slug}.py"
             report = self._grader.grade(exercise, script, on_result)
             if not report.problem:
                 self._workspace.record_check(exercise, report.passed)
             ran = script.read_text(encoding="utf-8") if script.is_file() else ""
-            return report, ran != self._workspace.code(exercise)
+            return CheckOutcome(report, ran != self._workspace.code(exercise), _plot_images(report))
 
         self._ui.run_job(work, self._checked, self._failed, lane=LANE)
 
-    def _checked(self, outcome: tuple[Report, bool]) -> None:
-        report, edited_since_run = outcome
+    def _on_watch(self) -> None:
+        path = self._attempt_paths.get(str(self._attempt_pick.value))
+        exercise = self._exercise
+        if path is None or exercise is None or self._watch is None:
+            return
+        told = attempt_heading(path) or "_Its verdict could not be read._"
+        heading = f"### Your attempt at {exercise.title}\n\n{attempt_label(path)}\n\n{told}"
+        self._watch(path, heading)
+
+    def _list_attempts(self) -> None:
+        """The Attempt dropdown: this exercise's kept attempts, the newest picked."""
+        store, exercise = self._grader.attempts, self._exercise
+        paths = store.attempts(exercise.slug)[::-1] if store and exercise else []
+        self._attempt_paths = {attempt_label(path): path for path in paths}
+        shown = bool(self._attempt_paths) and self._watch is not None
+        if shown:
+            self._attempt_pick.options = list(self._attempt_paths)
+            assign(self._attempt_pick, next(iter(self._attempt_paths)))
+        self._attempt_pick.visible = self._watch_button.visible = shown
+
+    def _show_plots(self, images: list[np.ndarray]) -> None:
+        for index, handle in enumerate(self._plots):
+            if index < len(images):
+                handle.image = images[index]
+            handle.visible = index < len(images)
+
+    def _checked(self, outcome: CheckOutcome) -> None:
+        report, edited_since_run = outcome.report, outcome.edited_since_run
+        self._show_plots(outcome.plots)
+        self._list_attempts()
         self._checking = False
         self._results = list(report.results)
         exercise = self._exercise
@@ -419,6 +486,17 @@ class ExercisePanel:
 
     def close(self) -> None:
         """The learner's process belongs to the supervisor, which stops it on shutdown."""
+
+
+def _plot_images(report: Report) -> list[np.ndarray]:
+    """The first traces' plots, drawn on the grading's thread (a plot takes ~0.1 s)."""
+    shown = []
+    for trace in report.traces()[:MOST_PLOTS]:
+        try:
+            shown.append(plots.pixels(trace))
+        except Exception:  # a plot that cannot be drawn never hides the verdict
+            log.exception("could not draw the plot %r", trace.title)
+    return shown
 
 
 def attempt_line(report: Report) -> str:

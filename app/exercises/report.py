@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from app.exercises.trace import Trace
+
 PASS, FAIL = "pass", "fail"
 
 
@@ -14,6 +16,7 @@ class Result:
     name: str  # e.g. "service /multiply" or "node_running /counter"
     passed: bool
     detail: str
+    traces: tuple[Trace, ...] = ()  # the quantities it judged over time, to plot
 
     def line(self) -> str:
         return f"{'PASS' if self.passed else 'FAIL'}  {self.name}: {self.detail}"
@@ -27,6 +30,10 @@ class Report:
     seed: int | None = None  # the probes' inputs were drawn from it: replays the grading
     attempt: str = ""  # the bag this grading was recorded into (app/exercises/attempts.py)
     attempt_note: str = ""  # why it was not kept, when it was not
+    plots: list[str] = field(default_factory=list)  # PNG files of the results' traces
+
+    def traces(self) -> list[Trace]:
+        return [trace for result in self.results for trace in result.traces]
 
     @property
     def passed(self) -> bool:

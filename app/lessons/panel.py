@@ -250,6 +250,17 @@ class LessonsPanel:
         if lesson is not None and lesson is not self._lesson:
             self._select(lesson, 0)
 
+    def open_lesson(self, lesson_id: str) -> bool:
+        """Open lesson ``lesson_id`` at its first step (a link into the course, such as an
+        LMS's launch); False for an id the course does not have."""
+        lesson = next((known for known in self._course.lessons if known.id == lesson_id), None)
+        if lesson is None:
+            return False
+        if lesson is not self._lesson:
+            assign(self._selector, _label(lesson))
+            self._select(lesson, 0)
+        return True
+
     def _following(self, lesson: Lesson) -> Lesson | None:
         """The lesson after ``lesson`` in the course, None after the last."""
         index = self._course.lessons.index(lesson)

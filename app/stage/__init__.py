@@ -13,6 +13,7 @@ STAGES: dict[str, str] = {
     "image": "Camera images",  # the camera's pictures and a node's output under them
     "lifecycle": "Lifecycle states",  # a managed node's state machine, its state lit
     "bag": "Newest bag",  # what the newest recording holds, and when each message came
+    "replay": "Watch a recording",  # a bag played: a graded attempt's run, seen from above
     "turtlesim": "Turtlesim",
     "scene": "3D scene",
     "tf": "TF tree",

@@ -59,8 +59,9 @@ def read_bag(path: Path) -> BagPicture:
     return BagPicture(info, stamps)
 
 
-def timeline_svg(picture: BagPicture) -> str:
-    """One row per topic, a tick per message, seconds from the bag's start along the bottom."""
+def timeline_svg(picture: BagPicture, cursor_ns: int | None = None) -> str:
+    """One row per topic, a tick per message, seconds from the bag's start along the bottom;
+    ``cursor_ns``: a red line at that moment (a recording being played)."""
     info = picture.info
     span = max(info.duration_ns, 1)
     plot_w = WIDTH - LABEL_W - 20
@@ -85,6 +86,12 @@ def timeline_svg(picture: BagPicture) -> str:
         for i in range(5)
     )
     height = axis_y + 24
+    if cursor_ns is not None:
+        x = LABEL_W + plot_w * min(max(cursor_ns - info.start_ns, 0), span) / span
+        marks += (
+            f'<line class="cursor" x1="{x:.1f}" y1="4" x2="{x:.1f}" y2="{axis_y}" '
+            'stroke="#e03131" stroke-width="2"/>'
+        )
     return (
         f'<svg class="stage-bag" width="{WIDTH}" height="{height}" '
         f'viewBox="0 0 {WIDTH} {height}" font-family="sans-serif" font-size="12" '

@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any, Protocol
 
 import viser
@@ -27,6 +28,7 @@ from app.stage.graph_stage import GraphStage
 from app.stage.image_stage import ImageStage
 from app.stage.lifecycle_stage import LifecycleStage
 from app.stage.plot_stage import PlotStage
+from app.stage.replay_stage import ReplayStage
 from app.stage.tf_stage import TfStage
 from app.stage.turtlesim_stage import TurtlesimStage
 from app.ui import assign
@@ -126,6 +128,7 @@ class Stage:
             self.image = ImageStage(gui, node)
             self.lifecycle = LifecycleStage(gui, ui, node, rosout, links)
             self.bag = BagStage(gui, ui)
+            self.replay = ReplayStage(gui, ui)
             self.turtlesim = TurtlesimStage(gui, ui, node, links)
             self.tf = TfStage(gui, node)
         # Under the code: what the learner's program printed (the exercise's output).
@@ -136,6 +139,7 @@ class Stage:
             "image": self.image,
             "lifecycle": self.lifecycle,
             "bag": self.bag,
+            "replay": self.replay,
             "turtlesim": self.turtlesim,
             "tf": self.tf,
             "code": self.code,
@@ -211,6 +215,11 @@ class Stage:
         now = time.monotonic()
         self._widths_due = [now + delay for delay in WIDTH_RESENDS]
         self._place_control_panel()
+
+    def watch(self, bag: Path, heading: str = "") -> None:
+        """Play the recording ``bag`` on stage (a graded attempt: its verdict as ``heading``)."""
+        self.replay.open(bag, heading)
+        self.show("replay")
 
     def forget(self) -> None:
         """A new lesson: its graph is laid out afresh, nothing inspected."""

@@ -69,6 +69,7 @@ def _on_stage(page: Page) -> list[str]:
         "image": shown(page.get_by_text(_IMAGE_NOTE)),
         "lifecycle": shown(page.get_by_text(_LIFECYCLE_NOTE)),
         "bag": shown(page.get_by_text("Newest bag", exact=True)),  # its folder's title
+        "replay": shown(page.get_by_text("Watch a recording", exact=True)),  # its folder's
         "code": shown(page.get_by_role("tab", name="Code of this lesson"))
         and shown(page.get_by_role("tab", name="Output of my node")),
         "turtlesim": shown(page.get_by_text("Arrow keys drive turtle1 while this window")),

@@ -16,7 +16,7 @@ import pytest
 import yaml
 
 from app.exercises import runner
-from app.exercises.attempts import AttemptStore
+from app.exercises.attempts import AttemptStore, attempt_heading, attempt_label
 from app.exercises.grader import Grader
 from app.exercises.model import load_exercises
 from app.exercises.report import Report
@@ -62,6 +62,18 @@ def test_the_oldest_attempts_of_all_exercises_go_first_over_the_size_cap(tmp_pat
     assert not huge.exists() and not middle.exists() and not newest.exists()
 
 
+def test_attempts_are_listed_by_time_verdict_and_seed_and_a_damaged_one_says_so(tmp_path):
+    kept = _attempt(tmp_path, SLUG, "20261129-101500-seed4242-fail")
+    assert attempt_label(kept) == "2026-11-29 10:15:00 UTC · fail · seed 4242"
+    again = _attempt(tmp_path, SLUG, "20261129-101500-2-seed5-pass")
+    assert attempt_label(again) == "2026-11-29 10:15:00 UTC · pass · seed 5"
+    killed = _attempt(tmp_path, SLUG, "20261129-101600.recording")
+    assert "damaged" in attempt_label(killed) and "reindex" in attempt_label(killed)
+    assert attempt_heading(killed) == ""  # no metadata.yaml: nothing to read, no crash
+    (kept / "metadata.yaml").write_text("rosbag2_bagfile_information: [", encoding="utf-8")
+    assert attempt_heading(kept) == ""
+
+
 @pytest.fixture(scope="module")
 def grading(tmp_path_factory):
     with grading_participant("attempt_test_grader", domain_id=78) as (node, supervisor):
@@ -98,6 +110,9 @@ def test_a_graded_attempt_is_a_bag_with_the_learners_log_seed_and_verdict(gradin
     assert custom["classroom.verdict"] == "fail"
     results = json.loads(custom["classroom.results"])
     assert [r["detail"] for r in results] == [r.detail for r in report.results]
+    # What Watch this attempt shows first: the verdict and each line, read from the bag.
+    heading = attempt_heading(bag)
+    assert report.summary() in heading and report.failures()[0].detail in heading
 
     # The independent reader: the learner node's own lines, as it answered the probes.
     messages = mcap_messages(bag)

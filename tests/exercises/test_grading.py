@@ -10,6 +10,7 @@ node names, and every learner process is stopped after its case.
 
 from __future__ import annotations
 
+import re
 import shutil
 from pathlib import Path
 
@@ -64,7 +65,35 @@ def _read_back(report: Report, ran: bool = True) -> Report:
     verdict = "problem" if report.problem else ("pass" if report.passed else "fail")
     assert report.attempt.endswith(f"-seed7-{verdict}"), report.attempt
     mcap_messages(Path(report.attempt))  # raises on a damaged file or an undecodable message
+    _plots_agree(report)
     return report
+
+
+def _plots_agree(report: Report) -> None:
+    """What a result plots agrees with its verdict, and the attempt keeps each plot as a PNG.
+
+    A passed result marks no moment; a failed one marks where its last trace was lost,
+    and for "closer than the bound" no later than the moment its line names.
+    """
+    for result in report.results:
+        for trace in result.traces:
+            assert trace.values, f"{result.name}: a trace with nothing in it"
+        marked = [t for t in result.traces if t.broken_at is not None]
+        if result.passed:
+            assert not marked, f"{result.name} passed, yet its plot marks {marked[0].broken_why}"
+        elif result.traces:
+            last = result.traces[-1]
+            assert last.broken_at is not None, f"{result.name} failed: {result.detail}"
+            near = re.search(r"of the wall ahead at (\d+\.\d) s: closer", result.detail)
+            if near:
+                assert last.broken_at <= float(near.group(1)) + 0.05, (last.broken_at, near[0])
+    drawn = [Path(p) for p in report.plots]
+    assert len(drawn) == len(report.traces()), (report.plots, report.attempt)
+    for path in drawn:
+        assert path.parent == Path(report.attempt) and path.read_bytes()[:8] == PNG, path
+
+
+PNG = b"\x89PNG\r\n\x1a\n"
 
 
 def _grade(grading_env, exercise: Exercise, code: str) -> Report:

@@ -18,10 +18,22 @@ FED = re.compile(r"published (\[[-0-9, ]+\])")
 
 
 def _check(ros_env, file: Path, seed: int) -> tuple[int, list[str], str]:
-    """(exit code, the verdict lines, the inputs the grader published)."""
+    """(exit code, the verdict lines, the inputs the grader published).
+
+    The grading is recorded into the bags folder of this test, and the output names it.
+    """
+    bags = file.parent / "bags"
+    env = {**ros_env, "ROS2_CLASSROOM_BAGS": str(bags)}
     done = run_cli(
-        "exercise", "check", EXERCISE.slug, str(file), "--seed", str(seed), env=ros_env, timeout=120
+        "exercise", "check", EXERCISE.slug, str(file), "--seed", str(seed), env=env, timeout=120
     )
+    recorded = re.search(r"^recorded: (\S+)$", done.stdout, re.MULTILINE)
+    assert recorded, f"the attempt was not kept:\n{done.stdout}"
+    kept = Path(recorded.group(1))
+    assert kept.parent == bags / "attempts" / EXERCISE.slug and kept.name.endswith(
+        f"-seed{seed}-{'pass' if done.returncode == 0 else 'fail'}"
+    ), kept
+    assert (kept / "metadata.yaml").is_file()
     verdicts = [line for line in done.stdout.splitlines() if line.startswith(("PASS", "FAIL"))]
     fed = FED.search(done.stdout)
     assert fed, f"no inputs in the output:\n{done.stdout}\n{done.stderr[-1500:]}"

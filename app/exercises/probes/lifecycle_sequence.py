@@ -10,6 +10,7 @@ from typing import Any
 
 from app.exercises.probes.base import ProbeContext, draw, register_probe
 from app.exercises.report import Result
+from app.exercises.trace import Trace
 from app.lessons.schema import Spec
 from app.ros import lifecycle
 from app.ros.convert import import_type
@@ -23,6 +24,7 @@ _VALID_TRANSITIONS = {
 }
 _TRANSITIONS = ("configure", "activate", "deactivate", "cleanup")
 INVALID_SHARE = 0.3  # of a walk's requests, about this many are invalid from the state
+STATES = ("unconfigured", "inactive", "active")  # the plot's levels, bottom to top
 
 
 @register_probe(
@@ -47,8 +49,29 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
         steps = p["steps"]
     else:
         raise ValueError("a lifecycle_sequence probe needs 'walk' (random) or 'steps'")
+    got: list[tuple[float, float]] = [(0.0, 0.0)]  # (request number, state) to plot
+    wanted: list[float] = [0.0]
+
+    def plotted(why: str = "") -> tuple[Trace, ...]:
+        return (
+            Trace.of(
+                f"state of {target} after each lifecycle request",
+                "state",
+                got,
+                broken_at=got[-1][0] if why else None,
+                broken_why=why,
+                along="request",
+                levels=STATES,
+                expected=wanted,
+            ),
+        )
+
+    def seen(number: int, state: str, expected: str | None) -> None:
+        got.append((float(number), float(STATES.index(state)) if state in STATES else -1.0))
+        wanted.append(float(STATES.index(expected)) if expected in STATES else got[-1][1])
+
     try:
-        for step in steps:
+        for number, step in enumerate(steps, start=1):
             transition, should_succeed = step["transition"], step.get("succeeds", True)
             try:
                 ok, _info = lifecycle.change_state(ctx.call, target, transition)
@@ -58,27 +81,44 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
                 why = "the node's callback returned failure"
             if ok != should_succeed:
                 said = "succeeded" if ok else f"failed ({why})"
+                state = _state_or_blank(ctx, target)
+                seen(number, state, step.get("state"))
                 return Result(
                     name,
                     False,
                     f"after {done or ['start']}: '{transition}' {said}, expected the opposite",
+                    plotted(f"'{transition}' {'succeeded' if ok else 'failed'}"),
                 )
             state = lifecycle.get_state(ctx.call, target)[1]
+            seen(number, state, step.get("state"))
             if "state" in step and state != step["state"]:
                 return Result(
                     name,
                     False,
                     f"after '{transition}' the node is {state}, expected {step['state']}",
+                    plotted(f"{state}, not {step['state']}"),
                 )
             done.append(transition if ok else f"{transition} (refused)")
             if monitor is not None and (ok or step is steps[-1]):
                 verdict = _publishing_verdict(ctx, monitor, state, p["topic"])
                 if verdict:
-                    return Result(name, False, f"after '{transition}' ({state}): {verdict}")
-        return Result(name, True, f"transitions {done} behaved, states as expected")
+                    return Result(
+                        name,
+                        False,
+                        f"after '{transition}' ({state}): {verdict}",
+                        plotted("published wrongly" if "messages" in verdict else "silent"),
+                    )
+        return Result(name, True, f"transitions {done} behaved, states as expected", plotted())
     finally:
         if monitor is not None:
             monitor.close()
+
+
+def _state_or_blank(ctx: ProbeContext, target: str) -> str:
+    try:
+        return lifecycle.get_state(ctx.call, target)[1]
+    except Ros2Error:
+        return ""
 
 
 def _path(start: str, end: str) -> list[tuple[str, str]]:

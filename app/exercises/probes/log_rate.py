@@ -7,6 +7,7 @@ import threading
 
 from app.exercises.probes.base import ProbeContext, register_probe
 from app.exercises.report import Result
+from app.exercises.trace import Trace, thinned
 from app.lessons.schema import Spec
 from app.ros.monitor import fitted_rate
 
@@ -57,13 +58,36 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
         skipped = _numbering_slip(texts, text)
         if skipped:
             return Result(name, False, f"{target} logs {what}, but {skipped}")
-    if p["min_hz"] <= rate <= p["max_hz"]:
-        return Result(name, True, f"{target} logs {what} at {measured}")
+    low, high = float(p["min_hz"]), float(p["max_hz"])
+    passed = low <= rate <= high
+    trace = Trace.of(
+        f"rate of {target}'s {what}, line by line (fitted: {rate:.2f} Hz)",
+        "Hz",
+        thinned(_line_rates(got)),
+        low=low,
+        high=high,
+        broken_at=None if passed else (got[-1] - got[0]) * 1e-9,
+        broken_why="" if passed else f"{rate:.2f} Hz fitted",
+        along="time by the node's log stamps (s)",
+    )
+    if passed:
+        return Result(name, True, f"{target} logs {what} at {measured}", (trace,))
     return Result(
         name,
         False,
         f"{target} logs {what} at {measured}; expected {p['min_hz']}-{p['max_hz']} Hz",
+        (trace,),
     )
+
+
+def _line_rates(stamps: list[int]) -> list[tuple[float, float]]:
+    """``(time since the first line, 1 / the gap to the line before)`` for each later line."""
+    first = stamps[0]
+    return [
+        ((now - first) * 1e-9, 1e9 / (now - before))
+        for before, now in zip(stamps, stamps[1:], strict=False)
+        if now > before
+    ]
 
 
 def _numbering_slip(texts: list[str], text: str) -> str:

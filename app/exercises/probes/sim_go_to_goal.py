@@ -24,6 +24,7 @@ from app.exercises.probes.sim import (
     touch_text,
 )
 from app.exercises.report import Result
+from app.exercises.trace import Trace, thinned
 from app.lessons.checks._sim_topics import wrap
 from app.lessons.checks._world_map import WorldMap
 from app.lessons.schema import Spec
@@ -80,17 +81,20 @@ def draw_trial(ctx: ProbeContext, p: Spec, plan: WorldMap, tries: int = 20000):
 )
 def run(ctx: ProbeContext, p: Spec) -> Result:
     trials = int(p.get("trials", 2))
-    lines = []
+    lines, traces = [], []
     with simulation(ctx, float(p.get("real_time_factor", DEFAULT_RTF))) as (world, recorder):
         for trial in range(trials):
-            passed, text = _trial(ctx, p, world, recorder)
+            passed, text, trace = _trial(ctx, p, world, recorder, trial + 1)
             lines.append(f"trial {trial + 1}: {text}")
+            traces.extend([trace] if trace else [])
             if not passed:
-                return Result("drive to the goal", False, "; ".join(lines))
-    return Result("drive to the goal", True, "; ".join(lines))
+                return Result("drive to the goal", False, "; ".join(lines), tuple(traces))
+    return Result("drive to the goal", True, "; ".join(lines), tuple(traces))
 
 
-def _trial(ctx: ProbeContext, p: Spec, world: World, recorder: Recorder) -> tuple[bool, str]:
+def _trial(
+    ctx: ProbeContext, p: Spec, world: World, recorder: Recorder, trial: int
+) -> tuple[bool, str, Trace | None]:
     position_tolerance = float(p.get("position_tolerance", 0.15))
     heading_tolerance = float(p.get("heading_tolerance", 0.25))
     within, hold = float(p.get("within", 40.0)), float(p.get("hold", 2.0))
@@ -115,9 +119,9 @@ def _trial(ctx: ProbeContext, p: Spec, world: World, recorder: Recorder) -> tupl
         f"= {pose_text(target)} in the world"
     )
     if stalled:
-        return False, f"{began}; {stalled}"
+        return False, f"{began}; {stalled}", None
     if not samples:
-        return False, f"{began}; no ground truth arrived during the trial"
+        return False, f"{began}; no ground truth arrived during the trial", None
     last = samples[-1]
     off = math.hypot(last.x - target[0], last.y - target[1])
     turned = abs(wrap(last.yaw - target[2]))
@@ -144,6 +148,20 @@ def _trial(ctx: ProbeContext, p: Spec, world: World, recorder: Recorder) -> tupl
         problems.append(f"heading error {turned:.3f} rad is above {heading_tolerance:g} rad")
     if not touched and not at_rest(samples, hold):
         problems.append(f"it did not come to rest within {within:g} s")
+    if touched:
+        broken = (touch.at, f"touched {touch.name}")
+    elif problems:  # judged where it ended: the last moment is where it was lost
+        broken = (spent, f"ended {off:.2f} m, {turned:.2f} rad off")
+    else:
+        broken = (0.0, "")
+    trace = Trace.of(
+        f"distance to the goal, trial {trial} (judged where it ends)",
+        "m",
+        thinned([(s.t - t0, math.hypot(s.x - target[0], s.y - target[1])) for s in samples]),
+        high=position_tolerance,
+        broken_at=broken[0] if broken[1] else None,
+        broken_why=broken[1],
+    )
     if problems:
-        return False, f"{began}; {figures}; " + "; ".join(problems)
-    return True, f"{began}; {figures}; {touch_text(touch)}"
+        return False, f"{began}; {figures}; " + "; ".join(problems), trace
+    return True, f"{began}; {figures}; {touch_text(touch)}", trace

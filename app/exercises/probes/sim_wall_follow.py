@@ -4,6 +4,7 @@ one side for a while: the distance to it stays in a band, it covers ground, it n
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 from app.exercises.probes.base import ProbeContext, register_probe
@@ -22,6 +23,7 @@ from app.exercises.probes.sim import (
     touch_text,
 )
 from app.exercises.report import Result
+from app.exercises.trace import Trace, thinned
 from app.lessons.checks._world_map import Box, Nearest, WorldMap
 from app.lessons.schema import Spec
 
@@ -103,8 +105,8 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
         return Result(name, False, f"{began}; no ground truth arrived during the trial")
     touch = closest_touch(plan, samples, t0)
     travel = path_length(samples)
-    judged = [s for s in _thinned(samples) if s.t - t0 >= settle]
-    distances = [side_distance(plan, s, sign).distance for s in judged]
+    every = [(s.t - t0, side_distance(plan, s, sign).distance) for s in _thinned(samples)]
+    distances = [d for t, d in every if t >= settle]
     inside = sum(low <= d <= high for d in distances)
     share = inside / len(distances) if distances else 0.0
     spent = samples[-1].t - t0
@@ -117,8 +119,10 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
             f"{share:.0%} of the time"
         )
     problems = []
+    broken = (0.0, "")  # when and why the plot marks the run as lost
     if touch.distance <= TOUCH:
         problems.append(touch_text(touch))
+        broken = (touch.at, f"touched {touch.name}")
     if travel < min_travel:
         problems.append(f"it drove only {travel:.2f} m ({min_travel:g} m needed)")
     # A follower that halts at a corner may already have covered the travel: halting fails alone.
@@ -127,10 +131,26 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
             f"it stood still for the last {STUCK:g} s (a wall follower keeps going: at a "
             "corner it turns)"
         )
+        broken = broken if broken[1] else (spent - STUCK, "stood still from here")
+    trace = Trace.of(
+        f"distance to the wall on the {side}",
+        "m",
+        thinned(every),
+        low=low,
+        high=high,
+        judged_from=settle,
+    )
     if distances and share < in_band:
         problems.append(
             f"the wall was in the band only {share:.0%} of the time ({in_band:.0%} needed)"
         )
+        out = trace.first_outside()
+        if not broken[1] and out is not None:
+            broken = (out[0], f"first out of the band: in it {share:.0%} of the time")
+    if travel < min_travel and not broken[1]:
+        broken = (spent, f"only {travel:.2f} m driven")
+    if broken[1]:
+        trace = dataclasses.replace(trace, broken_at=broken[0], broken_why=broken[1])
     if problems:
-        return Result(name, False, f"{began}; {figures}; " + "; ".join(problems))
-    return Result(name, True, f"{began}; {figures}; {touch_text(touch)}")
+        return Result(name, False, f"{began}; {figures}; " + "; ".join(problems), (trace,))
+    return Result(name, True, f"{began}; {figures}; {touch_text(touch)}", (trace,))

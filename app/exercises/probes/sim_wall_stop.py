@@ -23,6 +23,7 @@ from app.exercises.probes.sim import (
     touch_text,
 )
 from app.exercises.report import Result
+from app.exercises.trace import Trace, thinned
 from app.lessons.checks._world_map import WorldMap
 from app.lessons.schema import Spec
 
@@ -65,17 +66,34 @@ def _fits(plan: WorldMap, low: float, high: float):
 )
 def run(ctx: ProbeContext, p: Spec) -> Result:
     trials = int(p.get("trials", 2))
-    lines = []
+    lines, traces = [], []
     with simulation(ctx, float(p.get("real_time_factor", DEFAULT_RTF))) as (world, recorder):
         for trial in range(trials):
-            passed, text = _trial(ctx, p, world, recorder)
+            passed, text, trace = _trial(ctx, p, world, recorder, trial + 1)
             lines.append(f"trial {trial + 1}: {text}")
+            traces.extend([trace] if trace else [])
             if not passed:
-                return Result("stop before the wall", False, "; ".join(lines))
-    return Result("stop before the wall", True, "; ".join(lines))
+                return Result("stop before the wall", False, "; ".join(lines), tuple(traces))
+    return Result("stop before the wall", True, "; ".join(lines), tuple(traces))
 
 
-def _trial(ctx: ProbeContext, p: Spec, world: World, recorder: Recorder) -> tuple[bool, str]:
+def _trace(
+    trial: int, closest: float, points: list[tuple[float, float]], broken: tuple[float, str]
+) -> Trace:
+    at, why = broken
+    return Trace.of(
+        f"distance to the wall ahead, trial {trial}",
+        "m",
+        thinned(points),
+        low=closest,
+        broken_at=at if why else None,
+        broken_why=why,
+    )
+
+
+def _trial(
+    ctx: ProbeContext, p: Spec, world: World, recorder: Recorder, trial: int
+) -> tuple[bool, str, Trace | None]:
     closest, reach = float(p.get("closest", 0.35)), float(p.get("reach", 0.65))
     within, hold = float(p.get("within", 25.0)), float(p.get("hold", 3.0))
     low, high = p.get("ahead", [1.2, 3.0])
@@ -101,18 +119,23 @@ def _trial(ctx: ProbeContext, p: Spec, world: World, recorder: Recorder) -> tupl
     samples, stalled = run_until(ctx, recorder, t0, start, within + hold, world.rtf, done)
     began = f"start {pose_text(start)} with {wall.name} {wall.distance:.2f} m ahead"
     if stalled:
-        return False, f"{began}; {stalled}"
+        return False, f"{began}; {stalled}", None
     if not samples:
-        return False, f"{began}; no ground truth arrived during the trial"
+        return False, f"{began}; no ground truth arrived during the trial", None
     distances = [ahead(plan, s) for s in samples]
+    points = [(s.t - t0, d) for s, d in zip(samples, distances, strict=True)]
     nearest = min(distances)
     touch = closest_touch(plan, samples, t0)
     last, final = samples[-1], distances[-1]
     problems = []
+    broken = (0.0, "")  # when and why the plot marks the trial as lost
     if touch.distance <= TOUCH:
         problems.append(touch_text(touch))
+        broken = (touch.at, f"touched {touch.name}")
     if nearest < closest:
         at = samples[distances.index(nearest)].t - t0
+        first = next(t for t, d in points if d < closest)
+        broken = broken if broken[1] else (first, f"closer than {closest:g} m")
         problems.append(
             f"it came to {nearest:.3f} m of the wall ahead at {at:.1f} s: closer than "
             f"the bound {closest:g} m"
@@ -130,18 +153,24 @@ def _trial(ctx: ProbeContext, p: Spec, world: World, recorder: Recorder) -> tupl
         else:
             how = f": it came to rest {final:.2f} m from it after moving {moved:.2f} m"
         problems.append(f"it did not come within {reach:g} m of the wall{how}{why}")
+        broken = broken if broken[1] else (last.t - t0, f"never within {reach:g} m")
     elif not problems and not at_rest(samples, hold):
         problems.append(
             f"it came within {reach:g} m at {reached[0]:.1f} s but did not stand still for "
             f"{hold:g} s (now {final:.2f} m from the wall)"
         )
+        broken = (last.t - t0, "still moving")
     elif not problems and not closest <= final <= reach:
         problems.append(f"it stopped {final:.2f} m from the wall, outside {closest:g}-{reach:g} m")
+        broken = (last.t - t0, f"stopped {final:.2f} m away")
+    trace = _trace(trial, closest, points, broken)
     if problems:
-        return False, f"{began}; " + "; ".join(problems)
+        return False, f"{began}; " + "; ".join(problems), trace
     speed = (wall.distance - reach) / reached[0] if reached[0] > 0 else 0.0
-    return True, (
+    return (
+        True,
         f"{began}; within {reach:g} m after {reached[0]:.1f} s (about {speed:.2f} m/s), "
         f"stopped {final:.2f} m from it (closest {nearest:.2f} m, bound {closest:g} m), "
-        f"still for {hold:g} s; {touch_text(touch)}"
+        f"still for {hold:g} s; {touch_text(touch)}",
+        trace,
     )

@@ -12,6 +12,7 @@ from turtlesim.msg import Pose
 from app.exercises.probes.base import ProbeContext, draw, register_probe
 from app.exercises.probes.tf import WORLD_MAX, WORLD_MIN, teleport
 from app.exercises.report import Result
+from app.exercises.trace import Trace, thinned
 from app.lessons.schema import Spec
 from app.ros.errors import Ros2Error
 from app.ros.monitor import TopicMonitor
@@ -48,6 +49,23 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
     leader = TopicMonitor(node, f"/{lead}/pose", Pose, keep=5, qos=10)
     follower = TopicMonitor(node, f"/{follow}/pose", Pose, keep=5, qos=10)
     done: list[str] = []
+    began = time.monotonic()
+    points: list[tuple[float, float]] = []  # (s since the first move, distance) to plot
+
+    def plotted(broken_at: float | None = None, why: str = "") -> tuple[Trace, ...]:
+        if not points:
+            return ()
+        trace = Trace.of(
+            f"distance from {follow} to {lead} (it jumps at each move)",
+            "m",
+            thinned(points),
+            high=bound,
+            broken_at=broken_at,
+            broken_why=why,
+            along="time (s)",
+        )
+        return (trace,)
+
     try:
         deadline = time.monotonic() + float(p.get("spawn_within", 10.0))
         while follower.message() is None or leader.message() is None:
@@ -77,6 +95,8 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
             closest = trace[0]
             while (d := _distance(leader, follower) or math.inf) > bound:
                 closest = min(closest, d)
+                if math.isfinite(d):
+                    points.append((time.monotonic() - began, d))
                 if time.monotonic() - start > within:
                     trace.append(d)
                     way = "grew" if trace[-1] > trace[0] + 0.2 else "did not close"
@@ -86,10 +106,14 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
                         f"move {move + 1}: put {lead} at ({x:.2f}, {y:.2f}); in {within:g} s the "
                         f"distance {way}: {trace[0]:.2f} m -> {trace[-1]:.2f} m (closest "
                         f"{closest:.2f} m, needed below {bound:g} m)",
+                        plotted(time.monotonic() - began, f"move {move + 1}: not caught"),
                     )
                 ctx.call.sleep(0.1)
+            points.append((time.monotonic() - began, d))
             done.append(f"{trace[0]:.1f} m -> {d:.2f} m in {time.monotonic() - start:.1f} s")
-        return Result(name, True, f"{follow} caught up after every move: {'; '.join(done)}")
+        return Result(
+            name, True, f"{follow} caught up after every move: {'; '.join(done)}", plotted()
+        )
     finally:
         leader.close()
         follower.close()

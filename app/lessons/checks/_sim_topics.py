@@ -8,12 +8,12 @@ same stamp, so the checks pair them by stamp. Stamps are simulation time.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from functools import lru_cache
 from typing import TYPE_CHECKING, Any
 
 from app.lessons.checks._world_map import WorldMap, load_world_map
 from app.ros import rotations
+from app.ros.planar import Pose
 
 if TYPE_CHECKING:
     from app.lessons.runtime import LessonRuntime
@@ -24,19 +24,6 @@ ODOM = "/odom"
 CLOCK = "/clock"
 SIM_NODE = "/sim_world"
 WALL_CLOCK_SECONDS = 1e8  # a stamp beyond this (1973) is wall-clock time, not simulation time
-
-
-@dataclass(frozen=True)
-class Pose:
-    """A planar pose with the simulation time it was stamped at."""
-
-    t: float
-    x: float
-    y: float
-    yaw: float
-
-    def text(self) -> str:
-        return f"({self.x:.2f}, {self.y:.2f}, {self.yaw:.2f} rad)"
 
 
 def seconds(stamp: Any) -> float:

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from app import PROJECT_ROOT
+from app.ros.planar import Box
 
 WORLDS_DIR = PROJECT_ROOT / "nodes" / "worlds"
 BODY_BAND = (0.02, 0.2)  # m above the floor: the diffbot's chassis, wheels and scanner
@@ -37,59 +38,6 @@ _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_-]*$")
 
 class WorldMapError(ValueError):
     """A world file that cannot be read as a floor plan; the message says why."""
-
-
-@dataclass(frozen=True)
-class Box:
-    """A rectangle: centre, half sizes along its own axes, and its turn about z."""
-
-    name: str
-    x: float
-    y: float
-    half_x: float
-    half_y: float
-    yaw: float = 0.0
-
-    def corners(self) -> list[tuple[float, float]]:
-        c, s = math.cos(self.yaw), math.sin(self.yaw)
-        return [
-            (self.x + c * dx - s * dy, self.y + s * dx + c * dy)
-            for dx, dy in (
-                (self.half_x, self.half_y),
-                (-self.half_x, self.half_y),
-                (-self.half_x, -self.half_y),
-                (self.half_x, -self.half_y),
-            )
-        ]
-
-    def local(self, px: float, py: float) -> tuple[float, float]:
-        c, s = math.cos(self.yaw), math.sin(self.yaw)
-        dx, dy = px - self.x, py - self.y
-        return c * dx + s * dy, -s * dx + c * dy
-
-    def distance(self, px: float, py: float) -> float:
-        """Signed distance from a point to the rectangle (negative inside)."""
-        lx, ly = self.local(px, py)
-        qx, qy = abs(lx) - self.half_x, abs(ly) - self.half_y
-        outside = math.hypot(max(qx, 0.0), max(qy, 0.0))
-        return outside + min(max(qx, qy), 0.0)
-
-    def ray(self, px: float, py: float, angle: float) -> float:
-        """Distance along a ray from a point to the rectangle's outline (inf: missed)."""
-        lx, ly = self.local(px, py)
-        direction = angle - self.yaw
-        dx, dy = math.cos(direction), math.sin(direction)
-        near, far = -math.inf, math.inf
-        for origin, d, half in ((lx, dx, self.half_x), (ly, dy, self.half_y)):
-            if abs(d) < 1e-12:
-                if abs(origin) > half:
-                    return math.inf
-                continue
-            t1, t2 = (-half - origin) / d, (half - origin) / d
-            near, far = max(near, min(t1, t2)), min(far, max(t1, t2))
-        if near > far or far < 0:
-            return math.inf
-        return max(near, 0.0)
 
 
 @dataclass(frozen=True)

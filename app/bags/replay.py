@@ -1,0 +1,219 @@
+"""What a recording shows when it is watched: the robot's way, its scans, the room, and each
+topic's messages over time.
+
+A graded attempt (app/exercises/attempts.py) or any bag of the simulated world
+holds ``/ground_truth/odom`` (where the robot really was), ``/scan`` and the
+world's latched ``/sim_world/static_markers`` (floor, walls, furniture). This
+reads them once into plain numbers a player can step through by time: poses
+and scans as seen from above, the room as boxes, and every other message as
+a line of text at its moment (what the grader sent, what the node answered).
+Times are seconds since the bag's first message, by when each was recorded.
+"""
+
+from __future__ import annotations
+
+import bisect
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from rclpy.serialization import deserialize_message
+
+from app.bags.bagfile import READ_ERRORS, first_line, open_bag
+from app.bags.errors import BagError
+from app.bags.info import BagInfo, read_info
+from app.ros import rotations
+from app.ros.convert import import_type, to_plain
+from app.ros.planar import Box, Pose
+
+POSE_TOPICS = ("/ground_truth/odom", "/odom")  # the first one a bag holds is the robot's way
+SCAN_TOPIC = "/scan"
+ROOM_TOPIC = "/sim_world/static_markers"
+MOST_MOMENTS = 3000  # lines of other messages kept (a long bag keeps its first ones)
+MOMENT_TEXT = 160  # characters of one message's text
+FLOOR_HEIGHT = 0.05  # m: a marker no taller than this is floor, not an obstacle
+LOG_LEVELS = {10: "DEBUG", 20: "INFO", 30: "WARN", 40: "ERROR", 50: "FATAL"}
+JUMP = 0.5  # m between two poses: the world was reset (a new trial), not a drive
+# Drawn, not listed: their numbers are the picture (and images and clouds are never kept).
+DRAWN_TYPES = (
+    "nav_msgs/msg/Odometry",
+    "sensor_msgs/msg/LaserScan",
+    "visualization_msgs/msg/MarkerArray",
+    "tf2_msgs/msg/TFMessage",
+    "rosgraph_msgs/msg/Clock",
+    "sensor_msgs/msg/Imu",
+    "sensor_msgs/msg/JointState",
+)
+
+
+@dataclass(frozen=True)
+class Scan:
+    """One scan's returns in the world frame, from where the robot was when it was taken."""
+
+    t: float
+    points: tuple[tuple[float, float], ...]
+
+
+@dataclass(frozen=True)
+class Moment:
+    """One message of a topic that is not drawn, as a line of text."""
+
+    t: float
+    topic: str
+    text: str
+
+
+@dataclass
+class Track:
+    """A bag made ready to watch."""
+
+    info: BagInfo
+    duration: float
+    pose_topic: str = ""
+    poses: list[Pose] = field(default_factory=list)
+    scans: list[Scan] = field(default_factory=list)
+    room: list[Box] = field(default_factory=list)
+    floor: Box | None = None
+    moments: list[Moment] = field(default_factory=list)
+    stamps: dict[str, list[float]] = field(default_factory=dict)  # topic -> message times
+    problems: list[str] = field(default_factory=list)  # messages that could not be read
+
+    @property
+    def drives(self) -> bool:
+        """Whether there is a robot to watch (else: the messages' timeline)."""
+        return bool(self.poses)
+
+    def pose_at(self, t: float) -> Pose | None:
+        """The newest pose at ``t`` (None before the first)."""
+        return _newest(self.poses, t)
+
+    def scan_at(self, t: float) -> Scan | None:
+        return _newest(self.scans, t)
+
+    def way_until(self, t: float) -> list[list[Pose]]:
+        """The robot's way up to ``t``, cut where the world was reset (one piece per trial)."""
+        pieces: list[list[Pose]] = []
+        for pose in self.poses[: bisect.bisect_right([p.t for p in self.poses], t)]:
+            last = pieces[-1][-1] if pieces else None
+            if last is None or math.hypot(pose.x - last.x, pose.y - last.y) > JUMP:
+                pieces.append([])
+            pieces[-1].append(pose)
+        return pieces
+
+    def moments_until(self, t: float, most: int) -> list[Moment]:
+        """The last ``most`` messages at or before ``t``."""
+        end = bisect.bisect_right([m.t for m in self.moments], t)
+        return self.moments[max(0, end - most) : end]
+
+
+def _newest(items: Sequence[Any], t: float) -> Any:
+    index = bisect.bisect_right([item.t for item in items], t) - 1
+    return items[index] if index >= 0 else None
+
+
+def yaw_of(q: Any) -> float:
+    return rotations.yaw_of(q.x, q.y, q.z, q.w)
+
+
+def read_track(path: Path) -> Track:
+    """The bag at ``path`` made ready to watch; BagError when it cannot be read at all.
+
+    A message that cannot be decoded is counted in ``problems`` and skipped.
+    """
+    info = read_info(path)
+    start = info.start_ns
+    types = {t.name: t.msgtype for t in info.topics}
+    pose_topic = next((t for t in POSE_TOPICS if t in types), "")
+    track = Track(info, max(info.duration_ns, 0) / 1e9, pose_topic)
+    classes: dict[str, Any] = {}
+    try:
+        with open_bag(path) as reader:
+            wanted = _wanted_messages(reader, track, start)
+    except READ_ERRORS as exc:
+        raise BagError(f"{path}: {first_line(exc)}") from None
+    # A bag's file keeps messages in the order they were written, not always in time order
+    # (the recorder writes a batch of one topic, then another's): sorted here, by receive time.
+    for stamps in track.stamps.values():
+        stamps.sort()
+    for t, topic, kind, raw in sorted(wanted, key=lambda item: item[0]):
+        if kind not in DRAWN_TYPES and len(track.moments) >= MOST_MOMENTS:
+            continue
+        try:
+            cls = classes.get(kind) or classes.setdefault(kind, import_type(kind))
+            msg = deserialize_message(raw, cls)
+        except Exception as exc:  # a type we lack, or a damaged message
+            if len(track.problems) < 5:
+                track.problems.append(f"{topic}: {first_line(exc)}")
+            continue
+        _take(track, topic, kind, t, msg)
+    return track
+
+
+def _wanted_messages(reader: Any, track: Track, start: int) -> list[tuple[float, str, str, bytes]]:
+    """Every message's time noted; the ones to draw or list kept as (t, topic, type, CDR)."""
+    kept = []
+    for connection, stamp, raw in reader.messages():
+        topic, kind = connection.topic, connection.msgtype
+        t = max(0.0, (stamp - start) / 1e9)
+        track.stamps.setdefault(topic, []).append(t)
+        if topic in (track.pose_topic, SCAN_TOPIC, ROOM_TOPIC) or kind not in DRAWN_TYPES:
+            kept.append((t, topic, kind, bytes(raw)))
+    return kept
+
+
+def _take(track: Track, topic: str, kind: str, t: float, msg: Any) -> None:
+    if topic == track.pose_topic:
+        p = msg.pose.pose
+        track.poses.append(Pose(t, p.position.x, p.position.y, yaw_of(p.orientation)))
+    elif topic == SCAN_TOPIC and kind == "sensor_msgs/msg/LaserScan":
+        pose = track.pose_at(t)
+        if pose is not None:
+            track.scans.append(Scan(t, _scan_points(msg, pose)))
+    elif topic == ROOM_TOPIC and kind == "visualization_msgs/msg/MarkerArray":
+        _room(track, msg)
+    elif kind == "rcl_interfaces/msg/Log":  # as ros2 run prints a node's log line
+        level = LOG_LEVELS.get(msg.level, str(msg.level))
+        track.moments.append(Moment(t, topic, _cut(f"[{level}] [{msg.name}]: {msg.msg}")))
+    else:
+        text = json.dumps(to_plain(msg, max_items=8), separators=(", ", ": "))
+        track.moments.append(Moment(t, topic, _cut(text)))
+
+
+def _cut(text: str) -> str:
+    return text if len(text) <= MOMENT_TEXT else text[: MOMENT_TEXT - 1] + "…"
+
+
+def _scan_points(msg: Any, pose: Pose) -> tuple[tuple[float, float], ...]:
+    """Each return's place in the world, the scanner taken to sit at the robot's centre
+    (its few centimetres of offset do not show at a room's scale)."""
+    points = []
+    for i, r in enumerate(msg.ranges):
+        if not (math.isfinite(r) and msg.range_min <= r <= msg.range_max):
+            continue
+        a = pose.yaw + msg.angle_min + i * msg.angle_increment
+        points.append((round(pose.x + r * math.cos(a), 3), round(pose.y + r * math.sin(a), 3)))
+    return tuple(points)
+
+
+def _room(track: Track, msg: Any) -> None:
+    """The room from its markers: the largest flat one is the floor, the rest obstacles."""
+    boxes: list[Box] = []
+    floors: list[Box] = []
+    for marker in msg.markers:
+        if marker.action not in (0, 1):  # ADD, MODIFY
+            continue
+        p, s = marker.pose.position, marker.scale
+        box = Box(
+            f"{marker.ns}/{marker.id}",
+            p.x,
+            p.y,
+            abs(s.x) / 2,
+            abs(s.y) / 2,
+            yaw_of(marker.pose.orientation),
+        )
+        (floors if p.z + abs(s.z) / 2 <= FLOOR_HEIGHT else boxes).append(box)
+    track.room = boxes
+    track.floor = max(floors, key=lambda b: b.half_x * b.half_y, default=None)

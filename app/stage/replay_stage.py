@@ -1,0 +1,273 @@
+"""A recording played on stage: the robot's way seen from above, or each topic's messages.
+
+"Watch this attempt" beside a grading's result opens its bag here (any bag
+can be opened: a graded attempt is one). A bag of the simulated world plays
+as a top view: the room, the way the robot really went so far (one line per
+trial: the grader resets the world between them), the robot now and what its
+scan saw now. Any other bag plays as its messages' timeline, with the
+newest messages at the cursor as text: what the grader sent and what the
+node answered, and when. Play/pause, a speed and a time slider drive it.
+
+Threads: reading the bag is a worker job (``app.bags.replay.read_track``);
+everything else runs on the UI thread, one frame per refresh while playing.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+import time
+from pathlib import Path
+
+import viser
+
+from app.bags.replay import Pose, Track, read_track
+from app.ros.graph import GraphSnapshot
+from app.ros.planar import Box
+from app.stage.bag_stage import BagPicture, timeline_svg
+from app.ui import MarkdownView, assign, code_block
+from app.ui.loop import UiLoop
+
+WIDTH, HEIGHT = 760, 560  # px of the top view
+MARGIN_M = 0.3  # m around what is drawn
+SPEEDS = {"¼×": 0.25, "½×": 0.5, "1×": 1.0, "2×": 2.0, "4×": 4.0}
+LINES_AT_CURSOR = 8  # messages listed under the picture
+WAY_STEP_PX = 2.0  # a drawn way's points at least this far apart (a long run stays small)
+ROBOT_RADIUS_M = 0.17
+TRIAL_COLOURS = ("#1c7ed6", "#e8590c", "#2f9e44", "#ae3ec9")
+NOTHING = (
+    "_Nothing to watch yet._ After **Check my node**, click **Watch this attempt** under "
+    "the results: the grading plays here."
+)
+
+
+class TopView:
+    """World metres -> pixels of the top view (y up, as a map is read)."""
+
+    def __init__(self, low: tuple[float, float], high: tuple[float, float]) -> None:
+        span_x, span_y = max(high[0] - low[0], 0.5), max(high[1] - low[1], 0.5)
+        self.scale = min((WIDTH - 20) / span_x, (HEIGHT - 40) / span_y)
+        self.low = low
+        self.height = span_y * self.scale + 20
+        self.width = span_x * self.scale + 20
+
+    def px(self, x: float, y: float) -> tuple[float, float]:
+        return 10 + (x - self.low[0]) * self.scale, self.height - 10 - (
+            y - self.low[1]
+        ) * self.scale
+
+    @classmethod
+    def around(cls, track: Track) -> TopView:
+        """The floor, or else everything the robot went past and saw."""
+        if track.floor is not None:
+            corners = [c for box in (track.floor, *track.room) for c in box.corners()]
+        else:
+            corners = [(p.x, p.y) for p in track.poses]
+            corners += [c for box in track.room for c in box.corners()]
+            corners += [
+                pt for scan in track.scans[:: max(1, len(track.scans) // 50)] for pt in scan.points
+            ]
+        corners = corners or [(0.0, 0.0)]
+        xs, ys = [c[0] for c in corners], [c[1] for c in corners]
+        return cls(
+            (min(xs) - MARGIN_M, min(ys) - MARGIN_M), (max(xs) + MARGIN_M, max(ys) + MARGIN_M)
+        )
+
+
+def _xy(x: float, y: float) -> str:
+    return f"{x:.1f},{y:.1f}"
+
+
+def _polygon(view: TopView, box: Box, style: str) -> str:
+    points = " ".join(_xy(*view.px(x, y)) for x, y in box.corners())
+    return f'<polygon points="{points}" {style}><title>{html.escape(box.name)}</title></polygon>'
+
+
+def _way(view: TopView, piece: list[Pose], colour: str) -> str:
+    points: list[tuple[float, float]] = []
+    for pose in piece:
+        here = view.px(pose.x, pose.y)
+        if not points or math.dist(here, points[-1]) >= WAY_STEP_PX or pose is piece[-1]:
+            points.append(here)
+    text = " ".join(f"{x:.1f},{y:.1f}" for x, y in points)
+    return f'<polyline points="{text}" fill="none" stroke="{colour}" stroke-width="2"/>'
+
+
+def top_view_svg(track: Track, t: float, view: TopView | None = None) -> str:
+    """The room, the way so far, the scan and the robot at ``t`` seconds into the bag."""
+    view = view or TopView.around(track)
+    parts = []
+    if track.floor is not None:
+        parts.append(_polygon(view, track.floor, 'fill="#f8f9fa" stroke="#ced4da"'))
+    parts += [_polygon(view, box, 'fill="#adb5bd" stroke="#495057"') for box in track.room]
+    pieces = track.way_until(t)
+    for n, piece in enumerate(pieces):
+        parts.append(_way(view, piece, TRIAL_COLOURS[n % len(TRIAL_COLOURS)]))
+    scan = track.scan_at(t)
+    if scan is not None and t - scan.t < 1.0:
+        dots = "".join(
+            '<circle cx="{:.1f}" cy="{:.1f}" r="1.6"/>'.format(*view.px(x, y))
+            for x, y in scan.points
+        )
+        parts.append(f'<g class="replay-scan" fill="#e03131">{dots}</g>')
+    pose = track.pose_at(t)
+    if pose is not None:
+        cx, cy = view.px(pose.x, pose.y)
+        r = ROBOT_RADIUS_M * view.scale
+        nose = view.px(
+            pose.x + ROBOT_RADIUS_M * math.cos(pose.yaw),
+            pose.y + ROBOT_RADIUS_M * math.sin(pose.yaw),
+        )
+        # The robot carries its pose, so a test (or a curious learner's devtools) reads it.
+        parts.append(
+            f'<g id="replay-robot" data-x="{pose.x:.3f}" data-y="{pose.y:.3f}" '
+            f'data-yaw="{pose.yaw:.3f}" data-t="{pose.t:.3f}">'
+            f'<circle cx="{cx:.1f}" cy="{cy:.1f}" r="{r:.1f}" fill="#ffd43b" stroke="#212529" '
+            f'stroke-width="1.5"/><line x1="{cx:.1f}" y1="{cy:.1f}" x2="{nose[0]:.1f}" '
+            f'y2="{nose[1]:.1f}" stroke="#212529" stroke-width="2.5"/></g>'
+        )
+    trials = f" · trial {len(pieces)}" if len(pieces) > 1 else ""
+    caption = (
+        f"{t:.1f} s of {track.duration:.1f} s{trials} · seen from above: the line is where the "
+        f"robot really went ({track.pose_topic}), red dots what its /scan saw"
+    )
+    height = view.height + 24
+    return (
+        f'<svg class="stage-replay" width="{view.width:.0f}" height="{height:.0f}" '
+        f'viewBox="0 0 {view.width:.0f} {height:.0f}" font-family="sans-serif" font-size="12" '
+        f'role="img" aria-label="The recorded run seen from above at {t:.1f} s">'
+        f"{''.join(parts)}"
+        f'<text x="10" y="{height - 6:.0f}" fill="#495057">{html.escape(caption)}</text></svg>'
+    )
+
+
+def timeline_at(track: Track, t: float) -> str:
+    """Each topic's messages as ticks, with a red cursor at ``t``."""
+    start = track.info.start_ns
+    stamps = {topic: [start + int(s * 1e9) for s in times] for topic, times in track.stamps.items()}
+    return timeline_svg(BagPicture(track.info, stamps), cursor_ns=start + int(t * 1e9))
+
+
+class ReplayStage:
+    def __init__(self, gui: viser.GuiApi, ui: UiLoop) -> None:
+        self._ui = ui
+        self._active = False
+        self._track: Track | None = None
+        self._view: TopView | None = None
+        self._t = 0.0
+        self._playing = False
+        self._last_frame = 0.0
+        self._drawn = ""
+        self._box = gui.add_folder("Watch a recording", expand_by_default=True, visible=False)
+        with self._box:
+            self._heading = MarkdownView(gui, NOTHING)
+            self._play = gui.add_button("Play", icon=viser.Icon.PLAYER_PLAY, disabled=True)
+            self._speed = gui.add_dropdown("Speed", list(SPEEDS), initial_value="1×")
+            self._slider = gui.add_slider(
+                "Time (s)", min=0.0, max=1.0, step=0.1, initial_value=0.0, disabled=True
+            )
+            self._picture = gui.add_html("")
+            self._messages = MarkdownView(gui, "")
+        self._play.on_click(ui.callback(self._toggle))
+        self._slider.on_update(ui.callback(self._on_slider))
+
+    # -- opening ------------------------------------------------------------------
+
+    def open(self, bag: Path, heading: str = "") -> None:
+        """Read ``bag`` (a worker job) and show it from its start, paused."""
+        self._playing = False
+        self._track = None
+        self._heading.show(f"{heading}\n\n_Reading `{bag.name}`…_".strip())
+        self._set_picture("")
+        self._messages.show("")
+
+        def done(track: Track) -> None:
+            self._track, self._view = track, TopView.around(track) if track.drives else None
+            self._slider.max = max(track.duration, 0.1)
+            self._slider.disabled = self._play.disabled = False
+            self._t = 0.0
+            what = (
+                "It plays from the start: **Pause** stops it, the time slider goes to any moment."
+                if track.drives
+                else "No robot in this recording: its messages, topic by topic."
+            )
+            damaged = (
+                f"\n\n⚠ Some messages could not be read: {'; '.join(track.problems)}"
+                if track.problems
+                else ""
+            )
+            self._heading.show(
+                f"{heading}\n\n`{bag.name}` · {track.info.message_count} messages in "
+                f"{track.duration:.1f} s. {what}{damaged}".strip()
+            )
+            self._playing = track.drives
+            self._last_frame = time.monotonic()
+            self._draw()
+
+        def failed(text: str) -> None:
+            self._heading.show(f"{heading}\n\n✗ This recording cannot be played: {text}".strip())
+
+        self._ui.run_job(lambda: read_track(bag), done, failed)
+
+    # -- UI thread ------------------------------------------------------------------
+
+    def _toggle(self) -> None:
+        if self._track is None:
+            return
+        if not self._playing and self._t >= self._track.duration:
+            self._t = 0.0  # at the end: Play starts over
+        self._playing = not self._playing
+        self._last_frame = time.monotonic()
+        self._draw()
+
+    def _on_slider(self) -> None:
+        if self._track is not None and abs(float(self._slider.value) - self._t) > 0.05:
+            self._t = float(self._slider.value)  # a learner's drag (our own steps match)
+            self._draw()
+
+    def set_active(self, active: bool) -> None:
+        self._active = active
+        self._box.visible = active
+        if not active:
+            self._playing = False
+
+    def refresh(self, graph: GraphSnapshot) -> None:
+        track = self._track
+        if not self._active or track is None or not self._playing:
+            return
+        now = time.monotonic()
+        self._t = min(
+            track.duration, self._t + (now - self._last_frame) * SPEEDS.get(self._speed.value, 1.0)
+        )
+        self._last_frame = now
+        if self._t >= track.duration:
+            self._playing = False
+        self._draw()
+
+    def _draw(self) -> None:
+        track = self._track
+        if track is None:
+            return
+        self._play.label = "Pause" if self._playing else "Play"
+        self._play.icon = viser.Icon.PLAYER_PAUSE if self._playing else viser.Icon.PLAYER_PLAY
+        assign(self._slider, round(self._t, 1))
+        if track.drives:
+            self._set_picture(top_view_svg(track, self._t, self._view))
+        else:
+            self._set_picture(timeline_at(track, self._t))
+        lines = [
+            f"{m.t:7.2f} s  {m.topic}  {m.text}"
+            for m in track.moments_until(self._t, LINES_AT_CURSOR)
+        ]
+        self._messages.show(
+            f"**The last messages up to {self._t:.1f} s** (what was sent, what came back)\n\n"
+            + code_block(lines, "(none yet)")
+        )
+
+    def _set_picture(self, svg: str) -> None:
+        if svg != self._drawn:
+            self._drawn = svg
+            self._picture.content = svg
+
+    def close(self) -> None:
+        self._playing = False

@@ -1,0 +1,100 @@
+"""See why it failed: a wrong wall_stop solution is graded in the simulated world, its
+plot marks the moment it came too close, and "Watch this attempt" plays the run on stage
+with the robot where the recorded ground truth put it (read here by the independent
+``mcap`` reader, not by our code)."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from pathlib import Path
+
+from playwright.sync_api import Page, expect
+
+from app.exercises.model import load_exercises
+from tests.bags.readers import mcap_messages
+from tests.browser.helpers import choose, click, expect_text, open_tab
+from tests.browser.test_exercise import _type_code
+from tests.conftest import ARTIFACTS, DashboardProcess, free_port
+
+EXERCISE = load_exercises().get("wall_stop")
+MISTAKE = next(m for m in EXERCISE.mistakes if m.path.stem == "front_is_index_zero")
+
+
+def _ground_truth(bag: Path) -> list[tuple[float, float, float]]:
+    """(seconds since the bag's first message, x, y) of each /ground_truth/odom message."""
+    messages = mcap_messages(bag)
+    start = min(stamp for _topic, stamp, _msg in messages)
+    return [
+        ((stamp - start) / 1e9, m.pose.pose.position.x, m.pose.pose.position.y)
+        for topic, stamp, m in messages
+        if topic == "/ground_truth/odom"
+    ]
+
+
+def _robot(page: Page) -> dict[str, float]:
+    robot = page.locator("#replay-robot")
+    return {k: float(robot.get_attribute(f"data-{k}") or "nan") for k in ("t", "x", "y")}
+
+
+def test_a_failed_simulation_attempt_is_plotted_and_replayed(browser, ros_env, tmp_path):
+    bags = tmp_path / "bags"
+    env = {**ros_env, "ROS2_CLASSROOM_BAGS": str(bags)}
+    dashboard = DashboardProcess(env, free_port(), ["--progress-dir", str(tmp_path / "p")])
+    page = browser.new_page(viewport={"width": 1400, "height": 900})
+    try:
+        page.goto(dashboard.url)
+        open_tab(page, "Exercise")
+        choose(page, "Exercise", f"{EXERCISE.unit:02d} · {EXERCISE.title}")
+        page.get_by_role("tab", name="Your code").click()
+        editor = page.frame_locator(f"iframe[src*='slug={EXERCISE.slug}']")
+        expect(editor.locator("#status")).to_have_text(re.compile("saved|connected"))
+        _type_code(page, editor, MISTAKE.path.read_text(encoding="utf-8"))
+        click(page, "Run my node")
+        expect_text(page, re.compile(r"running \(pid \d+\) · on the graph"), 60_000)
+        click(page, "Check my node")
+        verdict = re.compile(r"of the wall ahead at (\d+\.\d) s: closer than the bound")
+        expect_text(page, verdict, 150_000)
+
+        # The plot of what was judged is under the results, and the attempt keeps it.
+        told = page.get_by_text(re.compile(r"ros2 bag info attempts/")).first
+        expect(told).to_be_visible(timeout=20_000)
+        name = re.search(r"ros2 bag info (attempts/\S+?-fail)\b", told.inner_text())
+        assert name, told.inner_text()
+        attempt = bags / name.group(1)
+        traces = json.loads((attempt / "traces.json").read_text(encoding="utf-8"))
+        assert traces and traces[-1]["broken_why"].startswith("closer than")
+        said = page.get_by_text(verdict).filter(visible=True).first.inner_text()
+        at = float(verdict.search(said).group(1))
+        assert traces[-1]["broken_at"] <= at + 0.05, (traces[-1]["broken_at"], at)
+        assert list(attempt.glob("plot-*.png"))
+        plot = page.locator("img").filter(visible=True)
+        assert plot.count() >= 1
+
+        # Watch it: the run plays on stage, the robot where the file's ground truth says.
+        click(page, "Watch this attempt")
+        expect_text(page, re.compile(r"\d+ messages in \d+\.\d s\. It plays from the start"))
+        truth = _ground_truth(attempt)
+        assert len(truth) > 20, len(truth)
+        seen: list[dict[str, float]] = []
+        robot = page.locator("#replay-robot")
+        expect(robot).to_be_visible(timeout=20_000)
+        choose(page, "Speed", "4×")
+        for _ in range(200):
+            now = _robot(page)
+            if not seen or now["t"] > seen[-1]["t"] + 1.0:
+                seen.append(now)
+            if len(seen) >= 3:
+                break
+            page.wait_for_timeout(250)
+        assert len(seen) >= 3, f"the replay did not move on: {seen}"
+        for drawn in seen:
+            # The newest ground truth at the drawn moment (the two clocks are the same
+            # bag's receive times; a millisecond of rounding either way).
+            newest = max((p for p in truth if p[0] <= drawn["t"] + 0.002), key=lambda p: p[0])
+            assert math.dist((drawn["x"], drawn["y"]), newest[1:]) < 0.002, (drawn, newest)
+    finally:
+        page.screenshot(path=str(ARTIFACTS / "attempt-replay.png"))
+        page.close()
+        dashboard.stop()
