@@ -13,6 +13,12 @@ teacher share (a second, small participant per dashboard; the learners' own
 domains stay isolated). With ``--network`` that domain reaches other
 machines, so a class spread over several hosts (each running ``classroom``
 with its own ``--site`` and base domain id) shows on any host's teacher page.
+
+With ``CLASSROOM_LTI_URL`` set (the address an LMS reaches this classroom
+at), the classroom is also an LTI 1.3 tool: the hub's LTI handlers on a port
+of their own (app/hub/lti_classroom.py), an LMS learner seated at a learner
+dashboard of their own, grades sent from the teacher page's roster, and the
+teacher's gradebook behind the teacher's token.
 """
 
 from __future__ import annotations
@@ -29,18 +35,24 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
+from urllib.parse import urlsplit
 
 from app import PROJECT_ROOT
 from app.dds import MAX_DOMAIN_ID
 
 if TYPE_CHECKING:
+    from app.hub.lti_classroom import ClassroomLtiServer
     from app.teacher.page import TeacherPage
+    from app.teacher.record import LearnerRecord
     from app.teacher.roster import Roster
 
 _PR_SET_PDEATHSIG = 1
 _libc = ctypes.CDLL(None, use_errno=True)
 READY_TIMEOUT_SEC = 90.0
 MAX_LEARNERS = 40
+LTI_URL_ENV = "CLASSROOM_LTI_URL"  # as the hub's teacher service reads it
+LTI_PORT_ENV = "CLASSROOM_LTI_PORT"  # where the LTI server listens (default: teacher page - 1)
+LTI_DIR_ENV = "CLASSROOM_LTI_DIR"  # the tool's key, platforms.toml, launches, seats and outbox
 
 
 @dataclass(frozen=True)
@@ -147,6 +159,62 @@ class TeacherView:
             self.page.close()
             remove_teacher_file(self.plan.progress_root)
         self.roster.close()
+
+
+def start_lti(
+    classroom: Classroom,
+    teacher: TeacherPlan,
+    records: Callable[[], list[LearnerRecord]],
+    env: Mapping[str, str],
+) -> ClassroomLtiServer | None:
+    """The LMS's way in, when ``CLASSROOM_LTI_URL`` says where the LMS reaches us; else None.
+
+    Raises ``ValueError``, ``OSError`` or ``RuntimeError`` with the reason (a plain http
+    address for another machine, a busy port, no tornado installed).
+    """
+    base = env.get(LTI_URL_ENV, "").strip()
+    if not base:
+        return None
+    try:
+        from app.hub.lti_classroom import DEFAULT_DIR, classroom_lti
+    except ImportError as exc:  # tornado comes with the hub extra
+        raise RuntimeError(
+            f"LTI needs tornado and PyJWT: pip install -e '.[hub]' ({exc})"
+        ) from None
+    port = int(env.get(LTI_PORT_ENV) or teacher.port - 1)
+    if port in [learner.port for learner in classroom.learners] + [teacher.port]:
+        raise ValueError(f"the LTI port {port} is also a dashboard's: set {LTI_PORT_ENV}")
+    server = classroom_lti(
+        base,
+        learner_urls={learner.name: learner.url(classroom.host) for learner in classroom.learners},
+        teacher_url=teacher.url(classroom.host),
+        teacher_token=teacher.token,
+        site=classroom.learners[0].site,
+        host=classroom.host,
+        port=port,
+        records=records,
+        folder=Path(env.get(LTI_DIR_ENV) or DEFAULT_DIR),
+    )
+    server.start()
+    return server
+
+
+def _lti_lines(lti: ClassroomLtiServer, host: str) -> list[str]:
+    from app.hosts import is_loopback
+
+    lines = [
+        f"  LMS (LTI 1.3): {lti.lti.tool.urls.base}  (served on {host}:{lti.port}; "
+        f"`ros2-classroom lti config --base-url {lti.lti.tool.urls.base}` prints what the "
+        "LMS needs)",
+        f"  Gradebook: {lti.gradebook_url}",
+    ]
+    public = urlsplit(lti.lti.tool.urls.base).hostname or ""
+    if is_loopback(host) and not is_loopback(public):
+        lines.append(
+            "  Note: the dashboards listen on this machine only: learners from the LMS on "
+            "other machines need --host 0.0.0.0 --allow-remote"
+        )
+    return lines
 
 
 def _die_with_parent() -> None:
@@ -267,7 +335,7 @@ def run(
 ) -> int:
     """Start everyone and the teacher page, print the URLs, stop on request."""
     classroom.start()
-    view = None
+    view = lti = None
     if teacher is not None:  # while the dashboards boot
         try:
             view = TeacherView(teacher, classroom.host)
@@ -275,9 +343,19 @@ def run(
             say(f"ros2-classroom: error: could not start the teacher page: {exc}")
             classroom.stop()
             return 1
+        try:
+            lti = start_lti(classroom, teacher, view.roster.records, os.environ)
+        except (OSError, ValueError, RuntimeError) as exc:
+            say(f"ros2-classroom: error: could not serve LTI for the LMS: {exc}")
+            view.close()
+            classroom.stop()
+            return 1
     try:
-        return _serve(classroom, stop_requested, say, teacher)
+        extra = _lti_lines(lti, classroom.host) if lti is not None else []
+        return _serve(classroom, stop_requested, say, teacher, extra)
     finally:
+        if lti is not None:
+            lti.close()
         if view is not None:
             view.close()
 
@@ -287,6 +365,7 @@ def _serve(
     stop_requested: threading.Event,
     say: Callable[[str], None],
     teacher: TeacherPlan | None,
+    extra: list[str] | None = None,
 ) -> int:
     failed = classroom.wait_ready()
     if failed:
@@ -305,6 +384,8 @@ def _serve(
             f"  Teacher page: {teacher.url(classroom.host)}  (own token; progress on ROS "
             f"domain {teacher.classroom_domain}; `ros2-classroom classroom status` prints it)"
         )
+    for line in extra or []:
+        say(line)
     say("Press Ctrl+C to stop every dashboard.")
     reported: set[str] = set()
     while not stop_requested.wait(0.5):

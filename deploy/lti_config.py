@@ -13,6 +13,10 @@ URL ``https://HUB/hub/lti13/jwks``; the LMS then gives the values below.
 Course instructors join the hub's "teachers" group at each login, so they
 open the teacher's page (/services/classroom-teacher/); everyone else is a
 learner. Values come from the environment so no secret lives in this file.
+
+This sends no grade back to the LMS. deploy/lti_tool_config.py does (the
+teacher service as the LMS's LTI tool, with the teacher's gradebook): use
+one or the other; docs/deploy/lti.md has the whole story.
 """
 
 import os

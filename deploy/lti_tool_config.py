@@ -3,9 +3,10 @@
 At the end of deploy/jupyterhub_config.py: ``load_subconfig("deploy/lti_tool_config.py")``.
 The teacher service (app/hub/teacher_service.py) then serves the LTI
 addresses under /services/classroom-teacher/lti/ and sends each learner's
-finished lessons and passed exercises to the LMS's gradebook; the hub logs
-in whoever the LMS launched (app/hub/lti_login.py) and keeps PAM for the
-school's own accounts. docs/deploy/lti.md is the whole story.
+finished lessons and passed exercises to the LMS's gradebook, and shows
+teachers what was sent and what waits at /services/classroom-teacher/gradebook;
+the hub logs in whoever the LMS launched (app/hub/lti_login.py) and keeps
+PAM for the school's own accounts. docs/deploy/lti.md is the whole story.
 
 Settings through the environment:
   CLASSROOM_LTI_URL   the service's public address as the LMS reaches it, e.g.

@@ -29,6 +29,7 @@ import os
 from asyncio import Future
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 from urllib.parse import quote, urlencode
@@ -39,6 +40,7 @@ from app import PROJECT_ROOT
 from app.hub.lti_catalog import course_activities
 from app.lti import claims
 from app.lti.deep_linking import Activity, DeepLinkingError
+from app.lti.gradebook import GradebookLine, gradebook
 from app.lti.handoff import Handoff, HandoffRefused, HandoffTickets
 from app.lti.launch import Launch
 from app.lti.learners import hub_user_name
@@ -187,11 +189,12 @@ class LtiService:
     # -- what the handlers hand over ----------------------------------------------------
 
     def after_launch(self, launch: Launch) -> str:
-        """Where a checked resource-link launch goes: the hub's handoff, with a ticket."""
+        """Where a checked resource-link launch goes; ``LaunchRejected`` when nowhere."""
+        name = hub_user_name(launch.registration.issuer, launch.user_id)
         if launch.is_instructor:
-            name = hub_user_name(launch.registration.issuer, launch.user_id)
             log.info("LTI: teacher %s (%s) launched; to the teacher's page", name, launch.name)
-            return self.handoff_url(Handoff(name, self.service_prefix, teacher=True))
+            return self.teacher_destination(name)
+        where = self.learner_destination(name)  # before anything is written: it may refuse
         name, item = self.tool.record_launch(launch)
         if item is None:
             log.info("LTI: learner %s launched a link that names no lesson or exercise", name)
@@ -203,7 +206,15 @@ class LtiService:
             log.info("LTI: %s launched %s %s; no score goes back", name, item.kind, item.slug)
         else:
             log.info("LTI: %s launched %s %s", name, item.kind, item.slug)
+        return where
+
+    def learner_destination(self, name: str) -> str:
+        """The hub's handoff page, which logs ``name`` in and opens their own server."""
         return self.handoff_url(Handoff(name, self.learner_url(name), teacher=False))
+
+    def teacher_destination(self, name: str) -> str:
+        """The hub's handoff page, which logs ``name`` in as a teacher and opens this service."""
+        return self.handoff_url(Handoff(name, self.service_prefix, teacher=True))
 
     def on_record(self, record: LearnerRecord) -> int:
         """A learner's progress report: queue the scores it earns; the number queued."""
@@ -218,7 +229,33 @@ class LtiService:
     def _known(self, kind: str, slug: str) -> bool:
         return any((a.kind, a.slug) == (kind, slug) for a in self.catalog)
 
-    def routes(self, prefix: str) -> list[tuple[str, type[web.RequestHandler], dict[str, Any]]]:
+    # -- the teacher's gradebook ----------------------------------------------------------
+
+    def seat_of(self, name: str) -> str:
+        """The learner dashboard ``name`` uses, where the deployment has fixed ones ('')."""
+        return ""
+
+    def gradebook(self) -> list[GradebookLine]:
+        titles = {(a.kind, a.slug): a.title for a in self.catalog}
+        lines = gradebook(self.tool.book.learners(), self.tool.outbox.entries(), titles)
+        return [replace(line, seat=self.seat_of(line.learner)) for line in lines]
+
+    def lms_names(self) -> dict[str, str]:
+        """Each LMS learner's name as the LMS gave it at launch, by hub user name."""
+        return {e.name: e.display_name for e in self.tool.book.learners() if e.display_name}
+
+    def retry_now(self) -> int:
+        """The teacher's Retry: every score not yet delivered is sent now; the number."""
+        count = self.tool.outbox.retry_now()
+        if count:
+            log.info("LTI: a teacher asked to retry %d score(s) now", count)
+            self.pump.kick()
+        return count
+
+    # -- routes -----------------------------------------------------------------------------
+
+    def lms_routes(self, prefix: str) -> list[tuple[str, type[web.RequestHandler], dict[str, Any]]]:
+        """What the LMS and the browsers it sends reach: login, launch, picker, keys."""
         args = {"lti": self}
         base = _slashed(prefix).rstrip("/")
         return [
@@ -227,8 +264,12 @@ class LtiService:
             (base + DEEP_LINK_PATH, LaunchHandler, args),
             (base + PICK_PATH, PickHandler, args),
             (base + JWKS_PATH, JwksHandler, args),
-            (base + HANDOFF_API, HandoffHandler, args),
         ]
+
+    def routes(self, prefix: str) -> list[tuple[str, type[web.RequestHandler], dict[str, Any]]]:
+        """The LMS's routes and the hub's ticket trade (the gradebook's come with its auth)."""
+        base = _slashed(prefix).rstrip("/")
+        return [*self.lms_routes(prefix), (base + HANDOFF_API, HandoffHandler, {"lti": self})]
 
 
 def _slashed(path: str) -> str:
@@ -317,7 +358,12 @@ class LaunchHandler(_LtiPage):
                 )
             )
             return
-        self.redirect(self.lti.after_launch(launch), status=303)
+        try:
+            where = self.lti.after_launch(launch)
+        except LaunchRejected as rejected:
+            self.refuse(str(rejected))
+            return
+        self.redirect(where, status=303)
 
 
 class PickHandler(_LtiPage):

@@ -21,12 +21,17 @@ With ``CLASSROOM_LTI_URL`` set, the service is also the LTI 1.3 tool an LMS
 launches (app/hub/lti_service.py): its login, launch, deep-linking and JWKS
 addresses are under ``lti/``, it holds the tool's private key and the score
 outbox in ``CLASSROOM_LTI_DIR``, and a report that shows a finished lesson or a
-passed exercise of a learner who came from the LMS sends that grade back.
+passed exercise of a learner who came from the LMS sends that grade back. The
+teacher's page then shows each LMS learner's name beside their ``lti-`` hub
+name, and links to the gradebook (``gradebook``, app/hub/lti_gradebook.py):
+what was sent to the LMS, what waits in the outbox, and a Retry button.
 """
 
 from __future__ import annotations
 
+import csv
 import html
+import io
 import json
 import logging
 import os
@@ -37,6 +42,7 @@ from urllib.parse import urlsplit
 
 from jupyterhub.services.auth import (
     HubAuth,
+    HubOAuth,
     HubOAuthCallbackHandler,
     HubOAuthenticated,
 )
@@ -159,7 +165,20 @@ def _int_arg(text: str) -> int:
         raise web.HTTPError(400, "since must be a whole number") from None
 
 
-class _TeacherBase(HubOAuthenticated, _Base):
+class TeacherAuth(HubOAuthenticated):
+    """The hub's OAuth, and only users the hub grants this service (admins, the teachers' group).
+
+    Which ``HubOAuth`` asks the hub is the app's ``teacher_auth`` setting when
+    given (a test's stand-in hub), else the one the service's environment sets up.
+    """
+
+    @property
+    def hub_auth(self) -> Any:
+        settings: dict[str, Any] = getattr(self, "settings", {})
+        return settings.get("teacher_auth") or HubOAuth.instance()
+
+
+class _TeacherBase(TeacherAuth, _Base):
     """Pages for teachers: the hub's OAuth, and only users granted this service."""
 
 
@@ -169,9 +188,11 @@ class PageHandler(_TeacherBase):
         user = self.current_user
         self.set_header("Content-Type", "text/html; charset=utf-8")
         self.set_header("Cache-Control", "no-store")
+        lti = self.settings.get("lti")
         self.finish(
             PAGE.replace("{{xsrf}}", html.escape(self.xsrf_token.decode()))
             .replace("{{teacher}}", html.escape(user["name"]))
+            .replace("{{gradebook}}", GRADEBOOK_LINK if lti is not None else "")
             .replace("{{columns}}", "".join(f"<th>{html.escape(c)}</th>" for c in COLUMNS))
             .replace("{{max_notice}}", str(MAX_NOTICE))
         )
@@ -188,6 +209,7 @@ class TableHandler(_TeacherBase):
                 "columns": COLUMNS,
                 "rows": rows,
                 "keys": sorted(r.key for r in records),
+                "names": _lms_names(self.settings.get("lti"), records),
                 "reports": self.state.reports,
                 "refused": self.state.refused,
                 "reveal_after": self.state.reveal_after,
@@ -200,7 +222,32 @@ class CsvHandler(_TeacherBase):
     def get(self) -> None:
         self.set_header("Content-Type", "text/csv; charset=utf-8")
         self.set_header("Content-Disposition", 'attachment; filename="classroom-progress.csv"')
-        self.finish(to_csv(self.state.records.values(), self.state.rule))
+        text = to_csv(self.state.records.values(), self.state.rule)
+        lti = self.settings.get("lti")
+        if lti is not None:  # the LMS's names, last: the other columns keep their places
+            text = _with_lms_names(text, lti.lms_names())
+        self.finish(text)
+
+
+def _lms_names(lti: LtiService | None, records: list[LearnerRecord]) -> dict[str, str]:
+    """The LMS's name of each learner in ``records`` who came from the LMS, by hub name."""
+    if lti is None:
+        return {}
+    known = lti.lms_names()
+    return {r.learner: known[r.learner] for r in records if r.learner in known}
+
+
+def _with_lms_names(text: str, names: dict[str, str]) -> str:
+    rows = list(csv.reader(io.StringIO(text)))
+    if not rows:
+        return text
+    learner = rows[0].index("learner")
+    out = io.StringIO()
+    writer = csv.writer(out)
+    writer.writerow([*rows[0], "lms_name"])
+    for row in rows[1:]:
+        writer.writerow([*row, names.get(row[learner], "")])
+    return out.getvalue()
 
 
 class LearnerHandler(_TeacherBase):
@@ -270,10 +317,12 @@ def make_app(
     state: ClassState | None = None,
     *,
     hub_auth: Any = None,
+    teacher_auth: HubOAuth | None = None,
     lti: LtiService | None = None,
 ) -> web.Application:
-    """The service's tornado app. ``hub_auth`` answers whose token a report carries (the
-    hub's, unless a test gives its own); ``lti`` serves LTI and sends grades (None: off)."""
+    """The service's tornado app. ``hub_auth`` answers whose token a report carries and
+    ``teacher_auth`` who opens a teacher's page (the hub's, unless a test points them at
+    its own); ``lti`` serves LTI, sends grades and the gradebook (None: off)."""
     state = state or ClassState()
     args = {"state": state}
     routes: list[Any] = [
@@ -287,12 +336,16 @@ def make_app(
         (url_path_join(prefix, "oauth_callback"), HubOAuthCallbackHandler),
     ]
     if lti is not None:
+        from app.hub.lti_gradebook import gradebook_routes
+
         routes += lti.routes(prefix)
+        routes += gradebook_routes(prefix, lti, TeacherAuth, back=("./", "The class"))
     return web.Application(
         routes,
         cookie_secret=os.urandom(32),
         login_url=url_path_join(prefix, "oauth_start"),  # replaced by HubOAuth's redirect
         hub_auth=hub_auth if hub_auth is not None else HubAuth(),
+        teacher_auth=teacher_auth,
         xsrf_cookies=True,
         lti=lti,
     )
@@ -327,6 +380,8 @@ def main() -> None:
             lti.stop()
 
 
+GRADEBOOK_LINK = ' · <a href="gradebook">Grades sent to the LMS (gradebook)</a>'
+
 PAGE = """<!doctype html>
 <html><head><meta charset="utf-8"><title>ROS 2 Classroom: teacher</title>
 <style>
@@ -337,7 +392,8 @@ pre{background:#f4f4f4;padding:.5em;max-height:24em;overflow:auto}
 </style></head><body>
 <h2>ROS 2 Classroom: teacher's view</h2>
 <p>Signed in through the hub as <b>{{teacher}}</b> ·
-<a href="progress.csv">Download the class's progress (CSV)</a> · <span id="summary"></span></p>
+<a href="progress.csv">Download the class's progress (CSV)</a>{{gradebook}} ·
+<span id="summary"></span></p>
 <table id="class"><thead><tr>{{columns}}</tr></thead><tbody></tbody></table>
 <section><label>Learner <select id="learner"><option value="">(choose a learner)</option>
 </select></label><div id="detail"></div></section>
@@ -353,10 +409,13 @@ pre{background:#f4f4f4;padding:.5em;max-height:24em;overflow:auto}
 // The hub's cookie counts for fetch() only with the XSRF token (JupyterHub >= 4.1).
 const xsrf = "{{xsrf}}";
 function cell(text){const td=document.createElement("td");td.textContent=text;return td;}
+let names={};  // the LMS's name of each learner who came from it, by hub name
+function named(learner){return names[learner]?`${learner} · ${names[learner]}`:learner;}
 function options(select, keys){
-  const have=[...select.options].map(o=>o.value).filter(v=>v);
-  for(const k of keys){if(!have.includes(k)){const o=document.createElement("option");
-    o.value=k;o.textContent=k;select.appendChild(o);}}
+  for(const k of keys){const label=named(k.slice(k.indexOf("/")+1));
+    let o=[...select.options].find(o=>o.value===k);
+    if(!o){o=document.createElement("option");o.value=k;select.appendChild(o);}
+    if(o.textContent!==label)o.textContent=label;}
 }
 async function post(path, body){
   const r=await fetch(path,{method:"POST",headers:{"Content-Type":"application/json",
@@ -368,8 +427,9 @@ async function refresh(){
     const r=await fetch("progress.json",{cache:"no-store",headers:{"X-XSRFToken":xsrf}});
     if(!r.ok)return;
     const data=await r.json();const body=document.querySelector("#class tbody");
+    names=data.names||{};
     body.replaceChildren(...data.rows.map(row=>{const tr=document.createElement("tr");
-      tr.dataset.learner=row[0];row.forEach(v=>tr.appendChild(cell(v)));
+      tr.dataset.learner=row[0];row.forEach((v,i)=>tr.appendChild(cell(i?v:named(v))));
       if(row[row.length-1])tr.className="stuck";return tr;}));
     document.getElementById("summary").textContent=
       `${data.rows.length} learners · updated ${new Date().toLocaleTimeString()}`;

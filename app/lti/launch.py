@@ -69,7 +69,7 @@ class Launch:
     message_type: str
     deployment_id: str
     user_id: str  # the platform's `sub`: stable per learner and platform
-    name: str | None
+    name: str | None  # `name`, else `given_name` and `family_name`: for the teacher's pages
     email: str | None
     roles: tuple[str, ...]
     context_id: str | None
@@ -78,6 +78,8 @@ class Launch:
     grade_service: GradeService | None
     deep_linking: DeepLinkingSettings | None
     custom: Mapping[str, str] = field(default_factory=dict)
+    context_title: str | None = None  # the course, as the LMS names it
+    link_title: str | None = None  # the activity, as the LMS names it (its grade column's label)
 
     @property
     def is_instructor(self) -> bool:
@@ -221,6 +223,15 @@ def _text(values: Mapping[str, Any], name: str) -> str | None:
     return value if isinstance(value, str) else None
 
 
+def _person_name(verified: Mapping[str, Any]) -> str | None:
+    """The OIDC ``name``; else ``given_name`` and ``family_name`` (some LMSes send only those)."""
+    full = (_text(verified, "name") or "").strip()
+    if full:
+        return full
+    parts = [(_text(verified, claim) or "").strip() for claim in ("given_name", "family_name")]
+    return " ".join(p for p in parts if p) or None
+
+
 def _object(values: Mapping[str, Any], name: str) -> Mapping[str, Any]:
     value = values.get(name)
     return value if isinstance(value, dict) else {}
@@ -272,7 +283,7 @@ def _read_launch(
         message_type=message_type,
         deployment_id=deployment_id,
         user_id=user_id,
-        name=_text(verified, "name"),
+        name=_person_name(verified),
         email=_text(verified, "email"),
         roles=tuple(str(r) for r in roles) if isinstance(roles, list) else (),
         context_id=_text(_object(verified, claims.CONTEXT), "id"),
@@ -282,4 +293,6 @@ def _read_launch(
         deep_linking=deep_linking,
         # Custom values are strings in LTI; some platforms send numbers, read them as text.
         custom={str(k): str(v) for k, v in _object(verified, claims.CUSTOM).items()},
+        context_title=_text(_object(verified, claims.CONTEXT), "title"),
+        link_title=_text(link, "title"),
     )

@@ -78,6 +78,8 @@ class LaunchedItem:
     score_maximum: float = 1.0  # the picked points (custom score_maximum); the LMS scales
     context_id: str | None = None
     launched_at: float = 0.0
+    context_title: str | None = None  # the course, as the LMS names it (the teacher's gradebook)
+    link_title: str | None = None  # the activity's name in the LMS, the label of its grade column
 
     @property
     def graded(self) -> bool:
@@ -146,6 +148,8 @@ class LaunchBook:
                 score_maximum=_points(launch.custom.get(SCORE_MAXIMUM_PARAM)),
                 context_id=launch.context_id,
                 launched_at=self._clock(),
+                context_title=launch.context_title,
+                link_title=launch.link_title,
             )
             # One entry per link: a relaunch updates it (the LMS may have moved its line item).
             kept = tuple(

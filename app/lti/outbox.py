@@ -104,6 +104,21 @@ class Outbox:
         with self._lock:
             return list(self._entries.values())
 
+    def retry_now(self) -> int:
+        """Make every score not yet delivered due now (the teacher's Retry); the number.
+
+        A refused score is tried again too: the teacher pressed Retry because the
+        cause is fixed in the LMS (the learner enrolled, the column opened again).
+        """
+        with self._lock:
+            now = self._clock()
+            waiting = [e for e in self._entries.values() if e.status != "delivered"]
+            for entry in waiting:
+                self._entries[entry.key] = replace(entry, status="pending", next_try=now)
+            if waiting:
+                self._save()
+            return len(waiting)
+
     def deliver_due(self) -> int:
         """Try every waiting score whose time has come; the number delivered."""
         with self._delivering:

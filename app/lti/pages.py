@@ -1,22 +1,26 @@
-"""The few HTML pages LTI shows a person: a refusal, and the teacher's activity picker.
+"""The few HTML pages LTI shows a person: a refusal, the activity picker, the gradebook.
 
-Server-rendered and self-contained (no script but the picker's one line, no
-outside file), since they open inside an LMS frame or a new tab before any
-of our other pages. Every value from a request or an LMS is escaped.
+Server-rendered and self-contained (no outside file; script only for the
+picker's one line and the gradebook's local times and filter), since they
+open inside an LMS frame or a new tab before any of our other pages. Every
+value from a request or an LMS is escaped.
 """
 
 from __future__ import annotations
 
 import html
 from collections.abc import Sequence
+from datetime import datetime, timezone
 
 from app.lti.deep_linking import Activity
+from app.lti.gradebook import GradebookLine, counts
 
 _STYLE = (
     "body{font-family:system-ui,sans-serif;margin:1.5em;max-width:52em;line-height:1.4}"
     "table{border-collapse:collapse}td,th{padding:.3em .6em;text-align:left;"
     "border-bottom:1px solid #ddd}.why{background:#fff4e5;border-left:4px solid #d97706;"
     "padding:.6em 1em}input[type=number]{width:5em}"
+    ".hub{color:#666;font-size:.85em}.sent{color:#166534}.refused{color:#b91c1c}"
 )
 
 
@@ -75,4 +79,122 @@ def picker_page(
         "<table><thead><tr><th></th><th>Activity</th><th>Kind</th><th>Points</th></tr>"
         f"</thead><tbody>\n{chr(10).join(rows)}\n</tbody></table>\n"
         '<p><button type="submit">Add to the course</button></p>\n</form>',
+    )
+
+
+_STATE_MARKS = {
+    "sent": "✓ sent",
+    "waiting": "… waiting",
+    "refused": "✗ refused",
+    "not done": "not done yet",
+    "no grade column": "no grade column",
+}
+
+
+def _time(stamp: float | str | None) -> str:
+    """A time the page's script shows in the teacher's own zone (UTC without script)."""
+    if not stamp:
+        return ""
+    when = (
+        datetime.fromtimestamp(stamp, timezone.utc)
+        if isinstance(stamp, (int, float))
+        else datetime.fromisoformat(stamp.replace("Z", "+00:00")).astimezone(timezone.utc)
+    )
+    iso = when.isoformat(timespec="seconds")
+    return f'<time datetime="{iso}">{when:%Y-%m-%d %H:%M:%S} UTC</time>'
+
+
+def _wait(seconds: float) -> str:
+    if seconds <= 1:
+        return "now"
+    if seconds < 120:
+        return f"in {seconds:.0f} s"
+    return f"in {seconds / 60:.0f} min"
+
+
+def _gradebook_row(line: GradebookLine, now: float, seats: bool) -> str:
+    who = html.escape(line.lms_name or "(no name from the LMS)")
+    hub_name = f'<span class="hub nowrap">{html.escape(line.learner)}</span>'
+    cells = [f"<td><b>{who}</b><br>{hub_name}</td>"]
+    if seats:
+        cells.append(f"<td>{html.escape(line.seat)}</td>")
+    column = html.escape(line.lineitem or "")
+    cells += [
+        f"<td>{html.escape(line.activity or '(a grade column no launch names now)')}</td>",
+        f'<td>{html.escape(line.link)}<br><span class="hub url">{column}</span></td>',
+        f'<td class="{line.state.replace(" ", "-")} nowrap">{_STATE_MARKS[line.state]}</td>',
+        f"<td>{html.escape(line.score)}</td>",
+    ]
+    if line.state == "sent":
+        answer = line.lms_answer or "accepted"
+        cells += [f"<td>{_time(line.sent_at)}</td>", f"<td>{html.escape(answer)}</td>", "<td></td>"]
+    elif line.state == "waiting":
+        answer = line.lms_answer if line.attempts else "not tried yet"
+        retry = _wait((line.next_try or now) - now)
+        tries = f" (after {line.attempts} tr{'y' if line.attempts == 1 else 'ies'})"
+        cells += [
+            f"<td>earned {_time(line.queued_at)}</td>",
+            f"<td>{html.escape(answer)}</td>",
+            f"<td>{retry}{tries if line.attempts else ''}</td>",
+        ]
+    elif line.state == "refused":
+        cells += [
+            f"<td>earned {_time(line.queued_at)}</td>",
+            f"<td>{html.escape(line.lms_answer)}</td>",
+            "<td>not retried: press Retry once fixed in the LMS</td>",
+        ]
+    else:
+        cells += [f"<td>launched {_time(line.launched_at)}</td>", "<td></td>", "<td></td>"]
+    return f'<tr data-state="{html.escape(line.state)}">{"".join(cells)}</tr>'
+
+
+def gradebook_page(
+    lines: Sequence[GradebookLine],
+    *,
+    now: float,
+    retry_form: str,
+    back: tuple[str, str] | None = None,
+    notice: str = "",
+) -> str:
+    """The teacher's gradebook: per learner and LMS link, what was sent and what waits.
+
+    ``retry_form`` is the form's opening tag and hidden fields (the web layer's
+    XSRF field); ``back`` a link to the teacher's page, (address, text).
+    """
+    found = counts(lines)
+    seats = any(line.seat for line in lines)
+    summary = " · ".join(f"{n} {state}" for state, n in found.items() if n) or "no launches yet"
+    retryable = found["waiting"] + found["refused"]
+    head = ["Learner", *(["Dashboard"] if seats else []), "Activity", "LMS link and grade column"]
+    head += ["Grade", "Score", "When", "The LMS's answer", "Next try"]
+    rows = "\n".join(_gradebook_row(line, now, seats) for line in lines)
+    back_link = (
+        f' · <a href="{html.escape(back[0], quote=True)}">{html.escape(back[1])}</a>'
+        if back
+        else ""
+    )
+    return _page(
+        "Gradebook: ROS 2 Classroom",
+        "<style>body{max-width:none}.url{display:inline-block;max-width:22em;"
+        "word-break:break-all}.nowrap{white-space:nowrap}</style>"
+        "<h1>Grades sent to the LMS</h1>\n"
+        f'<p>{html.escape(summary)}{back_link} · <a href="gradebook">Reload</a></p>\n'
+        + (f'<p class="why">{html.escape(notice)}</p>\n' if notice else "")
+        + "<p>One line per LMS link a learner opened. A finished lesson or passed exercise "
+        "becomes a score that waits in the outbox until the LMS takes it; an LMS that is "
+        "down gets it later (after 5 s, 10 s, 20 s ... up to every ten minutes).</p>\n"
+        f"{retry_form}"
+        f'<button type="submit">Retry the outbox now ({retryable} waiting or refused)</button>'
+        ' <label>Show only <input id="filter" placeholder="a name, an activity, a state"></label>'
+        "</form>\n"
+        '<table id="gradebook"><thead><tr>'
+        + "".join(f"<th>{h}</th>" for h in head)
+        + f"</tr></thead><tbody>\n{rows}\n</tbody></table>\n"
+        "<script>"
+        'for(const t of document.querySelectorAll("time"))'
+        "t.textContent=new Date(t.dateTime).toLocaleString();"
+        'const f=document.getElementById("filter");f.oninput=()=>{const q=f.value.toLowerCase();'
+        'for(const r of document.querySelectorAll("#gradebook tbody tr"))'
+        "r.hidden=q&&!r.textContent.toLowerCase().includes(q);};"
+        "</script>",
     )

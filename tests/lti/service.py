@@ -1,29 +1,36 @@
 """The real teacher service for the LTI tests: its tornado app on a loopback port, in a thread.
 
-No JupyterHub: the one thing the service asks the hub (whose API token a
-progress report carries) is answered by ``TestHub``, a stand-in with the
-same two calls as ``HubAuth``. Everything else is the service as it runs:
-``make_app`` with its LTI side, the tool's folder on disk, the outbox pump on
-tornado's loop, and real HTTP in and out.
+No JupyterHub: what the service asks the hub is answered by ``TestHub``, a
+stand-in. Whose API token a progress report carries it answers in process,
+with the same two calls as ``HubAuth``; who opens a teacher's page it
+answers over HTTP, at the hub API's ``/user`` as JupyterHub does, to the
+service's real ``HubOAuth``, which then checks the user's scopes itself.
+Everything else is the service as it runs: ``make_app`` with its LTI side,
+the tool's folder on disk, the outbox pump on tornado's loop, and real HTTP
+in and out.
 """
 
 from __future__ import annotations
 
 import asyncio
 import http.client
+import json
 import threading
 import time
 import urllib.parse
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from http.cookies import SimpleCookie
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
+from jupyterhub.services.auth import HubOAuth
 from tornado.httpserver import HTTPServer
 from tornado.netutil import bind_sockets
 
 from app.hub.lti_service import LtiService
-from app.hub.teacher_service import make_app
+from app.hub.teacher_service import SERVICE_NAME, make_app
 from app.lti.routes import ToolUrls
 from app.lti.tool import LtiTool
 from app.teacher.http_report import to_json
@@ -33,18 +40,83 @@ PREFIX = "/services/classroom-teacher/"
 HUB_BASE = "/"
 
 
+TEACHER_SCOPE = f"access:services!service={SERVICE_NAME}"  # what the hub's teachers role grants
+
+
 class TestHub:
-    """Whose hub API token is whose, as the hub would answer ``HubAuth``'s questions."""
+    """Whose hub API token is whose, as the hub would answer ``HubAuth``'s questions.
+
+    Its ``/hub/api/user`` answers as JupyterHub's does: the token's user with
+    their scopes (a teacher's token carries the service's access scope, as the
+    deployment's teachers role grants it; a learner's does not).
+    """
 
     __test__ = False
 
     def __init__(self) -> None:
         self._tokens: dict[str, str] = {}
+        self._scopes: dict[str, list[str]] = {}
+        self._server = ThreadingHTTPServer(("127.0.0.1", 0), self._handler())
+        self._thread = threading.Thread(
+            target=self._server.serve_forever, kwargs={"poll_interval": 0.05}, daemon=True
+        )
+        self._thread.start()
+        self.api_url = f"http://127.0.0.1:{self._server.server_address[1]}/hub/api"
+
+    def close(self) -> None:
+        self._server.shutdown()
+        self._server.server_close()
+        self._thread.join(timeout=5)
 
     def token_for(self, name: str) -> str:
         token = f"token-of-{name}"
         self._tokens[token] = name
+        self._scopes.setdefault(
+            token, [f"access:servers!user={name}", f"read:users:name!user={name}"]
+        )
         return token
+
+    def teacher_token(self, name: str) -> str:
+        token = self.token_for(name)
+        self._scopes[token] = [*self._scopes[token], TEACHER_SCOPE]
+        return token
+
+    def oauth(self) -> HubOAuth:
+        """The service's ``HubOAuth`` as the hub's environment would set it up, aimed here."""
+        return HubOAuth(
+            api_url=self.api_url,
+            api_token="token-of-the-service",
+            oauth_client_id=f"service-{SERVICE_NAME}",
+            access_scopes={TEACHER_SCOPE},
+            cache_max_age=0,
+        )
+
+    def _model(self, authorization: str) -> dict[str, Any] | None:
+        token = authorization.partition(" ")[2].strip()
+        name = self._tokens.get(token)
+        if name is None:
+            return None
+        return {"kind": "user", "name": name, "admin": False, "groups": [],
+                "scopes": self._scopes[token]}  # fmt: skip
+
+    def _handler(self) -> type[BaseHTTPRequestHandler]:
+        hub = self
+
+        class Handler(BaseHTTPRequestHandler):
+            def log_message(self, format: str, *args: Any) -> None:
+                pass
+
+            def do_GET(self) -> None:
+                model = hub._model(self.headers.get("Authorization", ""))
+                status = 200 if model and self.path == "/hub/api/user" else 403
+                body = json.dumps(model if status == 200 else {"error": "no such token"})
+                self.send_response(status)
+                self.send_header("Content-Type", "application/json")
+                self.send_header("Content-Length", str(len(body)))
+                self.end_headers()
+                self.wfile.write(body.encode())
+
+        return Handler
 
     def get_token(self, handler: Any, in_cookie: bool = True) -> str | None:
         header = handler.request.headers.get("Authorization", "")
@@ -53,6 +125,13 @@ class TestHub:
     async def user_for_token(self, token: str, sync: bool = True) -> dict[str, str] | None:
         name = self._tokens.get(token)
         return {"name": name, "kind": "user"} if name else None
+
+
+class ToolUnderTest(Protocol):
+    """A running tool the test LMS launches: the hub's teacher service, or a classroom's."""
+
+    @property
+    def urls(self) -> ToolUrls: ...
 
 
 class Clock:
@@ -70,6 +149,7 @@ class Answer:
     status: int
     headers: dict[str, str]
     body: str
+    cookies: dict[str, str] = field(default_factory=dict)  # every Set-Cookie, by name
 
     @property
     def location(self) -> str:
@@ -96,7 +176,16 @@ def request(
         connection.request(method, path, body=body, headers=sent)
         response = connection.getresponse()
         text = response.read().decode("utf-8", "replace")
-        return Answer(response.status, {k.lower(): v for k, v in response.getheaders()}, text)
+        jar = SimpleCookie()
+        for name, value in response.getheaders():
+            if name.lower() == "set-cookie":
+                jar.load(value)
+        return Answer(
+            response.status,
+            {k.lower(): v for k, v in response.getheaders()},
+            text,
+            {name: morsel.value for name, morsel in jar.items()},
+        )
     finally:
         connection.close()
 
@@ -128,7 +217,8 @@ class ServiceUnderTest:
         self.lti = LtiService(
             self.tool, service_prefix=PREFIX, hub_base=HUB_BASE, poll_sec=poll_sec
         )
-        self._server = HTTPServer(make_app(PREFIX, hub_auth=self.hub, lti=self.lti))
+        app = make_app(PREFIX, hub_auth=self.hub, teacher_auth=self.hub.oauth(), lti=self.lti)
+        self._server = HTTPServer(app)
         self._server.add_sockets(sockets)
         self.lti.start()
         self._ready.set()
@@ -143,6 +233,7 @@ class ServiceUnderTest:
         self._loop.call_soon_threadsafe(stop)
         self._thread.join(timeout=15)
         self._loop.close()
+        self.hub.close()
 
     def report(self, record: LearnerRecord) -> Answer:
         """A learner's dashboard posting its progress with its own hub token."""

@@ -31,7 +31,15 @@ from app.lti.registration import load_registrations
 from app.lti.tool import PLATFORMS_FILE
 from app.teacher.record import LearnerRecord
 from tests.lti.platform import CLIENT_ID, DEPLOYMENT_ID, TestPlatform
-from tests.lti.service import PREFIX, Answer, Clock, ServiceUnderTest, request, wait_for
+from tests.lti.service import (
+    PREFIX,
+    Answer,
+    Clock,
+    ServiceUnderTest,
+    ToolUnderTest,
+    request,
+    wait_for,
+)
 
 INSTRUCTOR = "http://purl.imsglobal.org/vocab/lis/v2/membership#Instructor"
 EXERCISE = "counter_publisher"  # lessons/05_topics/exercises/counter_publisher
@@ -71,7 +79,7 @@ def service(platform: TestPlatform, tmp_path: Path) -> Iterator[ServiceUnderTest
 # The LMS's side of a launch ------------------------------------------------------------
 
 
-def login(service: ServiceUnderTest, platform: TestPlatform, target: str) -> tuple[str, str]:
+def login(service: ToolUnderTest, platform: TestPlatform, target: str) -> tuple[str, str]:
     """The LMS's login initiation; the state and nonce our redirect hands its auth step."""
     query = urllib.parse.urlencode(
         {
@@ -91,7 +99,7 @@ def login(service: ServiceUnderTest, platform: TestPlatform, target: str) -> tup
 
 
 def launch(
-    service: ServiceUnderTest, platform: TestPlatform, *, to: str = "", **claims_: Any
+    service: ToolUnderTest, platform: TestPlatform, *, to: str = "", **claims_: Any
 ) -> Answer:
     target = to or service.urls.launch
     state, nonce = login(service, platform, target)

@@ -1,0 +1,189 @@
+"""LTI in the one-server classroom mode: the hub's handlers on the classroom's own LTI port.
+
+The server is app/hub/lti_classroom.py as ``classroom`` starts it, over real
+HTTP, against the test LMS; the roster (what the dashboards publish on the
+classroom domain, which needs ROS) is a list the test fills with records.
+tests/classroom/test_classroom_lti.py runs the whole command.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import re
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import pytest
+
+from app.classroom import Classroom, TeacherPlan, plan, start_lti
+from app.hub.lti_classroom import ClassroomLtiServer, classroom_lti
+from app.lti import claims
+from app.lti.routes import ToolUrls
+from app.teacher.record import LearnerRecord
+from tests.conftest import free_port
+from tests.lti.platform import TestPlatform
+from tests.lti.service import Answer, request, wait_for
+from tests.lti.test_service import (
+    EXERCISE,
+    INSTRUCTOR,
+    exercise_record,
+    graded_link,
+    launch,
+    refusal,
+    write_platforms,
+)
+
+SITE = "room-a"
+TEACHER_TOKEN = "teacher-token-0123456789"
+SEATS = {
+    "learner1": "http://127.0.0.1:8100/?token=seat1-token",
+    "learner2": "http://127.0.0.1:8101/?token=seat2-token",
+}
+TEACHER_URL = f"http://localhost:8099/?token={TEACHER_TOKEN}"
+
+
+@dataclass
+class Room:
+    """The classroom's LTI server on a free loopback port, and the roster it grades from."""
+
+    folder: Path
+    platform: TestPlatform
+    records: list[LearnerRecord] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        write_platforms(self.folder, self.platform)
+        port = free_port()
+        self.server: ClassroomLtiServer = classroom_lti(
+            f"http://127.0.0.1:{port}/classroom",
+            learner_urls=SEATS,
+            teacher_url=TEACHER_URL,
+            teacher_token=TEACHER_TOKEN,
+            site=SITE,
+            host="127.0.0.1",
+            port=port,
+            records=lambda: list(self.records),
+            folder=self.folder,
+        )
+        self.server.start()
+        self.platform.tool_jwks = json.loads(request("GET", self.urls.jwks).body)
+
+    @property
+    def urls(self) -> ToolUrls:
+        return self.server.lti.tool.urls
+
+    def close(self) -> None:
+        self.server.close()
+
+
+@pytest.fixture
+def room(platform: TestPlatform, tmp_path: Path) -> Iterator[Room]:
+    running = Room(tmp_path / "lti", platform)
+    yield running
+    running.close()
+
+
+def seat_record(seat: str, passed: bool, site: str = SITE) -> LearnerRecord:
+    """What a learner dashboard of the classroom publishes: its seat's name, not the LMS's."""
+    record = exercise_record(seat, passed=passed)
+    return replace(record, site=site)
+
+
+def test_lms_learners_each_get_a_dashboard_of_their_own_and_keep_it(
+    room: Room, platform: TestPlatform, tmp_path: Path
+) -> None:
+    link = graded_link(platform.lineitem_url("11"), {"exercise": EXERCISE})
+    ada = launch(room, platform, **link)
+    assert (ada.status, ada.location) == (303, SEATS["learner1"])
+    assert launch(room, platform, **link).location == SEATS["learner1"]  # Ada again
+    assert launch(room, platform, sub="learner-43", **link).location == SEATS["learner2"]
+    full = launch(room, platform, sub="learner-44", **link)
+    assert "all 2 learner dashboards of this classroom already have a learner" in refusal(full)
+    teacher = launch(room, platform, sub="teacher-1", **{claims.ROLES: [INSTRUCTOR]})
+    assert (teacher.status, teacher.location) == (303, TEACHER_URL)
+
+    # Another run of the classroom on the same folder: Ada still sits at learner1.
+    room.close()
+    again = Room(tmp_path / "lti", platform)
+    try:
+        assert launch(again, platform, sub="learner-44", **link).status == 400
+        assert launch(again, platform, **link).location == SEATS["learner1"]
+    finally:
+        again.close()
+
+
+def test_a_seat_that_passes_sends_its_lms_learners_grade_once(
+    room: Room, platform: TestPlatform
+) -> None:
+    link = graded_link(platform.lineitem_url("11"), {"exercise": EXERCISE, "score_maximum": "5"})
+    assert launch(room, platform, **link).location == SEATS["learner1"]  # Ada
+    assert launch(room, platform, sub="learner-43", **link).location == SEATS["learner2"]
+    room.records += [
+        seat_record("learner1", passed=False),
+        seat_record("learner2", passed=True, site="another-host"),  # not this classroom's seat
+        seat_record("learner3", passed=True),  # no LMS learner sits there
+    ]
+    time.sleep(1.5)  # past a round of the roster
+    assert platform.score_requests == []
+    room.records[0] = seat_record("learner1", passed=True)
+    wait_for(lambda: bool(platform.scores["11"]), why="Ada's score")
+    time.sleep(2.5)  # the roster is read every second: the same pass is not sent again
+    [score] = platform.scores["11"]
+    assert (score["userId"], score["scoreGiven"], score["scoreMaximum"]) == ("learner-42", 5, 5)
+    assert len(platform.score_requests) == 1
+
+
+def test_the_gradebook_is_the_teachers_by_token(room: Room, platform: TestPlatform) -> None:
+    link = graded_link(platform.lineitem_url("11"), {"exercise": EXERCISE})
+    assert launch(room, platform, **link).status == 303
+    platform.fail_next("11", 503, "maintenance", times=100)
+    room.records.append(seat_record("learner1", passed=True))
+    wait_for(lambda: bool(platform.score_requests), why="a first try")
+
+    page_url = room.urls.base + "/gradebook"
+    assert room.server.gradebook_url == f"{page_url}?token={TEACHER_TOKEN}"
+    for url in (page_url, f"{page_url}?token=seat1-token", page_url + ".json"):
+        refused = request("GET", url)
+        assert refused.status == 403 and "Ada Lovelace" not in refused.body, url
+    page = request("GET", room.server.gradebook_url)
+    assert page.status == 200, page.body
+    [row] = re.findall(r"<tbody>(.*?)</tbody>", page.body, re.S)
+    text = html.unescape(re.sub(r"<[^>]+>", " ", row))
+    assert "Ada Lovelace" in text and "learner1" in text and "… waiting" in text
+    assert "HTTP 503" in text and "maintenance" in text
+    [cookie] = [name for name in page.cookies if name.startswith("classroom_lti_teacher_")]
+    # The token came once in the address; the cookie carries it from then on (Retry too).
+    jar = f"{cookie}={page.cookies[cookie]}; _xsrf={page.cookies['_xsrf']}"
+    assert request("GET", page_url, headers={"Cookie": jar}).status == 200
+    with platform.lock:
+        platform.scripted["11"].clear()
+    xsrf = html.unescape(re.findall(r'name="_xsrf" value="([^"]+)"', page.body)[0])
+    retried = request("POST", page_url + "/retry", form={"_xsrf": xsrf}, headers={"Cookie": jar})
+    assert retried.status == 303 and retried.location == "/classroom/gradebook?retried=1"
+    wait_for(lambda: bool(platform.scores["11"]), timeout=4, why="the retried score")
+
+
+def test_the_classroom_serves_lti_only_when_given_its_address(tmp_path: Path) -> None:
+    learners = plan(2, base_port=free_port(), base_domain=20, progress_root=tmp_path, site=SITE)
+    room = Classroom(learners, {})
+    teacher = TeacherPlan(free_port(), TEACHER_TOKEN, 101, tmp_path)
+    assert start_lti(room, teacher, list, {}) is None
+    with pytest.raises(ValueError, match="LMSes only talk to LTI tools over https"):
+        start_lti(room, teacher, list, {"CLASSROOM_LTI_URL": "http://classroom.school.edu"})
+    port = free_port()
+    env = {
+        "CLASSROOM_LTI_URL": f"http://127.0.0.1:{port}",
+        "CLASSROOM_LTI_PORT": str(port),
+        "CLASSROOM_LTI_DIR": str(tmp_path / "lti"),
+    }
+    server = start_lti(room, teacher, list, env)
+    assert server is not None
+    try:
+        keys: Answer = request("GET", f"http://127.0.0.1:{port}/lti/jwks")
+        assert keys.status == 200 and json.loads(keys.body)["keys"]
+        assert server.lti.learner_urls == {ln.name: ln.url("127.0.0.1") for ln in learners}
+        assert server.lti.tool.folder == tmp_path / "lti" and (tmp_path / "lti" / "keys").is_dir()
+    finally:
+        server.close()

@@ -1,0 +1,202 @@
+"""The teacher's gradebook in the teacher service: what went to the LMS, what waits, and Retry.
+
+The service is the real tornado app with its LTI side (tests/lti/service.py),
+the LMS the test platform over HTTP, and who is a teacher is decided by the
+service's own ``HubOAuth`` asking a stand-in hub for the token's scopes.
+"""
+
+from __future__ import annotations
+
+import csv
+import html
+import io
+import json
+import re
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from app.lti import claims
+from app.lti.learners import hub_user_name
+from tests.lti.platform import TestPlatform
+from tests.lti.service import PREFIX, Answer, ServiceUnderTest, request, wait_for
+from tests.lti.test_service import (
+    EXERCISE,
+    LESSON,
+    exercise_record,
+    graded_link,
+    hub_login,
+    launch,
+    lesson_record,
+    start,
+)
+
+
+@pytest.fixture
+def service(platform: TestPlatform, tmp_path: Path) -> Iterator[ServiceUnderTest]:
+    running = start(tmp_path / "lti", platform)
+    yield running
+    running.close()
+
+
+def as_user(service: ServiceUnderTest, token: str, path: str, **form: str) -> Answer:
+    """A browser request of the teacher's pages with a hub token (GET, or POST a form)."""
+    headers = {"Authorization": f"token {token}"}
+    if not form:
+        return request("GET", service.url + PREFIX + path, headers=headers)
+    cookie = form.pop("cookie")
+    headers["Cookie"] = cookie
+    return request("POST", service.url + PREFIX + path, form=form, headers=headers)
+
+
+def gradebook_lines(service: ServiceUnderTest, token: str) -> list[dict[str, Any]]:
+    answer = as_user(service, token, "gradebook.json")
+    assert answer.status == 200, answer.body
+    lines: list[dict[str, Any]] = json.loads(answer.body)["lines"]
+    return lines
+
+
+def rows(page: str) -> list[str]:
+    """The gradebook table's rows as plain text, one string each."""
+    body = page.split("<tbody>", 1)[1].split("</tbody>", 1)[0]
+    found = re.findall(r"<tr[^>]*>(.*?)</tr>", body, re.S)
+    return [html.unescape(re.sub(r"<[^>]+>", " ", row)) for row in found]
+
+
+def retry_form(page: Answer) -> dict[str, str]:
+    """What the browser posts when the teacher presses Retry: the XSRF field and its cookie."""
+    field = re.search(r'name="_xsrf" value="([^"]+)"', page.body)
+    assert field, page.body
+    return {"_xsrf": html.unescape(field.group(1)), "cookie": f"_xsrf={page.cookies['_xsrf']}"}
+
+
+def test_a_teacher_sees_a_sent_score_a_waiting_one_and_retries_it(
+    service: ServiceUnderTest, platform: TestPlatform
+) -> None:
+    # Ada opens an exercise and a lesson, each with a grade column; the lesson's column
+    # answers 503 for now. Grace (whose LMS sends only given and family names) opens a
+    # link without a grade column.
+    exercise = graded_link(
+        platform.lineitem_url("11"), {"exercise": EXERCISE, "score_maximum": "5"}
+    )
+    exercise[claims.RESOURCE_LINK] = {"id": "link-3", "title": "Counter (graded)"}
+    ada = hub_login(service, launch(service, platform, **exercise))
+    lesson = graded_link(platform.lineitem_url("12"), {"lesson": LESSON}, "link-4")
+    assert hub_login(service, launch(service, platform, **lesson)) is not None
+    grace = hub_login(
+        service,
+        launch(
+            service,
+            platform,
+            sub="learner-43",
+            name=None,
+            given_name="Grace",
+            family_name="Hopper",
+            **{claims.AGS_ENDPOINT: None, claims.CUSTOM: {"lesson": LESSON}},
+        ),
+    )
+    assert ada is not None and grace is not None
+    name = ada["name"]
+    platform.fail_next("12", 503, "down for maintenance", times=100)
+    assert service.report(exercise_record(name, passed=True)).status == 200
+    assert service.report(lesson_record(name, step=6, states=("pass", "pass"))).status == 200
+    wait_for(lambda: bool(platform.scores["11"]), why="the exercise's score")
+    teacher = service.hub.teacher_token("mrs-teacher")
+    wait_for(
+        lambda: any(
+            line["state"] == "waiting" and line["attempts"]
+            for line in gradebook_lines(service, teacher)
+        ),
+        why="the lesson's first try",
+    )
+
+    page = as_user(service, teacher, "gradebook")
+    assert page.status == 200 and page.headers["content-type"].startswith("text/html")
+    assert page.headers["cache-control"] == "no-store"
+    sent, waiting, no_column = rows(page.body)  # by the LMS's name: Ada, Ada, Grace
+    assert "Ada Lovelace" in sent and name in sent
+    assert "A counter on a topic" in sent and "Counter (graded) in Robotics 101" in sent
+    assert "✓ sent" in sent and "5 of 5" in sent and "accepted" in sent
+    assert "Lesson 5:" in waiting and "… waiting" in waiting and "1 of 1" in waiting
+    assert "HTTP 503" in waiting and "down for maintenance" in waiting
+    assert re.search(r"in \d+ s \(after 1 try\)", waiting), waiting
+    assert "Grace Hopper" in no_column and "no grade column" in no_column
+    assert hub_user_name(platform.issuer, "learner-43") in no_column
+    assert "1 sent · 1 waiting · 1 no grade column" in page.body
+    assert "Retry the outbox now (1 waiting or refused)" in page.body
+
+    # The class page names LMS learners beside their hub names, and links the gradebook.
+    table = json.loads(as_user(service, teacher, "progress.json").body)
+    assert table["names"] == {name: "Ada Lovelace"}
+    assert 'href="gradebook"' in as_user(service, teacher, "").body
+    spreadsheet = list(csv.DictReader(io.StringIO(as_user(service, teacher, "progress.csv").body)))
+    assert [(r["learner"], r["lms_name"]) for r in spreadsheet] == [(name, "Ada Lovelace")]
+
+    # The LMS is back; the teacher does not wait for the backoff and presses Retry.
+    with platform.lock:
+        platform.scripted["12"].clear()
+    answer = as_user(service, teacher, "gradebook/retry", **retry_form(page))
+    assert answer.status == 303 and answer.location == PREFIX + "gradebook?retried=1"
+    wait_for(lambda: bool(platform.scores["12"]), timeout=4, why="the retried score (no 5 s wait)")
+    after = as_user(service, teacher, answer.location.removeprefix(PREFIX))
+    assert "Sending 1 score(s) now" in after.body
+    assert [line["state"] for line in gradebook_lines(service, teacher)] == [
+        "sent",
+        "sent",
+        "no grade column",
+    ]
+
+
+def test_a_refused_score_shows_the_lms_reason_and_retry_sends_it_once_fixed(
+    service: ServiceUnderTest, platform: TestPlatform
+) -> None:
+    link = graded_link(platform.lineitem_url("11"), {"exercise": EXERCISE})
+    ada = hub_login(service, launch(service, platform, **link))
+    assert ada is not None
+    platform.fail_next("11", 400, "this user is not enrolled in the course")
+    assert service.report(exercise_record(ada["name"], passed=True)).status == 200
+    teacher = service.hub.teacher_token("mrs-teacher")
+    wait_for(lambda: gradebook_lines(service, teacher)[0]["state"] == "refused", why="the refusal")
+    page = as_user(service, teacher, "gradebook")
+    [refused] = rows(page.body)
+    assert "✗ refused" in refused and "not enrolled in the course" in refused
+    assert "press Retry once fixed in the LMS" in refused
+    assert platform.scores["11"] == []
+    # The teacher enrols the learner in the LMS, then presses Retry.
+    answer = as_user(service, teacher, "gradebook/retry", **retry_form(page))
+    assert answer.status == 303
+    wait_for(lambda: bool(platform.scores["11"]), why="the score after Retry")
+    assert [line["state"] for line in gradebook_lines(service, teacher)] == ["sent"]
+
+
+def test_a_learner_without_teacher_rights_is_refused_the_gradebook(
+    service: ServiceUnderTest, platform: TestPlatform
+) -> None:
+    link = graded_link(platform.lineitem_url("11"), {"exercise": EXERCISE})
+    ada = hub_login(service, launch(service, platform, **link))
+    assert ada is not None
+    platform.fail_next("11", 503, "maintenance", times=100)
+    assert service.report(exercise_record(ada["name"], passed=True)).status == 200
+    teacher = service.hub.teacher_token("mrs-teacher")
+    wait_for(lambda: bool(gradebook_lines(service, teacher)[0]["attempts"]), why="a first try")
+    tries = len(platform.score_requests)
+
+    learner = service.hub.token_for(ada["name"])  # a real hub user, with no teacher scope
+    for path in ("gradebook", "gradebook.json", "", "progress.json"):
+        answer = as_user(service, learner, path)
+        assert answer.status == 403, (path, answer.status)
+        assert "Ada Lovelace" not in answer.body and "lineitems" not in answer.body
+    page = as_user(service, learner, "gradebook")
+    assert "the gradebook is for the class&#x27;s teachers" in page.body
+    # Nor can a learner press Retry, even with a good XSRF pair from a page of the service.
+    teacher_page = as_user(service, teacher, "gradebook")
+    refused = as_user(service, learner, "gradebook/retry", **retry_form(teacher_page))
+    assert refused.status == 403
+    [line] = gradebook_lines(service, teacher)
+    assert line["state"] == "waiting" and line["next_try"] > service.clock() + 1  # not due
+    assert len(platform.score_requests) == tries
+    # Without any hub login, the browser goes to the hub to sign in first.
+    anonymous = request("GET", service.url + PREFIX + "gradebook")
+    assert anonymous.status == 302 and "/oauth2/authorize" in anonymous.location
