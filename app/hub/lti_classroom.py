@@ -41,7 +41,7 @@ from tornado.httpserver import HTTPServer
 from tornado.netutil import bind_sockets
 
 from app.hub.lti_gradebook import PAGE_PATH, gradebook_routes
-from app.hub.lti_service import DEFAULT_DIR, OUTBOX_POLL_SEC, LtiService
+from app.hub.lti_service import DEFAULT_DIR, OUTBOX_POLL_SEC, LtiService, opening
 from app.lti.deep_linking import Activity
 from app.lti.rejection import LaunchRejected
 from app.lti.routes import ToolUrls
@@ -142,8 +142,8 @@ class ClassroomLti(LtiService):
         self.seats, self.learner_urls = seats, dict(learner_urls)
         self.teacher_url, self.site = teacher_url, site
 
-    def learner_destination(self, name: str) -> str:
-        return self.learner_urls[self.seats.take(name)]
+    def learner_destination(self, name: str, activity: tuple[str, str] | None = None) -> str:
+        return opening(self.learner_urls[self.seats.take(name)], activity)
 
     def teacher_destination(self, name: str) -> str:
         return self.teacher_url

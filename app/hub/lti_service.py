@@ -32,7 +32,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
-from urllib.parse import quote, urlencode
+from urllib.parse import quote, urlencode, urlsplit, urlunsplit
 
 from tornado import ioloop, web
 
@@ -43,7 +43,7 @@ from app.lti.deep_linking import Activity, DeepLinkingError
 from app.lti.gradebook import GradebookLine, gradebook
 from app.lti.handoff import Handoff, HandoffRefused, HandoffTickets
 from app.lti.launch import Launch
-from app.lti.learners import hub_user_name
+from app.lti.learners import activity_of, hub_user_name
 from app.lti.pages import picker_page, refusal_page
 from app.lti.rejection import LaunchRejected
 from app.lti.routes import DEEP_LINK_PATH, JWKS_PATH, LAUNCH_PATH, LOGIN_PATH, ToolUrls
@@ -177,10 +177,10 @@ class LtiService:
 
     # -- where people are sent ----------------------------------------------------------
 
-    def learner_url(self, name: str) -> str:
-        """The learner's own server. The dashboard has no parameter that opens a given
-        lesson or exercise yet, so the server's root: it opens where the learner left off."""
-        return f"{self.hub_base}user/{quote(name)}/"
+    def learner_url(self, name: str, activity: tuple[str, str] | None = None) -> str:
+        """The learner's own server, opened at the launch's lesson or exercise (the
+        dashboard's ``?lesson=ID`` / ``?exercise=SLUG``); with none, where they left off."""
+        return opening(f"{self.hub_base}user/{quote(name)}/", activity)
 
     def handoff_url(self, handoff: Handoff) -> str:
         ticket = self.tickets.issue(handoff)
@@ -194,7 +194,8 @@ class LtiService:
         if launch.is_instructor:
             log.info("LTI: teacher %s (%s) launched; to the teacher's page", name, launch.name)
             return self.teacher_destination(name)
-        where = self.learner_destination(name)  # before anything is written: it may refuse
+        # Before anything is written: it may refuse.
+        where = self.learner_destination(name, activity_of(launch))
         name, item = self.tool.record_launch(launch)
         if item is None:
             log.info("LTI: learner %s launched a link that names no lesson or exercise", name)
@@ -208,9 +209,9 @@ class LtiService:
             log.info("LTI: %s launched %s %s", name, item.kind, item.slug)
         return where
 
-    def learner_destination(self, name: str) -> str:
+    def learner_destination(self, name: str, activity: tuple[str, str] | None = None) -> str:
         """The hub's handoff page, which logs ``name`` in and opens their own server."""
-        return self.handoff_url(Handoff(name, self.learner_url(name), teacher=False))
+        return self.handoff_url(Handoff(name, self.learner_url(name, activity), teacher=False))
 
     def teacher_destination(self, name: str) -> str:
         """The hub's handoff page, which logs ``name`` in as a teacher and opens this service."""
@@ -325,6 +326,16 @@ class LoginHandler(_LtiPage):
             return
         self.set_header("Cache-Control", "no-store")
         self.redirect(redirect.url, status=302)
+
+
+def opening(url: str, activity: tuple[str, str] | None) -> str:
+    """``url`` with the query that opens a lesson or an exercise on the dashboard added to
+    what its query already says (a classroom's ``?token=``); ``url`` itself for none."""
+    if activity is None:
+        return url
+    parts = urlsplit(url)
+    query = "&".join(q for q in (parts.query, urlencode({activity[0]: activity[1]})) if q)
+    return urlunsplit(parts._replace(path=parts.path or "/", query=query))
 
 
 class LaunchHandler(_LtiPage):

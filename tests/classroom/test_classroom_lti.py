@@ -75,7 +75,8 @@ def test_an_lms_learner_gets_a_seat_and_their_pass_reaches_the_lms(ros_env, tmp_
 
         link = graded_link(platform.lineitem_url("11"), {"exercise": EXERCISE})
         seated = launch(Tool(base), platform, **link)
-        assert (seated.status, seated.location) == (303, f"http://127.0.0.1:{base_port}")
+        landing = f"http://127.0.0.1:{base_port}/?exercise={EXERCISE}"  # at the launched one
+        assert (seated.status, seated.location) == (303, landing)
 
         side = SideParticipant("lti_test_dashboard", classroom_domain)
         publisher = side.node.create_publisher(

@@ -91,14 +91,19 @@ def seat_record(seat: str, passed: bool, site: str = SITE) -> LearnerRecord:
     return replace(record, site=site)
 
 
+def at_exercise(seat: str) -> str:
+    """A seat's dashboard address, opened at the launched exercise (its ?exercise=)."""
+    return f"{SEATS[seat]}&exercise={EXERCISE}"
+
+
 def test_lms_learners_each_get_a_dashboard_of_their_own_and_keep_it(
     room: Room, platform: TestPlatform, tmp_path: Path
 ) -> None:
     link = graded_link(platform.lineitem_url("11"), {"exercise": EXERCISE})
     ada = launch(room, platform, **link)
-    assert (ada.status, ada.location) == (303, SEATS["learner1"])
-    assert launch(room, platform, **link).location == SEATS["learner1"]  # Ada again
-    assert launch(room, platform, sub="learner-43", **link).location == SEATS["learner2"]
+    assert (ada.status, ada.location) == (303, at_exercise("learner1"))
+    assert launch(room, platform, **link).location == at_exercise("learner1")  # Ada again
+    assert launch(room, platform, sub="learner-43", **link).location == at_exercise("learner2")
     full = launch(room, platform, sub="learner-44", **link)
     assert "all 2 learner dashboards of this classroom already have a learner" in refusal(full)
     teacher = launch(room, platform, sub="teacher-1", **{claims.ROLES: [INSTRUCTOR]})
@@ -109,7 +114,7 @@ def test_lms_learners_each_get_a_dashboard_of_their_own_and_keep_it(
     again = Room(tmp_path / "lti", platform)
     try:
         assert launch(again, platform, sub="learner-44", **link).status == 400
-        assert launch(again, platform, **link).location == SEATS["learner1"]
+        assert launch(again, platform, **link).location == at_exercise("learner1")
     finally:
         again.close()
 
@@ -118,8 +123,8 @@ def test_a_seat_that_passes_sends_its_lms_learners_grade_once(
     room: Room, platform: TestPlatform
 ) -> None:
     link = graded_link(platform.lineitem_url("11"), {"exercise": EXERCISE, "score_maximum": "5"})
-    assert launch(room, platform, **link).location == SEATS["learner1"]  # Ada
-    assert launch(room, platform, sub="learner-43", **link).location == SEATS["learner2"]
+    assert launch(room, platform, **link).location == at_exercise("learner1")  # Ada
+    assert launch(room, platform, sub="learner-43", **link).location == at_exercise("learner2")
     room.records += [
         seat_record("learner1", passed=False),
         seat_record("learner2", passed=True, site="another-host"),  # not this classroom's seat

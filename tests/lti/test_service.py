@@ -189,12 +189,15 @@ def test_a_learner_launch_ends_logged_in_at_their_own_server(
     user = hub_login(service, answer)
     name = hub_user_name(platform.issuer, "learner-42")
     assert user is not None
-    assert (user["name"], user["lti_next"], user["lti_teacher"]) == (name, f"/user/{name}/", False)
+    # Their own server, opened at the launched exercise (the dashboard's ?exercise=).
+    landing = f"/user/{name}/?exercise={EXERCISE}"
+    assert (user["name"], user["lti_next"], user["lti_teacher"]) == (name, landing, False)
     assert re.fullmatch(r"lti-[a-z2-7]{16}", name) and name.startswith(LTI_USER_PREFIX)
     # The same person again (another link, another day) is the same learner; another is not.
     again = hub_login(service, launch(service, platform, **{claims.CUSTOM: {"lesson": LESSON}}))
     other = hub_login(service, launch(service, platform, sub="learner-43"))
     assert again is not None and again["name"] == name
+    assert again["lti_next"] == f"/user/{name}/?lesson={LESSON}"
     assert other is not None and other["name"] == hub_user_name(platform.issuer, "learner-43")
     assert other["name"] != name
 
