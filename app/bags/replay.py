@@ -36,6 +36,7 @@ MOST_MOMENTS = 3000  # lines of other messages kept (a long bag keeps its first 
 MOMENT_TEXT = 160  # characters of one message's text
 FLOOR_HEIGHT = 0.05  # m: a marker no taller than this is floor, not an obstacle
 LOG_LEVELS = {10: "DEBUG", 20: "INFO", 30: "WARN", 40: "ERROR", 50: "FATAL"}
+SHORTEST_TRIAL = 0.5  # s: a shorter piece of the way is no trial (see Track.way_until)
 JUMP = 0.5  # m between two poses: the world was reset (a new trial), not a drive
 # Drawn, not listed: their numbers are the picture (and images and clouds are never kept).
 DRAWN_TYPES = (
@@ -74,6 +75,7 @@ class Track:
     duration: float
     pose_topic: str = ""
     poses: list[Pose] = field(default_factory=list)
+    sim_stamps: list[float] = field(default_factory=list)  # each pose's header stamp, in s
     scans: list[Scan] = field(default_factory=list)
     room: list[Box] = field(default_factory=list)
     floor: Box | None = None
@@ -94,13 +96,32 @@ class Track:
         return _newest(self.scans, t)
 
     def way_until(self, t: float) -> list[list[Pose]]:
-        """The robot's way up to ``t``, cut where the world was reset (one piece per trial)."""
-        pieces: list[list[Pose]] = []
-        for pose in self.poses[: bisect.bisect_right([p.t for p in self.poses], t)]:
-            last = pieces[-1][-1] if pieces else None
+        """The robot's way up to ``t``, cut where the world was reset: one piece per trial.
+
+        A piece shorter than ``SHORTEST_TRIAL`` is the world standing where it started
+        before the grader's first reset, not a trial: it is left out.
+        """
+        return [piece for piece, _ in self._pieces(t) if piece[-1].t - piece[0].t >= SHORTEST_TRIAL]
+
+    def trial_seconds(self, t: float) -> float | None:
+        """Simulated seconds since the current trial began, by the poses' own stamps (the
+        grader runs the world faster than real time: its verdicts count in these)."""
+        pieces = self._pieces(t)
+        if not pieces:
+            return None
+        first, last = pieces[-1][1][0], pieces[-1][1][-1]
+        return self.sim_stamps[last] - self.sim_stamps[first]
+
+    def _pieces(self, t: float) -> list[tuple[list[Pose], list[int]]]:
+        """The poses up to ``t`` cut at each jump, with their indices."""
+        pieces: list[tuple[list[Pose], list[int]]] = []
+        end = bisect.bisect_right([p.t for p in self.poses], t)
+        for index, pose in enumerate(self.poses[:end]):
+            last = pieces[-1][0][-1] if pieces else None
             if last is None or math.hypot(pose.x - last.x, pose.y - last.y) > JUMP:
-                pieces.append([])
-            pieces[-1].append(pose)
+                pieces.append(([], []))
+            pieces[-1][0].append(pose)
+            pieces[-1][1].append(index)
         return pieces
 
     def moments_until(self, t: float, most: int) -> list[Moment]:
@@ -168,6 +189,8 @@ def _take(track: Track, topic: str, kind: str, t: float, msg: Any) -> None:
     if topic == track.pose_topic:
         p = msg.pose.pose
         track.poses.append(Pose(t, p.position.x, p.position.y, yaw_of(p.orientation)))
+        stamp = msg.header.stamp
+        track.sim_stamps.append(stamp.sec + stamp.nanosec * 1e-9)
     elif topic == SCAN_TOPIC and kind == "sensor_msgs/msg/LaserScan":
         pose = track.pose_at(t)
         if pose is not None:

@@ -78,7 +78,7 @@ def _figure(trace: Trace) -> Figure:
             axes.axhline(bound, color=ALLOWED, linewidth=1.0, linestyle="--")
         # Words, not only a colour, say which side of a line is right.
         where, va = (low, "bottom") if trace.low is not None else (high, "top")
-        axes.text(end, where, "allowed ", color=ALLOWED, fontsize=8, ha="right", va=va)
+        axes.text(start, where, " allowed", color=ALLOWED, fontsize=8, ha="left", va=va)
     if trace.judged_from > start:
         axes.axvspan(start, trace.judged_from, color=NOT_JUDGED, alpha=0.18, linewidth=0)
         axes.text(

@@ -127,9 +127,11 @@ def top_view_svg(track: Track, t: float, view: TopView | None = None) -> str:
             f'y2="{nose[1]:.1f}" stroke="#212529" stroke-width="2.5"/></g>'
         )
     trials = f" · trial {len(pieces)}" if len(pieces) > 1 else ""
+    clock = track.trial_seconds(t)
+    simulated = f" ({clock:.1f} s simulated into the trial)" if clock is not None else ""
     caption = (
-        f"{t:.1f} s of {track.duration:.1f} s{trials} · seen from above: the line is where the "
-        f"robot really went ({track.pose_topic}), red dots what its /scan saw"
+        f"{t:.1f} s of {track.duration:.1f} s{simulated}{trials} · seen from above: the line "
+        f"is where the robot really went ({track.pose_topic}), red dots what its /scan saw"
     )
     height = view.height + 24
     return (
