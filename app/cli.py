@@ -464,6 +464,26 @@ def cmd_lti(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_foxglove(args: argparse.Namespace) -> int:
+    """The live ROS graph for Foxglove or Lichtblick (app/foxglove), until Ctrl+C."""
+    if not is_loopback(args.host) and not args.allow_remote:
+        raise CliError(
+            f"refusing to serve on {args.host}: a Foxglove client may publish on ROS (drive "
+            "the robot) and needs no password, so the bridge listens on this machine "
+            "(127.0.0.1) unless you add --allow-remote"
+        )
+    configure_this_process(domain_id=args.domain_id, network=args.network)
+    _check_port_free(args.host, args.port)
+    from app.foxglove.serve import serve
+
+    stop_requested = threading.Event()
+    set_on_signals(stop_requested)
+    try:
+        return serve(args.host, args.port, stop_requested, lambda line: print(line, flush=True))
+    except RuntimeError as exc:  # foxglove-sdk's FoxgloveError: the port went meanwhile
+        raise CliError(f"cannot serve on {args.host}:{args.port}: {exc}") from None
+
+
 ROS2_GROUPS = (
     "node", "topic", "service", "action", "param", "lifecycle", "interface", "bag", "pkg",
 )  # fmt: skip
@@ -653,6 +673,17 @@ def build_parser(prog: str = "ros2-classroom") -> argparse.ArgumentParser:
         "--keys-dir", type=Path, default=None, help="the tool key's folder (default var/lti/keys)"
     )
     lti.set_defaults(func=cmd_lti)
+
+    fox = sub.add_parser(
+        "foxglove", help="serve the live ROS graph to Foxglove or Lichtblick (WebSocket)"
+    )
+    fox.add_argument("--host", default="127.0.0.1", help="address to listen on")
+    fox.add_argument("--port", type=_port, default=8765, help="port to listen on (default 8765)")
+    fox.add_argument(
+        "--allow-remote", action="store_true", help="allow a --host other than loopback"
+    )
+    dds_options(fox)
+    fox.set_defaults(func=cmd_foxglove)
 
     # ros2-like verbs (app/ros2cli): `ros2-classroom topic list -t` is `ros2 topic list -t`.
     for group in ROS2_GROUPS:

@@ -1,0 +1,182 @@
+"""A Foxglove WebSocket client for tests and the latency benchmark: the protocol, spoken plainly.
+
+Written from the protocol's specification (foxglove/ws-protocol docs/spec.md),
+with the ``websockets`` package, so that it can also send what a real client
+never would. It offers both names of the protocol: ``foxglove.sdk.v1`` (the
+only one foxglove-sdk 0.30's server accepts; Foxglove's app offers it) and
+``foxglove.websocket.v1`` (the published spec's, the only one
+``@foxglove/ws-protocol`` 0.8 offers).
+
+Server to client: JSON ``serverInfo``, ``advertise``, ``unadvertise``,
+``status``; binary opcode 1 (message data): u32 subscription id, u64 log time
+(ns), payload; all little-endian. Client to server: JSON ``subscribe``,
+``unsubscribe``, ``advertise``, ``unadvertise``; binary opcode 1 (client
+message data): u32 client channel id, payload.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import struct
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from websockets.exceptions import ConnectionClosed
+from websockets.sync.client import ClientConnection, connect
+from websockets.typing import Subprotocol
+
+SUBPROTOCOLS = [Subprotocol("foxglove.sdk.v1"), Subprotocol("foxglove.websocket.v1")]
+MESSAGE_DATA = 0x01
+KEEP = 2000  # messages kept per subscription (the count goes on)
+
+
+@dataclass(frozen=True)
+class Received:
+    subscription: int
+    log_time: int  # ns, the server's receive time
+    payload: bytes
+    arrived: float  # time.time() when this client read it
+
+
+class FoxgloveClient:
+    """Connects, reads in a thread, and keeps what the server said."""
+
+    def __init__(
+        self,
+        url: str,
+        *,
+        on_message: Callable[[Received], None] | None = None,
+        timeout: float = 10.0,
+    ) -> None:
+        self.url = url
+        self.ws: ClientConnection = connect(
+            url, subprotocols=SUBPROTOCOLS, max_size=None, open_timeout=timeout
+        )
+        self.subprotocol = self.ws.subprotocol
+        self._lock = threading.Lock()
+        self._on_message = on_message
+        self.server_info: dict[str, Any] | None = None
+        self.channels: dict[int, dict[str, Any]] = {}
+        self.statuses: list[dict[str, Any]] = []
+        self.received: dict[int, deque[Received]] = {}
+        self.counts: dict[int, int] = {}
+        self._subscription_ids = itertools.count(1)
+        self._channel_ids = itertools.count(1)
+        self.closed = threading.Event()
+        self._reader = threading.Thread(target=self._read, name="foxglove-client", daemon=True)
+        self._reader.start()
+
+    # ------------------------------------------------------------------ reading
+
+    def _read(self) -> None:
+        try:
+            for frame in self.ws:
+                if isinstance(frame, str):
+                    self._on_json(json.loads(frame))
+                elif frame and frame[0] == MESSAGE_DATA and len(frame) >= 13:
+                    sub, log_time = struct.unpack_from("<IQ", frame, 1)
+                    got = Received(sub, log_time, bytes(frame[13:]), time.time())
+                    with self._lock:
+                        self.received.setdefault(sub, deque(maxlen=KEEP)).append(got)
+                        self.counts[sub] = self.counts.get(sub, 0) + 1
+                    if self._on_message is not None:
+                        self._on_message(got)
+        except ConnectionClosed:
+            pass
+        finally:
+            self.closed.set()
+
+    def _on_json(self, message: dict[str, Any]) -> None:
+        op = message.get("op")
+        with self._lock:
+            if op == "serverInfo":
+                self.server_info = message
+            elif op == "advertise":
+                for channel in message["channels"]:
+                    self.channels[channel["id"]] = channel
+            elif op == "unadvertise":
+                for channel_id in message["channelIds"]:
+                    self.channels.pop(channel_id, None)
+            elif op == "status":
+                self.statuses.append(message)
+
+    # ------------------------------------------------------------------ queries
+
+    def channel(self, topic: str) -> dict[str, Any] | None:
+        with self._lock:
+            return next((c for c in self.channels.values() if c["topic"] == topic), None)
+
+    def topics(self) -> set[str]:
+        with self._lock:
+            return {c["topic"] for c in self.channels.values()}
+
+    def messages(self, subscription: int) -> list[Received]:
+        with self._lock:
+            return list(self.received.get(subscription, ()))
+
+    def count(self, subscription: int) -> int:
+        with self._lock:
+            return self.counts.get(subscription, 0)
+
+    def status_texts(self) -> list[str]:
+        with self._lock:
+            return [s.get("message", "") for s in self.statuses]
+
+    def wait_for(self, predicate: Callable[[], Any], timeout: float, what: str) -> Any:
+        deadline = time.monotonic() + timeout
+        while True:
+            value = predicate()
+            if value:
+                return value
+            if time.monotonic() > deadline:
+                raise AssertionError(f"timed out after {timeout:.0f} s waiting for {what}")
+            time.sleep(0.02)
+
+    # ------------------------------------------------------------------ sending
+
+    def send_json(self, message: dict[str, Any]) -> None:
+        self.ws.send(json.dumps(message))
+
+    def subscribe(self, channel_id: int) -> int:
+        sub = next(self._subscription_ids)
+        self.send_json({"op": "subscribe", "subscriptions": [{"id": sub, "channelId": channel_id}]})
+        return sub
+
+    def subscribe_topic(self, topic: str, timeout: float = 30.0) -> int:
+        channel = self.wait_for(lambda: self.channel(topic), timeout, f"a channel for {topic}")
+        return self.subscribe(channel["id"])
+
+    def unsubscribe(self, subscription: int) -> None:
+        self.send_json({"op": "unsubscribe", "subscriptionIds": [subscription]})
+
+    def advertise(self, topic: str, schema_name: str, encoding: str = "cdr") -> int:
+        channel_id = next(self._channel_ids)
+        self.send_json(
+            {
+                "op": "advertise",
+                "channels": [
+                    {
+                        "id": channel_id,
+                        "topic": topic,
+                        "encoding": encoding,
+                        "schemaName": schema_name,
+                    }
+                ],
+            }
+        )
+        return channel_id
+
+    def unadvertise(self, channel_id: int) -> None:
+        self.send_json({"op": "unadvertise", "channelIds": [channel_id]})
+
+    def publish(self, channel_id: int, payload: bytes) -> None:
+        self.ws.send(struct.pack("<BI", MESSAGE_DATA, channel_id) + payload)
+
+    def close(self) -> None:
+        self.ws.close()
+        self._reader.join(5.0)
