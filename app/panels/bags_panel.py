@@ -24,6 +24,7 @@ from app.bags.folder import bags_dir, default_bag_name, list_bags
 from app.bags.info import BagInfo, human_size, info_lines, read_info
 from app.bags.player import Player, PlayOptions
 from app.bags.recorder import Recorder, RecordingStatus
+from app.panels.foxglove_section import FoxgloveSection
 from app.ros.errors import Cancelled
 from app.ros.graph import GraphSnapshot
 from app.ui import MarkdownView, assign, code_block, set_options
@@ -96,6 +97,7 @@ class BagsPanel:
             self._progress_text = MarkdownView(gui, "")
             self._download = gui.add_button("Download bag (.zip)", icon=viser.Icon.DOWNLOAD)
         self._result = MarkdownView(gui, "")
+        self._foxglove = FoxgloveSection(gui, ui, node)
         self._record.on_click(ui.callback(self._start_recording))
         self._stop.on_click(ui.callback(self._stop_recording))
         self._play.on_click(ui.callback(self._start_playing))
@@ -290,8 +292,10 @@ class BagsPanel:
                 f"{progress.published} messages{passes}"
             )
         self._result.show(self._message)
+        self._foxglove.refresh(graph)
 
     def close(self) -> None:
+        self._foxglove.close()
         self._play_cancel.set()
         if self._recorder is not None:
             self._recorder.stop()

@@ -8,6 +8,7 @@ import zipfile
 
 import pytest
 import viser
+from playwright.sync_api import expect
 from std_msgs.msg import String
 
 from app.panels.bags_panel import BagsPanel
@@ -93,3 +94,36 @@ def test_record_stop_inspect_and_replay_in_the_panel(bags_page, supervisor, prob
     expect_text(page, re.compile(r"^playing: .* · pass \d+$"))
     click(page, "Stop playback")
     expect_text(page, re.compile(r"Stopped rosbag2_.* after \d+ messages"))
+
+
+def test_open_in_foxglove_serves_the_live_graph_until_stopped(bags_page, supervisor, probe):
+    """The Bags tool's Open in Foxglove: a Foxglove client (tests/foxglove/client.py, written
+    from the protocol's specification) at the address shown gets /chatter as ROS 2 CDR."""
+    from rclpy.serialization import deserialize_message
+
+    from tests.foxglove.client import FoxgloveClient
+
+    page, _folder = bags_page
+    supervisor.start("talker")
+    wait_until(lambda: probe.node.count_publishers("/chatter") >= 1, timeout=30, what="talker")
+    page.get_by_text("Open in Foxglove", exact=True).first.click()  # the folder
+    click(page, "Open in Foxglove")
+    served = page.get_by_text(re.compile(r"Serving this dashboard's ROS graph at ws://"))
+    expect(served.first).to_be_visible(timeout=20_000)
+    url = re.search(r"ws://127\.0\.0\.1:\d+", served.first.inner_text())
+    assert url, served.first.inner_text()
+    client = FoxgloveClient(url.group())
+    try:
+        channel = client.wait_for(lambda: client.channel("/chatter"), 30, "/chatter offered")
+        assert (channel["encoding"], channel["schemaEncoding"]) == ("cdr", "ros2msg")
+        subscription = client.subscribe_topic("/chatter")
+        client.wait_for(lambda: client.count(subscription) >= 2, 30, "two /chatter messages")
+        said = deserialize_message(client.messages(subscription)[-1].payload, String)
+        assert said.data.startswith("Hello World: ")
+        expect_text(page, re.compile(r"\d+ topics offered · 1 watched by Foxglove"))
+        click(page, "Stop the Foxglove server")
+        expect_text(page, "The Foxglove server is stopped.")
+        assert client.closed.wait(10), "the client is still connected after Stop"
+    finally:
+        client.close()
+        supervisor.stop("talker").result(timeout=15)
