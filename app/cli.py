@@ -19,6 +19,7 @@ from typing import Any
 from app import catalog
 from app.dds import configure_this_process, validate_domain_id
 from app.hosts import is_loopback
+from app.ros2cli.groups import GROUPS
 from app.stop_signals import set_on_signals
 
 EXIT_USAGE = 2
@@ -484,9 +485,7 @@ def cmd_foxglove(args: argparse.Namespace) -> int:
         raise CliError(f"cannot serve on {args.host}:{args.port}: {exc}") from None
 
 
-ROS2_GROUPS = (
-    "node", "topic", "service", "action", "param", "lifecycle", "interface", "bag", "pkg",
-)  # fmt: skip
+ROS2_GROUPS = GROUPS  # the Console's groups, as the command line's verbs
 
 
 def cmd_ros2(args: argparse.Namespace) -> int:

@@ -6,6 +6,17 @@ work itself is done by app.ros, which the other front ends share.
 ros2cli itself is not installable from PyPI.
 """
 
-from app.ros2cli.parser import GROUPS, UsageError, run_argv, run_text, split_command
+from __future__ import annotations
+
+from typing import Any
 
 __all__ = ["GROUPS", "UsageError", "run_argv", "run_text", "split_command"]
+
+
+def __getattr__(name: str) -> Any:
+    """The parser's names, imported on first use: ``app.ros2cli.groups`` stays cheap."""
+    if name in __all__:
+        from app.ros2cli import parser
+
+        return getattr(parser, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

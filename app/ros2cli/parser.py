@@ -21,11 +21,11 @@ from app.ros.errors import Cancelled, Ros2Error
 from app.ros2cli import bag, interfaces, launch_verb, pkg, run
 from app.ros2cli import verbs as verb_args
 from app.ros2cli.common import Ros2cliMessage, SilentFailure, TerminalContext, settle_discovery
+from app.ros2cli.groups import GROUPS
 from app.ros2cli.verbs import NOT_HERE
 
 log = logging.getLogger(__name__)
 
-GROUPS = ("node", "topic", "service", "action", "param", "lifecycle", "interface", "bag", "pkg")
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 # ros2cli's exit code after Ctrl+C: rclpy's SIGINT handler shuts its context down,
 # the verb ends with ExternalShutdownException, and `ros2` returns SIGTERM's number.
