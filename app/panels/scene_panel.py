@@ -75,6 +75,7 @@ MARKERS = _Offer(
 SCANS = _Offer(("sensor_msgs/msg/LaserScan",), "sensor_msgs/msg/LaserScan topics", ("/scan",))
 # Where new browsers start: close to the lesson-13 desk, or over the whole simulated world.
 DESK_VIEW = ((1.3, -1.4, 1.1), (0.25, 0.0, 0.25))
+MIN_FRAMES_TO_FRAME = 3  # a robot's links with poses, before the cameras go to it
 JOINTS = _Offer(
     picker.JOINT_TYPES,
     "sensor_msgs/msg/JointState topics",
@@ -142,6 +143,7 @@ class ScenePanel:
         self.world = WorldLayer(node, server)
         self.more_robots = NamespacedRobots(node, server)
         self._world_shown = False
+        self._robot_framed = False  # the cameras were moved to a robot that came
         self._desk_shown = (True, True)  # (the desk's frames and arm, its frustum)
         self._light = scene.add_light_ambient("/sim_world_light", intensity=0.9, visible=False)
 
@@ -345,6 +347,28 @@ class ScenePanel:
         initial.position, initial.look_at = (tf.as_xyz(v) for v in view)
         self.drive.move_cameras(*view)  # the world has just appeared: show it whole
 
+    def _follow_robot(self, graph: GraphSnapshot) -> None:
+        """A robot from a robot_state_publisher came (no simulated world): the cameras go
+        to it and the frames around it, once (at the desk view the lesson-15 arm was 90 px
+        tall under a knot of labels). The learner's own camera moves stay theirs after."""
+        here = (
+            not self._world_shown
+            and graph.publishers("/robot_description") > 0
+            and self.tf_view.robot_drawn
+        )
+        if not here:
+            self._robot_framed = False
+            return
+        poses = self.tf_view.poses()
+        if self._robot_framed or len(poses) < MIN_FRAMES_TO_FRAME:
+            return
+        points = np.array([pose[:3, 3] for pose in poses.values()])
+        low, high = points.min(axis=0), points.max(axis=0)
+        self._robot_framed = True
+        position, look_at = overview(low, high)  # looks at the floor under the frames...
+        lift = np.array([0.0, 0.0, (high[2] - low[2]) / 2.0])  # ...and here at their middle
+        self.drive.move_cameras(position + lift, look_at + lift)
+
     def _pause_desk_arm(self, paused: bool) -> None:
         """The desk arm's joint row stops following /joint_states by itself while the desk
         gives way (robots then move on TF; the hidden desk arm would only cost CPU)."""
@@ -421,6 +445,7 @@ class ScenePanel:
         self.more_robots.refresh(graph)
         self.drive.refresh(graph)
         self._follow_world()
+        self._follow_robot(graph)
         self._follow_desk(graph)
         self._world_info.show(
             "\n\n".join(t for t in (self.world.describe(), self.more_robots.describe()) if t)
