@@ -46,6 +46,9 @@ MAX_WATCHED = 24  # services + actions watched at once
 KEEP = 200
 RESULT_DELAY_SEC = 0.3  # a result waits this long for late feedback (see _on_status)
 CLOCK_SLACK_SEC = 0.5  # between the server's clock stamping a goal and ours
+# A goal's end always shows, however far behind its feedback put the queue: it is what
+# the learner waits for (seen: a loaded machine's bunched feedback crowded the result out).
+NEVER_DROPPED = ("result",)
 
 SERVICE_EVENT = "/_service_event"
 ACTION_STATUS = "/_action/status"
@@ -151,7 +154,7 @@ class CallWatch:
         """Record a pulse, spaced after the last one of ``name`` (lock held)."""
         now = time.monotonic()
         start = max(now, self._next_free.get(name, 0.0))
-        if start - now > MAX_BEHIND_SEC:
+        if start - now > MAX_BEHIND_SEC and kind not in NEVER_DROPPED:
             return  # a burst: the screen shows some of it, not a queue minutes long
         self._next_free[name] = start + TRAVEL_SEC
         self._pulses.append(Pulse(kind, name, start, caller_id))

@@ -207,3 +207,19 @@ def test_a_service_with_only_a_client_says_no_server():
     server = NodeEndpoints("/add_two_ints_server", {}, {}, types, {}, {}, {})
     details = {v.name: v.detail for v in graph_picture([client, server])[0]}
     assert details["/add_two_ints"] == "example_interfaces/AddTwoInts"
+
+
+def test_a_goals_result_pulse_is_never_crowded_out_by_its_feedback():
+    """Feedback that came bunched (a loaded machine) fills the action's queue beyond what a
+    burst may wait; further feedback is thinned, but the result still travels, after it."""
+    from app.stage.pulses import MAX_BEHIND_SEC, TRAVEL_SEC, CallWatch
+
+    watch = CallWatch(node=None)  # type: ignore[arg-type]  # only the event side is used
+    with watch._lock:
+        for _ in range(int(MAX_BEHIND_SEC / TRAVEL_SEC) + 3):
+            watch._add("feedback", "/fibonacci")
+        watch._add("result", "/fibonacci")
+    kinds = [p.kind for p in watch._pulses]
+    assert kinds[-1] == "result" and kinds.count("feedback") < int(MAX_BEHIND_SEC / TRAVEL_SEC) + 3
+    shown = [p.shown_at for p in watch._pulses]
+    assert shown == sorted(shown)  # the result follows the feedback on screen
