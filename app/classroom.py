@@ -131,8 +131,8 @@ class TeacherPlan:
 class TeacherView:
     """The teacher page and the roster behind it, in this process."""
 
-    def __init__(self, plan: TeacherPlan, host: str) -> None:
-        from app.teacher.page import TeacherPage
+    def __init__(self, plan: TeacherPlan, host: str, site: str = "local") -> None:
+        from app.teacher.page import LocalAttempts, TeacherPage
         from app.teacher.roster import Roster
         from app.teacher.status import write_teacher_file
 
@@ -141,7 +141,13 @@ class TeacherView:
         self.page: TeacherPage | None = None
         try:
             self.page = TeacherPage(
-                host, plan.port, plan.token, self.roster, reveal_after=plan.reveal_after
+                host,
+                plan.port,
+                plan.token,
+                self.roster,
+                reveal_after=plan.reveal_after,
+                # Every dashboard here keeps its attempts beside its progress (app/cli.py).
+                attempts=LocalAttempts(plan.progress_root / "bags", site),
             )
             if self.page.port != plan.port:
                 raise ValueError(f"port {plan.port} became busy; pick another with --teacher-port")
@@ -338,7 +344,7 @@ def run(
     view = lti = None
     if teacher is not None:  # while the dashboards boot
         try:
-            view = TeacherView(teacher, classroom.host)
+            view = TeacherView(teacher, classroom.host, classroom.learners[0].site)
         except (OSError, ValueError, RuntimeError) as exc:
             say(f"ros2-classroom: error: could not start the teacher page: {exc}")
             classroom.stop()

@@ -28,6 +28,7 @@ from app.exercises.editor_server import EditorHub, editor_url
 from app.exercises.explain import panel_line
 from app.exercises.grader import Grader
 from app.exercises.lint import Problem, lint, refuses_to_run
+from app.exercises.mistakes import matched_mistake
 from app.exercises.model import Exercise, ExerciseBook
 from app.exercises.report import Report, Result
 from app.exercises.workspace import Workspace
@@ -301,13 +302,17 @@ class ExercisePanel:
                     self._grader, exercise, scratch, policy, on_result
                 )
                 if not report.problem:
-                    self._workspace.record_check(exercise, report.passed)
+                    self._workspace.record_check(
+                        exercise, report.passed, mistake=matched_mistake(exercise, report)
+                    )
                 return CheckOutcome(report, False, _plot_images(report))
             self._hub.flush(exercise.slug)
             script = self._workspace.scratch / f"{exercise.slug}.py"
             report = self._grader.grade(exercise, script, on_result)
             if not report.problem:
-                self._workspace.record_check(exercise, report.passed)
+                self._workspace.record_check(
+                    exercise, report.passed, mistake=matched_mistake(exercise, report)
+                )
             ran = script.read_text(encoding="utf-8") if script.is_file() else ""
             return CheckOutcome(report, ran != self._workspace.code(exercise), _plot_images(report))
 

@@ -103,9 +103,12 @@ class Workspace:
         write_atomically(script, self.code(exercise))
         return script
 
-    def record_check(self, exercise: Exercise, passed: bool) -> dict:
+    def record_check(self, exercise: Exercise, passed: bool, mistake: str = "") -> dict:
+        """One grading: counted, and on a failure the mistake it matched
+        (``app.exercises.mistakes``), kept until the exercise passes."""
         changes: dict = {"attempts": Added(1), "last_checked": time.time()}
         if passed:
+            changes["last_mistake"] = None  # removed: a pass leaves no mistake behind
             record = self.progress.exercise(exercise.slug)
             if "passed_at" not in record:
                 changes["passed_at"] = time.time()
@@ -113,6 +116,7 @@ class Workspace:
                 changes["seconds_to_pass"] = round(time.time() - start, 1)
         else:
             changes["failed_checks"] = Added(1)
+            changes["last_mistake"] = mistake or None
         return self.progress.update_exercise(exercise.slug, **changes)
 
     def passed(self, exercise: Exercise) -> bool:

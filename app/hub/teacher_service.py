@@ -14,8 +14,9 @@ it. Two kinds of callers:
   users the hub grants ``access:services!service=classroom-teacher`` get in:
   admins, and the teachers' group through the role in the config.
 
-All state lives on tornado's one thread: no locks. Rows, stuck marks and the
-CSV are those of ``classroom``'s teacher page (app.teacher.record).
+All state lives on tornado's one thread: no locks. Rows, stuck marks, the
+exercises across the class and the CSV are those of ``classroom``'s teacher
+page (app.teacher.record).
 
 With ``CLASSROOM_LTI_URL`` set, the service is also the LTI 1.3 tool an LMS
 launches (app/hub/lti_service.py): its login, launch, deep-linking and JWKS
@@ -56,6 +57,8 @@ from app.teacher.record import (
     LearnerRecord,
     StuckRule,
     checks_text,
+    class_exercises,
+    mistake_words,
     table,
     to_csv,
 )
@@ -203,13 +206,15 @@ class TableHandler(_TeacherBase):
     def get(self) -> None:
         records = list(self.state.records.values())
         rows = table(records, self.state.rule)
+        names = _lms_names(self.settings.get("lti"), records)
         self.set_header("Cache-Control", "no-store")
         self.finish(
             {
                 "columns": COLUMNS,
                 "rows": rows,
+                "exercises": class_exercises(records, names),
                 "keys": sorted(r.key for r in records),
-                "names": _lms_names(self.settings.get("lti"), records),
+                "names": names,
                 "reports": self.state.reports,
                 "refused": self.state.refused,
                 "reveal_after": self.state.reveal_after,
@@ -273,6 +278,7 @@ class LearnerHandler(_TeacherBase):
                 ],
                 "exercise": record.exercise,
                 "passed": record.exercise_passed_here,
+                "mistake": mistake_words(record.exercise_mistake),
                 "code": record.code_excerpt,
                 "last_error": record.last_error,
             }
@@ -395,6 +401,7 @@ pre{background:#f4f4f4;padding:.5em;max-height:24em;overflow:auto}
 <a href="progress.csv">Download the class's progress (CSV)</a>{{gradebook}} ·
 <span id="summary"></span></p>
 <table id="class"><thead><tr>{{columns}}</tr></thead><tbody></tbody></table>
+<section><h3>Exercises across the class</h3><ul id="exercises"></ul></section>
 <section><label>Learner <select id="learner"><option value="">(choose a learner)</option>
 </select></label><div id="detail"></div></section>
 <section><h3>Message to learners</h3>
@@ -433,6 +440,9 @@ async function refresh(){
       if(row[row.length-1])tr.className="stuck";return tr;}));
     document.getElementById("summary").textContent=
       `${data.rows.length} learners · updated ${new Date().toLocaleTimeString()}`;
+    const lines=data.exercises.length?data.exercises:["No learner is on an exercise yet."];
+    document.getElementById("exercises").replaceChildren(...lines.map(line=>{
+      const li=document.createElement("li");li.textContent=line;return li;}));
     options(document.getElementById("learner"),data.keys);
     options(document.getElementById("to"),data.keys);
     await detail();
@@ -446,7 +456,8 @@ async function detail(){
   if(!r.ok)return;const d=await r.json();
   const parts=[["h3",d.key],["p",d.where],["p","Checks "+d.checks],
     ...d.reasons.map(x=>["p",x]),["p",d.exercise?`Exercise ${d.exercise}: `+
-    (d.passed?"passed":"not passed yet"):"No exercise in this unit."]];
+    (d.passed?"passed":"not passed yet")+(d.mistake?`; last failure: ${d.mistake}`:""):
+    "No exercise in this unit."]];
   if(d.last_error)parts.push(["pre",d.last_error]);
   if(d.exercise)parts.push(["pre",d.code]);
   box.replaceChildren(...parts.map(([tag,text])=>{const e=document.createElement(tag);

@@ -32,7 +32,14 @@ from app.ros.side_participant import SideParticipant
 from app.supervisor import Supervisor
 from app.teacher import wire
 from app.teacher.hub_link import HubLink, HubTarget, NoticeSink, ReportRefused, SettingsSink
-from app.teacher.record import MAX_CODE, MAX_ERROR, LearnerRecord, clip, plain_markdown
+from app.teacher.record import (
+    MAX_CODE,
+    MAX_ERROR,
+    MAX_MISTAKE,
+    LearnerRecord,
+    clip,
+    plain_markdown,
+)
 from app.ui import MarkdownView
 from app.ui.loop import UiLoop
 
@@ -178,6 +185,7 @@ class ProgressBeacon:
                 exercise_attempts_here=here.get("attempts", 0),
                 exercise_failed_here=here.get("failed_checks", 0),
                 exercise_passed_here="passed_at" in here,
+                exercise_mistake=clip(str(here.get("last_mistake") or ""), MAX_MISTAKE),
                 code_excerpt=clip(s.workspace.code(exercise), MAX_CODE),
                 last_error=clip(self._last_error(exercise, here), MAX_ERROR),
             )

@@ -26,6 +26,7 @@ _TEXT_LIMITS = {
     "lesson_title": rec.MAX_TITLE,
     "step_title": rec.MAX_TITLE,
     "exercise": rec.MAX_NAME,
+    "exercise_mistake": rec.MAX_MISTAKE,
     "code_excerpt": rec.MAX_CODE,
     "last_error": rec.MAX_ERROR,
 }

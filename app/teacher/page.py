@@ -1,4 +1,4 @@
-"""The teacher page: one row per learner, live; their code; messages; the class's settings.
+"""The teacher page: one row per learner, live; the class's exercises; their code; messages.
 
 A viser page of its own, served by the ``classroom`` command on its own port
 and always behind its own token (``app.access``): a learner's URL never
@@ -20,8 +20,11 @@ import http
 import io
 import json
 import logging
+import re
 import threading
 import time
+from dataclasses import dataclass
+from pathlib import Path
 from urllib.parse import urlsplit
 
 import viser
@@ -36,6 +39,8 @@ from app.teacher.record import (
     LearnerRecord,
     StuckRule,
     checks_text,
+    class_exercises,
+    mistake_words,
     plain_markdown,
     table,
     to_csv,
@@ -73,8 +78,69 @@ def _fenced(text: str, language: str = "") -> str:
     return f"{fence}{language}\n{text}\n{fence}"
 
 
-def learner_detail(record: LearnerRecord) -> str:
-    """One learner, read-only: where they are, why checks fail, their code, their last error."""
+_NAME = re.compile(r"[A-Za-z0-9_-]{1,64}")  # a learner's name (app.lessons.progress)
+_SLUG = re.compile(r"[a-z][a-z0-9_]{2,48}")  # an exercise's (app.exercises.model)
+
+
+@dataclass(frozen=True)
+class LocalAttempts:
+    """The attempts this machine's learners keep, which a teacher page on it may list.
+
+    ``classroom`` runs every learner's dashboard on this machine, each keeping
+    its graded attempts in ``<bags_root>/<learner>/attempts/<exercise>/``
+    (app/exercises/attempts.py); learners of other sites keep theirs on their
+    machines. The names come from the classroom domain (anyone may publish
+    there), so only a learner's and an exercise's names ever reach a path.
+    """
+
+    bags_root: Path
+    site: str
+
+    def newest(self, record: LearnerRecord) -> Path | None:
+        """The newest kept attempt of the learner's current exercise (None: none here)."""
+        if record.site != self.site or not (
+            _NAME.fullmatch(record.learner) and _SLUG.fullmatch(record.exercise)
+        ):
+            return None
+        from app.exercises.attempts import ATTEMPTS_FOLDER  # only on a page that lists them
+
+        folder = self.bags_root / record.learner / ATTEMPTS_FOLDER / record.exercise
+        try:
+            kept = sorted((p for p in folder.iterdir() if p.is_dir()), key=lambda p: p.name)
+        except OSError:  # none yet, or not readable
+            return None
+        return kept[-1] if kept else None
+
+
+def attempt_text(path: Path) -> str:
+    """Where the newest attempt is, for a teacher on this machine to open in Foxglove."""
+    from app.exercises.attempts import attempt_label
+
+    mcap = sorted(path.glob("*.mcap"))
+    opened = _code(str(mcap[0])) if mcap else "the .mcap file in it"
+    return (
+        f"**Newest attempt** ({plain_markdown(attempt_label(path))}): {_code(str(path))}\n\n"
+        f"Open {opened} in Foxglove or Lichtblick (Open local file), or ask the learner to "
+        "pick it under **Attempt** in their Exercise tab and press **Watch this attempt**."
+    )
+
+
+def _code(text: str) -> str:
+    """Inline code whose backtick fence is longer than any run of backticks inside it."""
+    fence = "`" * (max((len(run) for run in re.findall(r"`+", text)), default=0) + 1)
+    return f"{fence} {text} {fence}" if "`" in text else f"`{text}`"
+
+
+def exercises_markdown(records: list[LearnerRecord]) -> str:
+    """The "Exercises across the class" section (the lines the hub's page shows too)."""
+    lines = class_exercises(records)
+    body = "\n".join(f"- {plain_markdown(line)}" for line in lines)
+    return "### Exercises across the class\n\n" + (body or "_No learner is on an exercise yet._")
+
+
+def learner_detail(record: LearnerRecord, newest_attempt: Path | None = None) -> str:
+    """One learner, read-only: where they are, why checks fail, their code, their last error
+    and (on the machine that keeps it) where their newest attempt is."""
     reasons = "\n".join(
         f"- **{plain_markdown(state)}**: {plain_markdown(reason)}"
         for state, reason in zip(record.check_states, record.check_reasons, strict=False)
@@ -87,10 +153,14 @@ def learner_detail(record: LearnerRecord) -> str:
     ]
     if record.exercise:
         mark = "✓ passed" if record.exercise_passed_here else "not passed yet"
+        mistake = mistake_words(record.exercise_mistake)
+        why = f"; last failure: {plain_markdown(mistake)}" if mistake else ""
         parts.append(
             f"**Exercise `{record.exercise}`**: {mark}, {record.exercise_attempts_here} checks, "
-            f"{record.exercise_failed_here} failed"
+            f"{record.exercise_failed_here} failed{why}"
         )
+        if newest_attempt is not None:
+            parts.append(attempt_text(newest_attempt))
         if record.last_error:
             parts.append("**Last error**\n\n" + _fenced(record.last_error))
         parts.append("**Their code** (read-only)\n\n" + _fenced(record.code_excerpt, "python"))
@@ -147,8 +217,10 @@ class TeacherPage:
         *,
         reveal_after: int | None = None,
         rule: StuckRule | None = None,
+        attempts: LocalAttempts | None = None,
     ) -> None:
         self.roster = roster
+        self.attempts = attempts
         self.routes = TeacherRoutes(roster)
         if rule is not None:
             self.routes.rule = rule
@@ -174,6 +246,7 @@ class TeacherPage:
         with window.add_tab("Class", viser.Icon.USERS):
             self._summary = MarkdownView(gui)
             self._table = MarkdownView(gui, "_Waiting for the learners' dashboards…_")
+            self._exercises = MarkdownView(gui)
         with window.add_tab("Learner's code", viser.Icon.CODE):
             self._detail = MarkdownView(gui, "_Choose a learner on the right._")
 
@@ -237,6 +310,7 @@ class TeacherPage:
                 + f" · updated {time.strftime('%H:%M:%S')}"
             )
             self._table.show(markdown_table(rows))
+            self._exercises.show(exercises_markdown(records))
         keys = sorted(r.key for r in records)
         set_options(self._learner, [NOBODY, *keys])
         set_options(self._to, [EVERYONE, *keys])
@@ -249,7 +323,11 @@ class TeacherPage:
             return
         by_key = {r.key: r for r in (records or self.roster.records())}
         record = by_key.get(chosen)
-        self._detail.show(learner_detail(record) if record else f"_{chosen}: no news yet._")
+        if record is None:
+            self._detail.show(f"_{chosen}: no news yet._")
+            return
+        newest = self.attempts.newest(record) if self.attempts and record.exercise else None
+        self._detail.show(learner_detail(record, newest))
 
     def _on_send(self) -> None:
         text = self._text.value.strip()

@@ -1,8 +1,10 @@
-"""One learner's progress as plain data, the "stuck" rule, and the class table.
+"""One learner's progress as plain data, the "stuck" rule, the class table and its exercises.
 
 Everything here is pure: the dashboard fills a ``LearnerRecord``, the wire
 module turns it into a message and back, and the teacher page, the CSV
-export and ``classroom status`` all render the same ``table`` rows.
+export and ``classroom status`` all render the same ``table`` rows; both
+teacher pages (``classroom``'s and the hub's) show the same
+``class_exercises`` lines.
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ import csv
 import io
 import re
 import time
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, fields
 
 # Bounds of the message (interfaces/classroom_interfaces/msg/LearnerProgress.msg).
@@ -23,6 +25,7 @@ MAX_CODE = 4000
 MAX_ERROR = 1000
 MAX_NODES = 32
 MAX_NOTICE = 280
+MAX_MISTAKE = 120
 
 _MARKS = {"pass": "✓", "fail": "✗", "waiting": "…"}
 
@@ -66,6 +69,10 @@ class LearnerRecord:
     exercise_attempts_here: int = 0
     exercise_failed_here: int = 0
     exercise_passed_here: bool = False
+    # What the last failed check of it matched: a recorded mistake's name
+    # ("front_is_index_zero") or, when none matched, the failed result's name
+    # ("stop before the wall"); '' when it passed or never failed.
+    exercise_mistake: str = ""
     code_excerpt: str = ""
     last_error: str = ""
     nodes_running: tuple[str, ...] = ()
@@ -126,8 +133,36 @@ def checks_text(record: LearnerRecord) -> str:
     return f"{marks} {passed}/{len(record.check_states)}"
 
 
+_STEM = re.compile(r"[a-z0-9]+(?:_[a-z0-9]+)*")
+
+
+def mistake_words(mistake: str) -> str:
+    """A mistake as a teacher reads it: a recorded mistake's name in plain words
+    ("front is index zero"), a check no recorded mistake explains as failed
+    ('"stop before the wall" failed'), '' for none."""
+    if not mistake:
+        return ""
+    if _STEM.fullmatch(mistake):
+        return mistake.replace("_", " ")
+    return f"“{mistake}” failed"
+
+
+def exercise_now(record: LearnerRecord) -> str:
+    """'wall_stop ✗ front is index zero', 'wall_stop ✓', 'wall_stop' (not checked yet) or '–'."""
+    if not record.exercise:
+        return "–"
+    if record.exercise_passed_here:
+        return f"{record.exercise} ✓"
+    if record.exercise_mistake:
+        return f"{record.exercise} ✗ {mistake_words(record.exercise_mistake)}"
+    if record.exercise_failed_here:
+        return f"{record.exercise} ✗"
+    return record.exercise
+
+
 COLUMNS = (
-    "learner", "where", "unit · step", "checks", "exercises", "nodes", "last activity", "stuck",
+    "learner", "where", "unit · step", "checks", "exercises", "exercise now", "nodes",
+    "last activity", "stuck",
 )  # fmt: skip
 OFFLINE_AFTER_SEC = 30.0  # three missed heartbeats
 
@@ -149,6 +184,7 @@ def table(records: Iterable[LearnerRecord], rule: StuckRule, now: float | None =
                 f"{r.unit} · {r.step}/{r.steps}" if r.steps else "–",
                 checks_text(r),
                 f"{r.exercises_passed} passed · {r.exercise_attempts} attempts",
+                exercise_now(r),
                 ", ".join(r.nodes_running) or "–",
                 activity,
                 f"⚠ {stuck}" if stuck else "",
@@ -162,6 +198,73 @@ def _natural(name: str) -> tuple:
     head = name.rstrip("0123456789")
     tail = name[len(head) :]
     return (head, int(tail) if tail else -1)
+
+
+UNKNOWN_FAILURE = "failed, reason not known"  # a dashboard that sent no mistake
+
+
+@dataclass(frozen=True)
+class ExerciseTally:
+    """Where the class stands on one exercise: who passed, who is on it, and why they fail."""
+
+    exercise: str
+    passed: tuple[str, ...]
+    trying: tuple[str, ...]
+    # (the mistake in plain words, the learners whose last check matched it), largest first
+    failures: tuple[tuple[str, tuple[str, ...]], ...]
+
+    def line(self) -> str:
+        """'wall_stop: 3 passed, 4 trying — front is index zero: ana, ben; ...'"""
+        head = f"{self.exercise}: {len(self.passed)} passed, {len(self.trying)} trying"
+        groups = "; ".join(f"{words}: {', '.join(who)}" for words, who in self.failures)
+        return f"{head} — {groups}" if groups else head
+
+
+def tally_exercises(
+    records: Iterable[LearnerRecord], names: Mapping[str, str] | None = None
+) -> list[ExerciseTally]:
+    """Each exercise someone is on (by its name), its learners by name (``names``: a
+    learner's display name, e.g. the LMS's; a class over several sites adds the site)."""
+    records = sorted(records, key=lambda r: (_natural(r.learner), r.site))
+    names = names or {}
+    several_sites = len({r.site for r in records}) > 1
+
+    def who(r: LearnerRecord) -> str:
+        shown = names.get(r.learner) or r.learner
+        return f"{shown} ({r.site})" if several_sites else shown
+
+    by_exercise: dict[str, list[LearnerRecord]] = {}
+    for r in records:
+        if r.exercise:
+            by_exercise.setdefault(r.exercise, []).append(r)
+    tallies = []
+    for exercise in sorted(by_exercise):
+        on_it = by_exercise[exercise]
+        groups: dict[str, list[str]] = {}
+        for r in on_it:
+            if r.exercise_passed_here:
+                continue
+            if r.exercise_mistake:
+                groups.setdefault(mistake_words(r.exercise_mistake), []).append(who(r))
+            elif r.exercise_failed_here:
+                groups.setdefault(UNKNOWN_FAILURE, []).append(who(r))
+        ranked = sorted(groups.items(), key=lambda item: (-len(item[1]), item[0]))
+        tallies.append(
+            ExerciseTally(
+                exercise,
+                passed=tuple(who(r) for r in on_it if r.exercise_passed_here),
+                trying=tuple(who(r) for r in on_it if not r.exercise_passed_here),
+                failures=tuple((words, tuple(learners)) for words, learners in ranked),
+            )
+        )
+    return tallies
+
+
+def class_exercises(
+    records: Iterable[LearnerRecord], names: Mapping[str, str] | None = None
+) -> list[str]:
+    """The "Exercises across the class" lines both teacher pages show, one per exercise."""
+    return [tally.line() for tally in tally_exercises(records, names)]
 
 
 def text_table(rows: list, columns: tuple[str, ...] = COLUMNS) -> str:
@@ -179,8 +282,8 @@ def text_table(rows: list, columns: tuple[str, ...] = COLUMNS) -> str:
 CSV_FIELDS = (
     "site", "learner", "domain_id", "lesson_id", "unit", "lesson_title", "step", "steps",
     "step_title", "steps_passed", "checks", "exercises_passed", "exercise_attempts", "exercise",
-    "exercise_attempts_here", "exercise_failed_here", "exercise_passed_here", "nodes_running",
-    "last_activity", "last_progress", "stuck",
+    "exercise_attempts_here", "exercise_failed_here", "exercise_passed_here", "exercise_mistake",
+    "nodes_running", "last_activity", "last_progress", "stuck",
 )  # fmt: skip
 
 
@@ -200,7 +303,8 @@ def to_csv(records: Iterable[LearnerRecord], rule: StuckRule, now: float | None 
                 r.site, r.learner, r.domain_id, r.lesson_id, r.unit, r.lesson_title, r.step,
                 r.steps, r.step_title, r.steps_passed, " ".join(r.check_states),
                 r.exercises_passed, r.exercise_attempts, r.exercise, r.exercise_attempts_here,
-                r.exercise_failed_here, r.exercise_passed_here, ";".join(r.nodes_running),
+                r.exercise_failed_here, r.exercise_passed_here, r.exercise_mistake,
+                ";".join(r.nodes_running),
                 _iso(r.last_activity), _iso(r.last_progress), rule.reason(r, now),
             ]
         )  # fmt: skip

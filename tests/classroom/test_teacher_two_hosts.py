@@ -280,10 +280,12 @@ def test_teacher_follows_three_learners_on_two_hosts(ros_env, two_hosts, tmp_pat
         assert "3 learners." in printed.stdout
 
         # -- an exercise: learner1 on A saves code, runs and checks it -----------------
-        reference = PROJECT_ROOT / "lessons/04_first_node/exercises/heartbeat_logger/reference.py"
+        # First a recorded mistake (a timer ten times too fast), then the reference.
+        exercise_dir = PROJECT_ROOT / "lessons/04_first_node/exercises/heartbeat_logger"
         code_dir = progress_a / "learner1" / "learner1.code"
         code_dir.mkdir(parents=True, exist_ok=True)
-        (code_dir / "heartbeat_logger.py").write_text(reference.read_text())  # as the editor saves
+        code = code_dir / "heartbeat_logger.py"
+        code.write_text((exercise_dir / "mistakes/too_fast.py").read_text())  # as the editor saves
         a("set", page="teacher", label="Learner", value="A/learner1", option=True)
         seen = a("wait_text", page="teacher", text='self.get_logger().info(f"beat {self.count}")')
         assert seen["ok"], seen["markdown"]  # the teacher reads the learner's code
@@ -293,15 +295,40 @@ def test_teacher_follows_three_learners_on_two_hosts(ros_env, two_hosts, tmp_pat
         assert seen["ok"], seen["markdown"]  # their node shows as running
         a("wait_text", page="a1", text="Started your node")
         a("click", page="a1", label="Check my node")
+        done = a("wait_text", page="a1", text="checks passed: not yet", timeout=60)
+        assert done["ok"], done["markdown"][-3000:]
+        # Kept where the teacher's docs say: <progress-dir>/bags/<learner>/attempts/<exercise>/.
+        kept = sorted((progress_a / "bags/learner1/attempts/heartbeat_logger").iterdir())
+        assert [p.name.endswith("-fail") for p in kept] == [True], kept
+        # The teacher sees the failure by the mistake it matched: in the learner's row, in
+        # the exercises across the class, and in the learner's detail.
+        seen = a(
+            "wait_regex",
+            page="teacher",
+            regex=_row("learner1", "A", 40, r".*heartbeat\\_logger ✗ too fast \|"),
+        )
+        assert seen["ok"], seen["markdown"]
+        across = "heartbeat\\_logger: 0 passed, 1 trying — too fast: learner1 \\(A\\)"
+        seen = a("wait_text", page="teacher", text=across)
+        assert seen["ok"], seen["markdown"]
+        assert "### Exercises across the class" in seen["markdown"]
+        assert "1 failed; last failure: too fast" in seen["markdown"]
+
+        code.write_text((exercise_dir / "reference.py").read_text())
+        a("click", page="a1", label="Run my node")
+        a("wait_text", page="a1", text="Started your node")
+        a("click", page="a1", label="Check my node")
         done = a("wait_text", page="a1", text="All checks pass", timeout=60)
         assert done["ok"], done["markdown"][-3000:]
         seen = a(
             "wait_regex",
             page="teacher",
-            regex=_row("learner1", "A", 40, r".*1 passed · 1 attempts"),
+            regex=_row("learner1", "A", 40, r".*1 passed · 2 attempts \| heartbeat\\_logger ✓"),
         )
         assert seen["ok"], seen["markdown"]
         latencies["exercise passed -> teacher page"] = seen["t"] - done["t"]
+        seen = a("wait_text", page="teacher", text="heartbeat\\_logger: 1 passed, 0 trying")
+        assert seen["ok"], seen["markdown"]
 
         # -- messages: to one learner on B, then to everyone ----------------------------
         a("set", page="teacher", label="To", value="B/learner1", option=True)

@@ -29,7 +29,7 @@ from playwright.sync_api import Browser, BrowserContext, Page, expect
 from app.dds import configure_dds_env
 from app.lessons.schema import load_course
 from app.teacher.http_report import to_json
-from app.teacher.record import LearnerRecord
+from app.teacher.record import COLUMNS, LearnerRecord
 from tests.browser.helpers import (
     answer_quiz,
     choose,
@@ -241,6 +241,10 @@ def test_each_learner_passes_a_lesson_step_and_an_exercise(hub, room):
     for user in LEARNERS:
         expect_text(room.classrooms[user], "All checks pass. Exercise done!", timeout=90_000)
         expect(_row(teacher, user)).to_contain_text("1 passed", timeout=2_000)
+    # The exercises across the class, as on `classroom`'s teacher page.
+    expect(teacher.locator("#exercises")).to_contain_text(
+        f"{EXERCISE.slug}: {len(LEARNERS)} passed, 0 trying", timeout=2_000
+    )
 
     # The CSV export and a learner's code, as on `classroom`'s teacher page.
     csv = _teacher_get(hub, teacher, "progress.csv")
@@ -301,7 +305,7 @@ def _teacher_table(hub: LocalHub, room: Room) -> dict[str, list]:
 
 def _shown(row: list) -> tuple:
     """What a forged report would change: where Bob is and which nodes he runs."""
-    return (row[0], row[1], row[2], row[5])
+    return (row[0], row[1], row[2], row[COLUMNS.index("nodes")])
 
 
 def test_bad_input_is_refused_with_a_clear_status(hub, room):

@@ -9,7 +9,7 @@ import pytest
 
 from app.hub.spawner import DomainPool, with_project_commands
 from app.teacher.http_report import MAX_BODY, ReportError, from_json, to_json
-from app.teacher.record import MAX_CODE, LearnerRecord
+from app.teacher.record import MAX_CODE, MAX_MISTAKE, LearnerRecord
 
 RECORD = LearnerRecord(
     site="hub",
@@ -30,6 +30,7 @@ RECORD = LearnerRecord(
     exercise_attempts_here=3,
     exercise_failed_here=2,
     exercise_passed_here=False,
+    exercise_mistake="front_is_index_zero",
     code_excerpt="import rclpy\n",
     last_error="2 failed checks",
     nodes_running=("listener", "talker"),
@@ -60,6 +61,7 @@ def test_a_record_survives_the_trip():
         (b'{"learner": "a", "exercise_passed_here": 1}', "must be true or false"),
         (b'{"learner": "a", "nodes_running": "talker"}', "nodes_running must be a list"),
         (b'{"learner": "a", "check_states": [1]}', "check_states must be a list of strings"),
+        (b'{"learner": "a", "exercise_mistake": ["adds"]}', "exercise_mistake must be a string"),
         (b"\xff\xfe", "must be JSON"),
     ],
 )
@@ -69,9 +71,15 @@ def test_a_bad_report_gets_its_reason(body, reason):
 
 
 def test_texts_and_lists_are_clipped_to_the_records_bounds():
-    long = replace(RECORD, code_excerpt="x" * 9000, nodes_running=tuple(f"n{i}" for i in range(50)))
+    long = replace(
+        RECORD,
+        code_excerpt="x" * 9000,
+        nodes_running=tuple(f"n{i}" for i in range(50)),
+        exercise_mistake="m" * 500,
+    )
     back = from_json(to_json(long), received_at=0.0)
     assert len(back.code_excerpt) == MAX_CODE and back.code_excerpt.endswith("…")
+    assert len(back.exercise_mistake) == MAX_MISTAKE
     assert len(back.nodes_running) == 32
 
 

@@ -13,6 +13,7 @@ import io
 import json
 import re
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -133,6 +134,12 @@ def test_a_teacher_sees_a_sent_score_a_waiting_one_and_retries_it(
     assert 'href="gradebook"' in as_user(service, teacher, "").body
     spreadsheet = list(csv.DictReader(io.StringIO(as_user(service, teacher, "progress.csv").body)))
     assert [(r["learner"], r["lms_name"]) for r in spreadsheet] == [(name, "Ada Lovelace")]
+    # ...and, as classroom's page does, the exercises across the class (a hub user's failure).
+    failed = replace(exercise_record("bob", passed=False), exercise_mistake="wrong_topic")
+    assert service.report(failed).status == 200
+    table = json.loads(as_user(service, teacher, "progress.json").body)
+    assert table["exercises"] == [f"{EXERCISE}: 0 passed, 1 trying — wrong topic: bob"]
+    assert "Exercises across the class" in as_user(service, teacher, "").body
 
     # The LMS is back; the teacher does not wait for the backoff and presses Retry.
     with platform.lock:

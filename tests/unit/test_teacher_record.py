@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+from dataclasses import replace
 
 from app.teacher import wire
 from app.teacher.record import (
@@ -12,7 +13,11 @@ from app.teacher.record import (
     LearnerRecord,
     StuckRule,
     checks_text,
+    class_exercises,
+    exercise_now,
+    mistake_words,
     table,
+    tally_exercises,
     text_table,
     to_csv,
 )
@@ -75,6 +80,7 @@ def test_rows_are_sorted_naturally_and_say_everything():
     assert row["unit · step"] == "3 · 2/6"
     assert row["checks"] == "✓✗ 1/2"
     assert row["nodes"] == "talker"
+    assert row["exercise now"] == "–"
     assert row["last activity"] == "5 s ago"
     assert row["stuck"] == ""
 
@@ -121,6 +127,8 @@ def test_message_round_trip_clips_to_the_bounds():
         check_states=("pass",) * 20,
         check_reasons=("r",) * 20,
         nodes_running=("talker", "listener"),
+        exercise="wall_stop",
+        exercise_mistake="front_is_index_zero",
     )
     msg = wire.to_message(record)
     back = wire.from_message(msg, received_at=NOW)
@@ -128,6 +136,10 @@ def test_message_round_trip_clips_to_the_bounds():
     assert len(back.lesson_title) == 120
     assert len(back.check_states) == 16 == len(back.check_reasons)
     assert back.nodes_running == ("talker", "listener")
+    assert back.exercise_mistake == "front_is_index_zero"
+    long_name = "log of your node contains " + "'beat' " * 40  # a failed check's name
+    clipped = wire.from_message(wire.to_message(_learner(exercise_mistake=long_name)))
+    assert len(clipped.exercise_mistake) == 120 and clipped.exercise_mistake.endswith("…")
     assert abs(back.last_activity - record.last_activity) < 1e-3
     assert back.key == "A/learner1"
     assert wire.node_name_for("host-1.lan", "learner1") == "classroom_learner_host_1_lan_learner1"
@@ -152,3 +164,109 @@ def test_text_from_the_classroom_domain_is_shown_never_interpreted():
 
     shown = plain_markdown("[win](http://evil) <img src=x>\n# big")
     assert shown == "\\[win\\]\\(http://evil\\) \\<img src=x\\> \\# big"
+
+
+def _on(name: str, exercise: str = "wall_stop", **fields) -> LearnerRecord:
+    return _learner(name, exercise=exercise, **fields)
+
+
+def test_a_mistake_reads_as_plain_words_and_a_check_no_mistake_explains_as_failed():
+    assert mistake_words("front_is_index_zero") == "front is index zero"
+    assert mistake_words("adds") == "adds"
+    assert mistake_words("stop before the wall") == "“stop before the wall” failed"
+    assert mistake_words("") == ""
+
+
+def test_a_learners_row_shows_the_exercise_they_are_on_and_their_mistake():
+    assert exercise_now(
+        _on("ana", exercise_mistake="publish_on_change", exercise_failed_here=2)
+    ) == ("wall_stop ✗ publish on change")
+    assert (
+        exercise_now(_on("ben", exercise_passed_here=True, exercise_mistake="x_y")) == "wall_stop ✓"
+    )
+    assert exercise_now(_on("cai", exercise_failed_here=1)) == "wall_stop ✗"  # no reason sent
+    assert exercise_now(_on("dan")) == "wall_stop"  # not checked yet
+    rows = table([_on("ana", exercise_mistake="front_is_index_zero")], StuckRule(), NOW)
+    assert dict(zip(COLUMNS, rows[0], strict=True))["exercise now"] == (
+        "wall_stop ✗ front is index zero"
+    )
+
+
+def test_the_class_exercises_count_passes_and_group_failures_by_mistake():
+    records = [
+        _on("learner10", exercise_mistake="front_is_index_zero", exercise_failed_here=1),
+        _on("learner2", exercise_mistake="front_is_index_zero", exercise_failed_here=3),
+        _on("cai", exercise_mistake="publish_on_change", exercise_failed_here=1),
+        _on("dan", exercise_failed_here=2),  # failed before mistakes were kept
+        _on("eve"),  # on it, not checked yet: trying, in no group
+        _on("fay", exercise_passed_here=True, exercise_mistake="front_is_index_zero"),
+        _on("gus", exercise_passed_here=True),
+        _on("hal", exercise="counter_publisher", exercise_mistake="talker_rate"),
+        _learner("ivy"),  # on no exercise: in no line
+    ]
+    assert class_exercises(records) == [
+        "counter_publisher: 0 passed, 1 trying — talker rate: hal",
+        "wall_stop: 2 passed, 5 trying — front is index zero: learner2, learner10; "
+        "failed, reason not known: dan; publish on change: cai",
+    ]
+    [_, wall] = tally_exercises(records)
+    assert wall.passed == ("fay", "gus") and "eve" in wall.trying
+    assert class_exercises([]) == []
+
+
+def test_the_class_exercises_name_learners_as_the_page_knows_them():
+    records = [
+        _on("lti-1", exercise_mistake="stop before the wall"),
+        _on("lti-2", exercise_mistake="stop before the wall"),
+    ]
+    assert class_exercises(records, {"lti-1": "Ada Lovelace"}) == [
+        "wall_stop: 0 passed, 2 trying — “stop before the wall” failed: Ada Lovelace, lti-2"
+    ]
+    two_sites = [_on("learner1", site="A", exercise_mistake="adds"), _on("learner1", site="B")]
+    assert class_exercises(two_sites) == ["wall_stop: 0 passed, 2 trying — adds: learner1 (A)"]
+
+
+def test_the_csv_has_the_mistake_of_each_learner():
+    parsed = list(
+        csv.DictReader(
+            io.StringIO(
+                to_csv([_on("ana", exercise_mistake="publish_on_change")], StuckRule(), NOW)
+            )
+        )
+    )
+    assert parsed[0]["exercise_mistake"] == "publish_on_change"
+
+
+def test_the_teacher_page_shows_the_class_exercises_and_a_learners_mistake(tmp_path):
+    from app.teacher.page import LocalAttempts, exercises_markdown, learner_detail
+
+    records = [
+        _on("ana", exercise_mistake="front_is_index_zero", exercise_failed_here=1),
+        _on("ben", exercise_passed_here=True),
+    ]
+    shown = exercises_markdown(records)
+    assert shown.startswith("### Exercises across the class\n\n- ")
+    assert "wall\\_stop: 1 passed, 1 trying — front is index zero: ana" in shown
+    assert "No learner is on an exercise yet" in exercises_markdown([_learner("cai")])
+    detail = learner_detail(records[0])
+    assert "1 failed; last failure: front is index zero" in detail
+    assert "Newest attempt" not in detail  # no folder to show
+
+    # On the classroom's machine the page finds the learner's newest attempt.
+    folder = tmp_path / "bags" / "ana" / "attempts" / "wall_stop"
+    older = folder / "20261129-101500-seed4242-fail"
+    newest = folder / "20261129-101900-seed77-fail"
+    for attempt in (older, newest):
+        attempt.mkdir(parents=True)
+    (newest / "20261129-101900-seed77-fail_0.mcap").write_bytes(b"")
+    attempts = LocalAttempts(tmp_path / "bags", site="A")
+    assert attempts.newest(records[0]) == newest
+    detail = learner_detail(records[0], attempts.newest(records[0]))
+    assert f"`{newest}`" in detail and f"`{newest}/20261129-101900-seed77-fail_0.mcap`" in detail
+    assert "2026-11-29 10:19:00 UTC · fail · seed 77" in detail
+    assert "Watch this attempt" in detail
+    # Another site's learner of the same name, or a name that is no name, reaches no folder.
+    assert attempts.newest(replace(records[0], site="B")) is None
+    assert attempts.newest(replace(records[0], exercise="../../etc")) is None
+    assert attempts.newest(replace(records[0], learner="..")) is None
+    assert attempts.newest(_on("ben")) is None  # nothing kept
