@@ -19,11 +19,10 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 from rclpy.node import Node
 from rclpy.publisher import Publisher
-from rosbags.interfaces import ConnectionExtRosbag2
+from rosbags.interfaces import Connection, ConnectionExtRosbag2
 
 from app.bags.bagfile import READ_ERRORS, first_line, open_bag
 from app.bags.errors import BagError
@@ -179,7 +178,9 @@ class Player:
             if not opts.loop or not self._publishers:
                 return self.progress()
 
-    def _play_once(self, connections: list[Any], first: int, cancel: threading.Event) -> None:
+    def _play_once(
+        self, connections: list[Connection], first: int, cancel: threading.Event
+    ) -> None:
         rate = self.options.rate
         origin: int | None = None
         clock0 = 0.0

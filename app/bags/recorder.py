@@ -34,11 +34,13 @@ import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Literal
 
 from rclpy.exceptions import InvalidHandle
 from rclpy.node import Node
 from rclpy.subscription import Subscription
+from rclpy.topic_endpoint_info import TopicEndpointInfo
+from rosbags.interfaces import Connection, Qos
 from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, Writer, WriterError
 from rosbags.rosbag2.storage_mcap import McapWriter
 from rosbags.rosbag2.storage_sqlite3 import Sqlite3Writer
@@ -48,6 +50,7 @@ from app.bags.definitions import definition
 from app.bags.errors import BagError
 from app.bags.repair import reindex, truncate_storage
 from app.ros.convert import ConversionError, import_type
+from app.ros.monitor import MessageInfo
 from app.ros.names import QUIET_TOPICS, is_internal_topic
 from app.ros.qos import matching_qos
 
@@ -97,7 +100,7 @@ class _NewTopic:
     msgtype: str
     msgdef: str
     rihs01: str
-    offered: list[Any]
+    offered: list[Qos]
 
 
 _Item = tuple[int, int, bytes] | _NewTopic | None
@@ -215,7 +218,7 @@ class Recorder:
         subscribed = {topic for topic, _type in self._topics}
         return [t for t in self._wanted if t not in subscribed and t not in self._skipped]
 
-    def _subscribe(self, topic: str, types: list[str], publishers: list[Any]) -> str:
+    def _subscribe(self, topic: str, types: list[str], publishers: list[TopicEndpointInfo]) -> str:
         msgtype = types[0]
         try:
             py_type = import_type(msgtype, "msg")
@@ -232,7 +235,7 @@ class Recorder:
         put = self._queue.put
         subscription: list[Subscription] = []
 
-        def on_message(data: bytes, info: dict[str, Any]) -> None:
+        def on_message(data: bytes, info: MessageInfo) -> None:
             # Executor thread: hand over; the writer thread does the rest. The
             # stamp is when the middleware received the message (as rosbag2
             # records it), not when this busy thread got round to it.
@@ -334,7 +337,7 @@ class Recorder:
             with self._lock:
                 self._finished = True
             return
-        connections: dict[int, Any] = {}
+        connections: dict[int, Connection] = {}
         next_flush = time.monotonic() + self._flush_interval
         try:
             while True:
@@ -364,7 +367,7 @@ class Recorder:
             with self._lock:
                 self._finished = True
 
-    def _write_batch(self, batch: list[_Item], connections: dict[int, Any]) -> bool:
+    def _write_batch(self, batch: list[_Item], connections: dict[int, Connection]) -> bool:
         """Write what arrived; True when the stop marker was among it."""
         counts: dict[int, int] = {}
         sizes: dict[int, int] = {}

@@ -15,12 +15,12 @@ from __future__ import annotations
 import os
 import sqlite3
 from pathlib import Path
-from typing import Any
+from typing import BinaryIO
 
 import yaml
-from rosbags.interfaces import ConnectionExtRosbag2
+from rosbags.interfaces import ConnectionExtRosbag2, Qos
 from rosbags.rosbag2 import ReaderError
-from rosbags.rosbag2.metadata import dump_qos_v9, parse_qos
+from rosbags.rosbag2.metadata import TopicWithMessageCount, dump_qos_v9, parse_qos
 from rosbags.rosbag2.storage_mcap import McapReader
 
 from app.bags.bagfile import first_line, storage_files
@@ -32,6 +32,9 @@ OP_FOOTER, OP_DATA_END, OP_MAX = 0x02, 0x0F, 0x10
 FOOTER_SIZE = 1 + 8 + 20 + len(MAGIC)
 BAG_VERSION = 9
 
+# What a storage file holds: (topic entries, message count, first stamp, last stamp).
+Summary = tuple[list[TopicWithMessageCount], int, int, int]
+
 
 def truncate_storage(path: Path, end: int) -> None:
     """Cut a storage file back to ``end`` bytes (the end of its last flushed chunk)."""
@@ -40,7 +43,7 @@ def truncate_storage(path: Path, end: int) -> None:
             handle.truncate(end)
 
 
-def _has_footer(handle: Any, size: int) -> bool:
+def _has_footer(handle: BinaryIO, size: int) -> bool:
     if size < len(MAGIC) + FOOTER_SIZE:
         return False
     handle.seek(size - FOOTER_SIZE)
@@ -81,7 +84,7 @@ def _type_hash(msgtype: str) -> str:
         return ""  # a type not installed here: readers decode from the stored definition
 
 
-def _topic_entry(name: str, msgtype: str, qos: list[Any], count: int) -> dict[str, Any]:
+def _topic_entry(name: str, msgtype: str, qos: list[Qos], count: int) -> TopicWithMessageCount:
     return {
         "topic_metadata": {
             "name": name,
@@ -94,7 +97,7 @@ def _topic_entry(name: str, msgtype: str, qos: list[Any], count: int) -> dict[st
     }
 
 
-def _mcap_summary(path: Path) -> tuple[list[dict[str, Any]], int, int, int]:
+def _mcap_summary(path: Path) -> Summary:
     """(topic entries, message count, first stamp, last stamp) by scanning the file."""
     reader = McapReader(path)
     try:
@@ -118,7 +121,7 @@ def _mcap_summary(path: Path) -> tuple[list[dict[str, Any]], int, int, int]:
             reader.close()
 
 
-def _sqlite_summary(path: Path) -> tuple[list[dict[str, Any]], int, int, int]:
+def _sqlite_summary(path: Path) -> Summary:
     try:
         # A normal connection: a hot journal left by a killed writer is rolled back here.
         conn = sqlite3.connect(f"file:{path}", uri=True)
@@ -147,7 +150,7 @@ def _sqlite_summary(path: Path) -> tuple[list[dict[str, Any]], int, int, int]:
     return topics, count, start, end
 
 
-def write_metadata(folder: Path, storage: str, files: list[Path], summary: tuple) -> None:
+def write_metadata(folder: Path, storage: str, files: list[Path], summary: Summary) -> None:
     topics, count, start, end = summary
     start = start if count else 0
     duration = max(0, end - start) if count else 0
@@ -198,7 +201,7 @@ def reindex(folder: Path) -> str:
         storage = "sqlite3"
     else:
         raise BagError(f"{folder} mixes storage formats; keep one kind of file")
-    merged: dict[str, dict[str, Any]] = {}
+    merged: dict[str, TopicWithMessageCount] = {}
     for topics, *_ in summaries:
         for entry in topics:
             name = entry["topic_metadata"]["name"]

@@ -18,9 +18,10 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Protocol, TypeVar, cast
 
 from rclpy.serialization import deserialize_message
+from rosbags.rosbag2 import Reader
 
 from app.bags.bagfile import READ_ERRORS, first_line, open_bag
 from app.bags.errors import BagError
@@ -28,6 +29,13 @@ from app.bags.info import BagInfo, read_info
 from app.ros import rotations
 from app.ros.convert import import_type, to_plain
 from app.ros.planar import Box, Pose
+
+if TYPE_CHECKING:
+    from geometry_msgs.msg import Quaternion
+    from nav_msgs.msg import Odometry
+    from rcl_interfaces.msg import Log
+    from sensor_msgs.msg import LaserScan
+    from visualization_msgs.msg import MarkerArray
 
 POSE_TOPICS = ("/ground_truth/odom", "/odom")  # the first one a bag holds is the robot's way
 SCAN_TOPIC = "/scan"
@@ -130,12 +138,20 @@ class Track:
         return self.moments[max(0, end - most) : end]
 
 
-def _newest(items: Sequence[Any], t: float) -> Any:
+class _Timed(Protocol):
+    @property
+    def t(self) -> float: ...
+
+
+Timed = TypeVar("Timed", bound=_Timed)
+
+
+def _newest(items: Sequence[Timed], t: float) -> Timed | None:
     index = bisect.bisect_right([item.t for item in items], t) - 1
     return items[index] if index >= 0 else None
 
 
-def yaw_of(q: Any) -> float:
+def yaw_of(q: Quaternion) -> float:
     return rotations.yaw_of(q.x, q.y, q.z, q.w)
 
 
@@ -149,7 +165,7 @@ def read_track(path: Path) -> Track:
     types = {t.name: t.msgtype for t in info.topics}
     pose_topic = next((t for t in POSE_TOPICS if t in types), "")
     track = Track(info, max(info.duration_ns, 0) / 1e9, pose_topic)
-    classes: dict[str, Any] = {}
+    classes: dict[str, type] = {}
     try:
         with open_bag(path) as reader:
             wanted = _wanted_messages(reader, track, start)
@@ -173,7 +189,9 @@ def read_track(path: Path) -> Track:
     return track
 
 
-def _wanted_messages(reader: Any, track: Track, start: int) -> list[tuple[float, str, str, bytes]]:
+def _wanted_messages(
+    reader: Reader, track: Track, start: int
+) -> list[tuple[float, str, str, bytes]]:
     """Every message's time noted; the ones to draw or list kept as (t, topic, type, CDR)."""
     kept = []
     for connection, stamp, raw in reader.messages():
@@ -185,21 +203,24 @@ def _wanted_messages(reader: Any, track: Track, start: int) -> list[tuple[float,
     return kept
 
 
-def _take(track: Track, topic: str, kind: str, t: float, msg: Any) -> None:
+def _take(track: Track, topic: str, kind: str, t: float, msg: object) -> None:
+    """One message of the bag, of the type ``kind`` names."""
     if topic == track.pose_topic:
-        p = msg.pose.pose
+        odometry = cast("Odometry", msg)
+        p = odometry.pose.pose
         track.poses.append(Pose(t, p.position.x, p.position.y, yaw_of(p.orientation)))
-        stamp = msg.header.stamp
+        stamp = odometry.header.stamp
         track.sim_stamps.append(stamp.sec + stamp.nanosec * 1e-9)
     elif topic == SCAN_TOPIC and kind == "sensor_msgs/msg/LaserScan":
         pose = track.pose_at(t)
         if pose is not None:
-            track.scans.append(Scan(t, _scan_points(msg, pose)))
+            track.scans.append(Scan(t, _scan_points(cast("LaserScan", msg), pose)))
     elif topic == ROOM_TOPIC and kind == "visualization_msgs/msg/MarkerArray":
-        _room(track, msg)
+        _room(track, cast("MarkerArray", msg))
     elif kind == "rcl_interfaces/msg/Log":  # as ros2 run prints a node's log line
-        level = LOG_LEVELS.get(msg.level, str(msg.level))
-        track.moments.append(Moment(t, topic, _cut(f"[{level}] [{msg.name}]: {msg.msg}")))
+        log = cast("Log", msg)
+        level = LOG_LEVELS.get(log.level, str(log.level))
+        track.moments.append(Moment(t, topic, _cut(f"[{level}] [{log.name}]: {log.msg}")))
     else:
         text = json.dumps(to_plain(msg, max_items=8), separators=(", ", ": "))
         track.moments.append(Moment(t, topic, _cut(text)))
@@ -209,7 +230,7 @@ def _cut(text: str) -> str:
     return text if len(text) <= MOMENT_TEXT else text[: MOMENT_TEXT - 1] + "…"
 
 
-def _scan_points(msg: Any, pose: Pose) -> tuple[tuple[float, float], ...]:
+def _scan_points(msg: LaserScan, pose: Pose) -> tuple[tuple[float, float], ...]:
     """Each return's place in the world, the scanner taken to sit at the robot's centre
     (its few centimetres of offset do not show at a room's scale)."""
     points = []
@@ -221,7 +242,7 @@ def _scan_points(msg: Any, pose: Pose) -> tuple[tuple[float, float], ...]:
     return tuple(points)
 
 
-def _room(track: Track, msg: Any) -> None:
+def _room(track: Track, msg: MarkerArray) -> None:
     """The room from its markers: the largest flat one is the floor, the rest obstacles."""
     boxes: list[Box] = []
     floors: list[Box] = []

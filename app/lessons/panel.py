@@ -11,7 +11,7 @@ import html
 import re
 from collections.abc import Callable
 from functools import lru_cache
-from typing import Any, Final
+from typing import Final
 
 import viser
 
@@ -165,11 +165,11 @@ class LessonsPanel:
         course: Course,
         live: LessonRuntime,
         progress: ProgressStore,
-        side_window: Any,
+        side_window: viser.PanelHandle,
         exercise_marks: Callable[[str], str] = lambda _lesson_id: "",
         show_stage: Callable[[str], None] = lambda _stage: None,
         *,
-        step_card: Any = None,
+        step_card: viser.GuiFolderHandle | None = None,
         open_tool: Callable[[str], None] = lambda _tool: None,
         start_requests: StartRequests | None = None,
         new_lesson: Callable[[], None] = lambda: None,
@@ -195,8 +195,8 @@ class LessonsPanel:
         self._requests = start_requests or StartRequests()  # the stage shows a Start at once
         self._new_lesson = new_lesson
         self._leftovers: list[str] = []  # nodes running when this lesson was opened
-        self._stop_buttons: list[tuple[Any, list[str]]] = []  # (button, what it stops)
-        self._dynamic: list[Any] = []
+        self._stop_buttons: list[tuple[viser.GuiButtonHandle, list[str]]] = []  # (button, stops)
+        self._dynamic: list[viser.GuiButtonHandle | viser.GuiMarkdownHandle] = []
         by_label = {_label(lesson): lesson for lesson in course.lessons}
         self._by_label = by_label
         if not course.lessons:

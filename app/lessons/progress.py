@@ -16,7 +16,7 @@ import tempfile
 import threading
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 
 from app import PROJECT_ROOT
 
@@ -52,6 +52,13 @@ RENUMBERED_IN_V2: dict[str, tuple[tuple[int, str, int], ...]] = {
 }
 
 
+class LessonRecord(TypedDict):
+    """A lesson's progress: the step shown last and the steps passed."""
+
+    step: int
+    passed: list[int]
+
+
 def _renumbered(lesson_id: str, step: int) -> tuple[str, int]:
     parts = RENUMBERED_IN_V2.get(lesson_id, ((0, lesson_id, 0),))
     _first, new_id, shift = max(part for part in parts if part[0] <= max(step, 0))
@@ -62,7 +69,7 @@ def migrate(data: dict[str, Any]) -> dict[str, Any]:
     """A version-1 record, its lesson ids and steps moved to where those steps are now."""
     if data.get("version", 1) >= VERSION:
         return data
-    lessons: dict[str, dict[str, Any]] = {}
+    lessons: dict[str, LessonRecord] = {}
     for old_id, entry in data["lessons"].items():
         for step in sorted(int(s) for s in entry.get("passed", [])):
             new_id, new_step = _renumbered(old_id, step)
@@ -110,7 +117,7 @@ class ProgressStore:
             self.warning = f"Progress file was unreadable ({exc}); kept it as {aside.name}."
             return {"version": VERSION, "lessons": {}}
 
-    def lesson(self, lesson_id: str) -> dict[str, Any]:
+    def lesson(self, lesson_id: str) -> LessonRecord:
         with self._lock:
             entry = self._data["lessons"].get(lesson_id, {})
             return {"step": int(entry.get("step", 0)), "passed": list(entry.get("passed", []))}

@@ -42,7 +42,7 @@ import importlib
 import pkgutil
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING, TypeVar
 
 if TYPE_CHECKING:
     from app.lessons.runtime import LessonRuntime
@@ -87,7 +87,8 @@ class ActionKind:
 
 CHECKS: dict[str, CheckKind] = {}
 ACTIONS: dict[str, ActionKind] = {}
-F = TypeVar("F", bound=Callable[..., Any])
+Evaluate = TypeVar("Evaluate", bound="Callable[[LessonRuntime, Spec], CheckResult]")
+Perform = TypeVar("Perform", bound="Callable[[LessonRuntime, Spec], str]")
 E = TypeVar("E")
 
 
@@ -98,10 +99,12 @@ def add_kind(table: dict[str, E], family: str, name: str, entry: E) -> None:
     table[name] = entry
 
 
-def register_check(name: str, *, required: str, optional: str = "", words: str) -> Callable[[F], F]:
+def register_check(
+    name: str, *, required: str, optional: str = "", words: str
+) -> Callable[[Evaluate], Evaluate]:
     """Decorator: ``evaluate(rt, check) -> CheckResult`` is the check kind ``name``."""
 
-    def add(evaluate: F) -> F:
+    def add(evaluate: Evaluate) -> Evaluate:
         add_kind(
             CHECKS, "check", name, CheckKind(name, make_kind(required, optional), evaluate, words)
         )
@@ -112,10 +115,10 @@ def register_check(name: str, *, required: str, optional: str = "", words: str) 
 
 def register_action(
     name: str, *, required: str, optional: str = "", words: str
-) -> Callable[[F], F]:
+) -> Callable[[Perform], Perform]:
     """Decorator: ``perform(rt, action) -> str`` is the step action kind ``name``."""
 
-    def add(perform: F) -> F:
+    def add(perform: Perform) -> Perform:
         add_kind(
             ACTIONS, "action", name, ActionKind(name, make_kind(required, optional), perform, words)
         )

@@ -23,6 +23,7 @@ from collections.abc import Callable
 from typing import Any, Protocol, TypeVar
 
 from rclpy.node import Node
+from rclpy.publisher import Publisher
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from app import catalog
@@ -77,7 +78,7 @@ class LessonRuntime:
         self.supervisor = supervisor
         self.lock = threading.Lock()
         self._graph = GraphSnapshot()
-        self._taps: dict[tuple[str, str], TopicMonitor] = {}
+        self._taps: dict[tuple[str, str], TopicMonitor[object]] = {}
         self._watches: dict[str, Closable] = {}  # shared by several checks (TF, sim speed)
         self._read: dict[Any, float] = {}  # when a check last read each tap or watch
         self._last_look = self._next_sweep = time.monotonic()
@@ -87,13 +88,16 @@ class LessonRuntime:
         self.changed_at: float | None = None
         self.services = ServicePoller(node, RECALL_PERIOD_SEC)
         self.goals: dict[str, GoalRun] = {}
-        self.senders: dict[tuple[str, str], Any] = {}  # kept: a fresh one misses subscribers
+        self.senders: dict[tuple[str, str], Publisher] = {}  # kept: a fresh one misses subscribers
         self.quiz_answers: dict[str, str] = {}
         # Runs a `ros2 ...` line in the Console tab (the dashboard wires it; UI thread).
         self.console: Callable[[str], None] | None = None
 
-    def tap(self, topic: str, type_name: str, history: bool = False) -> TopicMonitor:
-        """A kept subscription; ``history``: the reliable, transient-local /rosout kind."""
+    def tap(self, topic: str, type_name: str, history: bool = False) -> TopicMonitor[Any]:
+        """A kept subscription; ``history``: the reliable, transient-local /rosout kind.
+
+        Its messages are untyped: their class is named by text (``type_name``).
+        """
         with self.lock:
             key = (topic, type_name + (" (history)" if history else ""))
             if key not in self._taps:

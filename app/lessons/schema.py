@@ -10,9 +10,10 @@ tabs they name are checked against the product at load.
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar, overload
 
 try:
     import tomllib
@@ -46,7 +47,7 @@ class Spec:
     """An action or a check: its kind and its validated fields."""
 
     kind: str
-    fields: dict[str, Any]
+    fields: dict[str, Any]  # TOML values, checked by kind: each kind reads its own fields
 
     def __getitem__(self, key: str) -> Any:
         return self.fields[key]
@@ -94,7 +95,22 @@ class Course:
         return next((lesson for lesson in self.lessons if lesson.id == lesson_id), None)
 
 
-def _require(table: dict[str, Any], key: str, kind: type | tuple[type, ...], where: str) -> Any:
+T = TypeVar("T")
+
+
+@overload
+def _require(table: Mapping[str, object], key: str, kind: type[T], where: str) -> T: ...
+
+
+@overload
+def _require(
+    table: Mapping[str, object], key: str, kind: tuple[type, ...], where: str
+) -> object: ...
+
+
+def _require(
+    table: Mapping[str, object], key: str, kind: type | tuple[type, ...], where: str
+) -> object:
     if key not in table:
         raise LessonError(f"{where}: missing field '{key}'")
     value = table[key]
@@ -110,7 +126,9 @@ _GROUP_NAMES = frozenset(group.name for group in GROUPS)
 _ROS_NODE_NAMES = frozenset({entry.node_name for entry in ENTRIES} | {f"/{DASHBOARD_NODE_NAME}"})
 
 
-def _check_names(kind: str, fields: dict[str, Any], where: str, learner_node: str | None) -> None:
+def _check_names(
+    kind: str, fields: Mapping[str, object], where: str, learner_node: str | None
+) -> None:
     """Names a lesson uses must exist in the product it runs in.
 
     In an exercise, ``learner_node`` is the ROS node the learner's program
@@ -143,7 +161,7 @@ def _check_names(kind: str, fields: dict[str, Any], where: str, learner_node: st
 
 
 def parse_spec(
-    raw: Any, table: dict[str, Kind], where: str, learner_node: str | None = None
+    raw: object, table: dict[str, Kind], where: str, learner_node: str | None = None
 ) -> Spec:
     """One action or check table, validated against the registry and the product."""
     if not isinstance(raw, dict):
@@ -175,7 +193,7 @@ def inside(base: Path, relative: str, where: str) -> Path:
     return candidate
 
 
-def _step_image(raw: dict[str, Any], where: str) -> tuple[str, str]:
+def _step_image(raw: Mapping[str, object], where: str) -> tuple[str, str]:
     """A step's optional picture: a file in static/ and the alt text it needs."""
     if "image" not in raw:
         if "image_alt" in raw:
@@ -193,7 +211,7 @@ def _step_image(raw: dict[str, Any], where: str) -> tuple[str, str]:
     return image, alt.strip()
 
 
-def _stage(table: dict[str, Any], where: str, default: str) -> str:
+def _stage(table: Mapping[str, object], where: str, default: str) -> str:
     """The optional ``stage`` field: one of the names the stage knows."""
     if "stage" not in table:
         return default

@@ -14,8 +14,9 @@ import time
 import urllib.parse
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
-from typing import Any, Literal
+from typing import Literal
 
+from app.jsonish import JSONObject
 from app.lti import claims
 from app.lti.keys import ToolKeys
 from app.lti.launch import Launch
@@ -39,8 +40,8 @@ class Activity:
     score_maximum: float
     text: str = ""
 
-    def content_item(self, launch_url: str) -> dict[str, Any]:
-        item: dict[str, Any] = {
+    def content_item(self, launch_url: str) -> JSONObject:
+        item: JSONObject = {
             "type": RESOURCE_LINK_TYPE,
             "title": self.title,
             "url": launch_url,
@@ -109,7 +110,7 @@ def deep_linking_response(
     if len(picked) > 1 and not settings.accept_multiple:
         raise DeepLinkingError("the LMS accepts one activity here; pick one")
     now = int(clock())
-    body: dict[str, Any] = {
+    body: JSONObject = {
         "iss": launch.registration.client_id,
         "aud": launch.registration.issuer,
         "iat": now,

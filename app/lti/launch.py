@@ -7,10 +7,10 @@ can never use up a real learner's login.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
-from typing import Any
+from typing import cast
 
 import jwt
 
@@ -144,7 +144,7 @@ class LaunchValidator:
         self._nonces.redeem(state, str(verified["nonce"]))
         return launch
 
-    def _registration(self, unverified: Mapping[str, Any]) -> PlatformRegistration:
+    def _registration(self, unverified: Mapping[str, object]) -> PlatformRegistration:
         issuer = unverified.get("iss")
         if not isinstance(issuer, str) or not issuer:
             raise LaunchRejected("the id_token names no issuer (iss)")
@@ -154,7 +154,11 @@ class LaunchValidator:
                 f"the issuer {issuer!r} is not a platform registered with this tool"
             )
         audience = unverified.get("aud")
-        audiences = [audience] if isinstance(audience, str) else list(audience or [])
+        audiences = (
+            [audience]
+            if isinstance(audience, str)
+            else list(cast("Iterable[object]", audience or []))
+        )
         for registration in candidates:
             if registration.client_id in audiences:
                 return registration
@@ -164,14 +168,14 @@ class LaunchValidator:
         )
 
     def _verified(
-        self, id_token: str, header: Mapping[str, Any], registration: PlatformRegistration
-    ) -> dict[str, Any]:
+        self, id_token: str, header: Mapping[str, object], registration: PlatformRegistration
+    ) -> dict[str, object]:
         keys = self._keys.get(registration.jwks_url)
         if keys is None:
             keys = self._keys.setdefault(
                 registration.jwks_url, self._new_keys(registration.jwks_url)
             )
-        key = keys.key_for(header.get("kid"))
+        key = keys.key_for(cast("str | None", header.get("kid")))  # a JWT header's kid is text
         try:
             return jwt.decode(
                 id_token,
@@ -203,7 +207,7 @@ class LaunchValidator:
             raise LaunchRejected(f"the id_token was refused: {error}") from None
 
     def _check_audience(
-        self, verified: Mapping[str, Any], registration: PlatformRegistration
+        self, verified: Mapping[str, object], registration: PlatformRegistration
     ) -> None:
         # OpenID Connect: with several audiences, `azp` names the one the token was issued to.
         audience = verified["aud"]
@@ -218,12 +222,12 @@ class LaunchValidator:
             )
 
 
-def _text(values: Mapping[str, Any], name: str) -> str | None:
+def _text(values: Mapping[str, object], name: str) -> str | None:
     value = values.get(name)
     return value if isinstance(value, str) else None
 
 
-def _person_name(verified: Mapping[str, Any]) -> str | None:
+def _person_name(verified: Mapping[str, object]) -> str | None:
     """The OIDC ``name``; else ``given_name`` and ``family_name`` (some LMSes send only those)."""
     full = (_text(verified, "name") or "").strip()
     if full:
@@ -232,7 +236,7 @@ def _person_name(verified: Mapping[str, Any]) -> str | None:
     return " ".join(p for p in parts if p) or None
 
 
-def _object(values: Mapping[str, Any], name: str) -> Mapping[str, Any]:
+def _object(values: Mapping[str, object], name: str) -> Mapping[str, object]:
     value = values.get(name)
     return value if isinstance(value, dict) else {}
 
@@ -245,7 +249,7 @@ def _when(id_token: str, claim: str) -> str:
 
 
 def _read_launch(
-    verified: Mapping[str, Any],
+    verified: Mapping[str, object],
     registration: PlatformRegistration,
     message_type: str,
     deployment_id: str,
@@ -265,7 +269,9 @@ def _read_launch(
             raise LaunchRejected("the deep-linking request has no deep_link_return_url")
         deep_linking = DeepLinkingSettings(
             return_url=return_url,
-            accept_types=tuple(str(t) for t in settings.get("accept_types") or ()),
+            accept_types=tuple(
+                str(t) for t in cast("Iterable[object]", settings.get("accept_types") or ())
+            ),
             accept_multiple=settings.get("accept_multiple") is not False,
             data=_text(settings, "data"),
         )
@@ -275,7 +281,7 @@ def _read_launch(
         grade_service = GradeService(
             lineitem=_text(endpoint, "lineitem"),
             lineitems=_text(endpoint, "lineitems"),
-            scopes=tuple(str(s) for s in endpoint.get("scope") or ()),
+            scopes=tuple(str(s) for s in cast("Iterable[object]", endpoint.get("scope") or ())),
         )
     roles = verified.get(claims.ROLES)
     return Launch(

@@ -26,6 +26,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
 
+from app.jsonish import JSONObject
 from app.lti.deep_linking import MAX_POINTS, SCORE_MAXIMUM_PARAM
 from app.lti.launch import Launch
 
@@ -97,7 +98,7 @@ class LearnerEntry:
     email: str | None = None
     items: tuple[LaunchedItem, ...] = ()
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> JSONObject:
         return {**asdict(self), "items": [asdict(item) for item in self.items]}
 
     @classmethod

@@ -7,8 +7,8 @@ tool set-up form, so the values can be copied line by line.
 from __future__ import annotations
 
 import json
-from typing import Any
 
+from app.jsonish import JSONObject
 from app.lti.claims import SCORE_SCOPE
 from app.lti.keys import ToolKeys
 from app.lti.routes import ToolUrls
@@ -17,7 +17,7 @@ TOOL_TITLE = "ROS 2 Classroom"
 LINEITEM_SCOPE = "https://purl.imsglobal.org/spec/lti-ags/scope/lineitem"
 
 
-def canvas_json(urls: ToolUrls) -> dict[str, Any]:
+def canvas_json(urls: ToolUrls) -> JSONObject:
     """Canvas's "Paste JSON" developer key configuration."""
     picker = {"message_type": "LtiDeepLinkingRequest", "target_link_uri": urls.deep_link}
     return {

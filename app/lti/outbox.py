@@ -23,6 +23,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any, Literal, Protocol
 
+from app.jsonish import JSONObject
 from app.lti.ags import PostOutcome
 from app.lti.score import Score
 
@@ -53,7 +54,7 @@ class OutboxEntry:
     def key(self) -> tuple[str, str]:
         return (self.lineitem, self.score.user_id)
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> JSONObject:
         return {**asdict(self), "score": self.score.to_ags()}
 
     @classmethod

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from datetime import datetime, timedelta, timezone
-from typing import Any
+from typing import TypedDict
 
 ACTIVITY_PROGRESS = ("Initialized", "Started", "InProgress", "Submitted", "Completed")
 GRADING_PROGRESS = ("FullyGraded", "Pending", "PendingManual", "Failed", "NotReady")
@@ -22,6 +22,21 @@ def _parse(stamp: str) -> datetime:
 def now_iso() -> str:
     """An ISO 8601 time with its offset, to the millisecond, as AGS wants timestamps."""
     return datetime.now(timezone.utc).isoformat(timespec="milliseconds")
+
+
+class _AgsScoreRequired(TypedDict):
+    userId: str
+    scoreGiven: float
+    scoreMaximum: float
+    activityProgress: str
+    gradingProgress: str
+    timestamp: str
+
+
+class AgsScore(_AgsScoreRequired, total=False):
+    """A score as AGS carries it: the JSON body of a POST to ``<lineitem>/scores``."""
+
+    comment: str
 
 
 @dataclass(frozen=True)
@@ -65,7 +80,7 @@ class Score:
             return self
         return replace(self, timestamp=floor.isoformat(timespec="milliseconds"))
 
-    def to_ags(self) -> dict[str, Any]:
+    def to_ags(self) -> AgsScore:
         """The JSON body of a POST to ``<lineitem>/scores``."""
         return {
             "userId": self.user_id,
@@ -78,7 +93,7 @@ class Score:
         }
 
     @classmethod
-    def from_ags(cls, body: dict[str, Any]) -> Score:
+    def from_ags(cls, body: AgsScore) -> Score:
         return cls(
             user_id=str(body["userId"]),
             score_given=float(body["scoreGiven"]),

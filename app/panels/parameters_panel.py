@@ -14,7 +14,7 @@ import math
 import shlex
 import time
 from dataclasses import dataclass
-from typing import Any
+from typing import cast
 
 import viser
 from rcl_interfaces.msg import ParameterDescriptor, ParameterType, ParameterValue
@@ -25,12 +25,15 @@ from app.ros.context import CallContext, panel_context
 from app.ros.graph import GraphSnapshot, published_topics
 from app.ros.rates import RateBoard, rate_text
 from app.ros.rosout import RosoutLog, format_record
-from app.ui import MarkdownView, assign, code_block, set_options
+from app.ui import Input, MarkdownView, assign, code_block, set_options
 from app.ui.loop import UiLoop
 
 NONE = "(pick a node)"
 SYNC_PERIOD_SEC = 3.0
 LOG_LINES = 6
+
+# What an editor holds: a checkbox's bool, a number's or slider's number, or text.
+EditorValue = bool | int | float | str
 
 
 @dataclass(frozen=True)
@@ -39,7 +42,7 @@ class ParamSpec:
 
     name: str
     type: int
-    value: Any
+    value: object  # as rp.python_value gives it
     description: str = ""
     read_only: bool = False
     low: float | None = None
@@ -73,7 +76,7 @@ def spec_from(name: str, value: ParameterValue, descriptor: ParameterDescriptor)
     )
 
 
-def value_for(spec: ParamSpec, widget_value: Any) -> Any:
+def value_for(spec: ParamSpec, widget_value: EditorValue) -> object:
     """What the editor holds, as the Python value of the parameter's own type."""
     if spec.type == ParameterType.PARAMETER_BOOL:
         return bool(widget_value)
@@ -89,7 +92,7 @@ def value_for(spec: ParamSpec, widget_value: Any) -> Any:
     return rp.parse_value(str(widget_value))  # arrays and untyped: YAML, as ros2 param set
 
 
-def command_value(value: Any) -> str:
+def command_value(value: object) -> str:
     """A value as it would be typed after `ros2 param set <node> <name>`."""
     if isinstance(value, bool):
         return "true" if value else "false"
@@ -123,10 +126,10 @@ class ParametersPanel:
         self._synced_at = 0.0
         self._built_for: str | None = None
         self._specs: dict[str, ParamSpec] = {}
-        self._widgets: dict[str, Any] = {}
+        self._widgets: dict[str, Input[EditorValue]] = {}
         # What each editor showed when it last matched the node: an editor whose
         # value differs from it is being edited, and a sync leaves it alone.
-        self._known: dict[str, Any] = {}
+        self._known: dict[str, object] = {}
         self._message = ""
         self._rates = RateBoard(node, limit=8)
         gui.add_markdown(
@@ -137,7 +140,7 @@ class ParametersPanel:
         self._info = MarkdownView(gui, "")
         self._result = MarkdownView(gui, "")  # above the editors: seen right after a click
         self._editors = gui.add_folder("Parameters", expand_by_default=True)
-        self._editor_folder: Any = None
+        self._editor_folder: viser.GuiFolderHandle | None = None
         self._activity = MarkdownView(gui, "")
         self._selector.on_update(ui.callback(lambda: self._select(self._selector.value)))
 
@@ -216,14 +219,15 @@ class ParametersPanel:
                 button.on_click(self._ui.callback(self._set, spec.name))
         self._built_for = target
 
-    def _editor(self, spec: ParamSpec) -> Any:
+    def _editor(self, spec: ParamSpec) -> Input[EditorValue]:
         gui, label, value = self._gui, spec.name, spec.value
         disabled = spec.read_only
         if spec.type == ParameterType.PARAMETER_BOOL:
             return gui.add_checkbox(label, bool(value), disabled=disabled)
         if spec.type in (ParameterType.PARAMETER_INTEGER, ParameterType.PARAMETER_DOUBLE):
             whole = spec.type == ParameterType.PARAMETER_INTEGER
-            number = int(value or 0) if whole else float(value or 0.0)
+            amount = cast(float, value or 0)  # an integer or a double parameter's number
+            number = int(amount) if whole else float(amount)
             if spec.low is not None and spec.high is not None and spec.high > spec.low:
                 step = spec.step or (1 if whole else _nice_step(spec.high - spec.low))
                 return gui.add_slider(label, spec.low, spec.high, step, number, disabled=disabled)
@@ -246,12 +250,12 @@ class ParametersPanel:
         self._message = f"`{command}` …"
         ctx = self._ctx()
 
-        def work() -> tuple[bool, str, Any]:
+        def work() -> tuple[bool, str, object]:
             ok, reason = rp.set_value(ctx, target, name, value)
             kept = None if ok else rp.python_value(rp.get_values(ctx, target, [name])[0])
             return ok, reason, kept
 
-        def done(answer: tuple[bool, str, Any]) -> None:
+        def done(answer: tuple[bool, str, object]) -> None:
             ok, reason, kept = answer
             if ok:
                 verdict = "✅ Set parameter successful"
@@ -278,11 +282,11 @@ class ParametersPanel:
         self._synced_at = time.monotonic()
         ctx = self._ctx()
 
-        def work() -> dict[str, Any]:
+        def work() -> dict[str, object]:
             values = rp.get_values(ctx, target, names)
             return {n: rp.python_value(v) for n, v in zip(names, values, strict=False)}
 
-        def done(fresh: dict[str, Any]) -> None:
+        def done(fresh: dict[str, object]) -> None:
             self._syncing = False
             if self._built_for == target:
                 self._apply_synced(fresh)
@@ -293,7 +297,7 @@ class ParametersPanel:
 
         self._ui.run_job(work, done, failed)
 
-    def _apply_synced(self, fresh: dict[str, Any]) -> None:
+    def _apply_synced(self, fresh: dict[str, object]) -> None:
         for name, value in fresh.items():
             widget, spec = self._widgets.get(name), self._specs.get(name)
             if widget is None or spec is None or value is None:
@@ -301,7 +305,7 @@ class ParametersPanel:
             shown = shown_value(spec, value)
             # Only overwrite what the learner has not started editing.
             if widget.value == self._known.get(name) and widget.value != shown:
-                widget.value = shown
+                assign(widget, shown)
             if widget.value == shown:
                 self._known[name] = shown
 
@@ -347,7 +351,7 @@ class ParametersPanel:
         self._rates.close()
 
 
-def shown_value(spec: ParamSpec, value: Any) -> Any:
+def shown_value(spec: ParamSpec, value: object) -> object:
     """A parameter value as its editor holds it: plain types as they are, others as text."""
     return value if spec.type in _PLAIN_TYPES else str(value)
 

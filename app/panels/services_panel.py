@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 import viser
 from rclpy.node import Node
 
@@ -72,10 +70,10 @@ class ServicesPanel:
         self._message = f"`{command}`\n\nwaiting for the response…"
         ctx = panel_context(self._node)
 
-        def work() -> Any:
+        def work() -> object:
             return call_service(ctx, name, import_type(type_text, "srv"), request)
 
-        def done(response: Any) -> None:
+        def done(response: object) -> None:
             self._message = f"`{command}`\n\n**response:** `{message_repr(response)}`"
 
         def failed(text: str) -> None:

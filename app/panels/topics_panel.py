@@ -13,13 +13,14 @@ from __future__ import annotations
 import math
 import time
 from collections import deque
-from typing import Any
 
 import numpy as np
 import viser
 import viser.uplot as uplot
 from rclpy.node import Node
+from rclpy.publisher import Publisher
 from rclpy.timer import Timer
+from rclpy.topic_endpoint_info import TopicEndpointInfo
 
 from app.ros.convert import (
     ConversionError,
@@ -66,7 +67,7 @@ def preferred_field(cls: type) -> str:
     return NO_FIELD
 
 
-def plot_value(msg: Any, path: str) -> float | None:
+def plot_value(msg: object, path: str) -> float | None:
     """The number at ``path`` as a float, or None when it is not a finite number."""
     try:
         value = field_value(msg, path)
@@ -78,7 +79,7 @@ def plot_value(msg: Any, path: str) -> float | None:
     return value if math.isfinite(value) else None
 
 
-def others_count(infos: list[Any], own_name: str, own_namespace: str) -> int:
+def others_count(infos: list[TopicEndpointInfo], own_name: str, own_namespace: str) -> int:
     """Endpoints not belonging to this dashboard (its own taps would confuse a learner)."""
     return sum(1 for i in infos if (i.node_name, i.node_namespace) != (own_name, own_namespace))
 
@@ -92,13 +93,13 @@ class TopicsPanel:
         self._counts: dict[str, tuple[int, int]] = {}
         self._counts_at = 0.0
         self._topic: str | None = None
-        self._monitor: TopicMonitor | None = None
+        self._monitor: TopicMonitor[object] | None = None
         self._seen = 0
-        self._latest: deque[tuple[float, Any]] = deque(maxlen=SHOWN_MESSAGES)
+        self._latest: deque[tuple[float, object]] = deque(maxlen=SHOWN_MESSAGES)
         self._samples: deque[tuple[float, float]] = deque(maxlen=PLOT_SAMPLES)
         self._plot_dirty = False
         self._plot_path = ""
-        self._publisher: Any = None
+        self._publisher: Publisher | None = None
         self._timer: Timer | None = None
         self._sent = 0  # written only by the timer's callback (executor thread)
         self._pub_message = ""
@@ -194,7 +195,7 @@ class TopicsPanel:
 
     # --- publishing ------------------------------------------------------------
 
-    def _message(self) -> Any | None:
+    def _message(self) -> object | None:
         form = self._form_slot.form
         if form is None:
             return None
@@ -204,7 +205,7 @@ class TopicsPanel:
             self._pub_message = f"⚠️ {exc}"
             return None
 
-    def _ensure_publisher(self) -> Any:
+    def _ensure_publisher(self) -> Publisher | None:
         if self._publisher is None and self._monitor is not None:
             self._publisher = self._node.create_publisher(
                 self._monitor.msg_type, self._monitor.topic, 10
@@ -313,7 +314,7 @@ class TopicsPanel:
             set_options(self._selector, [NONE, *sorted(types)])
             self._select(self._selector.value)
 
-    def _take_fresh(self, monitor: TopicMonitor | None) -> list[tuple[float, Any]]:
+    def _take_fresh(self, monitor: TopicMonitor[object] | None) -> list[tuple[float, object]]:
         """New messages since the last refresh (at most KEEP), fed to echo and the plot."""
         if monitor is None or monitor.count == self._seen:
             return []
@@ -329,7 +330,12 @@ class TopicsPanel:
                     self._plot_dirty = True
         return fresh
 
-    def _show_topic(self, topic: str | None, monitor: TopicMonitor | None, fresh: list) -> None:
+    def _show_topic(
+        self,
+        topic: str | None,
+        monitor: TopicMonitor[object] | None,
+        fresh: list[tuple[float, object]],
+    ) -> None:
         if topic is None:
             self._info.show("_Pick a topic to echo, measure, plot or publish on it._")
             self._stats.show("")

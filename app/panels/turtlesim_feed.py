@@ -10,8 +10,6 @@ that asks it for a full snapshot), each turtle's pose, and its
 
 from __future__ import annotations
 
-from typing import Any
-
 from rcl_interfaces.msg import ParameterEvent
 from rclpy.node import Node
 from rclpy.publisher import Publisher
@@ -101,12 +99,13 @@ class TurtlesimFeed:
         )
         ctx = panel_context(node)
 
-        def work() -> list[Any]:
+        def work() -> list[object]:
             return [python_value(v) for v in get_values(ctx, sim, list(BACKGROUND))]
 
-        def done(values: list[Any]) -> None:
-            if self.sim == sim and all(isinstance(v, int) for v in values):
-                view.set_background((values[0], values[1], values[2]))
+        def done(values: list[object]) -> None:
+            channels = [v for v in values if isinstance(v, int)]
+            if self.sim == sim and len(channels) == len(values):
+                view.set_background((channels[0], channels[1], channels[2]))
 
         self._ui.run_job(work, done, lambda _text: None)
 

@@ -17,7 +17,7 @@ tab is shown, are left alone.
 from __future__ import annotations
 
 import json
-from typing import Any
+from collections.abc import Callable
 
 import viser
 from rclpy.node import Node
@@ -149,7 +149,7 @@ class TurtlesimPanel:
 
     # -- keys (viser's threads post; the UI thread publishes) ------------------
 
-    def _key_action(self, name: str) -> Any:
+    def _key_action(self, name: str) -> Callable[[], None]:
         return lambda: self._post_key(name)
 
     def _post_key(self, name: str) -> None:

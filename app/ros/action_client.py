@@ -13,9 +13,24 @@ for actions, until rclpy's own ``ActionClient`` does.
 from __future__ import annotations
 
 import threading
-from typing import Any
+from collections.abc import Callable
+from typing import Any, Protocol, cast
 
 from rclpy.action import ActionClient
+from rclpy.action.client import ClientGoalHandle
+from rclpy.node import Node
+from rclpy.task import Future
+from unique_identifier_msgs.msg import UUID
+
+from app.ros.convert import RosType
+
+
+class FeedbackMessage(Protocol):
+    """An action's feedback as its client gets it: the goal it is for, and the feedback."""
+
+    goal_id: UUID
+    feedback: object
+
 
 # What ``execute`` takes under the lock: the answers filed by sequence number.
 _ANSWERS = ("goal", "cancel", "result")
@@ -31,24 +46,31 @@ class ThreadSafeActionClient(ActionClient):
     def _rclpy(self) -> Any:
         return super()
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
+    def __init__(
+        self, node: Node, action_type: RosType, action_name: str, **kwargs: object
+    ) -> None:
         # Re-entrant: a feedback or done callback run inside ``execute`` may send again.
         self._requests_lock = threading.RLock()
-        self._rclpy.__init__(*args, **kwargs)
+        self._rclpy.__init__(node, action_type, action_name, **kwargs)
 
-    def send_goal_async(self, *args: Any, **kwargs: Any) -> Any:
+    def send_goal_async(
+        self,
+        goal: object,
+        feedback_callback: Callable[[FeedbackMessage], None] | None = None,
+        goal_uuid: UUID | None = None,
+    ) -> Future:
         with self._requests_lock:
-            return self._rclpy.send_goal_async(*args, **kwargs)
+            return cast(Future, self._rclpy.send_goal_async(goal, feedback_callback, goal_uuid))
 
-    def _cancel_goal_async(self, goal_handle: Any) -> Any:
+    def _cancel_goal_async(self, goal_handle: ClientGoalHandle) -> Future:
         with self._requests_lock:
-            return self._rclpy._cancel_goal_async(goal_handle)
+            return cast(Future, self._rclpy._cancel_goal_async(goal_handle))
 
-    def _get_result_async(self, goal_handle: Any) -> Any:
+    def _get_result_async(self, goal_handle: ClientGoalHandle) -> Future:
         with self._requests_lock:
-            return self._rclpy._get_result_async(goal_handle)
+            return cast(Future, self._rclpy._get_result_async(goal_handle))
 
-    async def execute(self, taken_data: dict[str, Any]) -> None:
+    async def execute(self, taken_data: dict[str, object]) -> None:
         answers = {key: taken_data.pop(key) for key in _ANSWERS if key in taken_data}
         if answers:
             # rclpy's handling of these three awaits nothing: the lock is never held

@@ -12,15 +12,17 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Protocol, cast
 
 from action_msgs.msg import GoalStatus
 from rclpy.action.client import ClientGoalHandle
 from rclpy.action.graph import get_action_names_and_types
+from rclpy.client import Client
 from rclpy.node import Node
 from rclpy.task import Future
+from unique_identifier_msgs.msg import UUID
 
-from app.ros.action_client import ThreadSafeActionClient
+from app.ros.action_client import FeedbackMessage, ThreadSafeActionClient
 from app.ros.context import CallContext
 from app.ros.convert import import_type, type_name
 from app.ros.errors import Cancelled, NoAnswer, Ros2Error
@@ -36,7 +38,7 @@ STATUS_NAMES = {
 }
 
 
-def wait_future(ctx: CallContext, future: Future, timeout: float, what: str) -> Any:
+def wait_future(ctx: CallContext, future: Future, timeout: float, what: str) -> object:
     """Block this (non-executor) thread until ``future`` is done, bounded and cancellable."""
     done = threading.Event()
     future.add_done_callback(lambda _f: done.set())
@@ -80,12 +82,14 @@ def call_service(
     ctx: CallContext,
     name: str,
     srv_type: type,
-    request: Any,
+    request: object,
     timeout: float | None = None,
     *,
     resend_unanswered: bool = False,
-) -> Any:
+) -> object:
     """Send one request and return the response, or raise one clear Ros2Error.
+
+    The response is a ``srv_type.Response``: the caller that reads it names that type.
 
     ``resend_unanswered``: for a request that is safe to repeat (a pure function, an
     absolute teleport), send it once more when no answer came. A new client's first
@@ -126,15 +130,15 @@ class GoalRun:
 
     action: str
     type_text: str
-    goal: Any
-    feedback: list[Any] = field(default_factory=list)
+    goal: object  # a Goal of the action's type, as are feedback and result below
+    feedback: list[object] = field(default_factory=list)
     status: str = "SENDING"
-    result: Any = None
+    result: object = None
     error: str | None = None
     goal_id: str = ""
     command: str = ""  # the equivalent `ros2 action send_goal ...` line
     done: threading.Event = field(default_factory=threading.Event)
-    _handle: Any = None
+    _handle: ClientGoalHandle | None = None
 
     @property
     def outcome(self) -> str:
@@ -149,13 +153,20 @@ class GoalRun:
             handle.cancel_goal_async()
 
 
+class _ResultResponse(Protocol):
+    """An action's GetResult response: the final status and the result."""
+
+    status: int
+    result: object
+
+
 GOAL_SETTLE_SEC = 0.5  # after a new action client finds its server (see send_goal)
 
 
 def send_goal(
     ctx: CallContext,
     run: GoalRun,
-    on_feedback: Callable[[Any], None] | None = None,
+    on_feedback: Callable[[object], None] | None = None,
     on_accepted: Callable[[GoalRun], None] | None = None,
 ) -> GoalRun:
     """Drive ``run`` to its end: accepted or rejected, feedback, final status and result."""
@@ -166,9 +177,9 @@ def send_goal(
     # Sent from this job's thread while the runtime spins in its own (see action_client).
     client = ThreadSafeActionClient(ctx.node, action_cls, run.action)
 
-    running_id: list[Any] = []  # the goal's id, once feedback proves it runs
+    running_id: list[UUID] = []  # the goal's id, once feedback proves it runs
 
-    def feedback_cb(message: Any) -> None:
+    def feedback_cb(message: FeedbackMessage) -> None:
         if not running_id:
             running_id.append(message.goal_id)
         run.feedback.append(message.feedback)
@@ -184,7 +195,9 @@ def send_goal(
         ctx.sleep(GOAL_SETTLE_SEC)
         future = client.send_goal_async(run.goal, feedback_callback=feedback_cb)
         try:
-            handle = wait_future(ctx, future, timeout, f"action server '{run.action}'")
+            handle = cast(
+                ClientGoalHandle, wait_future(ctx, future, timeout, f"action server '{run.action}'")
+            )
         except Ros2Error:
             if not running_id:
                 raise
@@ -200,11 +213,14 @@ def send_goal(
         run.status = "EXECUTING"
         if on_accepted:
             on_accepted(run)
-        response = wait_future(
-            ctx,
-            handle.get_result_async(),
-            ctx.limits.action_timeout,
-            f"action '{run.action}' (result)",
+        response = cast(
+            _ResultResponse,
+            wait_future(
+                ctx,
+                handle.get_result_async(),
+                ctx.limits.action_timeout,
+                f"action '{run.action}' (result)",
+            ),
         )
         run.status = STATUS_NAMES.get(response.status, str(response.status))
         run.result = response.result
@@ -237,10 +253,10 @@ class ServicePoller:
         self._node = node
         self._period = period
         self._lock = threading.Lock()
-        self._clients: dict[tuple[str, str], Any] = {}
-        self._calls: dict[str, tuple[Future | None, Any, float]] = {}
+        self._clients: dict[tuple[str, str], Client] = {}
+        self._calls: dict[str, tuple[Future | None, object, float]] = {}
 
-    def client(self, service: str, srv_type: type) -> Any:
+    def client(self, service: str, srv_type: type) -> Client:
         """One cached client per (service, type)."""
         with self._lock:
             key = (service, type_name(srv_type))
@@ -248,8 +264,11 @@ class ServicePoller:
                 self._clients[key] = self._node.create_client(srv_type, service)
             return self._clients[key]
 
-    def latest(self, key: str, service: str, srv_type: type, request: Any) -> Any:
-        """The newest response for ``key`` (None before the first); asks again when due."""
+    def latest(self, key: str, service: str, srv_type: type, request: object) -> object:
+        """The newest response for ``key`` (None before the first); asks again when due.
+
+        The response is a ``srv_type.Response``: the caller that reads it names that type.
+        """
         client = self.client(service, srv_type)
         with self._lock:
             future, result, sent_at = self._calls.get(key, (None, None, 0.0))
@@ -267,7 +286,7 @@ class ServicePoller:
             self._calls[key] = (future, result, sent_at)
             return result
 
-    def send(self, service: str, srv_type: type, request: Any) -> None:
+    def send(self, service: str, srv_type: type, request: object) -> None:
         """Fire one request and forget the answer (a step action)."""
         self.client(service, srv_type).call_async(request)
 

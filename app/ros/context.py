@@ -10,7 +10,6 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
 
 from rclpy.node import Node
 
@@ -47,8 +46,9 @@ class CallContext:
     limits: Limits = field(default_factory=Limits)
     cancel: threading.Event = field(default_factory=threading.Event)
     # What starts programs for `ros2 run` (the dashboard's supervisor, given by
-    # the Console); None on the command line. Untyped: the ROS layer knows no supervisor.
-    programs: Any = None
+    # the Console); None on the command line. Only ``object`` here: the ROS layer knows no
+    # supervisor (app.ros2cli.run.programs_of reads it as one).
+    programs: object = None
 
     def sleep(self, seconds: float) -> None:
         """Sleep that wakes up (and raises) when the call is cancelled."""

@@ -14,11 +14,13 @@ import importlib
 import math
 import re
 import time
-from typing import Any
+from collections.abc import Mapping, Sequence
+from typing import Any, ClassVar, NoReturn, Protocol, TypeGuard, TypeVar, cast
 
 import yaml
 from rosidl_parser import definition as idl
 
+from app.jsonish import JSON
 from app.ros.errors import Ros2Error
 
 KINDS = ("msg", "srv", "action")
@@ -26,6 +28,18 @@ KINDS = ("msg", "srv", "action")
 # Goal, SLOT_TYPES, get_fields_and_field_types) are made by rosidl at build
 # time, so the type checker cannot know them.
 RosType = Any
+M = TypeVar("M")  # the message a generated class makes (untyped, as the class is)
+
+
+class RosMessage(Protocol):
+    """A generated message: its class names its fields, their ROS types and rosidl types."""
+
+    SLOT_TYPES: ClassVar[tuple[idl.AbstractType, ...]]
+
+    @classmethod
+    def get_fields_and_field_types(cls) -> dict[str, str]: ...
+
+
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 
 _INT_RANGES = {
@@ -104,7 +118,7 @@ def _looks_generated(cls: type, kind: str) -> bool:
     return hasattr(cls, "Goal") and hasattr(cls, "Result") and hasattr(cls, "Feedback")
 
 
-def is_message(value: Any) -> bool:
+def is_message(value: object) -> TypeGuard[RosMessage]:
     return hasattr(type(value), "get_fields_and_field_types") and hasattr(value, "__slots__")
 
 
@@ -112,7 +126,7 @@ def _nested_class(slot: idl.NamespacedType) -> RosType:
     return import_type("/".join([*slot.namespaces, slot.name]))
 
 
-def fields_of(cls: RosType) -> list[tuple[str, str, Any]]:
+def fields_of(cls: RosType) -> list[tuple[str, str, idl.AbstractType]]:
     """(name, ros type text, rosidl slot type) for every field of a message class."""
     names = list(cls.get_fields_and_field_types().items())
     return [(n, t, slot) for (n, t), slot in zip(names, cls.SLOT_TYPES, strict=True)]
@@ -121,7 +135,7 @@ def fields_of(cls: RosType) -> list[tuple[str, str, Any]]:
 # ------------------------------------------------------------ message -> dict
 
 
-def to_plain(value: Any, *, max_items: int | None = None) -> Any:
+def to_plain(value: object, *, max_items: int | None = None) -> JSON:
     """A message (or any field value) as plain Python: dicts, lists, numbers, text."""
     if is_message(value):
         return {
@@ -139,10 +153,10 @@ def to_plain(value: Any, *, max_items: int | None = None) -> Any:
         if max_items is not None and len(value) > max_items:
             items.append(f"... ({len(value) - max_items} more)")
         return items
-    return value
+    return cast(JSON, value)  # what is left of a message field: a number, text, a bool
 
 
-def to_yaml(msg: Any, *, max_items: int | None = 32) -> str:
+def to_yaml(msg: object, *, max_items: int | None = 32) -> str:
     """A message as YAML (lists of numbers inline, to stay short), without the --- line."""
     plain = to_plain(msg, max_items=max_items)
     if not plain:
@@ -154,7 +168,7 @@ class _Dumper(yaml.SafeDumper):  # type: ignore[misc]  # PyYAML ships no types
     """Block-style mappings (as ros2 prints them), lists of plain values on one line."""
 
 
-def _represent_list(dumper: yaml.SafeDumper, data: list[Any]) -> Any:
+def _represent_list(dumper: yaml.SafeDumper, data: list[object]) -> yaml.SequenceNode:
     flat = all(not isinstance(v, dict | list) for v in data)
     return dumper.represent_sequence("tag:yaml.org,2002:seq", data, flow_style=flat)
 
@@ -162,12 +176,12 @@ def _represent_list(dumper: yaml.SafeDumper, data: list[Any]) -> Any:
 _Dumper.add_representer(list, _represent_list)
 
 
-def dump_yaml(value: Any) -> str:
+def dump_yaml(value: object) -> str:
     text = yaml.dump(value, Dumper=_Dumper, sort_keys=False, default_flow_style=False, width=100)
     return str(text).rstrip()
 
 
-def field_value(msg: Any, path: str) -> Any:
+def field_value(msg: object, path: str) -> object:
     """The value at 'a.b.c' (or 'a.b[2]'), as `ros2 topic echo --field` selects it."""
     current = msg
     for part in [p for p in path.strip().split(".") if p]:
@@ -180,20 +194,20 @@ def field_value(msg: Any, path: str) -> Any:
         current = getattr(current, name)
         for index in re.findall(r"\[(\d+)\]", indexes):
             try:
-                current = current[int(index)]
+                current = cast("Sequence[object]", current)[int(index)]
             except (IndexError, TypeError):
                 raise ConversionError(f"index {index} out of range in '{path}'") from None
     return current
 
 
-def _describe_msg(value: Any) -> str:
+def _describe_msg(value: object) -> str:
     return type_name(type(value)) if is_message(value) else f"a {type(value).__name__}"
 
 
 # ------------------------------------------------------------ dict -> message
 
 
-def parse_yaml(text: str | None) -> dict[str, Any]:
+def parse_yaml(text: str | None) -> dict[str, object]:
     """YAML (or JSON) text from a learner -> a mapping; empty text is {}."""
     if text is None or not text.strip():
         return {}
@@ -213,11 +227,11 @@ def parse_yaml(text: str | None) -> dict[str, Any]:
     return data
 
 
-def from_yaml(cls: type, text: str | None) -> Any:
+def from_yaml(cls: type[M], text: str | None) -> M:
     return fill(cls, parse_yaml(text))
 
 
-def fill(cls: type, data: dict[str, Any] | None, path: str = "") -> Any:
+def fill(cls: type[M], data: Mapping[str, object] | None, path: str = "") -> M:
     """A new ``cls`` message with the fields named in ``data`` set (others default)."""
     msg = cls()
     if data is None:
@@ -252,7 +266,7 @@ def _at(path: str) -> str:
     return f"field '{path}': " if path else ""
 
 
-def _kind_of(value: Any) -> str:
+def _kind_of(value: object) -> str:
     if isinstance(value, bool):
         return f"a boolean ({value})"
     if isinstance(value, int):
@@ -271,11 +285,11 @@ def _kind_of(value: Any) -> str:
     return f"a {type(value).__name__}"
 
 
-def _wrong(path: str, ros_type: str, value: Any, expected: str) -> ConversionError:
+def _wrong(path: str, ros_type: str, value: object, expected: str) -> ConversionError:
     return ConversionError(f"field '{path}' ({ros_type}) expects {expected}, got {_kind_of(value)}")
 
 
-def _coerce(slot: Any, ros_type: str, value: Any, path: str) -> Any:
+def _coerce(slot: idl.AbstractType, ros_type: str, value: object, path: str) -> object:
     if isinstance(slot, idl.NamespacedType):
         cls = _nested_class(slot)
         if type_name(cls) == "builtin_interfaces/msg/Time" and value == "now":
@@ -317,11 +331,11 @@ def _coerce(slot: Any, ros_type: str, value: Any, path: str) -> Any:
     raise ConversionError(f"field '{path}' has a type this tool cannot fill ({ros_type})")
 
 
-def _is_byte_like(slot: Any) -> bool:
+def _is_byte_like(slot: idl.AbstractType) -> bool:
     return isinstance(slot, idl.BasicType) and slot.typename in ("octet", "uint8", "char")
 
 
-def _coerce_basic(typename: str, ros_type: str, value: Any, path: str) -> Any:
+def _coerce_basic(typename: str, ros_type: str, value: object, path: str) -> object:
     if typename == "boolean":
         if not isinstance(value, bool):
             raise _wrong(path, ros_type, value, "true or false")
@@ -364,7 +378,7 @@ def _coerce_basic(typename: str, ros_type: str, value: Any, path: str) -> Any:
     raise ConversionError(f"field '{path}' has a type this tool cannot fill ({ros_type})")
 
 
-def _raise(exc: Exception) -> Any:
+def _raise(exc: Exception) -> NoReturn:
     raise exc
 
 
@@ -398,7 +412,7 @@ def leaf_fields(cls: type, prefix: str = "", depth: int = 0) -> list[tuple[str, 
     return out
 
 
-def value_from_text(kind: str, text: str) -> Any:
+def value_from_text(kind: str, text: str) -> object:
     """Interpret what a learner typed into one generated form field."""
     if kind == "text":
         return text
@@ -429,24 +443,24 @@ def value_from_text(kind: str, text: str) -> Any:
     raise ConversionError(f"unknown form field kind {kind!r}")
 
 
-def nest(flat: dict[str, Any]) -> dict[str, Any]:
+def nest(flat: Mapping[str, object]) -> dict[str, object]:
     """{'linear.x': 1} -> {'linear': {'x': 1}}; None values are left out."""
-    out: dict[str, Any] = {}
+    out: dict[str, object] = {}
     for path, value in flat.items():
         if value is None:
             continue
         parts = path.split(".")
         target = out
         for part in parts[:-1]:
-            target = target.setdefault(part, {})
+            target = cast("dict[str, object]", target.setdefault(part, {}))
         target[parts[-1]] = value
     return out
 
 
-def fill_from_form(cls: type, values: dict[str, Any]) -> Any:
+def fill_from_form(cls: type[M], values: Mapping[str, object]) -> M:
     """A message from generated form values (already typed or raw text)."""
     kinds = {path: kind for path, _t, kind in leaf_fields(cls)}
-    typed: dict[str, Any] = {}
+    typed: dict[str, object] = {}
     for path, value in values.items():
         if path not in kinds:
             raise ConversionError(f"unknown field '{path}' in {type_name(cls)}")
@@ -459,12 +473,12 @@ def fill_from_form(cls: type, values: dict[str, Any]) -> Any:
     return fill(cls, nest(typed))
 
 
-def message_repr(msg: Any) -> str:
+def message_repr(msg: object) -> str:
     """ros2cli's one-line form: 'std_msgs.msg.String(data=...)'."""
     return repr(msg)
 
 
-def yaml_inline(msg: Any) -> str:
+def yaml_inline(msg: object) -> str:
     """A message as '{a: 1, b: 2}', quoted for the equivalent ros2 command line."""
     text = str(yaml.safe_dump(to_plain(msg), default_flow_style=True, width=10_000)).strip()
     return "'" + text.replace("'", "'\"'\"'") + "'"

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import cast
 
 from lifecycle_msgs.msg import Transition
 from lifecycle_msgs.srv import ChangeState, GetAvailableTransitions, GetState
@@ -48,14 +49,17 @@ def lifecycle_target(ctx: CallContext, fqn: str) -> str:
 
 
 def get_state(ctx: CallContext, fqn: str) -> tuple[int, str]:
-    response = call_service(ctx, f"{fqn}/get_state", GetState, GetState.Request())
+    response = cast(
+        GetState.Response, call_service(ctx, f"{fqn}/get_state", GetState, GetState.Request())
+    )
     return response.current_state.id, response.current_state.label
 
 
 def available_transitions(ctx: CallContext, fqn: str) -> list[TransitionInfo]:
     request = GetAvailableTransitions.Request()
-    response = call_service(
-        ctx, f"{fqn}/get_available_transitions", GetAvailableTransitions, request
+    response = cast(
+        GetAvailableTransitions.Response,
+        call_service(ctx, f"{fqn}/get_available_transitions", GetAvailableTransitions, request),
     )
     return [
         TransitionInfo(t.transition.id, t.transition.label, t.start_state.label, t.goal_state.label)
@@ -75,7 +79,9 @@ def change_state(ctx: CallContext, fqn: str, transition: str) -> tuple[bool, Tra
             f"available: {labels}"
         )
     request = ChangeState.Request(transition=Transition(id=chosen.id, label=chosen.label))
-    response = call_service(ctx, f"{fqn}/change_state", ChangeState, request)
+    response = cast(
+        ChangeState.Response, call_service(ctx, f"{fqn}/change_state", ChangeState, request)
+    )
     return bool(response.success), chosen
 
 

@@ -20,9 +20,9 @@ import threading
 import time
 from bisect import bisect_left
 from collections import deque
-from collections.abc import Hashable, Iterator, Sequence
+from collections.abc import Hashable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Generic, TypedDict, TypeVar
 
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
@@ -34,6 +34,19 @@ from app.ros.qos import matching_qos
 # clock (ns, 0 when unknown), its sequence number (None when unknown), and the
 # writer it came from (None when the middleware does not say).
 Sample = tuple[float, int, int, int | None, Hashable | None]
+
+M = TypeVar("M")  # the topic's messages (their generated class is untyped)
+
+
+class MessageInfo(TypedDict, total=False):
+    """What rclpy hands a raw subscription's callback with each message (rmw's message info)."""
+
+    source_timestamp: int  # ns, the publisher's clock
+    received_timestamp: int  # ns, ours
+    publication_sequence_number: int  # per writer
+    reception_sequence_number: int
+    publisher_gid: Mapping[str, Hashable]  # the writer ("data"); not in Jazzy's rclpy
+
 
 # More breaks than this in one writer's sequence numbers within a window is
 # not a publisher restarting: several publishers interleave.
@@ -293,7 +306,7 @@ def _arrival(sample: Sample) -> float:
     return sample[0]
 
 
-class TopicMonitor:
+class TopicMonitor(Generic[M]):
     """One raw subscription: arrival stamps, sizes, publisher info, and the last few messages.
 
     The subscription callback (executor thread) is the single writer; readers
@@ -304,7 +317,7 @@ class TopicMonitor:
         self,
         node: Node,
         topic: str,
-        msg_type: type,
+        msg_type: type[M],
         *,
         window: int = 10_000,
         keep: int = 100,
@@ -335,7 +348,7 @@ class TopicMonitor:
             raw=True,
         )
 
-    def _on_message(self, data: bytes, info: dict[str, Any]) -> None:
+    def _on_message(self, data: bytes, info: MessageInfo) -> None:
         now = time.monotonic()
         gid = info.get("publisher_gid")  # not in Jazzy's rclpy; newer ones name the writer
         sample = (
@@ -364,14 +377,14 @@ class TopicMonitor:
         with self._cond:
             return self._cond.wait_for(lambda: self.count >= count, timeout)
 
-    def message(self, index_from_end: int = 1) -> tuple[float, Any] | None:
+    def message(self, index_from_end: int = 1) -> tuple[float, M] | None:
         with self._cond:
             if len(self._recent) < index_from_end:
                 return None
             stamp, data, _seq = self._recent[-index_from_end]
         return stamp, deserialize_message(data, self.msg_type)
 
-    def recent(self, last: int | None = None) -> list[tuple[float, Any]]:
+    def recent(self, last: int | None = None) -> list[tuple[float, M]]:
         """The newest ``last`` kept messages (all kept ones for None), oldest first."""
         with self._cond:
             raw = list(self._recent)
@@ -379,7 +392,7 @@ class TopicMonitor:
             raw = raw[-last:] if last > 0 else []
         return [(stamp, deserialize_message(data, self.msg_type)) for stamp, data, _ in raw]
 
-    def sequenced(self, last: int) -> list[tuple[int | None, Any]]:
+    def sequenced(self, last: int) -> list[tuple[int | None, M]]:
         """The newest ``last`` kept messages with the publisher's sequence number (None when
         the middleware does not give it), oldest first: a check that reads a message's own
         stamps counts the messages the publisher sent between them."""
@@ -392,7 +405,7 @@ class TopicMonitor:
         """How many messages are kept to look back on."""
         return self._recent.maxlen or 0
 
-    def newest(self) -> Iterator[tuple[float, Any]]:
+    def newest(self) -> Iterator[tuple[float, M]]:
         """Kept messages newest first, each deserialised only when reached."""
         with self._cond:
             raw = list(self._recent)
@@ -406,7 +419,7 @@ class TopicMonitor:
         stats = self.published_rate(window_sec)
         return stats.rate if stats else None
 
-    def messages_since(self, count_before: int) -> list[tuple[float, Any]]:
+    def messages_since(self, count_before: int) -> list[tuple[float, M]]:
         """Messages that arrived after the total count was ``count_before`` (as kept)."""
         with self._cond:
             fresh = min(self.count - count_before, len(self._recent))

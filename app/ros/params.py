@@ -7,10 +7,10 @@ Conversion between ``ParameterValue`` and plain Python lives here once; the
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, cast
 
 import yaml
-from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
+from rcl_interfaces.msg import Parameter, ParameterDescriptor, ParameterType, ParameterValue
 from rcl_interfaces.srv import (
     DescribeParameters,
     GetParameters,
@@ -49,7 +49,10 @@ TYPE_NAMES = {
 
 
 def python_value(value: ParameterValue) -> Any:
-    """A ParameterValue as plain Python (None when not set)."""
+    """A ParameterValue as plain Python (None when not set).
+
+    Untyped on purpose, not a union: callers check the kind they expect and use it.
+    """
     entry = TYPE_WORDS.get(value.type)
     if entry is None:
         return None
@@ -61,7 +64,7 @@ def python_value(value: ParameterValue) -> Any:
     return raw
 
 
-def parameter_value(value: Any) -> ParameterValue:
+def parameter_value(value: object) -> ParameterValue:
     """Plain Python -> ParameterValue, with the type inferred as `ros2 param set` does."""
     out = ParameterValue()
     if isinstance(value, bool):
@@ -90,7 +93,7 @@ def parameter_value(value: Any) -> ParameterValue:
     return out
 
 
-def parse_value(text: str) -> Any:
+def parse_value(text: str) -> object:
     """'5' -> 5, 'true' -> True, '[1, 2]' -> [1, 2], anything else stays text."""
     try:
         value = yaml.safe_load(text)
@@ -107,50 +110,61 @@ def _service(fqn: str, suffix: str) -> str:
 
 def list_names(ctx: CallContext, fqn: str) -> list[str]:
     request = ListParameters.Request()
-    response = call_service(ctx, _service(fqn, "list_parameters"), ListParameters, request)
+    response = cast(
+        ListParameters.Response,
+        call_service(ctx, _service(fqn, "list_parameters"), ListParameters, request),
+    )
     return sorted(response.result.names)
 
 
 def get_values(ctx: CallContext, fqn: str, names: list[str]) -> list[ParameterValue]:
     request = GetParameters.Request(names=names)
-    return list(call_service(ctx, _service(fqn, "get_parameters"), GetParameters, request).values)
+    response = cast(
+        GetParameters.Response,
+        call_service(ctx, _service(fqn, "get_parameters"), GetParameters, request),
+    )
+    return list(response.values)
 
 
-def describe(ctx: CallContext, fqn: str, names: list[str]) -> list[Any]:
+def describe(ctx: CallContext, fqn: str, names: list[str]) -> list[ParameterDescriptor]:
     request = DescribeParameters.Request(names=names)
-    response = call_service(ctx, _service(fqn, "describe_parameters"), DescribeParameters, request)
+    response = cast(
+        DescribeParameters.Response,
+        call_service(ctx, _service(fqn, "describe_parameters"), DescribeParameters, request),
+    )
     return list(response.descriptors)
 
 
-def set_request(name: str, value: Any) -> SetParameters.Request:
+def set_request(name: str, value: object) -> SetParameters.Request:
     """A request that sets one parameter, its type inferred as `ros2 param set` does."""
     return SetParameters.Request(parameters=[Parameter(name=name, value=parameter_value(value))])
 
 
-def set_value(ctx: CallContext, fqn: str, name: str, value: Any) -> tuple[bool, str]:
+def set_value(ctx: CallContext, fqn: str, name: str, value: object) -> tuple[bool, str]:
     """(successful, reason) as the node answered."""
-    response = call_service(
-        ctx, _service(fqn, "set_parameters"), SetParameters, set_request(name, value)
+    response = cast(
+        SetParameters.Response,
+        call_service(ctx, _service(fqn, "set_parameters"), SetParameters, set_request(name, value)),
     )
     result = response.results[0]
     return bool(result.successful), result.reason
 
 
-def dump_dict(ctx: CallContext, fqn: str) -> dict[str, Any]:
+def dump_dict(ctx: CallContext, fqn: str) -> dict[str, object]:
     target = require_node(ctx, fqn)
     names = list_names(ctx, target)
     values = get_values(ctx, target, names) if names else []
-    params: dict[str, Any] = {}
+    params: dict[str, object] = {}
     for name, value in zip(names, values, strict=False):
         node = params
         parts = name.split(".")
         for part in parts[:-1]:
-            node = node.setdefault(part, {})
+            node = cast("dict[str, object]", node.setdefault(part, {}))
         node[parts[-1]] = python_value(value)
     return {target: {"ros__parameters": params}}
 
 
-def same_value(actual: Any, expected: Any) -> bool:
+def same_value(actual: object, expected: object) -> bool:
     """Equality as a learner means it: 5 equals 5.0, floats compare with a tolerance."""
     numbers = (int, float)
     if isinstance(actual, bool) or isinstance(expected, bool):

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
 
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
@@ -53,10 +52,10 @@ def suit_publishers(
 def qos_lines(qos: QoSProfile) -> list[str]:
     """A profile as `ros2 topic info -v` prints it."""
 
-    def policy(value: Any) -> str:
-        return getattr(value, "name", str(value)).upper()
+    def policy(value: object) -> str:
+        return str(getattr(value, "name", value)).upper()
 
-    def duration(value: Any) -> str:
+    def duration(value: object) -> str:
         nanos = getattr(value, "nanoseconds", 0)
         return "Infinite" if nanos == 0 or nanos >= 2**63 - 1 else f"{nanos} nanoseconds"
 

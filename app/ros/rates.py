@@ -12,7 +12,6 @@ import logging
 import threading
 import time
 from collections.abc import Callable
-from typing import Any
 
 from rclpy.node import Node
 
@@ -86,7 +85,7 @@ class RateBoard:
         self._node = node
         self._limit = limit
         self._lock = threading.Lock()
-        self._monitors: dict[str, tuple[str, TopicMonitor]] = {}
+        self._monitors: dict[str, tuple[str, TopicMonitor[object]]] = {}
 
     def watch(self, topics: dict[str, str]) -> None:
         """Measure exactly these topics (name -> type), at most ``limit`` of them."""
@@ -119,7 +118,7 @@ class RateBoard:
             return None
         return steady_rate(entry[1].rate_hz, window_sec)  # as published, not as received
 
-    def latest(self, topic: str) -> tuple[float, Any] | None:
+    def latest(self, topic: str) -> tuple[float, object] | None:
         """The newest message of a watched topic with its arrival time (monotonic), or None."""
         with self._lock:
             entry = self._monitors.get(topic)
@@ -165,7 +164,7 @@ class SharedRates:
     def rate(self, topic: str, window_sec: float = RATE_WINDOW_SEC) -> float | None:
         return self._board.rate(topic, window_sec)
 
-    def latest(self, topic: str) -> tuple[float, Any] | None:
+    def latest(self, topic: str) -> tuple[float, object] | None:
         return self._board.latest(topic)
 
     def watched(self) -> list[str]:
@@ -189,7 +188,7 @@ class SharedRatesClient:
     def rate(self, topic: str, window_sec: float = RATE_WINDOW_SEC) -> float | None:
         return self._shared.rate(topic, window_sec)
 
-    def latest(self, topic: str) -> tuple[float, Any] | None:
+    def latest(self, topic: str) -> tuple[float, object] | None:
         return self._shared.latest(topic)
 
     def watched(self) -> list[str]:

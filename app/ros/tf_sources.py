@@ -36,16 +36,20 @@ import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING
 
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
+from rclpy.subscription import Subscription
 from tf2_msgs.msg import TFMessage
 from tf2_ros._wire import Entry, decode_tf_message
 from tf2_ros.buffer import Buffer
 
 from app.ros.names import node_fqn
+
+if TYPE_CHECKING:
+    from geometry_msgs.msg import TransformStamped
 
 log = logging.getLogger(__name__)
 
@@ -129,7 +133,7 @@ def _loaded_library(name: str) -> str:
     raise OSError(f"{name} is not loaded")
 
 
-def _entry(t: Any) -> Entry:
+def _entry(t: TransformStamped) -> Entry:
     """A TransformStamped as the fields tf2_ros._wire reads."""
     v, r, stamp = t.transform.translation, t.transform.rotation, t.header.stamp
     return (
@@ -168,7 +172,7 @@ class RclTaker:
         if rcutils.rcutils_uint8_array_init(ctypes.byref(self._bytes), 4096, self._allocator):
             raise OSError("could not allocate a buffer for serialized messages")
 
-    def take(self, subscription: Any) -> tuple[bytes, bytes] | None:
+    def take(self, subscription: Subscription) -> tuple[bytes, bytes] | None:
         with subscription.handle:  # the handle stays alive while rcl uses it
             ret = self._rcl.rcl_take_serialized_message(
                 subscription.handle.pointer, ctypes.byref(self._bytes), self._info, None
@@ -187,7 +191,7 @@ class RclTaker:
 class RclpyTaker:
     """The fallback: rclpy's take, which has no GID."""
 
-    def take(self, subscription: Any) -> tuple[bytes, bytes] | None:
+    def take(self, subscription: Subscription) -> tuple[bytes, bytes] | None:
         with subscription.handle:
             got = subscription.handle.take_message(TFMessage, True)
         if got is None:
@@ -312,7 +316,7 @@ class TfSources:
                 except Exception:  # a bad sample or a closing context: keep the panel going
                     log.exception("TF panel: taking %s failed", subscription.topic_name)
 
-    def _drain(self, subscription: Any, static: bool) -> bool:
+    def _drain(self, subscription: Subscription, static: bool) -> bool:
         """Take and read what waits; whether anything did."""
         took = False
         for _ in range(MAX_TAKES):

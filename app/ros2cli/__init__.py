@@ -8,12 +8,15 @@ ros2cli itself is not installable from PyPI.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # their types, for the type checker; imported on first use below
+    from app.ros2cli.parser import GROUPS, UsageError, run_argv, run_text, split_command
 
 __all__ = ["GROUPS", "UsageError", "run_argv", "run_text", "split_command"]
 
 
-def __getattr__(name: str) -> Any:
+def __getattr__(name: str) -> object:
     """The parser's names, imported on first use: ``app.ros2cli.groups`` stays cheap."""
     if name in __all__:
         from app.ros2cli import parser

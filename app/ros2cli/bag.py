@@ -18,7 +18,7 @@ import functools
 import threading
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import ParamSpec
 
 from app.bags.errors import BagError
 from app.bags.folder import existing_path, output_path
@@ -28,16 +28,19 @@ from app.bags.recorder import COMPRESSION_MODES, STORAGES, SUBSCRIBED, Recorder
 from app.bags.repair import reindex
 from app.ros.context import CallContext
 from app.ros.errors import Cancelled
+from app.ros2cli.common import Commands, Verb
+
+P = ParamSpec("P")
 
 CONSOLE_CAP_SEC = 600.0  # the browser's longest recording or playback
 PROGRESS_EVERY_SEC = 5.0
 
 
-def _disk_errors_as_one_line(verb: Callable[..., int]) -> Callable[..., int]:
+def _disk_errors_as_one_line(verb: Callable[P, int]) -> Callable[P, int]:
     """A folder we may not write or a file we may not read: one line, not a traceback."""
 
     @functools.wraps(verb)
-    def wrapped(*args: Any, **kwargs: Any) -> int:
+    def wrapped(*args: P.args, **kwargs: P.kwargs) -> int:
         try:
             return verb(*args, **kwargs)
         except OSError as exc:
@@ -208,10 +211,7 @@ def reindex_verb(ctx: CallContext, path: str) -> int:
     return 0
 
 
-Verb = Callable[[Any, str, str, Callable[[CallContext, argparse.Namespace], int]], Any]
-
-
-def add_verbs(verbs: Any, verb: Verb) -> None:
+def add_verbs(verbs: Commands, verb: Verb) -> None:
     """The `ros2 bag ...` verbs, registered on the parser's `bag` group."""
     p = verb(
         verbs,

@@ -3,8 +3,11 @@ letting a brand-new node see the graph."""
 
 from __future__ import annotations
 
+import argparse
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Protocol
 
 from rclpy.topic_or_service_is_hidden import topic_or_service_is_hidden
 
@@ -13,6 +16,30 @@ from app.ros.convert import ConversionError, RosType, import_type
 from app.ros.errors import Ros2Error
 
 MIN_DISCOVERY_SEC = 1.5
+
+# What a verb does with its parsed arguments: its exit code.
+Handler = Callable[[CallContext, argparse.Namespace], int]
+
+
+class Commands(Protocol):
+    """A "Commands:" table (argparse's sub-parsers, made by ``parser.commands``).
+
+    Its parsers raise instead of exiting and print through ``write``.
+    """
+
+    def add_parser(
+        self,
+        name: str,
+        *,
+        help: str | None = ...,
+        description: str | None = ...,
+        formatter_class: type[argparse.HelpFormatter] = ...,
+        write: Write,
+    ) -> argparse.ArgumentParser: ...
+
+
+# The parser's helper that adds one verb to a group: (group, name, description, handler).
+Verb = Callable[[Commands, str, str, Handler], argparse.ArgumentParser]
 
 
 class Ros2cliMessage(Ros2Error):

@@ -9,7 +9,6 @@ are bounded here: a few messages or seconds, and a Stop button.
 from __future__ import annotations
 
 import threading
-from typing import Any
 
 import viser
 from rclpy.node import Node
@@ -17,6 +16,7 @@ from rclpy.node import Node
 from app.ros.context import CONSOLE_LIMITS, CallContext
 from app.ros.graph import GraphSnapshot
 from app.ros2cli.parser import run_text
+from app.ros2cli.run import Programs
 from app.ros2cli.workspace_files import WorkspaceFiles
 from app.ui import MarkdownView, code_block
 from app.ui.loop import UiLoop
@@ -46,7 +46,9 @@ class _Output:
 
 
 class ConsolePanel:
-    def __init__(self, gui: viser.GuiApi, ui: UiLoop, node: Node, programs: Any = None) -> None:
+    def __init__(
+        self, gui: viser.GuiApi, ui: UiLoop, node: Node, programs: Programs | None = None
+    ) -> None:
         self._ui = ui
         self._node = node
         self._programs = programs  # the supervisor: `ros2 run` starts catalog nodes through it

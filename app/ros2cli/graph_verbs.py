@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import threading
 import time
-from typing import Any
+from typing import cast
 
 from rclpy.action import (
     get_action_client_names_and_types_by_node,
@@ -26,7 +26,7 @@ from app.ros.calls import (
     wait_future,
 )
 from app.ros.context import CallContext
-from app.ros.convert import from_yaml, message_repr
+from app.ros.convert import RosMessage, from_yaml, message_repr
 from app.ros.errors import Cancelled
 from app.ros.graph import all_nodes, wait_for_graph
 from app.ros.names import split_node_name
@@ -225,10 +225,10 @@ def action_info(ctx: CallContext, name: str, show_types: bool = False, count: bo
     return 0
 
 
-def write_message_block(ctx: CallContext, title: str, msg: Any, indent: int) -> None:
+def write_message_block(ctx: CallContext, title: str, msg: object, indent: int) -> None:
     """ros2cli's "Title:\n<indent><yaml>": only the YAML's first line is indented."""
     ctx.write(f"{title}:")
-    write_text(ctx, " " * indent + message_to_yaml(msg))
+    write_text(ctx, " " * indent + message_to_yaml(cast(RosMessage, msg)))  # a goal, ...
 
 
 def action_send_goal(
@@ -258,7 +258,7 @@ def action_send_goal(
             ctx.write(f"Goal accepted with ID: {run.goal_id}")
             ctx.write("")
 
-    def on_feedback(message: Any) -> None:
+    def on_feedback(message: object) -> None:
         if feedback:
             with lock:
                 write_message_block(ctx, "Feedback", message, 4)

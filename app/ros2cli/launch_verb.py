@@ -21,10 +21,10 @@ from __future__ import annotations
 import argparse
 import re
 from pathlib import Path
-from typing import Any
 
-from app.ros.context import CallContext
+from app.ros.context import CallContext, Write
 from app.ros.errors import Ros2Error
+from app.ros2cli.common import Commands
 from app.ros2cli.run import Programs, programs_of
 
 _ARGUMENT = re.compile(r"^[A-Za-z_][\w.-]*:=[^\n\x00]*$")
@@ -139,7 +139,7 @@ def stop(ctx: CallContext, package: str, launch_file: str) -> int:
     return 0
 
 
-def add_command(groups: Any, write: Any) -> None:
+def add_command(groups: Commands, write: Write) -> None:
     """Register `launch` on the parser's sub-command table (parser.build_parser)."""
     p = groups.add_parser(
         "launch", help="run a launch file: ros2 launch PACKAGE FILE [name:=value ...]", write=write

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import cast
+
 from lifecycle_msgs.srv import GetAvailableTransitions
 
 from app.ros.calls import call_service
@@ -48,11 +50,14 @@ def verb_get(ctx: CallContext, fqn: str | None = None, include_hidden: bool = Fa
 def verb_list(ctx: CallContext, fqn: str, include_hidden: bool = False, all_: bool = False) -> int:
     target = _target(ctx, fqn, include_hidden)
     if all_:  # every transition of the state machine, not only those from here
-        response = call_service(
-            ctx,
-            f"{target}/get_transition_graph",
-            GetAvailableTransitions,
-            GetAvailableTransitions.Request(),
+        response = cast(
+            GetAvailableTransitions.Response,
+            call_service(
+                ctx,
+                f"{target}/get_transition_graph",
+                GetAvailableTransitions,
+                GetAvailableTransitions.Request(),
+            ),
         )
         rows = [
             (t.transition.label, t.transition.id, t.start_state.label, t.goal_state.label)

@@ -12,15 +12,19 @@ from __future__ import annotations
 
 import array
 import sys
-from typing import Any
+from collections.abc import Collection
+from typing import cast
 
 import yaml
 from rosidl_parser import definition as idl
 
-from app.ros.convert import is_message
+from app.ros.convert import RosMessage, is_message
 
 # `ros2 topic echo` cuts arrays, bytes and strings after this many items.
 ECHO_TRUNCATE_LENGTH = 128
+
+# An array or sequence field: a list, tuple, array.array or numpy array.
+_Array = Collection[object]
 
 
 class _BlockDumper(yaml.SafeDumper):
@@ -42,7 +46,7 @@ def _cut(text: str, limit: int | None) -> str:
     return text[:limit] + "..." if limit is not None and len(text) > limit else text
 
 
-def _type_name(value_type: Any) -> str:
+def _type_name(value_type: idl.AbstractType) -> str:
     if isinstance(value_type, idl.BasicType):
         return str(value_type.typename)
     if isinstance(value_type, idl.AbstractWString):
@@ -56,7 +60,7 @@ def _type_name(value_type: Any) -> str:
     return "unknown"
 
 
-def array_summary(value: Any, field_type: Any) -> str:
+def array_summary(value: _Array, field_type: idl.AbstractNestedType) -> str:
     """What `--no-arr` prints instead of an array or sequence field."""
     name = _type_name(field_type.value_type)
     if isinstance(field_type, idl.Array):
@@ -69,13 +73,13 @@ def array_summary(value: Any, field_type: Any) -> str:
 
 
 def plain_value(
-    value: Any,
+    value: object,
     limit: int | None = None,
     *,
-    field_type: Any = None,
+    field_type: idl.AbstractType | None = None,
     no_arr: bool = False,
     no_str: bool = False,
-) -> Any:
+) -> object:
     """One field value as ros2cli turns it into YAML data (bytes become text, arrays lists)."""
     if isinstance(value, bytes | bytearray):
         return _cut("".join(chr(b) for b in value), limit)
@@ -84,13 +88,14 @@ def plain_value(
     if isinstance(value, list | tuple | array.array) or (
         hasattr(value, "tolist") and hasattr(value, "shape") and value.shape != ()
     ):
+        sequence = cast(_Array, value)
         if no_arr and field_type is not None:
-            return array_summary(value, field_type)
+            return array_summary(sequence, field_type)
         items = [
             plain_value(v, limit, no_arr=no_arr, no_str=no_str)
-            for v in list(value)[: limit if limit is not None else None]
+            for v in list(sequence)[: limit if limit is not None else None]
         ]
-        if limit is not None and len(value) > limit:
+        if limit is not None and len(sequence) > limit:
             items.append("...")
         return items
     if hasattr(value, "item") and not isinstance(value, bool | int | float):
@@ -101,8 +106,8 @@ def plain_value(
 
 
 def message_to_plain(
-    msg: Any, limit: int | None = None, *, no_arr: bool = False, no_str: bool = False
-) -> dict[str, Any]:
+    msg: RosMessage, limit: int | None = None, *, no_arr: bool = False, no_str: bool = False
+) -> dict[str, object]:
     """A message as an ordered dict of plain values, in the order its definition gives."""
     return {
         name: plain_value(getattr(msg, name), limit, field_type=slot, no_arr=no_arr, no_str=no_str)
@@ -111,7 +116,7 @@ def message_to_plain(
 
 
 def message_to_yaml(
-    msg: Any,
+    msg: RosMessage,
     truncate_length: int | None = None,
     *,
     no_arr: bool = False,
@@ -130,18 +135,23 @@ def message_to_yaml(
 
 
 def message_to_csv(
-    msg: Any, truncate_length: int | None = None, *, no_arr: bool = False, no_str: bool = False
+    msg: RosMessage,
+    truncate_length: int | None = None,
+    *,
+    no_arr: bool = False,
+    no_str: bool = False,
 ) -> str:
     """`ros2 topic echo --csv`: every leaf value, depth first, joined by commas."""
 
-    def text(value: Any, field_type: Any = None) -> str:
+    def text(value: object, field_type: idl.AbstractType | None = None) -> str:
         if isinstance(value, list | tuple | array.array) or (
             hasattr(value, "tolist") and hasattr(value, "shape") and value.shape != ()
         ):
+            sequence = cast(_Array, value)
             if no_arr and field_type is not None:
-                return array_summary(value, field_type)
+                return array_summary(sequence, field_type)
             parts = []
-            for i, item in enumerate(list(value)):
+            for i, item in enumerate(list(sequence)):
                 if truncate_length is not None and i >= truncate_length:
                     parts.append("...")
                     break

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 import time
+from typing import cast
 
 import yaml
 from rcl_interfaces.msg import Parameter, ParameterDescriptor, ParameterType, ParameterValue
@@ -129,7 +130,8 @@ def param_delete(ctx: CallContext, fqn: str, name: str, include_hidden: bool = F
     unset = ParameterValue(type=ParameterType.PARAMETER_NOT_SET)
     request = SetParameters.Request(parameters=[Parameter(name=name, value=unset)])
     service = f"{target.rstrip('/')}/set_parameters"
-    result = call_service(ctx, service, SetParameters, request).results[0]
+    response = cast(SetParameters.Response, call_service(ctx, service, SetParameters, request))
+    result = response.results[0]
     words = "Deleted parameter successfully" if result.successful else "Deleting parameter failed"
     write_outcome(ctx, result.successful, words + (f": {result.reason}" if result.reason else ""))
     return 0

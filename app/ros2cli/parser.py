@@ -11,8 +11,7 @@ from __future__ import annotations
 import argparse
 import logging
 import shlex
-from collections.abc import Callable
-from typing import Any, NoReturn
+from typing import Any, NoReturn, TypeAlias
 
 from rclpy.exceptions import NameValidationException
 
@@ -20,7 +19,14 @@ from app.ros.context import CallContext, Write
 from app.ros.errors import Cancelled, Ros2Error
 from app.ros2cli import bag, interfaces, launch_verb, pkg, run
 from app.ros2cli import verbs as verb_args
-from app.ros2cli.common import Ros2cliMessage, SilentFailure, TerminalContext, settle_discovery
+from app.ros2cli.common import (
+    Commands,
+    Handler,
+    Ros2cliMessage,
+    SilentFailure,
+    TerminalContext,
+    settle_discovery,
+)
 from app.ros2cli.groups import GROUPS
 from app.ros2cli.verbs import NOT_HERE
 
@@ -49,7 +55,7 @@ class _Parser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
         self._write = write
 
-    def _print_message(self, message: str, file: Any = None) -> None:
+    def _print_message(self, message: str, file: object = None) -> None:
         if message:
             for line in message.rstrip("\n").splitlines():
                 self._write(line)
@@ -84,9 +90,6 @@ def split_command(text: str) -> list[str]:
     return words
 
 
-Handler = Callable[[CallContext, argparse.Namespace], int]
-
-
 COMMANDS_HINT = "Call `{prog} <command> -h` for more detailed usage."
 RAW = argparse.RawDescriptionHelpFormatter
 
@@ -97,7 +100,11 @@ NOT_HERE_VERBS = {
 }
 
 
-def commands(parser: argparse.ArgumentParser, dest: str) -> Any:
+# The "Commands:" table of ``ros2`` or of one group (a ``Commands`` to the verbs' modules).
+_Commands: TypeAlias = "argparse._SubParsersAction[_Parser]"  # not generic at run time
+
+
+def commands(parser: argparse.ArgumentParser, dest: str) -> _Commands:
     """A "Commands:" section as ros2cli makes one: its lines are filled in by finish_commands."""
     sub = parser.add_subparsers(
         title="Commands",
@@ -110,7 +117,7 @@ def commands(parser: argparse.ArgumentParser, dest: str) -> Any:
     return sub
 
 
-def finish_commands(parser: argparse.ArgumentParser, sub: Any) -> None:
+def finish_commands(parser: argparse.ArgumentParser, sub: _Commands) -> None:
     """One line per command (its description), sorted, as ros2cli's -h lists them.
 
     The choices are sorted too (argparse's "invalid choice" error names them in
@@ -143,9 +150,9 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
     )
     parser.set_defaults(handler=lambda ctx, _args: _print_help(ctx, parser))
     groups = commands(parser, "group")
-    groups_done: list[tuple[argparse.ArgumentParser, Any, str]] = []
+    groups_done: list[tuple[argparse.ArgumentParser, _Commands, str]] = []
 
-    def group(name: str, description: str):
+    def group(name: str, description: str) -> _Commands:
         g = groups.add_parser(name, description=description, formatter_class=RAW, write=write)
         verb_args.command_options(name, g)  # `ros2 topic --include-hidden-topics ...`
         g.set_defaults(handler=lambda ctx, _args: _print_help(ctx, g))
@@ -153,7 +160,9 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
         groups_done.append((g, verbs, name))
         return verbs
 
-    def verb(verbs, name: str, help_text: str, handler: Handler) -> argparse.ArgumentParser:
+    def verb(
+        verbs: Commands, name: str, help_text: str, handler: Handler
+    ) -> argparse.ArgumentParser:
         p = verbs.add_parser(name, description=help_text, formatter_class=RAW, write=write)
         p.set_defaults(handler=handler)
         return p

@@ -25,16 +25,16 @@ import re
 import sys
 import time
 from pathlib import Path
-from typing import Any
 
 from ros2pkg.verb import add_create_arguments, main_create
 
 from app.learner_ws import build, folder, overlay, served
 from app.learner_ws.folder import LearnerWorkspace
-from app.ros.context import CallContext
+from app.ros.context import CallContext, Write
 from app.ros.errors import Cancelled, Ros2Error
 from app.ros2cli import run
-from app.ros2cli.common import Ros2cliMessage
+from app.ros2cli.common import Commands, Ros2cliMessage, Verb
+from app.ros2cli.run import Programs
 from app.supervisor import LearnerProgram, own_program_key
 
 NO_DDS = {("pkg", v) for v in ("create", "list", "executables", "prefix")}
@@ -84,7 +84,7 @@ def setup_workspace(
 # -- ros2 pkg --------------------------------------------------------------------------
 
 
-def add_verbs(verbs: Any, verb: Any) -> None:
+def add_verbs(verbs: Commands, verb: Verb) -> None:
     """The `pkg` group's verbs (parser.build_parser gives the group and its helper)."""
     p = verb(verbs, "create", "Create a new ROS 2 package", _create)
     add_create_arguments(p)
@@ -97,7 +97,7 @@ def add_verbs(verbs: Any, verb: Any) -> None:
     p.add_argument("--share", action="store_true", help="Show share directory for the package")
 
 
-def add_commands(groups: Any, write: Any) -> None:
+def add_commands(groups: Commands, write: Write) -> None:
     """`colcon VERB ...` and `source FILE`: commands the tutorials type beside ros2."""
     p = groups.add_parser("colcon", help="build the workspace: colcon build [options]", write=write)
     p.add_argument("words", nargs=argparse.REMAINDER, help="verb and options")
@@ -229,7 +229,7 @@ def _colcon(ctx: CallContext, args: argparse.Namespace) -> int:
     return follow_build(ctx, programs, program.name, ws)
 
 
-def follow_build(ctx: CallContext, programs: Any, key: str, ws: LearnerWorkspace) -> int:
+def follow_build(ctx: CallContext, programs: Programs, key: str, ws: LearnerWorkspace) -> int:
     """Stream a build's output until it ends; stop it at the time or disk limit, or on Stop."""
     started = time.monotonic()
     shown = 0
@@ -281,7 +281,9 @@ def follow_build(ctx: CallContext, programs: Any, key: str, ws: LearnerWorkspace
     return 1
 
 
-def _point_at_errors(ctx: CallContext, lines: list[str], ws: LearnerWorkspace, code: Any) -> None:
+def _point_at_errors(
+    ctx: CallContext, lines: list[str], ws: LearnerWorkspace, code: int | None
+) -> None:
     """After colcon's own lines: each error with the file and line it is in."""
     errors = build.error_summary(lines, ws)
     unread = any("package identification" in line and "ERROR" in line for line in lines)
@@ -302,7 +304,7 @@ def _point_at_errors(ctx: CallContext, lines: list[str], ws: LearnerWorkspace, c
         ctx.write(f"({head}: the full logs are in {ws.shown(ws.root / 'log')})")
 
 
-def _progress(programs: Any, key: str) -> str:
+def _progress(programs: Programs, key: str) -> str:
     """How many packages colcon started and finished so far, from its own lines."""
     lines = programs.output(key)
     began = sum(line.startswith("Starting >>> ") for line in lines)
@@ -321,7 +323,7 @@ def _explain_dash_spelling(ctx: CallContext, lines: list[str]) -> None:
         )
 
 
-def _active(programs: Any, key: str) -> bool:
+def _active(programs: Programs, key: str) -> bool:
     return key in programs.statuses() and programs.statuses()[key].active
 
 
@@ -375,7 +377,7 @@ def _node_names(ctx: CallContext) -> set[str]:
     return {f"{ns.rstrip('/')}/{n}" for n, ns in ctx.node.get_node_names_and_namespaces()}
 
 
-def _show_own_start(ctx: CallContext, programs: Any, key: str, before: set[str]) -> int:
+def _show_own_start(ctx: CallContext, programs: Programs, key: str, before: set[str]) -> int:
     """Its output while it starts; all of it when it ends meanwhile (a script that prints)."""
     status = run.follow_start(ctx, programs, key, lambda: _node_names(ctx) - before)
     if not status.active:

@@ -29,17 +29,20 @@ from __future__ import annotations
 import argparse
 import re
 from collections.abc import Callable, Iterable, Mapping
+from concurrent.futures import Future
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Protocol, cast
 
 import yaml
 
 from app.catalog import ENTRIES, CatalogEntry, UnknownNodeError, lookup
 from app.containment.policy import RunPolicy
-from app.ros.context import CallContext
+from app.ros.context import CallContext, Write
 from app.ros.errors import Ros2Error
 from app.ros2cli import tool_args
+from app.ros2cli.common import Commands
+from app.supervisor import NodeStatus, Program
 
 # (package, executable) of the tutorials -> catalog name.
 UPSTREAM: dict[tuple[str, str], str] = {
@@ -117,15 +120,15 @@ class Programs(Protocol):
 
     learner_policy: RunPolicy | None  # how learner code may run here (None: it may not)
 
-    def start_program(self, entry: Any, extra_ros_args: Iterable[str] = ()) -> Any: ...
+    def start_program(self, entry: Program, extra_ros_args: Iterable[str] = ()) -> NodeStatus: ...
 
-    def status(self, name: str) -> Any: ...
+    def status(self, name: str) -> NodeStatus: ...
 
-    def statuses(self) -> Mapping[str, Any]: ...
+    def statuses(self) -> Mapping[str, NodeStatus]: ...
 
     def output(self, name: str, last: int | None = None) -> list[str]: ...
 
-    def stop(self, name: str) -> Any: ...
+    def stop(self, name: str) -> Future[NodeStatus]: ...
 
 
 def programs_of(ctx: CallContext) -> Programs:
@@ -136,7 +139,7 @@ def programs_of(ctx: CallContext) -> Programs:
             "`ros2 run` starts nodes through the dashboard's supervisor, which this console "
             "was not given; in a terminal use `ros2-classroom run NODE` with a catalog name"
         )
-    return programs
+    return cast(Programs, programs)
 
 
 def resolve(package: str, executable: str) -> CatalogEntry:
@@ -310,7 +313,7 @@ def running_as(programs: Programs, key: str) -> str | None:
         return None
 
 
-def write_new_output(ctx: CallContext, programs: Any, key: str, shown: int) -> int:
+def write_new_output(ctx: CallContext, programs: Programs, key: str, shown: int) -> int:
     """Write lines not shown yet; ``shown`` counts lines ever produced (the buffer is bounded)."""
     status = programs.status(key)
     lines = programs.output(key)
@@ -321,7 +324,9 @@ def write_new_output(ctx: CallContext, programs: Any, key: str, shown: int) -> i
     return total
 
 
-def follow_start(ctx: CallContext, programs: Any, key: str, is_up: Any) -> Any:
+def follow_start(
+    ctx: CallContext, programs: Programs, key: str, is_up: Callable[[], object]
+) -> NodeStatus:
     """Write what a starting program says until it is up and has gone quiet; its status.
 
     Up is ``is_up()`` (its node on the graph) with at least one line shown;
@@ -370,7 +375,7 @@ def _show_start(ctx: CallContext, programs: Programs, key: str, fqn: str) -> int
 OwnFirst = Callable[[CallContext, str, str, list[str]], int | None]
 
 
-def add_command(groups: Any, write: Any, own_packages_first: OwnFirst) -> None:
+def add_command(groups: Commands, write: Write, own_packages_first: OwnFirst) -> None:
     """Register `run` on the parser's sub-command table (parser.build_parser)."""
     p = groups.add_parser(
         "run", help="start a node: ros2 run PACKAGE EXECUTABLE [--ros-args ...]", write=write

@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TypeVar
 
 import yaml
 from rclpy.duration import Duration
 from rclpy.exceptions import InvalidTopicNameException
 from rclpy.expand_topic_name import expand_topic_name
+from rclpy.publisher import Publisher
 from rclpy.qos import (
     DurabilityPolicy,
     QoSDurabilityPolicy,
@@ -21,10 +23,12 @@ from rclpy.qos import (
     QoSReliabilityPolicy,
     ReliabilityPolicy,
 )
+from rclpy.topic_endpoint_info import TopicEndpointInfo
 from rclpy.validate_full_topic_name import validate_full_topic_name
 
 from app.ros.context import CallContext
 from app.ros.convert import (
+    RosType,
     fields_of,
     fill,
     import_type,
@@ -45,6 +49,8 @@ from app.ros2cli.common import (
     write_text,
 )
 from app.ros2cli.msg_yaml import ECHO_TRUNCATE_LENGTH, message_to_csv, message_to_yaml
+
+M = TypeVar("M")  # a message (its generated class is untyped)
 
 # ------------------------------------------------------------------ verbs
 
@@ -131,7 +137,7 @@ def _deadline(ctx: CallContext) -> float:
     return time.monotonic() + limit if limit else math.inf
 
 
-def qos_fallback_lines(publishers: list[Any]) -> list[str]:
+def qos_fallback_lines(publishers: list[TopicEndpointInfo]) -> list[str]:
     """What `ros2 topic echo` says when only some publishers are reliable or transient local."""
     lines = []
     for attr, good, name, fallback in (
@@ -228,7 +234,7 @@ def not_published_yet(topic: str) -> str:
     return f"WARNING: topic [{topic}] does not appear to be published yet"
 
 
-def _echo_type(ctx: CallContext, topic: str, type_text: str | None) -> type:
+def _echo_type(ctx: CallContext, topic: str, type_text: str | None) -> RosType:
     if type_text:
         return ros2_type(type_text, "msg")
     full = _full_topic_name(ctx, topic)
@@ -256,7 +262,7 @@ def _measured_type(ctx: CallContext, topic: str) -> type | None:
     return import_type(found, "msg")
 
 
-def _selected(msg: Any, field: list[str] | None, field_text: str) -> Any:
+def _selected(msg: object, field: list[str] | None, field_text: str) -> object:
     for part in field or []:
         try:
             msg = getattr(msg, part)
@@ -276,7 +282,7 @@ class EchoStyle:
     csv: bool = False
 
 
-def echo_text(value: Any, style: EchoStyle = EchoStyle()) -> str:
+def echo_text(value: object, style: EchoStyle = EchoStyle()) -> str:
     """One echoed message as ros2cli prints it, up to and with its closing '---'."""
     if not is_message(value):
         return f"{value}\n---"  # a selected field that is not a message: printed as Python does
@@ -406,7 +412,9 @@ def bw(ctx: CallContext, topic: str, type_text: str | None = None, window: int =
     return _measure(ctx, topic, type_text, window, report, f"Subscribed to [{topic}]")
 
 
-def with_stamps(cls: type, data: dict[str, Any], stamp: dict[str, int]) -> dict[str, Any]:
+def with_stamps(
+    cls: RosType, data: Mapping[str, object], stamp: dict[str, int]
+) -> dict[str, object]:
     """`ros2 topic pub`'s keywords: a Header given as "auto", a Time given as "now"."""
     filled = dict(data)
     for name, ros_type, _slot in fields_of(cls):
@@ -420,13 +428,13 @@ def with_stamps(cls: type, data: dict[str, Any], stamp: dict[str, int]) -> dict[
     return filled
 
 
-def _stamped(ctx: CallContext, msg_type: type, data: dict[str, Any]) -> Any:
+def _stamped(ctx: CallContext, msg_type: type[M], data: Mapping[str, object]) -> M:
     now = ctx.node.get_clock().now().to_msg()
     return fill(msg_type, with_stamps(msg_type, data, {"sec": now.sec, "nanosec": now.nanosec}))
 
 
 def _wait_for_subscribers(
-    ctx: CallContext, publisher: Any, wanted: int, max_wait_time: float | None
+    ctx: CallContext, publisher: Publisher, wanted: int, max_wait_time: float | None
 ) -> None:
     """ros2cli's wait: a 'Waiting for ...' line each second while too few subscriptions match."""
     started = time.monotonic()

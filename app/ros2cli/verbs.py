@@ -11,8 +11,8 @@ typed, never silently ignored.
 from __future__ import annotations
 
 import argparse
-from collections.abc import Callable, Sequence
-from typing import Any
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, TypedDict
 
 from rclpy.qos import (
     QoSDurabilityPolicy,
@@ -23,8 +23,10 @@ from rclpy.qos import (
 )
 
 from app.ros2cli import graph_verbs, lifecycle, param, topic
+from app.ros2cli.common import Commands, Verb
 
-Verb = Callable[..., argparse.ArgumentParser]
+if TYPE_CHECKING:
+    from typing_extensions import Unpack  # typing's own from Python 3.11
 
 NOT_HERE = "not supported here"
 
@@ -32,13 +34,34 @@ NOT_HERE = "not supported here"
 class _NotHere(argparse.Action):
     """An option Jazzy's ros2 has and we do not: shown in -h, refused when used."""
 
-    def __call__(self, parser: Any, namespace: Any, values: Any, option_string: Any = None) -> None:
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: object,
+        option_string: str | None = None,
+    ) -> None:
         raise argparse.ArgumentError(self, f"{NOT_HERE} (see the end of -h)")
 
 
-def not_here(p: argparse.ArgumentParser | Any, *flags: str, flag: bool = False, **kw: Any) -> None:
-    """Add an option we do not offer (``flag``: it takes no value), and name it in the epilog."""
-    target = kw.pop("group", p)
+class _NotHereOptions(TypedDict, total=False):
+    help: str
+    metavar: str
+    dest: str
+
+
+def not_here(
+    p: argparse.ArgumentParser,
+    *flags: str,
+    flag: bool = False,
+    group: argparse._MutuallyExclusiveGroup | None = None,
+    **kw: Unpack[_NotHereOptions],
+) -> None:
+    """Add an option we do not offer (``flag``: it takes no value), and name it in the epilog.
+
+    ``group``: the mutually exclusive group it belongs to (else the parser itself).
+    """
+    target = p if group is None else group
     target.add_argument(*flags, action=_NotHere, nargs=0 if flag else None, **kw)
     names: list[str] = p.__dict__.setdefault("_not_here", [])
     names.append("/".join(sorted(flags, key=len)))
@@ -168,7 +191,7 @@ def qos_of(a: argparse.Namespace) -> topic.QosOptions:
     )
 
 
-def _node_listing_options(p: Any) -> None:
+def _node_listing_options(p: argparse.ArgumentParser) -> None:
     """`ros2 node list` and `ros2 lifecycle nodes` take the same options."""
     strategy(p)
     p.add_argument("-a", "--all", action="store_true", help="Display all nodes even hidden ones")
@@ -180,7 +203,7 @@ def _node_listing_options(p: Any) -> None:
     )
 
 
-def add_node(v: Any, verb: Verb) -> None:
+def add_node(v: Commands, verb: Verb) -> None:
     p = verb(
         v,
         "list",
@@ -206,7 +229,7 @@ def add_node(v: Any, verb: Verb) -> None:
 HIDDEN_TOPICS_HELP = "Consider hidden topics as well"
 
 
-def add_topic(v: Any, verb: Verb) -> None:
+def add_topic(v: Commands, verb: Verb) -> None:
     p = verb(
         v,
         "list",
@@ -325,7 +348,7 @@ def add_topic(v: Any, verb: Verb) -> None:
     _add_pub(v, verb)
 
 
-def _add_echo(v: Any, verb: Verb) -> None:
+def _add_echo(v: Commands, verb: Verb) -> None:
     p = verb(
         v,
         "echo",
@@ -416,7 +439,7 @@ def _add_echo(v: Any, verb: Verb) -> None:
     )
 
 
-def _add_pub(v: Any, verb: Verb) -> None:
+def _add_pub(v: Commands, verb: Verb) -> None:
     p = verb(
         v,
         "pub",
@@ -514,7 +537,7 @@ def _count_services(p: argparse.ArgumentParser) -> None:
     )
 
 
-def add_service(v: Any, verb: Verb) -> None:
+def add_service(v: Commands, verb: Verb) -> None:
     p = verb(
         v,
         "list",
@@ -595,7 +618,7 @@ def add_service(v: Any, verb: Verb) -> None:
     )
 
 
-def add_action(v: Any, verb: Verb) -> None:
+def add_action(v: Commands, verb: Verb) -> None:
     p = verb(
         v,
         "list",
@@ -679,7 +702,7 @@ def _timeout(p: argparse.ArgumentParser) -> None:
     )
 
 
-def add_param(v: Any, verb: Verb) -> None:
+def add_param(v: Commands, verb: Verb) -> None:
     p = verb(
         v,
         "list",
@@ -799,7 +822,7 @@ def add_param(v: Any, verb: Verb) -> None:
     _timeout(p)
 
 
-def add_lifecycle(v: Any, verb: Verb) -> None:
+def add_lifecycle(v: Commands, verb: Verb) -> None:
     p = verb(
         v,
         "get",

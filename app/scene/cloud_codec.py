@@ -15,11 +15,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from nodes.common.pointcloud import POINTFIELD_DTYPES
+
+if TYPE_CHECKING:
+    from sensor_msgs.msg import PointCloud2, PointField
 
 # A small perceptual colour ramp (dark blue -> teal -> yellow) for intensity
 # and height; 5 stops interpolated in numpy.
@@ -51,7 +54,9 @@ def _pointfield_dtype(datatype: int) -> np.dtype | None:
     return dtype if isinstance(dtype, np.dtype) else None
 
 
-def _field_view(buf: np.ndarray, n: int, step: int, field: Any, big_endian: bool) -> np.ndarray:
+def _field_view(
+    buf: np.ndarray, n: int, step: int, field: PointField, big_endian: bool
+) -> np.ndarray:
     dtype = _pointfield_dtype(int(field.datatype))
     if dtype is None:
         raise CloudFormatError(f"field {field.name!r} has unknown datatype {field.datatype}")
@@ -77,7 +82,7 @@ def colour_ramp(values: np.ndarray) -> np.ndarray:
     return (_RAMP[idx] * (1 - frac) + _RAMP[idx + 1] * frac).astype(np.uint8)
 
 
-def decode_cloud(msg: Any, budget: int | None = None) -> DecodedCloud:
+def decode_cloud(msg: PointCloud2, budget: int | None = None) -> DecodedCloud:
     """Points and colours of a PointCloud2, at most ``budget`` points (even stride)."""
     fields = {f.name: f for f in msg.fields}
     if not all(axis in fields for axis in "xyz"):

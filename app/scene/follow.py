@@ -9,7 +9,7 @@ only hands messages to ``deliver`` (by default the layer's
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import Generic, TypeVar
 
 from rclpy.node import Node
 from rclpy.qos import QoSProfile
@@ -19,8 +19,10 @@ from app.scene.latest import LatestWorker
 from app.scene.qos import SCENE_CALLBACK_GROUP, newest_only_qos
 from app.scene.topic_picker import NONE
 
+M = TypeVar("M")  # the topic's messages (their generated classes are untyped)
 
-class TopicFollower:
+
+class TopicFollower(Generic[M]):
     """A scene layer's one subscription: which topic it follows, its messages into a worker.
 
     ``qos`` defaults to :func:`newest_only_qos`, asked afresh for each topic.
@@ -31,11 +33,11 @@ class TopicFollower:
     def __init__(
         self,
         node: Node,
-        worker: LatestWorker,
-        msg_type: type,
+        worker: LatestWorker,  # draws the messages (with ``deliver``: what the layer offers it)
+        msg_type: type[M],
         *,
         qos: QoSProfile | int | None = None,
-        deliver: Callable[[Any], None] | None = None,
+        deliver: Callable[[M], None] | None = None,
         on_switch: Callable[[str], None] | None = None,
     ) -> None:
         self.worker = worker
@@ -47,7 +49,7 @@ class TopicFollower:
         self._deliver = deliver if deliver is not None else worker.offer
         self._on_switch = on_switch
 
-    def select(self, topic: str, msg_type: type | None = None) -> bool:
+    def select(self, topic: str, msg_type: type[M] | None = None) -> bool:
         """Follow ``topic`` ("(none)": nothing), dropping the old backlog; False if unchanged.
 
         ``msg_type`` overrides the type given at construction, for this topic.

@@ -7,9 +7,12 @@ per-pixel Python.
 from __future__ import annotations
 
 import array
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from sensor_msgs.msg import Image
 
 _CHANNELS = {"rgb8": 3, "bgr8": 3, "rgba8": 4, "bgra8": 4, "mono8": 1, "8UC1": 1, "8UC3": 3}
 
@@ -18,7 +21,7 @@ class ImageFormatError(ValueError):
     """An encoding the panel does not draw."""
 
 
-def image_to_rgb(msg: Any) -> np.ndarray:
+def image_to_rgb(msg: Image) -> np.ndarray:
     """(H, W, 3) uint8 RGB view or copy of the image in ``msg``."""
     enc = msg.encoding
     if enc == "mono16" or enc == "16UC1":
@@ -47,7 +50,7 @@ def downscale(rgb: np.ndarray, max_width: int) -> np.ndarray:
     return rgb[::step, ::step] if step > 1 else rgb
 
 
-def rgb_to_image_msg(rgb: np.ndarray, encoding: str = "rgb8", frame_id: str = "camera") -> Any:
+def rgb_to_image_msg(rgb: np.ndarray, encoding: str = "rgb8", frame_id: str = "camera") -> Image:
     """An Image message from an (H, W, 3) or (H, W) uint8 array; for tests and demos."""
     from sensor_msgs.msg import Image
 

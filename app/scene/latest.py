@@ -13,19 +13,21 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from typing import Any
+from typing import Generic, TypeVar
 
 log = logging.getLogger(__name__)
 
+M = TypeVar("M")  # what is drawn: a message, or a token that says "look again"
 
-class LatestWorker:
-    def __init__(self, name: str, draw: Callable[[Any], None], max_hz: float) -> None:
+
+class LatestWorker(Generic[M]):
+    def __init__(self, name: str, draw: Callable[[M], None], max_hz: float) -> None:
         self._draw = draw
         self._min_interval = 1.0 / max_hz
         self._lock = threading.Lock()
         self._wake = threading.Event()
         self._stop = threading.Event()
-        self._pending: Any = None
+        self._pending: M | None = None
         self._received = 0
         self._arrivals: deque[float] = deque(maxlen=64)
         self._last_arrival: float | None = None
@@ -33,7 +35,7 @@ class LatestWorker:
         self._thread = threading.Thread(target=self._run, name=f"scene-{name}", daemon=True)
         self._thread.start()
 
-    def offer(self, msg: Any) -> None:
+    def offer(self, msg: M) -> None:
         """Called from the ROS executor: O(1), never blocks for long."""
         now = time.monotonic()
         with self._lock:

@@ -7,11 +7,15 @@ mapping pure makes every type, scale rule and colour rule unit-testable.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Literal, TypedDict
+from typing import TYPE_CHECKING, Literal, TypedDict
 
 import numpy as np
 
 from app.scene.transforms import ros_to_wxyz
+
+if TYPE_CHECKING:
+    from std_msgs.msg import ColorRGBA
+    from visualization_msgs.msg import Marker
 
 # visualization_msgs/Marker type and action constants
 ARROW, CUBE, SPHERE, CYLINDER = 0, 1, 2, 3
@@ -128,15 +132,15 @@ def _byte(v: float) -> int:
     return int(np.clip(round(float(v) * 255), 0, 255))
 
 
-def _rgb(c: Any) -> tuple[int, int, int]:
+def _rgb(c: ColorRGBA) -> tuple[int, int, int]:
     return (_byte(c.r), _byte(c.g), _byte(c.b))
 
 
-def _points(marker: Any) -> np.ndarray:
+def _points(marker: Marker) -> np.ndarray:
     return np.array([[p.x, p.y, p.z] for p in marker.points], dtype=np.float32).reshape(-1, 3)
 
 
-def _point_colors(marker: Any, n: int) -> np.ndarray:
+def _point_colors(marker: Marker, n: int) -> np.ndarray:
     if len(marker.colors) == n and n:
         return np.array([_rgb(c) for c in marker.colors], dtype=np.uint8)
     return np.tile(np.array(_rgb(marker.color), dtype=np.uint8), (n, 1))
@@ -151,7 +155,7 @@ def _segments(points: np.ndarray, strip: bool) -> np.ndarray:
     return points[: 2 * pairs].reshape(pairs, 2, 3)
 
 
-def plan_marker(marker: Any) -> Plan:
+def plan_marker(marker: Marker) -> Plan:
     """Translate one Marker message into a :class:`Plan`."""
     key = (str(marker.ns), int(marker.id))
     if marker.action == DELETEALL:
@@ -173,7 +177,7 @@ def plan_marker(marker: Any) -> Plan:
     return Plan(shape)
 
 
-def _shape_args(marker: Any) -> ShapeArgs | str:
+def _shape_args(marker: Marker) -> ShapeArgs | str:
     """The primitive a Marker's type maps to, or why it is not drawn."""
     s, t = marker.scale, int(marker.type)
     if t == SPHERE:

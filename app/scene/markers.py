@@ -13,7 +13,7 @@ from __future__ import annotations
 import threading
 from collections import deque
 from collections.abc import Callable, Iterable, Mapping
-from typing import Any, TypedDict
+from typing import TypedDict
 
 import numpy as np
 import viser
@@ -75,7 +75,7 @@ class MarkerDrawing:
         self._drawn: dict[tuple[str, int], tuple[Shape, viser.SceneNodeHandle]] = {}
         self.skipped = ""
 
-    def apply(self, markers: Iterable[Any]) -> None:
+    def apply(self, markers: Iterable[Marker]) -> None:
         """Apply Marker messages in order, in one atomic update of the scene."""
         with self._server.atomic():
             for marker in markers:
@@ -178,7 +178,7 @@ class MarkerLayer(OneTopicLayer):
     def __init__(self, node: Node, server: viser.ViserServer) -> None:
         self._node = node
         self._lock = threading.Lock()  # the queue: the executor fills it, the worker empties it
-        self._queue: deque[Any] = deque(maxlen=MAX_QUEUED)
+        self._queue: deque[Marker] = deque(maxlen=MAX_QUEUED)
         self.drawing = MarkerDrawing(server)
         self._clear_pending = False
         worker = LatestWorker("markers", self._apply, MAX_HZ)
@@ -207,13 +207,13 @@ class MarkerLayer(OneTopicLayer):
             self._clear_pending = True  # the worker removes the old topic's markers
         self.worker.offer(True)
 
-    def _on_message(self, msg: Any) -> None:
+    def _on_message(self, msg: Marker | MarkerArray) -> None:
         markers = msg.markers if isinstance(msg, MarkerArray) else [msg]
         with self._lock:
             self._queue.extend(markers)
         self.worker.offer(True)
 
-    def _apply(self, _token: Any) -> None:
+    def _apply(self, _token: bool) -> None:
         with self._lock:
             batch = list(self._queue)
             self._queue.clear()

@@ -20,7 +20,6 @@ from __future__ import annotations
 import logging
 import threading
 from functools import partial
-from typing import Any
 
 import viser
 from rclpy.node import Node
@@ -104,7 +103,7 @@ class NamespacedRobots:
         self.worker.offer(True)
 
     # --- worker thread ---
-    def _apply(self, _token: Any) -> None:
+    def _apply(self, _token: bool) -> None:
         with self._lock:
             pending, self._pending = self._pending, {}
         for topic, text in pending.items():

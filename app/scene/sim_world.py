@@ -20,13 +20,12 @@ import threading
 import time
 from collections import deque
 from functools import partial
-from typing import Any
 
 import numpy as np
 import viser
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from visualization_msgs.msg import MarkerArray
+from visualization_msgs.msg import Marker, MarkerArray
 
 from app.ros.graph import GraphSnapshot
 from app.scene.latest import LatestWorker
@@ -49,7 +48,7 @@ def tf_frame_path(frame: str) -> str:
     return f"{TF_PATH}/frames/{scene_name(frame.strip().lstrip('/'))}"
 
 
-def marker_bounds(markers: list[Any]) -> tuple[np.ndarray, np.ndarray] | None:
+def marker_bounds(markers: list[Marker]) -> tuple[np.ndarray, np.ndarray] | None:
     """A box (low, high corners) around markers' positions and sizes, in their frame."""
     corners = []
     for marker in markers:
@@ -69,7 +68,7 @@ class WorldLayer:
     def __init__(self, node: Node, server: viser.ViserServer) -> None:
         self._node = node
         self._lock = threading.Lock()
-        self._queue: deque[tuple[str, list[Any]]] = deque(maxlen=64)
+        self._queue: deque[tuple[str, list[Marker]]] = deque(maxlen=64)
         self._clear_pending = False
         self._last_message: float | None = None
         self.static = MarkerDrawing(server, parent_for=tf_frame_path, folder="sim_world")
@@ -95,7 +94,7 @@ class WorldLayer:
         self.worker.offer(True)
 
     # --- worker thread ---
-    def _apply(self, _token: Any) -> None:
+    def _apply(self, _token: bool) -> None:
         with self._lock:
             batches = list(self._queue)
             self._queue.clear()

@@ -8,8 +8,6 @@ coincide in the 3D view.
 
 from __future__ import annotations
 
-from typing import Any
-
 import viser
 from geometry_msgs.msg import PointStamped, PoseStamped
 from rclpy.node import Node
@@ -45,7 +43,7 @@ class _StampedTopic:
         self._follower = TopicFollower(layer.node, self.worker, msg_type, qos=10)
         self._follower.select(topic)
 
-    def _draw(self, msg: Any) -> None:
+    def _draw(self, msg: PoseStamped | PointStamped) -> None:
         parent, known = scene_path_for_frame(msg.header.frame_id, self.topic)
         path = f"{parent}/stamped/{_leaf(self.topic)}"
         if self.is_pose:

@@ -21,7 +21,6 @@ from __future__ import annotations
 import logging
 import threading
 import time
-from typing import Any
 
 import numpy as np
 import viser
@@ -70,7 +69,10 @@ class TfView:
         self._labels: dict[str, viser.LabelHandle] = {}  # while names are shown
         self._axes: viser.BatchedAxesHandle | None = None  # every frame's axes, instanced
         self._axes_count = 0
-        self._placed: dict[str, tuple[Any, Any]] = {}  # frame -> (position, wxyz) last sent
+        # frame -> (position, wxyz) last sent
+        self._placed: dict[
+            str, tuple[tuple[float, float, float], tuple[float, float, float, float]]
+        ] = {}
         self._visuals: list[viser.SceneNodeHandle] = []
         self._logged: set[str] = set()
         self._sent: dict[str, tuple[object, ...]] = {}  # scene path -> pose last sent

@@ -5,7 +5,6 @@ under it what the learner's latest program printed.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
 
 import viser
 
@@ -23,7 +22,7 @@ class CodeStage:
     def __init__(
         self,
         gui: viser.GuiApi,
-        code_window: Any,
+        code_window: viser.PanelHandle,
         program_output: Callable[[], tuple[str, list[str]]] = lambda: ("", []),
     ) -> None:
         """``program_output()``: the learner's latest program (its state) and its last

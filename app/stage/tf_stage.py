@@ -19,7 +19,6 @@ import threading
 import time
 from collections import deque
 from dataclasses import dataclass, field
-from typing import Any
 
 import viser
 from rclpy.node import Node
@@ -82,7 +81,7 @@ class TfRecorder:
             self._frames.clear()
             self.version += 1
 
-    def view_frames(self, now: float | None = None) -> dict[str, dict[str, Any]]:
+    def view_frames(self, now: float | None = None) -> dict[str, dict[str, object]]:
         """Child -> the fields view_frames prints (parent, broadcaster, rate, buffer, times)."""
         now = time.monotonic() if now is None else now
         with self._lock:
@@ -90,7 +89,7 @@ class TfRecorder:
                 child: (f.parent, f.static, list(f.stamps), list(f.arrivals))
                 for child, f in self._frames.items()
             }
-        out: dict[str, dict[str, Any]] = {}
+        out: dict[str, dict[str, object]] = {}
         for child, (parent, static, stamps, arrivals) in sorted(frames.items()):
             recent = [t for t in arrivals if now - t <= BUFFER_SEC]
             if static:
@@ -112,7 +111,7 @@ class TfRecorder:
         return out
 
 
-def tf_tree_html(frames: dict[str, dict[str, Any]], recorded_time: float) -> str:
+def tf_tree_html(frames: dict[str, dict[str, object]], recorded_time: float) -> str:
     """tf2_tools' picture at its natural size (never shrunk: its labels stay readable; a
     big tree scrolls), on white paper in either colour scheme."""
     svg = render(frames, recorded_time)

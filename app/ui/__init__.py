@@ -40,7 +40,7 @@ viser (1.1.1) from each thread:
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Protocol, runtime_checkable
+from typing import Protocol, TypeVar, runtime_checkable
 
 import viser
 
@@ -112,9 +112,16 @@ class Inspector(Protocol):
 class MarkdownView:
     """A markdown handle that is re-sent only when its text changes."""
 
-    def __init__(self, gui: Any, content: str = "", **kwargs: Any) -> None:
+    def __init__(
+        self,
+        gui: viser.GuiApi,
+        content: str = "",
+        *,
+        order: float | None = None,
+        visible: bool = True,
+    ) -> None:
         self._content = content
-        self.handle = gui.add_markdown(content, **kwargs)
+        self.handle = gui.add_markdown(content, order=order, visible=visible)
 
     def show(self, content: str) -> None:
         if content != self._content:
@@ -126,9 +133,20 @@ class MarkdownView:
         return self._content
 
 
-def assign(handle: Any, value: Any) -> None:
-    """Set a viser input's value (viser 1.1's setter is not typed as one)."""
-    handle.value = value
+V = TypeVar("V")
+V_co = TypeVar("V_co", covariant=True)
+
+
+class Input(Protocol[V_co]):
+    """A viser input (text, number, slider, dropdown, checkbox, progress bar...)."""
+
+    @property
+    def value(self) -> V_co: ...
+
+
+def assign(handle: Input[V], value: V) -> None:
+    """Set a viser input's value (viser 1.1 types ``value`` read-only; its setter is there)."""
+    setattr(handle, "value", value)  # noqa: B010 (mypy sees no setter)
 
 
 def topic_item(name: str, type_text: str, publishers: int, subscribers: int) -> str:
@@ -145,7 +163,9 @@ def code_block(lines: list[str], empty: str = "(nothing yet)") -> str:
     return f"```\n{body}\n```"
 
 
-def set_options(dropdown: Any, options: list[str], keep_current: bool = True) -> None:
+def set_options(
+    dropdown: viser.GuiDropdownHandle[str], options: list[str], keep_current: bool = True
+) -> None:
     """New dropdown options without stealing the learner's choice.
 
     With ``keep_current`` the current value stays selectable even when it has

@@ -7,11 +7,11 @@ Built and read on the UI thread only (see the threading model in app.ui).
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
 
 import viser
 
 from app.ros.convert import ConversionError, fill_from_form, from_yaml, leaf_fields, type_name
+from app.ui import Input
 
 
 class MessageForm:
@@ -27,7 +27,7 @@ class MessageForm:
     def __init__(self, gui: viser.GuiApi, cls: type, title: str) -> None:
         self.cls = cls
         self._folder = gui.add_folder(title)
-        self._widgets: dict[str, tuple[str, Any]] = {}
+        self._widgets: dict[str, tuple[str, Input[object]]] = {}  # path -> (kind, widget)
         fields = leaf_fields(cls)
         with self._folder:
             if not fields:
@@ -38,7 +38,7 @@ class MessageForm:
                 return
             for path, ros_type, kind in fields:
                 label = f"{path} ({ros_type})"
-                widget: Any
+                widget: Input[object]
                 if kind == "bool":
                     widget = gui.add_checkbox(label, False)
                 elif kind == "int":
@@ -51,18 +51,20 @@ class MessageForm:
                     widget = gui.add_text(label, "")
                 self._widgets[path] = (kind, widget)
 
-    def values(self) -> dict[str, Any]:
+    def values(self) -> dict[str, object]:
         return {path: widget.value for path, (_kind, widget) in self._widgets.items()}
 
-    def message(self) -> Any:
+    def message(self) -> object:
+        """A message of the form's class, or one ConversionError line."""
         if self._yaml is not None:
             return from_yaml(self.cls, self._yaml.value)
         values = self.values()
         for path, (kind, _w) in self._widgets.items():
-            if kind == "int" and isinstance(values[path], float):
-                if not values[path].is_integer():
+            value = values[path]
+            if kind == "int" and isinstance(value, float):
+                if not value.is_integer():
                     raise ConversionError(f"field '{path}' needs a whole number")
-                values[path] = int(values[path])
+                values[path] = int(value)
         return fill_from_form(self.cls, values)
 
     def remove(self) -> None:

@@ -7,7 +7,7 @@ import queue
 import threading
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
-from typing import Any, TypeVar
+from typing import TypeVar
 
 from app.ros.errors import Ros2Error
 
@@ -48,7 +48,7 @@ class UiLoop:
         if refresh:
             self._wake.set()
 
-    def callback(self, intent: Callable[..., None], *args: Any) -> Callable[[Any], None]:
+    def callback(self, intent: Callable[..., None], *args: object) -> Callable[[object], None]:
         """A viser callback that posts ``intent(*args)`` when a browser changed the widget.
 
         viser also runs update callbacks, synchronously, when the server itself
@@ -56,7 +56,7 @@ class UiLoop:
         change and already knows it, so no intent is posted for it.
         """
 
-        def on_event(event: Any) -> None:
+        def on_event(event: object) -> None:
             if getattr(event, "client", True) is None:
                 return
             self.post(lambda: intent(*args))

@@ -16,7 +16,8 @@ tab: the one the lesson last pointed at.
 from __future__ import annotations
 
 import json
-from typing import Any
+
+import viser
 
 from app.ui.page_script import page_script
 
@@ -72,7 +73,7 @@ def opener_html(path: list[str], nonce: int) -> str:
 class TabOpener:
     """One per dashboard; ``open`` is called on the UI thread only."""
 
-    def __init__(self, gui: Any, paths: dict[str, list[str]]) -> None:
+    def __init__(self, gui: viser.GuiApi, paths: dict[str, list[str]]) -> None:
         """``paths`` maps a tab's name to the tabs to press to reach it, outermost first."""
         self._paths = paths
         self._nonce = 0

@@ -5,7 +5,7 @@ some feedback).
 from __future__ import annotations
 
 import threading
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from app.lessons.registry import register_action
 from app.ros.calls import GoalRun, send_goal
@@ -33,7 +33,7 @@ def perform(rt: LessonRuntime, action: Spec) -> str:
     run = GoalRun(name, type_text, goal)
     cancel_after = action.get("cancel_after_feedback")
 
-    def on_feedback(_feedback: Any) -> None:
+    def on_feedback(_feedback: object) -> None:
         if cancel_after and len(run.feedback) == cancel_after:
             run.cancel()
 

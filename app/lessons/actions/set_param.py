@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from rcl_interfaces.srv import SetParameters
 
@@ -11,6 +11,8 @@ from app.lessons.registry import register_action
 from app.ros import params
 
 if TYPE_CHECKING:
+    from rclpy.task import Future
+
     from app.lessons.runtime import LessonRuntime
     from app.lessons.schema import Spec
 
@@ -23,7 +25,7 @@ def perform(rt: LessonRuntime, action: Spec) -> str:
     client = rt.services.client(f"{action['node']}/set_parameters", SetParameters)
     rt.changed_at = time.monotonic()  # until the node answers, from the click
 
-    def answered(_future: Any) -> None:
+    def answered(_future: Future) -> None:
         # From now on the node runs with the new value: a rate judged later hears only it.
         rt.changed_at = time.monotonic()
 

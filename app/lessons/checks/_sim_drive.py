@@ -22,7 +22,7 @@ import time
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
@@ -30,6 +30,7 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 from app.lessons.checks._sim_speed import factor_text
 from app.lessons.checks._sim_topics import TRUTH, Pose, pose_of, wrap
+from app.ros.monitor import MessageInfo
 
 if TYPE_CHECKING:
     from app.lessons.runtime import LessonRuntime
@@ -117,7 +118,7 @@ class DriveWatch:
         # Two parameters: rclpy passes the message info (a dict) as the second.
         self._subscription = node.create_subscription(Odometry, TRUTH, self._on_pose, TRACK_QOS)  # type: ignore[arg-type]
 
-    def _on_pose(self, msg: Odometry, info: dict[str, Any]) -> None:
+    def _on_pose(self, msg: Odometry, info: MessageInfo) -> None:
         stamp = info.get("source_timestamp") or 0
         sample = (stamp * 1e-9 if stamp > 0 else time.time(), pose_of(msg))
         with self.lock:

@@ -21,12 +21,14 @@ from bisect import bisect_left
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64
+
+from app.ros.monitor import MessageInfo
 
 if TYPE_CHECKING:
     from app.lessons.runtime import LessonRuntime
@@ -164,19 +166,19 @@ class SimSpeedWatch:
             node.create_subscription(Float64, REPORTS, self._on_report, REPORT_QOS),  # type: ignore[arg-type]
         ]
 
-    def _wall(self, info: dict[str, Any]) -> float:
+    def _wall(self, info: MessageInfo) -> float:
         stamp = info.get("source_timestamp") or 0
         if stamp > 0:
             return stamp * 1e-9
         self.by_arrival = True
         return time.time()
 
-    def _on_clock(self, msg: Clock, info: dict[str, Any]) -> None:
+    def _on_clock(self, msg: Clock, info: MessageInfo) -> None:
         sample = (self._wall(info), msg.clock.sec + msg.clock.nanosec * 1e-9)
         with self.lock:
             self.clock.append(sample)
 
-    def _on_report(self, msg: Float64, info: dict[str, Any]) -> None:
+    def _on_report(self, msg: Float64, info: MessageInfo) -> None:
         report = Report(self._wall(info), info.get("publication_sequence_number"), msg.data)
         with self.lock:
             self.reports.append(report)

@@ -9,13 +9,17 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from app.lessons.checks._world_map import WorldMap, load_world_map
 from app.ros import rotations
 from app.ros.planar import Pose
 
 if TYPE_CHECKING:
+    from builtin_interfaces.msg import Time
+    from geometry_msgs.msg import Quaternion
+    from nav_msgs.msg import Odometry
+
     from app.lessons.runtime import LessonRuntime
 
 ODOM_TYPE = "nav_msgs/msg/Odometry"
@@ -26,11 +30,11 @@ SIM_NODE = "/sim_world"
 WALL_CLOCK_SECONDS = 1e8  # a stamp beyond this (1973) is wall-clock time, not simulation time
 
 
-def seconds(stamp: Any) -> float:
+def seconds(stamp: Time) -> float:
     return stamp.sec + stamp.nanosec * 1e-9
 
 
-def yaw_of(q: Any) -> float:
+def yaw_of(q: Quaternion) -> float:
     """Yaw of a geometry_msgs Quaternion."""
     return rotations.yaw_of(q.x, q.y, q.z, q.w)
 
@@ -39,7 +43,7 @@ def wrap(angle: float) -> float:
     return math.atan2(math.sin(angle), math.cos(angle))
 
 
-def pose_of(msg: Any) -> Pose:
+def pose_of(msg: Odometry) -> Pose:
     """The planar pose of a nav_msgs/Odometry message."""
     p = msg.pose.pose
     return Pose(seconds(msg.header.stamp), p.position.x, p.position.y, yaw_of(p.orientation))

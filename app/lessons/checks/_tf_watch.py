@@ -16,7 +16,7 @@ from __future__ import annotations
 import threading
 import time
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from rclpy.node import Node
 from tf2_msgs.msg import TFMessage
@@ -46,7 +46,8 @@ class TfWatch:
         self.buffer = Buffer()
         self.lock = threading.Lock()
         self.frames: dict[str, HeardFrame] = {}
-        self.memory: dict[str, Any] = {}  # per check key: what a check remembers between calls
+        # Per check key: what a check remembers between calls (each check knows its own).
+        self.memory: dict[str, object] = {}
         self._subscriptions = [
             node.create_subscription(TFMessage, "/tf", self._on_tf, TF_QOS),
             node.create_subscription(TFMessage, "/tf_static", self._on_static, STATIC_QOS),

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 from lifecycle_msgs.srv import GetState
 
@@ -19,7 +19,10 @@ if TYPE_CHECKING:
 def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
     if not rt.graph.has_node(c["node"]):
         return CheckResult(FAIL, f"{c['node']} is not on the graph")
-    response = rt.services.latest(c.key, f"{c['node']}/get_state", GetState, GetState.Request())
+    response = cast(
+        "GetState.Response | None",
+        rt.services.latest(c.key, f"{c['node']}/get_state", GetState, GetState.Request()),
+    )
     if response is None:
         return CheckResult(WAITING, f"asking {c['node']} for its state")
     label = response.current_state.label

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 from rcl_interfaces.srv import GetParameters
 
@@ -21,7 +21,10 @@ def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
     if not rt.graph.has_node(c["node"]):
         return CheckResult(FAIL, f"{c['node']} is not on the graph")
     request = GetParameters.Request(names=[c["name"]])
-    response = rt.services.latest(c.key, f"{c['node']}/get_parameters", GetParameters, request)
+    response = cast(
+        "GetParameters.Response | None",
+        rt.services.latest(c.key, f"{c['node']}/get_parameters", GetParameters, request),
+    )
     if response is None:
         return CheckResult(WAITING, f"asking {c['node']} for {c['name']}")
     if not response.values:

@@ -10,7 +10,7 @@ off to the side on the way, so the shortest range alone would not tell).
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from app.lessons.checks._sim_drive import newest_drive_of
 from app.lessons.checks._sim_topics import (
@@ -23,6 +23,8 @@ from app.lessons.checks._sim_topics import (
 from app.lessons.registry import FAIL, PASS, WAITING, CheckResult, register_check
 
 if TYPE_CHECKING:
+    from sensor_msgs.msg import LaserScan
+
     from app.lessons.checks._sim_drive import Drive
     from app.lessons.runtime import LessonRuntime
     from app.lessons.schema import Spec
@@ -79,7 +81,7 @@ def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
     return _share_of_the_way(c, scan, drive, text)
 
 
-def _share_of_the_way(c: Spec, scan: Any, drive: Drive, text: str) -> CheckResult:
+def _share_of_the_way(c: Spec, scan: LaserScan, drive: Drive, text: str) -> CheckResult:
     """A drive slowed by the computer: the range ahead came its share of the way down."""
     start = drive.start
     before = world_map(c.get("world", "room")).ray(start.x, start.y, start.yaw).distance
@@ -94,7 +96,7 @@ def _share_of_the_way(c: Spec, scan: Any, drive: Drive, text: str) -> CheckResul
     return CheckResult(WAITING, f"{said}; drive on until it is closer than {needed:.2f} m")
 
 
-def _range_ahead(scan: Any) -> float:
+def _range_ahead(scan: LaserScan) -> float:
     """The closest of the rays either side of straight ahead (inf: nothing in range)."""
     centre = round(-scan.angle_min / scan.angle_increment) if scan.angle_increment else 0
     rays = (

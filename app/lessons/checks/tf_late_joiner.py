@@ -14,8 +14,9 @@ from __future__ import annotations
 import threading
 import time
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, TypedDict, cast
 
+from rclpy.subscription import Subscription
 from tf2_msgs.msg import TFMessage
 
 from app.lessons.checks._tf_watch import watch_of
@@ -35,7 +36,7 @@ DEFAULT_WITHIN_SEC = 8.0
 class LateJoiner:
     """A fresh /tf_static subscription and the frames (child -> parent) it received."""
 
-    subscription: Any
+    subscription: Subscription | None  # made once the joiner is there to be called
     joined: float = field(default_factory=time.monotonic)
     frames: dict[str, str] = field(default_factory=dict)
     lock: threading.Lock = field(default_factory=threading.Lock)
@@ -48,6 +49,13 @@ class LateJoiner:
     def parent_of(self, frame: str) -> str | None:
         with self.lock:
             return self.frames.get(frame)
+
+
+class _Memory(TypedDict, total=False):
+    """What the check keeps between evaluations (in the TF watch's memory)."""
+
+    publisher_seen: float
+    joiner: LateJoiner
 
 
 @register_check(
@@ -63,10 +71,10 @@ def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
     if not rt.publishers("/tf_static"):
         watch.memory.pop(c.key, None)
         return CheckResult(FAIL, "nobody publishes /tf_static")
-    memory = watch.memory.setdefault(c.key, {"publisher_seen": time.monotonic()})
+    memory = cast(_Memory, watch.memory.setdefault(c.key, {"publisher_seen": time.monotonic()}))
     if time.monotonic() - memory["publisher_seen"] < JOIN_AFTER_SEC:
         return CheckResult(WAITING, "a publisher is on /tf_static; joining late in a moment")
-    joiner: LateJoiner | None = memory.get("joiner")
+    joiner = memory.get("joiner")
     if joiner is None:
         joiner = LateJoiner(subscription=None)
         joiner.subscription = rt.node.create_subscription(
@@ -81,6 +89,7 @@ def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
     if waited < within:
         return CheckResult(WAITING, f"a late subscriber has waited {waited:.0f} s for '{frame}'")
     # Give up on this subscriber; the next evaluation joins afresh.
+    assert joiner.subscription is not None  # made with the joiner, above
     rt.node.destroy_subscription(joiner.subscription)
     watch.memory.pop(c.key, None)
     if got is not None:

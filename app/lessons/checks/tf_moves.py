@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 from rclpy.time import Time
 from tf2_ros import TransformException
@@ -15,6 +15,9 @@ from app.ros.rotations import rotation_angle
 if TYPE_CHECKING:
     from app.lessons.runtime import LessonRuntime
     from app.lessons.schema import Spec
+
+# Where a frame was: its translation and rotation (x, y, z, w).
+_Placement = tuple[tuple[float, float, float], tuple[float, float, float, float]]
 
 
 @register_check(
@@ -43,7 +46,7 @@ def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
         return CheckResult(WAITING, f"no transform from '{frame}' to '{reference}' yet: {exc}")
     v, r = t.transform.translation, t.transform.rotation
     now = ((v.x, v.y, v.z), (r.x, r.y, r.z, r.w))
-    start = watch.memory.setdefault(c.key, now)
+    start = cast(_Placement, watch.memory.setdefault(c.key, now))
     moved = math.dist(start[0], now[0])
     turned = rotation_angle(start[1], now[1])
     text = f"'{frame}' moved {moved:.2f} m and turned {turned:.2f} rad in '{reference}'"
