@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import asyncio
 import base64
+import concurrent.futures
 import html
 import json
 import re
@@ -125,9 +126,11 @@ def hub_login(service: ServiceUnderTest, answer: Answer) -> dict[str, Any] | Non
     assert parts.path == "/hub/lti-handoff"
     [ticket] = urllib.parse.parse_qs(parts.query)["ticket"]
     authenticator = ClassroomLtiAuthenticator(lti_service_url=service.url + PREFIX)
-    found: dict[str, Any] | None = asyncio.run(
-        authenticator.get_authenticated_user(None, {"lti_ticket": ticket})
-    )
+    trade = authenticator.get_authenticated_user(None, {"lti_ticket": ticket})
+    # In a thread of its own: this worker's thread may hold a running event loop (a browser
+    # test's Playwright ran on it before), where asyncio.run refuses to start.
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        found: dict[str, Any] | None = pool.submit(asyncio.run, trade).result(timeout=60)
     return found
 
 
