@@ -45,6 +45,7 @@ from app.hub.lti_service import DEFAULT_DIR, OUTBOX_POLL_SEC, LtiService, openin
 from app.lti.deep_linking import Activity
 from app.lti.rejection import LaunchRejected
 from app.lti.routes import ToolUrls
+from app.lti.state_file import save_json
 from app.lti.tool import LtiTool
 from app.teacher.record import LearnerRecord
 
@@ -91,12 +92,7 @@ class Seats:
         return free
 
     def _save(self) -> None:
-        draft = self.path.with_name(f".{self.path.name}.tmp")
-        with open(draft, "w", encoding="utf-8") as out:
-            json.dump({"version": 1, "seats": self._seat}, out, indent=1)
-            out.flush()
-            os.fsync(out.fileno())
-        os.replace(draft, self.path)
+        save_json(self.path, {"version": 1, "seats": dict(self._seat)})
 
 
 class TeacherToken(web.RequestHandler):

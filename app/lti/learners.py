@@ -19,7 +19,6 @@ from __future__ import annotations
 import base64
 import hashlib
 import json
-import os
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, replace
@@ -29,6 +28,7 @@ from typing import Any, Literal
 from app.jsonish import JSONObject
 from app.lti.deep_linking import MAX_POINTS, SCORE_MAXIMUM_PARAM
 from app.lti.launch import Launch
+from app.lti.state_file import save_json
 
 LAUNCHES_FILE = "launches.json"
 NAME_PREFIX = "lti-"
@@ -171,10 +171,5 @@ class LaunchBook:
         return list(self._learners.values())
 
     def _save(self) -> None:
-        document = {"version": 1, "learners": [e.to_json() for e in self._learners.values()]}
-        draft = self.path.with_name(f".{self.path.name}.tmp")
-        with open(draft, "w", encoding="utf-8") as out:
-            json.dump(document, out, indent=1)
-            out.flush()
-            os.fsync(out.fileno())
-        os.replace(draft, self.path)
+        learners = [e.to_json() for e in self._learners.values()]
+        save_json(self.path, {"version": 1, "learners": learners})

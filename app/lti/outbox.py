@@ -15,7 +15,6 @@ deliver at once.
 from __future__ import annotations
 
 import json
-import os
 import threading
 import time
 from collections.abc import Callable
@@ -26,6 +25,7 @@ from typing import Any, Literal, Protocol
 from app.jsonish import JSONObject
 from app.lti.ags import PostOutcome
 from app.lti.score import Score
+from app.lti.state_file import save_json
 
 OUTBOX_FILE = "outbox.json"
 FIRST_RETRY_SEC = 5.0
@@ -174,15 +174,5 @@ class Outbox:
             return int(outcome.kind == "delivered")
 
     def _save(self) -> None:
-        document = {"version": 1, "entries": [e.to_json() for e in self._entries.values()]}
-        draft = self.path.with_name(f".{self.path.name}.tmp")
-        with open(draft, "w", encoding="utf-8") as out:
-            json.dump(document, out, indent=1)
-            out.flush()
-            os.fsync(out.fileno())
-        os.replace(draft, self.path)
-        directory = os.open(self.path.parent, os.O_RDONLY)
-        try:
-            os.fsync(directory)  # the rename itself survives a power cut
-        finally:
-            os.close(directory)
+        entries = [e.to_json() for e in self._entries.values()]
+        save_json(self.path, {"version": 1, "entries": entries})

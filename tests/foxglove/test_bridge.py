@@ -21,6 +21,7 @@ from mcap_ros2._dynamic import generate_dynamic, serialize_dynamic
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
+from tests.conftest import wait_until
 from tests.foxglove.client import SUBPROTOCOLS, FoxgloveClient
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(180)]
@@ -39,14 +40,8 @@ DISCOVERY_SEC = 60.0  # a fresh world on a loaded machine (DESIGN.md: history af
 
 
 def _wait(predicate: Any, timeout: float, what: str) -> Any:
-    deadline = time.monotonic() + timeout
-    while True:
-        value = predicate()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            pytest.fail(f"timed out after {timeout:.0f} s waiting for {what}")
-        time.sleep(0.05)
+    """``wait_until`` with the reason third, as these tests read."""
+    return wait_until(predicate, timeout, what=what)
 
 
 @pytest.fixture
