@@ -574,6 +574,43 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         args=("ros_python/src/urdf_tutorial_r2d2/urdf/r2d2.urdf.xml",),
         package="urdf_tutorial_r2d2",
     ),
+    # --- maps and navigation (issue 40): the office world, mapping, Nav2's map files ---
+    CatalogEntry(
+        "sim_office",
+        "sim_world",
+        "/sim_world",
+        "The MuJoCo office (10 m x 8 m: a corridor, four rooms, furniture) with the diffbot.",
+        ros_args=("-p", "world:=office"),
+        package="sim_world",
+    ),
+    CatalogEntry(
+        "sim_office_mapping",
+        "sim_world",
+        "/sim_world",
+        "The office world for mapping: no world -> odom on /tf (the mapper's map -> odom).",
+        ros_args=("-p", "world:=office", "-p", "publish_world_tf:=false"),
+        package="sim_world",
+    ),
+    CatalogEntry(
+        "grid_mapper",
+        "grid_mapper",
+        "/grid_mapper",
+        "Log-odds occupancy grid from /scan: /map (5 cm cells, latched), map -> odom on /tf.",
+    ),
+    CatalogEntry(
+        "map_server",
+        "map_server",
+        "/map_server",
+        "Nav2's map_server (lifecycle): loads yaml_filename, /map on activate, load_map service.",
+        package="nav2_map_server",
+    ),
+    CatalogEntry(
+        "map_saver_cli",
+        "map_saver_cli",
+        "/map_saver",
+        "Nav2's map_saver_cli: saves /map as PATH.pgm + PATH.yaml (-f PATH) and exits.",
+        package="nav2_map_server",
+    ),
 )
 
 GROUPS: tuple[LaunchGroup, ...] = (
@@ -695,6 +732,12 @@ GROUPS: tuple[LaunchGroup, ...] = (
         "urdf_tutorial_r2d2_demo",
         "demo.launch.py of urdf_tutorial_r2d2: robot_state_publisher + state_publisher",
         ("r2d2_rsp", "r2d2_state_publisher"),
+    ),
+    # --- maps and navigation (issue 40) ---
+    LaunchGroup(
+        "office_mapping",
+        "the office world, the robot's state publisher, the grid mapper and the teleop: map it",
+        ("sim_office_mapping", "sim_robot_state_publisher", "grid_mapper", "sim_teleop_key"),
     ),
 )
 

@@ -14,6 +14,13 @@ domains stay isolated). With ``--network`` that domain reaches other
 machines, so a class spread over several hosts (each running ``classroom``
 with its own ``--site`` and base domain id) shows on any host's teacher page.
 
+Warm start (app/warm_start.py): the imports every dashboard needs are paid
+once, by a warm parent that starts nothing; each learner's dashboard is a
+fork of it that then starts as a cold ``serve`` does, and is this command's
+child all the same. ``CLASSROOM_COLD_START=1`` starts every dashboard cold;
+a warm parent that cannot start, or a fork that fails, means a cold start
+for those learners, said on the console.
+
 With ``CLASSROOM_LTI_URL`` set (the address an LMS reaches this classroom
 at), the classroom is also an LTI 1.3 tool: the hub's LTI handlers on a port
 of their own (app/hub/lti_classroom.py), an LMS learner seated at a learner
@@ -39,6 +46,7 @@ from urllib.parse import urlsplit
 
 from app import PROJECT_ROOT
 from app.dds import MAX_DOMAIN_ID
+from app.warm_start import COLD_START_VAR, WarmChild, WarmStarter, WarmStartError, cold_start_asked
 
 if TYPE_CHECKING:
     from app.hub.lti_classroom import ClassroomLtiServer
@@ -228,6 +236,9 @@ def _die_with_parent() -> None:
     _libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
 
 
+Process = subprocess.Popen[bytes] | WarmChild  # a dashboard started cold, or a warm fork
+
+
 class Classroom:
     """The learner dashboards as child processes; start, watch, stop."""
 
@@ -239,16 +250,25 @@ class Classroom:
         host: str = "127.0.0.1",
         serve_flags: tuple[str, ...] = (),
         log_dir: Path | None = None,
+        warm: bool | None = None,
+        say: Callable[[str], None] | None = None,
     ) -> None:
         self.learners = learners
         self.host = host
         self._env = dict(env)
         self._flags = serve_flags
         self._log_dir = log_dir
-        self._procs: dict[str, subprocess.Popen[bytes]] = {}
+        # Warm start unless told otherwise (warm=False, or CLASSROOM_COLD_START=1).
+        self.warm = not cold_start_asked(env) if warm is None else warm
+        self.say: Callable[[str], None] = say or (lambda line: print(line, flush=True))
+        self.warm_starter: WarmStarter | None = None
+        self._procs: dict[str, Process] = {}
         self._ready: dict[str, threading.Event] = {}
 
     def start(self) -> None:
+        self.warm_starter = self._start_warm_parent() if self.warm else None
+        if not self.warm:
+            self.say(f"Cold start ({COLD_START_VAR}=1): each dashboard imports everything itself.")
         for learner in self.learners:
             argv = [
                 sys.executable, "-m", "app", "serve",
@@ -267,7 +287,7 @@ class Classroom:
             env.pop("CLASSROOM_TOKEN", None)
             if learner.token:  # through the environment: a token on argv shows in `ps`
                 env["CLASSROOM_TOKEN"] = learner.token
-            proc = subprocess.Popen(
+            proc = self._start_warm(learner, argv, env) or subprocess.Popen(
                 argv,
                 cwd=PROJECT_ROOT,
                 env=env,
@@ -283,7 +303,40 @@ class Classroom:
                 target=self._pump, args=(learner, proc), name=f"log-{learner.name}", daemon=True
             ).start()
 
-    def _pump(self, learner: Learner, proc: subprocess.Popen[bytes]) -> None:
+    def _start_warm_parent(self) -> WarmStarter | None:
+        """The warm parent, ready; None (said why) when it cannot start: everyone starts cold."""
+        log = self._log_dir / "warm-parent.log" if self._log_dir is not None else None
+        if self._log_dir is not None:
+            self._log_dir.mkdir(parents=True, exist_ok=True)
+        starter = WarmStarter(self._env, say=self.say, log_path=log)
+        try:
+            starter.start()
+        except WarmStartError as exc:
+            self.say(f"Warm start unavailable ({exc}): every dashboard starts cold.")
+            return None
+        self.say(
+            f"Warm start: the dashboards fork from one warm parent (pid {starter.pid}) that "
+            f"imported everything once, in {starter.import_sec:.1f} s "
+            f"({COLD_START_VAR}=1 starts each cold)."
+        )
+        return starter
+
+    def _start_warm(self, learner: Learner, argv: list[str], env: dict[str, str]) -> Process | None:
+        """The learner's dashboard as a fork of the warm parent; None: start it cold."""
+        if self.warm_starter is None:
+            return None
+        try:
+            return self.warm_starter.spawn(argv, env, PROJECT_ROOT)
+        except WarmStartError as exc:
+            self.say(f"  {learner.name}: warm start failed ({exc}); starting it cold.")
+            return None
+
+    def watch(self) -> None:
+        """Call now and then: a warm parent that ended is restarted (and said so)."""
+        if self.warm_starter is not None:
+            self.warm_starter.check()
+
+    def _pump(self, learner: Learner, proc: Process) -> None:
         """Copy a child's output to its log file and notice when it is ready."""
         assert proc.stdout is not None
         log = None
@@ -314,7 +367,8 @@ class Classroom:
 
     def ended(self) -> dict[str, int]:
         """Learner dashboards that have exited, with their exit codes."""
-        return {name: p.returncode for name, p in self._procs.items() if p.poll() is not None}
+        codes = {name: p.poll() for name, p in self._procs.items()}
+        return {name: code for name, code in codes.items() if code is not None}
 
     def pids(self) -> dict[str, int]:
         return {name: proc.pid for name, proc in self._procs.items()}
@@ -331,6 +385,8 @@ class Classroom:
             except subprocess.TimeoutExpired:
                 os.killpg(proc.pid, signal.SIGKILL)
                 proc.wait()
+        if self.warm_starter is not None:
+            self.warm_starter.close()
 
 
 def run(
@@ -340,6 +396,7 @@ def run(
     teacher: TeacherPlan | None = None,
 ) -> int:
     """Start everyone and the teacher page, print the URLs, stop on request."""
+    classroom.say = say
     classroom.start()
     view = lti = None
     if teacher is not None:  # while the dashboards boot
@@ -395,6 +452,7 @@ def _serve(
     say("Press Ctrl+C to stop every dashboard.")
     reported: set[str] = set()
     while not stop_requested.wait(0.5):
+        classroom.watch()
         for name, code in classroom.ended().items():
             if name not in reported:
                 reported.add(name)

@@ -351,7 +351,13 @@ def cmd_classroom(args: argparse.Namespace) -> int:
         flags += ("--reveal-solution-after", str(args.reveal_solution_after))
     stop_requested = threading.Event()
     set_on_signals(stop_requested)
-    room = classroom.Classroom(learners, os.environ, host=args.host, serve_flags=flags)
+    room = classroom.Classroom(
+        learners,
+        os.environ,
+        host=args.host,
+        serve_flags=flags,
+        warm=False if args.cold_start else None,  # None: warm unless CLASSROOM_COLD_START=1
+    )
     configure_this_process(network=args.network)  # the teacher page's DDS participant
     return classroom.run(room, stop_requested, lambda line: print(line, flush=True), teacher)
 
@@ -599,6 +605,12 @@ def build_parser(prog: str = "ros2-classroom") -> argparse.ArgumentParser:
         "--allow-learner-code",
         action="store_true",
         help="with --allow-remote: learners may run their exercise code (always contained)",
+    )
+    room.add_argument(
+        "--cold-start",
+        action="store_true",
+        help="start every dashboard by itself, not as a fork of one warm parent "
+        "(as CLASSROOM_COLD_START=1; slower, for comparing or debugging)",
     )
     room.add_argument(
         "--reveal-solution-after",

@@ -110,8 +110,14 @@ def classroom(learners: int, seconds: float) -> dict[str, Any]:
                 raise SystemExit(f"the teacher page never listed {learners} learners")
             time.sleep(0.2)
         time.sleep(SETTLE_SEC)
-        dashboards = {f"d{i}": p.pid for i, p in enumerate(psutil.Process(room.pid).children())}
-        figures = sample({"teacher": room.pid, **dashboards}, seconds)
+        children = psutil.Process(room.pid).children()
+        # The learners' dashboards; the warm parent they fork from (app/warm_start.py) counts
+        # in the whole class, not as a dashboard.
+        serving = [p for p in children if "serve" in p.cmdline()]
+        dashboards = {f"d{i}": p.pid for i, p in enumerate(serving)}
+        others = [p for p in children if p not in serving]
+        warm = {f"warm_parent{i}": p.pid for i, p in enumerate(others)}
+        figures = sample({"teacher": room.pid, **dashboards, **warm}, seconds)
         frames = teacher.frames
     finally:
         for client in clients:
@@ -128,6 +134,7 @@ def classroom(learners: int, seconds: float) -> dict[str, Any]:
         "teacher_rss_mb": figures["teacher"]["rss_mb"],
         "teacher_pss_mb": figures["teacher"]["pss_mb"],
         "teacher_frames": frames,
+        "warm_parent_pss_mb": sum(figures[name]["pss_mb"] for name in warm),
         "total_cpu_percent": sum(f["cpu_percent"] for f in figures.values()),
         "total_pss_mb": sum(f["pss_mb"] for f in figures.values()),
     }

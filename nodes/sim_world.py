@@ -11,7 +11,9 @@ drivers publish, stamped with simulation time:
   reckoning from the wheel encoders (it drifts, as on a real robot);
 - ``world -> odom`` on ``/tf``: the odometry's error, so that world -> odom ->
   base_link is where the robot really is (what a localization node publishes
-  as map -> odom on a real robot; here the simulator knows the truth);
+  as map -> odom on a real robot; here the simulator knows the truth). With
+  ``publish_world_tf:=false`` it is left out, so that a mapping or
+  localization node's ``map -> odom`` is odom's only parent (TF is a tree);
 - ``/ground_truth/odom`` (nav_msgs/Odometry, frame ``world``): where the robot
   really is, for lessons to compare with;
 - ``/scan`` (sensor_msgs/LaserScan, 360 rays at 10 Hz, noisy), ``/imu``
@@ -147,6 +149,14 @@ class SimWorld(Node):
         p("camera_height", 240)
         p("step_duration", 0.1, _range(0.001, 10.0, "s that /step_simulation advances"))
         p("seed", 0)
+        p(
+            "publish_world_tf",
+            True,
+            ParameterDescriptor(
+                description="world -> odom on /tf; false when a mapping or localization node "
+                "publishes map -> odom (odom may have one parent only)"
+            ),
+        )
         g = self._param
         for name, (low, high) in INTEGER_RANGES.items():
             if not low <= int(g(name)) <= high:
@@ -178,6 +188,7 @@ class SimWorld(Node):
         self.command_time = -math.inf
         self.rtf_measured = 0.0
         self.cmd_vel_timeout = float(g("cmd_vel_timeout"))
+        self.publish_world_tf = bool(g("publish_world_tf"))
 
         self.clock_pub = self.create_publisher(Clock, "/clock", 10)
         self.odom_pub = self.create_publisher(Odometry, "odom", 10)
@@ -360,7 +371,8 @@ class SimWorld(Node):
         t, r = correction.transform.translation, correction.transform.rotation
         t.x, t.y, t.z = where
         r.x, r.y, r.z, r.w = turn
-        self.tf_pub.publish(TFMessage(transforms=[correction, tf]))
+        transforms = [correction, tf] if self.publish_world_tf else [tf]
+        self.tf_pub.publish(TFMessage(transforms=transforms))
 
         truth = Odometry()
         truth.header.stamp = header_stamp

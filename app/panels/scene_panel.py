@@ -32,6 +32,7 @@ from app.scene.images import ImageLayer
 from app.scene.laser_scan import LaserScanLayer
 from app.scene.markers import MarkerLayer
 from app.scene.namespaced_robots import NamespacedRobots
+from app.scene.occupancy_grid import OccupancyGridLayer
 from app.scene.plots import JointPlot
 from app.scene.pointclouds import PointCloudLayer
 from app.scene.sim_world import TOPICS as WORLD_TOPICS
@@ -58,6 +59,7 @@ class _Offer(NamedTuple):
     hint: str
     preferred: tuple[str, ...]
     avoid: tuple[str, ...] = ()  # never followed by itself (the dashboard's own topics)
+    latched: bool = False  # published once and kept (a map): silence is not a problem
 
 
 CLOUDS = _Offer(picker.CLOUD_TYPES, "sensor_msgs/msg/PointCloud2 topics", ("/cam/map_points",))
@@ -73,6 +75,12 @@ MARKERS = _Offer(
     avoid=WORLD_TOPICS,  # the simulated world is drawn by its own layer, at its TF frame
 )
 SCANS = _Offer(("sensor_msgs/msg/LaserScan",), "sensor_msgs/msg/LaserScan topics", ("/scan",))
+MAPS = _Offer(
+    ("nav_msgs/msg/OccupancyGrid",),
+    "nav_msgs/msg/OccupancyGrid topics (rviz's Map)",
+    ("/map",),
+    latched=True,
+)
 # Where new browsers start: close to the lesson-13 desk, or over the whole simulated world.
 DESK_VIEW = ((1.3, -1.4, 1.1), (0.25, 0.0, 0.25))
 MIN_FRAMES_TO_FRAME = 3  # a robot's links with poses, before the cameras go to it
@@ -155,6 +163,12 @@ class ScenePanel:
             self._scan_row = _TopicRow(gui, "Scan topic", SCANS)
             self.scan = LaserScanLayer(node, server, self._frame_pose)
             self._scan_info = MarkdownView(gui)
+        with gui.add_folder("Map"):
+            self._map_row = _TopicRow(gui, "Map topic", MAPS)
+            self.map = OccupancyGridLayer(
+                node, server, frame_known=lambda frame: frame in self.tf_view.frame_names()
+            )
+            self._map_info = MarkdownView(gui)
 
         with gui.add_folder("Point cloud"):
             self._cloud_row = _TopicRow(gui, "Cloud topic", CLOUDS)
@@ -233,6 +247,7 @@ class ScenePanel:
         ui = self._ui
         self._cloud_row.on_pick(ui, self.clouds.select)
         self._scan_row.on_pick(ui, self.scan.select)
+        self._map_row.on_pick(ui, self.map.select)
         self._image_row.on_pick(ui, self.images.select)
         self._marker_row.on_pick(ui, self.markers.select)
         self._joint_row.on_pick(ui, self._select_joints)
@@ -265,6 +280,7 @@ class ScenePanel:
         rows = (
             (self._cloud_row, self.clouds.select),
             (self._scan_row, self.scan.select),
+            (self._map_row, self.map.select),
             (self._image_row, self.images.select),
             (self._marker_row, self.markers.select),
             (self._joint_row, self._select_joints),
@@ -430,6 +446,7 @@ class ScenePanel:
         rows = (
             (self._cloud_row, self.clouds.worker, self.clouds.topic),
             (self._scan_row, self.scan.worker, self.scan.topic),
+            (self._map_row, self.map.worker, self.map.topic),
             (self._image_row, self.images.worker, self.images.topic),
             (self._marker_row, self.markers.worker, self.markers.topic),
             (self._joint_row, self.arm.worker, self.arm.topic),
@@ -437,7 +454,7 @@ class ScenePanel:
         for row, worker, topic in rows:
             row.refresh_options(graph)
             received, _drawn, rate, since = worker.stats()
-            note = picker.liveness_note(graph, topic, received, since)
+            note = picker.liveness_note(graph, topic, received, since, row.offer.latched)
             if not note and rate:
                 note = f"{rate:.1f} Hz received"
             row.note.show(note)
@@ -451,6 +468,7 @@ class ScenePanel:
             "\n\n".join(t for t in (self.world.describe(), self.more_robots.describe()) if t)
         )
         self._scan_info.show(self.scan.note)
+        self._map_info.show(self.map.describe())
         self._cloud_status.show(self.clouds.describe())
         camera = self.images.tf_camera
         note = camera.note if camera is not None else ""
@@ -472,7 +490,7 @@ class ScenePanel:
 
     def close(self) -> None:
         layers = (self.clouds, self.images, self.markers, self.arm, self.stamped, self.params)
-        sim = (self.scan, self.world, self.more_robots, self.drive)
+        sim = (self.scan, self.map, self.world, self.more_robots, self.drive)
         for layer in (*layers, *sim, self.tf_view, self.joint_sliders):
             layer.close()
         if self.images.tf_camera is not None:

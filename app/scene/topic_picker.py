@@ -55,8 +55,12 @@ def liveness_note(
     topic: str,
     received: int,
     seconds_since_last: float | None,
+    latched: bool = False,
 ) -> str:
-    """One line for a beginner: is anything arriving, and if not, why probably not."""
+    """One line for a beginner: is anything arriving, and if not, why probably not.
+
+    ``latched``: the topic is published once and kept (a map): silence is normal.
+    """
     if topic == NONE:
         return "Pick a topic to draw it."
     info = graph.topic(topic) if graph else None
@@ -70,6 +74,8 @@ def liveness_note(
         return f"⚠️ `{topic}` has **no publisher**: start a node that publishes it."
     if received == 0:
         return f"⏳ `{topic}` has {publishers} publisher(s); waiting for the first message…"
+    if latched:
+        return ""
     if seconds_since_last is not None and seconds_since_last > STALE_AFTER_SEC:
         return (
             f"⚠️ `{topic}` **stopped publishing** {seconds_since_last:.0f} s ago "

@@ -191,3 +191,44 @@ def test_the_desk_shows_only_while_a_node_feeds_it(page, probe):
         repeater.stop()
         probe.node.destroy_publisher(publisher)
     page.wait_for_function(f"() => !({DESK_SHOWN_JS})()", polling=200, timeout=30_000)
+
+
+def test_a_map_published_once_is_drawn_on_the_floor_of_its_frame(page, probe):
+    """A latched /map (as map_server and the grid mapper publish it) shows up in the Map row."""
+    import array
+
+    from geometry_msgs.msg import TransformStamped
+    from nav_msgs.msg import OccupancyGrid
+    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+    from tf2_msgs.msg import TFMessage
+
+    latched = QoSProfile(
+        depth=1,
+        reliability=ReliabilityPolicy.RELIABLE,
+        durability=DurabilityPolicy.TRANSIENT_LOCAL,
+    )
+    grid = OccupancyGrid()
+    grid.header.frame_id = "map"
+    grid.info.width, grid.info.height, grid.info.resolution = 40, 20, 0.1
+    grid.info.origin.position.x, grid.info.origin.position.y = -2.0, -1.0
+    grid.info.origin.orientation.w = 1.0
+    cells = [-1] * 800
+    cells[: 40 * 10] = [0] * 400  # the lower half known free, a wall across its middle
+    cells[40 * 5 : 40 * 6] = [100] * 40
+    grid.data = array.array("b", cells)
+    probe.node.create_publisher(OccupancyGrid, "/map", latched).publish(grid)  # once only
+    link = TransformStamped()
+    link.header.frame_id, link.child_frame_id = "map", "odom"
+    link.transform.rotation.w = 1.0
+    probe.node.create_publisher(TFMessage, "/tf_static", latched).publish(
+        TFMessage(transforms=[link])
+    )
+
+    open_tab(page, "3D view")
+    picture = "/tf_view/frames/map/occupancy_grid"
+    page.wait_for_function(HAS_NODE_JS, arg=picture, polling=200, timeout=30_000)
+    expect(page.get_by_text("40 x 20 cells of 0.1 m").first).to_be_visible(timeout=20_000)
+    note = page.get_by_text("50 % known, in").first  # `map` is code: TF has the frame
+    expect(note).to_be_visible(timeout=20_000)
+    assert "stopped publishing" not in page.locator("body").inner_text()  # latched: normal
+    page.screenshot(path=str(ARTIFACTS / "scene-map.png"))

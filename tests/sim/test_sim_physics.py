@@ -186,7 +186,9 @@ def test_a_world_that_does_not_parse_or_exist_is_refused_with_the_reason(tmp_pat
     unknown.write_text("<mujoco><worldbody><geom type='doughnut'/></worldbody></mujoco>")
     with pytest.raises(WorldError, match="doughnut"):
         load_world(str(unknown))
-    with pytest.raises(WorldError, match=r"does not exist \(worlds under nodes/worlds: room\)"):
+    with pytest.raises(
+        WorldError, match=r"does not exist \(worlds under nodes/worlds: office, room\)"
+    ):
         load_world("atlantis")
     with pytest.raises(WorldError, match="neither a world name"):
         load_world("../../etc/passwd")

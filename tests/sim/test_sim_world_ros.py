@@ -226,7 +226,7 @@ def test_a_world_that_does_not_load_or_a_bad_parameter_stops_the_node_with_the_r
         check=False,
     )
     assert missing.returncode == 2
-    assert "does not exist (worlds under nodes/worlds: room)" in missing.stderr
+    assert "does not exist (worlds under nodes/worlds: office, room)" in missing.stderr
     ticks = subprocess.run(
         [sys.executable, "-m", "nodes.sim_world", "--ros-args", "-p", "encoder_ticks:=0"],
         cwd=PROJECT_ROOT,

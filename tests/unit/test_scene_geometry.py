@@ -147,6 +147,7 @@ def test_picker_offers_only_drawable_topics_and_explains_silence():
     assert "waiting" in picker.liveness_note(graph, "/cloud", 0, None)
     assert "stopped publishing" in picker.liveness_note(graph, "/cloud", 5, 10.0)
     assert picker.liveness_note(graph, "/cloud", 5, 0.1) == ""
+    assert picker.liveness_note(graph, "/cloud", 1, 60.0, latched=True) == ""  # a map, say
 
 
 def test_the_desk_shows_only_while_another_node_feeds_it():
