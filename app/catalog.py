@@ -592,6 +592,13 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         package="sim_world",
     ),
     CatalogEntry(
+        "office_tour",
+        "office_tour",
+        "/office_tour",
+        "Drives the diffbot through every room of the office (19 waypoints) on ground truth.",
+        package="sim_world",
+    ),
+    CatalogEntry(
         "grid_mapper",
         "grid_mapper",
         "/grid_mapper",

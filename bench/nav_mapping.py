@@ -12,8 +12,8 @@ cell with the world file's floor plan (``app.lessons.checks._world_map``):
 - ``map_agreement_percent``: of the cells the map knows (free or occupied),
   how many agree with the plan (an occupied cell has an obstacle reaching
   into it; a free cell's centre is in no obstacle). Aim >= 95 (issue 40);
-- ``map_coverage_percent``: of the plan's free floor inside the outer walls
-  (cell centres 0.1 m or more from any obstacle), how much the map calls free;
+- ``map_coverage_percent``: of the plan's floor the robot can reach (points
+  0.1 m or more from any obstacle, joined to the start), how much the map calls free;
 - ``occupied_agree_percent`` and ``free_agree_percent`` apart, the map's size,
   the tour's simulated and wall seconds, the real-time factor the world kept,
   the mapper's CPU (per cent of one core) and the closest the robot's body
@@ -38,47 +38,38 @@ from typing import Any
 import numpy as np
 
 from bench._common import configure_dds, require_private_netns, rounded
+from nodes.office_tour import REACHED, TOUR, command  # the tour office_tour drives
 
 AIM_PERCENT = 95.0
-TOUR = [
-    (4.15, 0.0), (4.15, 1.4), (4.15, 3.55), (0.5, 3.55), (-0.5, 3.25), (-0.5, 2.4),
-    (-2.95, 2.4), (-2.95, 0.0), (-3.45, 0.0), (-3.45, -1.5), (-2.0, -1.5), (-3.45, -1.5),
-    (-3.45, 0.0), (1.45, 0.0), (1.45, -1.6), (3.6, -1.6), (1.45, -1.6), (1.45, 0.0), (0.0, 0.0),
-]  # fmt: skip
 MEMBERS = ("sim_office_mapping", "sim_robot_state_publisher", "grid_mapper")
-REACHED = 0.08  # m
-MAX_LINEAR, MAX_ANGULAR = 0.4, 1.5
-
-
-def command(pose: tuple[float, float, float], goal: tuple[float, float]) -> tuple[float, float]:
-    """(linear, angular) towards ``goal``: turn on the spot first, then drive and steer."""
-    x, y, yaw = pose
-    heading = math.atan2(goal[1] - y, goal[0] - x)
-    error = math.atan2(math.sin(heading - yaw), math.cos(heading - yaw))
-    turn = max(-MAX_ANGULAR, min(MAX_ANGULAR, 2.5 * error))
-    if abs(error) > 0.25:
-        return 0.0, turn
-    return min(MAX_LINEAR, 1.0 * math.dist((x, y), goal) + 0.05), turn
 
 
 def plan_figures(msg: Any) -> dict[str, float]:
     from app.lessons.checks._world_map import load_world_map
-    from nodes.common.occupancy_grid import cell_centres, map_agreement, plan_distance
+    from nodes.common.occupancy_grid import (
+        cell_centres,
+        floor_coverage,
+        floor_points,
+        map_agreement,
+        map_values_at,
+        plan_distance,
+    )
 
     plan = load_world_map("office")
     origin = (msg.info.origin.position.x, msg.info.origin.position.y)
-    xs, ys = cell_centres(origin, msg.info.resolution, msg.info.width, msg.info.height)
+    size = (msg.info.resolution, msg.info.width, msg.info.height)
+    xs, ys = cell_centres(origin, *size)
     distance = plan_distance(plan.obstacles, xs, ys)
     data = np.array(msg.data, np.int8).reshape(distance.shape)
     result = map_agreement(data, distance, msg.info.resolution)
-    inside = (np.abs(xs) < 5.0) & (np.abs(ys) < 4.0) & (distance >= 0.1)
+    floor = map_values_at(data, origin, *size, *floor_points(plan.obstacles))
     return {
         "map_agreement_percent": result.percent,
         "occupied_agree_percent": 100.0 * result.occupied_agree / max(result.occupied, 1),
         "free_agree_percent": 100.0 * result.free_agree / max(result.free, 1),
         "known_cells": result.known,
         "occupied_cells": result.occupied,
-        "map_coverage_percent": 100.0 * float((inside & (data == 0)).sum()) / inside.sum(),
+        "map_coverage_percent": floor_coverage(floor),
         "map_width": msg.info.width,
         "map_height": msg.info.height,
     }

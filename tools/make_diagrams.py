@@ -14,6 +14,7 @@ Usage: ``python tools/make_diagrams.py [output folder]`` (default ``static/``).
 
 from __future__ import annotations
 
+import math
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -598,6 +599,60 @@ def slam_pipeline() -> Svg:
     return svg
 
 
+def log_odds_cell() -> Svg:
+    """One map cell's evidence over seven scans, with the thresholds that name it."""
+    steps = [("start", 0.0), ("miss", -0.4), ("miss", -0.4), ("miss", -0.4),
+             ("hit", 0.85), ("hit", 0.85), ("hit", 0.85)]  # fmt: skip
+    free_at, occupied_at = math.log(0.25 / 0.75), math.log(0.65 / 0.35)  # -1.10, +0.62
+    svg = Svg(
+        400,
+        "One map cell's log-odds, scan by scan",
+        "The cell starts at log-odds 0 (probability 0.5, unknown). Beams of three scans "
+        "cross it, minus 0.4 each: -0.4, -0.8, -1.2, below the free line (probability "
+        "0.25, log-odds -1.10), so the map calls it free. Then beams of three scans end "
+        "in it, plus 0.85 each: -0.35 and +0.5 (unknown again), then +1.35, above the "
+        "occupied line (probability 0.65, log-odds +0.62): occupied. Evidence adds up, "
+        "and the cell can change its mind.",
+    )
+    left, right, top, bottom = 58.0, W - 16.0, 40.0, 300.0
+    low, high = -1.6, 1.6
+
+    def y_of(value: float) -> float:
+        return bottom - (value - low) / (high - low) * (bottom - top)
+
+    svg.text(W / 2, 22, "One cell, scan by scan", size=15, bold=True)
+    bands = ((high, occupied_at, BAD, "occupied"), (occupied_at, free_at, ("#f1f3f5", SOFT),
+             "unknown"), (free_at, low, GOOD, "free"))  # fmt: skip
+    for upper, lower, colors, name in bands:
+        svg.rect(left, y_of(upper), right - left, y_of(lower) - y_of(upper), colors[0], "none", 0)
+        svg.text(left + 6, y_of(upper) + 17, name, size=13, bold=True, fill=colors[1],
+                 anchor="start")  # fmt: skip
+    for value, label, x, dy, anchor in (
+        (occupied_at, "+0.62 (p 0.65)", (left + right) / 2, 15, "middle"),  # clear of the line
+        (free_at, "-1.10 (p 0.25)", right - 6, -6, "end"),
+    ):
+        svg.path([(left, y_of(value)), (right, y_of(value))], SOFT, 1.5, arrow=False, dashed=True)
+        svg.text(x, y_of(value) + dy, label, size=12, fill=SOFT, anchor=anchor)
+    svg.text(left - 8, y_of(0.0) + 4, "0", size=12, fill=SOFT, anchor="end")
+    svg.text(16, (top + bottom) / 2, "log-odds", size=13, fill=SOFT, rotate=-90)
+    gap = (right - left) / len(steps)
+    total, points = 0.0, []
+    for i, (_event, change) in enumerate(steps):
+        total += change
+        points.append((left + gap * (i + 0.5), y_of(total)))
+    svg.path(points, LINE, 2, arrow=False)
+    total = 0.0
+    for (x, y), (event, change) in zip(points, steps, strict=True):
+        total += change
+        svg.raw(f'<circle cx="{_n(x)}" cy="{_n(y)}" r="5" fill="{LINE}"/>')
+        svg.text(x, y - 10 if total <= 0.2 else y + 20, f"{total:+.2f}".replace("+0.00", "0"),
+                 size=12, bold=True)  # fmt: skip
+        svg.text(x, bottom + 18, event, size=12, fill=SOFT)
+    svg.lines(W / 2, bottom + 48, ["miss: a beam crossed it, -0.4",
+              "hit: a beam ended in it, +0.85"], size=13, fill=SOFT)  # fmt: skip
+    return svg
+
+
 DIAGRAMS: dict[str, Callable[[], Svg]] = {
     "dds_layers.svg": dds_layers,
     "topic_graph.svg": topic_graph,
@@ -607,6 +662,7 @@ DIAGRAMS: dict[str, Callable[[], Svg]] = {
     "qos_compatibility.svg": qos_compatibility,
     "camera_base_frames.svg": camera_base_frames,
     "slam_pipeline.svg": slam_pipeline,
+    "log_odds.svg": log_odds_cell,
 }
 
 

@@ -393,3 +393,60 @@ def map_agreement(
         free=int(free.sum()),
         free_agree=free_agree,
     )
+
+
+def floor_points(
+    obstacles: Sequence[Any],
+    start: tuple[float, float] = (0.0, 0.0),
+    spacing: float = 0.05,
+    clearance: float = 0.1,
+) -> tuple[np.ndarray, np.ndarray]:
+    """x, y of the floor a robot starting at ``start`` can reach, on a lattice of ``spacing``.
+
+    The floor is every lattice point at least ``clearance`` from any obstacle
+    and joined to ``start`` through such points (rooms behind a closed wall,
+    or the outside of the building, are not floor).
+    """
+    import cv2  # the connected regions of a picture, as OpenCV finds them
+
+    extent = [(o.x, o.y, getattr(o, "radius", 0.0) + getattr(o, "half_x", 0.0)
+               + getattr(o, "half_y", 0.0)) for o in obstacles]  # fmt: skip
+    low_x = min(x - r for x, _y, r in extent)
+    high_x = max(x + r for x, _y, r in extent)
+    low_y = min(y - r for _x, y, r in extent)
+    high_y = max(y + r for _x, y, r in extent)
+    xs, ys = np.meshgrid(np.arange(low_x, high_x, spacing), np.arange(low_y, high_y, spacing))
+    open_floor = (plan_distance(obstacles, xs, ys) >= clearance).astype(np.uint8)
+    _count, labels = cv2.connectedComponents(open_floor, connectivity=4)
+    row, col = np.unravel_index(np.argmin(np.hypot(xs - start[0], ys - start[1])), xs.shape)
+    if not open_floor[row, col]:
+        return np.empty(0), np.empty(0)
+    reachable = labels == labels[row, col]
+    return xs[reachable], ys[reachable]
+
+
+def map_values_at(
+    data: Sequence[int] | np.ndarray,
+    origin: tuple[float, float],
+    resolution: float,
+    width: int,
+    height: int,
+    xs: np.ndarray,
+    ys: np.ndarray,
+) -> np.ndarray:
+    """The map's value (-1, 0..100) at each point; -1 where the (unturned) map does not reach."""
+    grid = np.asarray(data, np.int16).reshape(height, width)
+    cols = np.floor((xs - origin[0]) / resolution).astype(np.int64)
+    rows = np.floor((ys - origin[1]) / resolution).astype(np.int64)
+    inside = (cols >= 0) & (cols < width) & (rows >= 0) & (rows < height)
+    values = np.full(np.shape(xs), UNKNOWN, np.int16)
+    values[inside] = grid[rows[inside], cols[inside]]
+    return values
+
+
+def floor_coverage(values_at_floor: np.ndarray) -> float:
+    """Per cent of the floor's points the map calls free (0..49)."""
+    if values_at_floor.size == 0:
+        return math.nan
+    free = (values_at_floor >= 0) & (values_at_floor < 50)
+    return 100.0 * float(free.sum()) / values_at_floor.size

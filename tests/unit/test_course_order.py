@@ -1,6 +1,7 @@
 """The course as a learner meets it: lessons numbered 1..N in the order they are taken (the
 folder's prefix is the number the picker, the position line and the teacher's view show),
-the capstone last, and no lesson so long that its step list stops being a plan.
+the capstone last of the core course (navigation units follow it), and no lesson so long
+that its step list stops being a plan.
 """
 
 from __future__ import annotations
@@ -14,8 +15,10 @@ COURSE_ORDER = [
     "05_topics", "06_qos", "07_services", "08_interfaces", "09_actions", "10_parameters",
     "11_lifecycle", "12_launch", "13_executors", "14_images_opencv", "15_frames_and_arm",
     "16_tf2_turtlesim", "17_tf2_time", "18_urdf_robot", "19_wheeled_robot",
-    "20_workspaces_packages", "21_bags", "22_slam_capstone",
+    "20_workspaces_packages", "21_bags", "22_slam_capstone", "23_maps",
 ]  # fmt: skip
+# After the capstone that closes the core course, units that go on towards navigation.
+BEYOND_THE_CAPSTONE = {"23_maps"}
 MOST_STEPS = 12
 # Longer on purpose: its second half changes the package its first half built.
 LONG_ON_PURPOSE = {"20_workspaces_packages"}
@@ -26,7 +29,9 @@ def test_lessons_are_numbered_one_to_n_in_course_order_with_the_capstone_last():
     assert not course.errors
     assert [lesson.id for lesson in course.lessons] == COURSE_ORDER
     assert [lesson.unit for lesson in course.lessons] == list(range(1, len(COURSE_ORDER) + 1))
-    assert "capstone" in course.lessons[-1].id
+    core = [lesson for lesson in course.lessons if lesson.id not in BEYOND_THE_CAPSTONE]
+    assert "capstone" in core[-1].id
+    assert [lesson.id for lesson in course.lessons[len(core) :]] == sorted(BEYOND_THE_CAPSTONE)
 
 
 def test_no_lesson_is_too_long_to_follow():
