@@ -612,6 +612,70 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         package="nav2_map_server",
     ),
     CatalogEntry(
+        "map_server_office",
+        "map_server",
+        "/map_server",
+        "Nav2's map_server with the office's map (nodes/worlds/office/map.yaml), for navigation.",
+        ros_args=("-p", "yaml_filename:=nodes/worlds/office/map.yaml"),
+        package="nav2_map_server",
+    ),
+    # --- localization and navigation (issue 40): Nav2's servers, our Python versions ---
+    CatalogEntry(
+        "amcl",
+        "amcl",
+        "/amcl",
+        "Nav2's amcl (lifecycle): particle filter on /map from /scan and odom; /amcl_pose, "
+        "/particle_cloud, map -> odom; /initialpose or reinitialize_global_localization.",
+        package="nav2_amcl",
+    ),
+    CatalogEntry(
+        "amcl_office",
+        "amcl",
+        "/amcl",
+        "Nav2's amcl told where the office robot starts (set_initial_pose at 0, 0, facing east).",
+        ros_args=("-p", "set_initial_pose:=true"),
+        package="nav2_amcl",
+    ),
+    CatalogEntry(
+        "planner_server",
+        "planner_server",
+        "/planner_server",
+        "Nav2's planner server (lifecycle): /global_costmap/costmap from /map, "
+        "compute_path_to_pose (GridBased), /plan.",
+        package="nav2_planner",
+    ),
+    CatalogEntry(
+        "controller_server",
+        "controller_server",
+        "/controller_server",
+        "Nav2's controller server (lifecycle): follow_path, regulated pure pursuit on /cmd_vel.",
+        package="nav2_controller",
+    ),
+    CatalogEntry(
+        "bt_navigator",
+        "bt_navigator",
+        "/bt_navigator",
+        "Nav2's navigator (lifecycle): navigate_to_pose and navigate_through_poses "
+        "(plan, follow, replan once a second).",
+        package="nav2_bt_navigator",
+    ),
+    CatalogEntry(
+        "lifecycle_manager",
+        "lifecycle_manager",
+        "/lifecycle_manager_navigation",
+        "Nav2's lifecycle manager: configures and activates the map server, amcl and the "
+        "navigation servers in order (autostart).",
+        ros_args=(
+            "-r",
+            "__node:=lifecycle_manager_navigation",
+            "-p",
+            "autostart:=true",
+            "-p",
+            "node_names:=[map_server,amcl,planner_server,controller_server,bt_navigator]",
+        ),
+        package="nav2_lifecycle_manager",
+    ),
+    CatalogEntry(
         "map_saver_cli",
         "map_saver_cli",
         "/map_saver",
@@ -745,6 +809,21 @@ GROUPS: tuple[LaunchGroup, ...] = (
         "office_mapping",
         "the office world, the robot's state publisher, the grid mapper and the teleop: map it",
         ("sim_office_mapping", "sim_robot_state_publisher", "grid_mapper", "sim_teleop_key"),
+    ),
+    LaunchGroup(
+        "office_navigation",
+        "the office world, its map, amcl and Nav2's planner, controller and navigator, "
+        "brought up by the lifecycle manager: send a navigation goal",
+        (
+            "sim_office_mapping",
+            "sim_robot_state_publisher",
+            "map_server_office",
+            "amcl_office",
+            "planner_server",
+            "controller_server",
+            "bt_navigator",
+            "lifecycle_manager",
+        ),
     ),
 )
 

@@ -25,6 +25,7 @@ from geometry_msgs.msg import Twist
 from nav2_map_server.map_io import load_map_from_yaml
 from nav_msgs.msg import OccupancyGrid, Odometry
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from std_srvs.srv import Empty
 from tf2_msgs.msg import TFMessage
 
 from app import PROJECT_ROOT
@@ -54,6 +55,7 @@ class Watcher:
         self.lock = threading.Lock()
         self.map: OccupancyGrid | None = None
         self.maps = 0
+        self.map_at = time.monotonic()
         self.truth: tuple[float, float, float, float] | None = None  # t, x, y, yaw
         self.edges: set[tuple[str, str]] = set()
         self.static_edges: set[tuple[str, str]] = set()
@@ -66,6 +68,12 @@ class Watcher:
     def on_map(self, msg: OccupancyGrid) -> None:
         with self.lock:
             self.map, self.maps = msg, self.maps + 1
+            self.map_at = time.monotonic()
+
+    def quiet_for(self) -> float:
+        """Seconds since the last map came."""
+        with self.lock:
+            return time.monotonic() - self.map_at
 
     def on_truth(self, msg: Odometry) -> None:
         q = msg.pose.pose.orientation
@@ -164,6 +172,14 @@ def test_driving_the_office_builds_a_map_that_agrees_with_the_floor_plan(
     assert not any("Traceback" in line for line in supervisor.output("grid_mapper"))
 
     # Nav2's map_saver_cli saves that latched map; the files load back as the same grid.
+    # The world is paused first: no more scans, so the map the saver gets is the newest one.
+    pause = probe.node.create_client(Empty, "/pause_physics")
+    assert pause.wait_for_service(timeout_sec=10)
+    paused = pause.call_async(Empty.Request())
+    wait_until(paused.done, timeout=10, what="/pause_physics")
+    wait_until(  # the mapper publishes once a second while its map changes
+        lambda: watcher.quiet_for() > 2.5, timeout=30, what="a map that stops changing"
+    )
     base = tmp_path / "maps" / "office"
     saving = time.monotonic()
     saved = subprocess.run(

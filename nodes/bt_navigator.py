@@ -1,0 +1,12 @@
+"""`ros2 run nav2_bt_navigator bt_navigator`: Nav2's bt_navigator.
+
+A lifecycle-managed part of the navigation stack (issue 40); see the
+module's docstring for its actions, services and parameters.
+"""
+
+from nav2_bt_navigator.bt_navigator import main
+
+from nodes.common.run import run_program
+
+if __name__ == "__main__":
+    run_program(main)  # Ctrl+C and SIGTERM end it the same quiet way

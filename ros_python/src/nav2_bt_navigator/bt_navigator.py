@@ -1,0 +1,430 @@
+"""bt_navigator: Nav2's navigator: ``navigate_to_pose`` and ``navigate_through_poses``.
+
+Nav2's bt_navigator runs a behaviour tree (``navigate_to_pose_w_replanning_and_recovery.xml``);
+this one runs the same steps as plain code, no behaviour tree (nor its XML,
+``behavior_tree`` in the goal is ignored):
+
+1. plan with the planner server's ``compute_path_to_pose`` (``planner_id``
+   ``GridBased``) from the robot to the goal, and again about once a second
+   (``replanning_period``, the tree's RateController at 1 Hz) while driving;
+2. follow each new path with the controller server's ``follow_path``
+   (``controller_id`` ``FollowPath``);
+3. when following fails, count a recovery (``number_of_recoveries``), plan
+   again and carry on, at most ``number_of_retries`` (6) times, as the tree's
+   RecoveryNode; then the goal ends aborted with the failing server's error
+   code and message (e.g. ComputePathToPose's ``GOAL_OCCUPIED`` 206,
+   FollowPath's ``FAILED_TO_MAKE_PROGRESS`` 105). A first plan that fails
+   ends the goal at once.
+
+Feedback as Nav2 sends it: ``current_pose`` (TF ``map -> base_link``),
+``navigation_time``, ``estimated_time_remaining`` (distance over speed),
+``number_of_recoveries``, ``distance_remaining`` (along the path), and
+``number_of_poses_remaining`` for ``navigate_through_poses`` (a pose counts
+as passed within 0.5 m, as RemovePassedGoals). Cancelling stops the
+controller, hence the robot. A new goal preempts the running one.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import threading
+import time
+from typing import Any
+
+from geometry_msgs.msg import PoseStamped
+from lifecycle_msgs.msg import State
+from nav2_costmap_2d.costmap_2d_ros import yaw_of
+from nav2_msgs.action import ComputePathToPose, FollowPath, NavigateThroughPoses, NavigateToPose
+from nav2_util.lifecycle_node import LifecycleNode
+from nav2_util.server_main import spin_server
+from nav_msgs.msg import Odometry, Path
+from rclpy.action import ActionClient, ActionServer, CancelResponse, GoalResponse
+from rclpy.action.client import ClientGoalHandle
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.duration import Duration
+from rclpy.lifecycle import LifecycleState, TransitionCallbackReturn
+from rclpy.task import Future
+from rclpy.time import Time
+from tf2_ros.buffer import Buffer
+from tf2_ros.transform_listener import TransformListener
+
+SUCCEEDED, CANCELED, ABORTED = 4, 5, 6  # action_msgs/GoalStatus
+
+
+class NavigationFailed(Exception):
+    def __init__(self, code: int, message: str) -> None:
+        super().__init__(message)
+        self.code = code
+
+
+class Preempted(Exception):
+    pass
+
+
+def wait_for(future: Future, timeout: float, stop: Any = None) -> bool:
+    """Wait (from an execute thread) for a future; False on timeout or when ``stop()``."""
+    done = threading.Event()
+    future.add_done_callback(lambda _f: done.set())
+    deadline = time.monotonic() + timeout
+    while not done.wait(0.02):
+        if time.monotonic() > deadline or (stop is not None and stop()):
+            return False
+    return True
+
+
+def remaining_length(path: list[tuple[float, float]], pose: tuple[float, float, float]) -> float:
+    if not path:
+        return 0.0
+    best = min(
+        range(len(path)), key=lambda i: math.hypot(path[i][0] - pose[0], path[i][1] - pose[1])
+    )
+    length = math.hypot(path[best][0] - pose[0], path[best][1] - pose[1])
+    for a, b in zip(path[best:], path[best + 1 :], strict=False):
+        length += math.hypot(b[0] - a[0], b[1] - a[1])
+    return length
+
+
+class BtNavigator(LifecycleNode):
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__("bt_navigator", **kwargs)
+        self.get_logger().info("Creating")
+        p = self.declare_parameter
+        p("global_frame", "map")
+        p("robot_base_frame", "base_link")
+        p("transform_tolerance", 0.1)
+        p("odom_topic", "odom")
+        p("replanning_period", 1.0)
+        p("number_of_retries", 6)
+        p("planner_id", "GridBased")
+        p("controller_id", "FollowPath")
+        p("goal_reached_tol", 0.5)  # RemovePassedGoals' radius for navigate_through_poses
+        self.group = ReentrantCallbackGroup()
+        self.lock = threading.Lock()
+        self.current: Any = None
+        self.speed = 0.0
+        self.servers: list[ActionServer] = []
+        self.action_clients: list[ActionClient] = []
+        self.odom_sub: Any = None
+        self.tf_buffer = Buffer(node=self)
+        self.tf_listener = TransformListener(self.tf_buffer, self)
+
+    # --- transitions ---
+    def on_configure(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.get_logger().info("Configuring")
+        g = self.get_parameter
+        self.global_frame = str(g("global_frame").value)
+        self.robot_base_frame = str(g("robot_base_frame").value)
+        self.planner = ActionClient(
+            self, ComputePathToPose, "compute_path_to_pose", callback_group=self.group
+        )
+        self.controller = ActionClient(self, FollowPath, "follow_path", callback_group=self.group)
+        self.action_clients = [self.planner, self.controller]
+        self.odom_sub = self.create_subscription(
+            Odometry, str(g("odom_topic").value), self.on_odom, 10, callback_group=self.group
+        )
+        for action_type, name, execute in (
+            (NavigateToPose, "navigate_to_pose", self.navigate_to_pose),
+            (NavigateThroughPoses, "navigate_through_poses", self.navigate_through_poses),
+        ):
+            self.servers.append(
+                ActionServer(
+                    self,
+                    action_type,
+                    name,
+                    execute_callback=execute,
+                    goal_callback=self.on_goal,
+                    handle_accepted_callback=self.on_accepted,
+                    cancel_callback=lambda _goal: CancelResponse.ACCEPT,
+                    callback_group=self.group,
+                )
+            )
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_activate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.get_logger().info("Activating")
+        return super().on_activate(state)
+
+    def on_deactivate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.get_logger().info("Deactivating")
+        with self.lock:
+            self.current = None
+        return super().on_deactivate(state)
+
+    def on_cleanup(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.get_logger().info("Cleaning up")
+        self.release()
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_shutdown(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.get_logger().info("Shutting down")
+        self.release()
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_error(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.get_logger().error(f"Error in state '{state.label}': released everything")
+        self.release()
+        return TransitionCallbackReturn.SUCCESS
+
+    def release(self) -> None:
+        with self.lock:
+            self.current = None
+        for server in self.servers:
+            server.destroy()
+        for client in self.action_clients:
+            client.destroy()
+        self.servers, self.action_clients = [], []
+        if getattr(self, "odom_sub", None) is not None:
+            self.destroy_subscription(self.odom_sub)
+            self.odom_sub = None
+
+    def active(self) -> bool:
+        return self._state_machine.current_state[0] == State.PRIMARY_STATE_ACTIVE
+
+    def on_odom(self, msg: Odometry) -> None:
+        self.speed = math.hypot(msg.twist.twist.linear.x, msg.twist.twist.linear.y)
+
+    def robot_pose(self) -> tuple[float, float, float] | None:
+        try:
+            tf = self.tf_buffer.lookup_transform(
+                self.global_frame,
+                self.robot_base_frame,
+                Time(),
+                Duration(seconds=float(self.get_parameter("transform_tolerance").value) + 0.4),
+            )
+        except Exception as exc:
+            self.get_logger().error(f"Could not get robot pose: {exc}", throttle_duration_sec=2.0)
+            return None
+        t = tf.transform.translation
+        return (t.x, t.y, yaw_of(tf.transform.rotation))
+
+    # --- the actions ---
+    def on_goal(self, goal: Any) -> GoalResponse:
+        if not self.active():
+            self.get_logger().warning("Action server is inactive. Rejecting the goal.")
+            return GoalResponse.REJECT
+        return GoalResponse.ACCEPT
+
+    def on_accepted(self, handle: Any) -> None:
+        with self.lock:
+            previous, self.current = self.current, handle
+        if previous is not None:
+            self.get_logger().info("Received goal preemption request")
+        handle.execute()
+
+    def navigate_to_pose(self, handle: Any) -> Any:
+        goal = handle.request.pose
+        return self.navigate(handle, [goal], NavigateToPose)
+
+    def navigate_through_poses(self, handle: Any) -> Any:
+        return self.navigate(handle, list(handle.request.poses), NavigateThroughPoses)
+
+    def navigate(self, handle: Any, goals: list[PoseStamped], action: Any) -> Any:
+        result = action.Result()
+        started = time.monotonic()
+        through = action is NavigateThroughPoses
+        if not goals:
+            result.error_code, result.error_msg = 0, "No poses to navigate through"
+            self.get_logger().error(result.error_msg)
+            handle.abort()
+            return result
+        pose = self.robot_pose()
+        where = f"({pose[0]:.2f}, {pose[1]:.2f})" if pose else "(unknown)"
+        last = goals[-1].pose.position
+        if through:
+            self.get_logger().info(
+                f"Begin navigating from current location {where} using {len(goals)} poses"
+            )
+        else:
+            self.get_logger().info(
+                f"Begin navigating from current location {where} to ({last.x:.2f}, {last.y:.2f})"
+            )
+        state: dict[str, Any] = {"follow": None, "path": [], "recoveries": 0}
+
+        def stop() -> bool:
+            return handle.is_cancel_requested or handle is not self.current
+
+        try:
+            period = float(self.get_parameter("replanning_period").value)
+            retries = int(self.get_parameter("number_of_retries").value)
+            path = self.plan(goals, stop)
+            follow = self.follow(path, stop)
+            state["path"] = [(p.pose.position.x, p.pose.position.y) for p in path.poses]
+            last_plan = time.monotonic()
+            failures = 0
+            while True:
+                if handle.is_cancel_requested:
+                    self.cancel_follow(follow)
+                    self.get_logger().info("Goal was canceled. Stopping the robot.")
+                    handle.canceled()
+                    return result
+                if handle is not self.current:
+                    raise Preempted()
+                if follow is not None and follow.done():
+                    outcome = follow.result()
+                    if outcome is not None and outcome.status == SUCCEEDED:
+                        self.get_logger().info("Goal succeeded")
+                        handle.succeed()
+                        return result
+                    code = outcome.result.error_code if outcome is not None else 0
+                    message = outcome.result.error_msg if outcome is not None else ""
+                    if state["recoveries"] >= retries:
+                        raise NavigationFailed(code, message or "Following the path failed")
+                    state["recoveries"] += 1
+                    self.get_logger().warning(
+                        f"Following the path failed ({code}: {message}); "
+                        f"recovery {state['recoveries']} of {retries}: planning again"
+                    )
+                    time.sleep(0.2)
+                    last_plan = 0.0
+                    follow = None
+                pose = self.robot_pose()
+                if through and pose is not None:
+                    tol = float(self.get_parameter("goal_reached_tol").value)
+                    while (
+                        len(goals) > 1
+                        and math.hypot(
+                            goals[0].pose.position.x - pose[0], goals[0].pose.position.y - pose[1]
+                        )
+                        < tol
+                    ):
+                        goals = goals[1:]
+                if follow is None or time.monotonic() - last_plan >= period:
+                    last_plan = time.monotonic()
+                    try:
+                        path = self.plan(goals, stop)
+                        failures = 0
+                        follow = self.follow(path, stop)
+                        state["path"] = [(p.pose.position.x, p.pose.position.y) for p in path.poses]
+                    except NavigationFailed:
+                        failures += 1
+                        if follow is None or failures >= 3:
+                            raise
+                self.send_feedback(handle, action, pose, started, state, goals)
+                time.sleep(0.1)
+        except Preempted:
+            handle.abort()
+            return result
+        except NavigationFailed as exc:
+            if handle.is_cancel_requested:
+                self.get_logger().info("Goal was canceled. Stopping the robot.")
+                handle.canceled()
+                return result
+            if handle is not self.current:
+                handle.abort()
+                return result
+            self.get_logger().error(f"Goal failed: {exc} (error code {exc.code})")
+            result.error_code = int(exc.code)
+            result.error_msg = str(exc)
+            handle.abort()
+            return result
+
+    def send_feedback(
+        self,
+        handle: Any,
+        action: Any,
+        pose: tuple[float, float, float] | None,
+        started: float,
+        state: dict[str, Any],
+        goals: list[PoseStamped],
+    ) -> None:
+        feedback = action.Feedback()
+        if pose is not None:
+            feedback.current_pose.header.frame_id = self.global_frame
+            feedback.current_pose.header.stamp = self.get_clock().now().to_msg()
+            p = feedback.current_pose.pose
+            p.position.x, p.position.y = pose[0], pose[1]
+            p.orientation.z, p.orientation.w = math.sin(pose[2] / 2), math.cos(pose[2] / 2)
+            feedback.distance_remaining = float(remaining_length(state["path"], pose))
+        elapsed = time.monotonic() - started
+        feedback.navigation_time = Duration(seconds=elapsed).to_msg()
+        if self.speed > 0.01:
+            remaining = feedback.distance_remaining / self.speed
+            feedback.estimated_time_remaining = Duration(seconds=remaining).to_msg()
+        feedback.number_of_recoveries = int(state["recoveries"])
+        if action is NavigateThroughPoses:
+            feedback.number_of_poses_remaining = len(goals)
+        handle.publish_feedback(feedback)
+
+    def plan(self, goals: list[PoseStamped], stop: Any) -> Path:
+        """One path through ``goals`` (each leg a ComputePathToPose from the previous pose)."""
+        poses: list[PoseStamped] = []
+        start: PoseStamped | None = None
+        for goal in goals:
+            request = ComputePathToPose.Goal()
+            request.goal = goal
+            request.planner_id = str(self.get_parameter("planner_id").value)
+            if start is not None:
+                request.start, request.use_start = start, True
+            outcome = self.call(self.planner, request, stop, "compute_path_to_pose")
+            leg = outcome.result.path
+            if outcome.status != SUCCEEDED or not leg.poses:
+                raise NavigationFailed(
+                    outcome.result.error_code, outcome.result.error_msg or "Planning failed"
+                )
+            poses.extend(leg.poses if not poses else leg.poses[1:])
+            start = leg.poses[-1]
+        path = Path()
+        path.header.frame_id = self.global_frame
+        path.header.stamp = self.get_clock().now().to_msg()
+        path.poses = poses
+        return path
+
+    def call(self, client: ActionClient, request: Any, stop: Any, name: str) -> Any:
+        if not client.wait_for_server(timeout_sec=5.0):
+            raise NavigationFailed(0, f"Action server {name} is not available")
+        sent = client.send_goal_async(request)
+        if not wait_for(sent, 10.0, stop):
+            raise NavigationFailed(0, f"{name} did not answer the goal")
+        goal_handle: ClientGoalHandle = sent.result()
+        if not goal_handle.accepted:
+            raise NavigationFailed(0, f"{name} rejected the goal")
+        done = goal_handle.get_result_async()
+        if not wait_for(done, 30.0, stop):
+            goal_handle.cancel_goal_async()
+            raise NavigationFailed(0, f"{name} did not finish")
+        return done.result()
+
+    def follow(self, path: Path, stop: Any) -> Any:
+        """Send the path to the controller; a future-like handle on its result."""
+        request = FollowPath.Goal()
+        request.path = path
+        request.controller_id = str(self.get_parameter("controller_id").value)
+        if not self.controller.wait_for_server(timeout_sec=5.0):
+            raise NavigationFailed(0, "Action server follow_path is not available")
+        sent = self.controller.send_goal_async(request)
+        if not wait_for(sent, 10.0, stop):
+            raise NavigationFailed(0, "follow_path did not answer the goal")
+        goal_handle = sent.result()
+        if not goal_handle.accepted:
+            raise NavigationFailed(0, "follow_path rejected the goal")
+        return _Following(goal_handle, goal_handle.get_result_async())
+
+    def cancel_follow(self, follow: Any) -> None:
+        if follow is None:
+            return
+        cancel = follow.handle.cancel_goal_async()
+        wait_for(cancel, 2.0)
+
+
+class _Following:
+    def __init__(self, handle: ClientGoalHandle, result: Future) -> None:
+        self.handle, self.future = handle, result
+
+    @property
+    def status(self) -> int | None:
+        return int(self.handle.status)
+
+    def done(self) -> bool:
+        return self.future.done()
+
+    def result(self) -> Any:
+        return self.future.result()
+
+
+def main(args: list[str] | None = None) -> int:
+    return spin_server(BtNavigator, args, "bt_navigator")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,254 @@
+"""The regulated pure pursuit controller, as Nav2's ``RegulatedPurePursuitController`` steers.
+
+Pure pursuit drives the arc that passes through a *carrot*: the point of
+the path ``lookahead_dist`` ahead of the robot. In the robot's frame, with
+the carrot at (x, y) and L its distance, the arc's curvature is ``2 y / L**2``
+and the turn rate ``v * curvature``. Nav2's *regulated* version then
+
+- slows down on tight curves (radius below ``regulated_linear_scaling_min_radius``),
+  near obstacles (cost of the robot's cell, ``use_cost_regulated_linear_velocity_scaling``)
+  and while approaching the end of the path (``approach_velocity_scaling_dist``),
+  never below ``regulated_linear_scaling_min_speed`` (or ``min_approach_linear_velocity``
+  at the end);
+- turns on the spot towards the path when it points more than
+  ``rotate_to_heading_min_angle`` away (``use_rotate_to_heading``), and to the
+  goal's heading once within the goal tolerance;
+- checks the arc it is about to drive against the costmap for
+  ``max_allowed_time_to_collision_up_to_carrot`` seconds and refuses to move
+  into an obstacle ("detected collision ahead!").
+
+No ROS here: poses are (x, y, yaw) tuples in the costmap's frame.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from nav2_costmap_2d.cost_values import (
+    INSCRIBED_INFLATED_OBSTACLE,
+    LETHAL_OBSTACLE,
+    NO_INFORMATION,
+)
+from nav2_costmap_2d.costmap_2d import Costmap2D
+
+Pose2D = tuple[float, float, float]
+
+
+class ControllerException(RuntimeError):
+    """A control failure, turned into FollowPath's error codes by the server."""
+
+
+class NoValidControl(ControllerException):
+    pass
+
+
+@dataclass
+class RPPParameters:
+    desired_linear_vel: float = 0.5
+    lookahead_dist: float = 0.6
+    min_lookahead_dist: float = 0.3
+    max_lookahead_dist: float = 0.9
+    lookahead_time: float = 1.5
+    use_velocity_scaled_lookahead_dist: bool = False
+    rotate_to_heading_angular_vel: float = 1.8
+    use_rotate_to_heading: bool = True
+    rotate_to_heading_min_angle: float = 0.785
+    max_angular_accel: float = 3.2
+    use_regulated_linear_velocity_scaling: bool = True
+    use_cost_regulated_linear_velocity_scaling: bool = False
+    regulated_linear_scaling_min_radius: float = 0.9
+    regulated_linear_scaling_min_speed: float = 0.25
+    approach_velocity_scaling_dist: float = 0.6
+    min_approach_linear_velocity: float = 0.05
+    use_collision_detection: bool = True
+    max_allowed_time_to_collision_up_to_carrot: float = 1.0
+    cost_scaling_dist: float = 0.3
+    cost_scaling_gain: float = 1.0
+    inflation_cost_scaling_factor: float = 3.0
+
+
+def normalize(angle: float) -> float:
+    return math.atan2(math.sin(angle), math.cos(angle))
+
+
+def to_robot_frame(robot: Pose2D, x: float, y: float) -> tuple[float, float]:
+    dx, dy = x - robot[0], y - robot[1]
+    c, s = math.cos(robot[2]), math.sin(robot[2])
+    return (c * dx + s * dy, -s * dx + c * dy)
+
+
+def closest_index(path: list[Pose2D], robot: Pose2D, start: int = 0) -> int:
+    """The path pose nearest the robot, searched from ``start`` on (the path is pruned)."""
+    best, best_d = start, math.inf
+    for i in range(start, len(path)):
+        d = math.hypot(path[i][0] - robot[0], path[i][1] - robot[1])
+        if d < best_d:
+            best, best_d = i, d
+    return best
+
+
+def path_length(path: list[Pose2D], start: int = 0) -> float:
+    return sum(
+        math.hypot(path[i + 1][0] - path[i][0], path[i + 1][1] - path[i][1])
+        for i in range(start, len(path) - 1)
+    )
+
+
+def lookahead_point(path_robot: list[tuple[float, float]], lookahead: float) -> tuple[float, float]:
+    """The carrot: where the path (in the robot's frame) leaves the lookahead circle."""
+    prev = (0.0, 0.0)
+    for point in path_robot:
+        if math.hypot(*point) >= lookahead:
+            # interpolate on the segment prev -> point where |p| == lookahead
+            ax, ay = prev
+            bx, by = point
+            dx, dy = bx - ax, by - ay
+            a = dx * dx + dy * dy
+            b = 2 * (ax * dx + ay * dy)
+            c = ax * ax + ay * ay - lookahead * lookahead
+            disc = b * b - 4 * a * c
+            if a > 1e-12 and disc >= 0:
+                t = (-b + math.sqrt(disc)) / (2 * a)
+                if 0.0 <= t <= 1.0:
+                    return (ax + t * dx, ay + t * dy)
+            return point
+        prev = point
+    return path_robot[-1] if path_robot else (0.0, 0.0)
+
+
+@dataclass
+class Command:
+    linear: float
+    angular: float
+    carrot: tuple[float, float]  # in the robot's frame
+    lookahead: float
+
+
+def compute_velocity(
+    robot: Pose2D,
+    path: list[Pose2D],
+    speed: tuple[float, float],
+    params: RPPParameters,
+    *,
+    goal_dist_tol: float = 0.25,
+    costmap: Costmap2D | None = None,
+    dt: float = 0.05,
+) -> Command:
+    """The velocity command (``computeVelocityCommands``) for a pruned path from the robot on."""
+    if not path:
+        raise ControllerException("Path is empty.")
+    v_now, w_now = speed
+    lookahead = params.lookahead_dist
+    if params.use_velocity_scaled_lookahead_dist:
+        lookahead = abs(v_now) * params.lookahead_time
+        lookahead = min(max(lookahead, params.min_lookahead_dist), params.max_lookahead_dist)
+    path_robot = [to_robot_frame(robot, p[0], p[1]) for p in path]
+    carrot = lookahead_point(path_robot, lookahead)
+    carrot_dist2 = carrot[0] ** 2 + carrot[1] ** 2
+    curvature = 2.0 * carrot[1] / carrot_dist2 if carrot_dist2 > 0.001 else 0.0
+
+    goal = path[-1]
+    goal_dist = math.hypot(goal[0] - robot[0], goal[1] - robot[1])
+    linear = params.desired_linear_vel
+    angular: float
+    if params.use_rotate_to_heading and goal_dist < goal_dist_tol:
+        angular = rotate_to(normalize(goal[2] - robot[2]), w_now, params, dt)
+        linear = 0.0
+    elif (
+        params.use_rotate_to_heading
+        and abs(math.atan2(carrot[1], carrot[0])) > params.rotate_to_heading_min_angle
+    ):
+        angular = rotate_to(math.atan2(carrot[1], carrot[0]), w_now, params, dt)
+        linear = 0.0
+    else:
+        linear = regulate(linear, curvature, path, robot, params, costmap)
+        angular = linear * curvature
+    if params.use_collision_detection and costmap is not None:
+        if in_collision_ahead(robot, linear, angular, carrot, params, costmap):
+            raise NoValidControl("RegulatedPurePursuitController detected collision ahead!")
+    return Command(linear, angular, carrot, lookahead)
+
+
+def rotate_to(angle: float, w_now: float, params: RPPParameters, dt: float) -> float:
+    """Turn on the spot towards ``angle`` (rad, robot frame), within the angular acceleration."""
+    sign = 1.0 if angle > 0 else -1.0
+    w = sign * params.rotate_to_heading_angular_vel
+    step = params.max_angular_accel * dt
+    w = min(max(w, w_now - step), w_now + step)
+    # do not overshoot: slow down when the remaining angle is small
+    limit = math.sqrt(2.0 * params.max_angular_accel * abs(angle))
+    return max(-limit, min(limit, w))
+
+
+def regulate(
+    linear: float,
+    curvature: float,
+    path: list[Pose2D],
+    robot: Pose2D,
+    params: RPPParameters,
+    costmap: Costmap2D | None,
+) -> float:
+    """The desired speed after Nav2's curvature, cost and approach regulation."""
+    v = linear
+    if params.use_regulated_linear_velocity_scaling and abs(curvature) > 1e-9:
+        radius = abs(1.0 / curvature)
+        if radius < params.regulated_linear_scaling_min_radius:
+            v *= radius / params.regulated_linear_scaling_min_radius
+    if params.use_cost_regulated_linear_velocity_scaling and costmap is not None:
+        cell = costmap.world_to_map(robot[0], robot[1])
+        if cell is not None:
+            cost = costmap.get_cost(*cell)
+            if 0 < cost < INSCRIBED_INFLATED_OBSTACLE:
+                dist = -math.log(cost / (INSCRIBED_INFLATED_OBSTACLE - 1)) / max(
+                    params.inflation_cost_scaling_factor, 1e-6
+                )
+                if dist < params.cost_scaling_dist:
+                    v *= params.cost_scaling_gain * dist / params.cost_scaling_dist
+    v = max(v, params.regulated_linear_scaling_min_speed)
+    remaining = path_length([(robot[0], robot[1], 0.0), *path])
+    if remaining < params.approach_velocity_scaling_dist:
+        v = min(
+            v,
+            max(
+                params.desired_linear_vel * remaining / params.approach_velocity_scaling_dist,
+                params.min_approach_linear_velocity,
+            ),
+        )
+    return min(v, params.desired_linear_vel)
+
+
+def in_collision_ahead(
+    robot: Pose2D,
+    linear: float,
+    angular: float,
+    carrot: tuple[float, float],
+    params: RPPParameters,
+    costmap: Costmap2D,
+) -> bool:
+    """Does the arc driven for the next second (at most to the carrot) cross a wall?"""
+    if abs(linear) < 0.01 and abs(angular) < 0.01:
+        return False
+    horizon = params.max_allowed_time_to_collision_up_to_carrot
+    carrot_dist = math.hypot(*carrot)
+    step = costmap.resolution / max(abs(linear), 0.01)
+    x, y, yaw = robot
+    here = costmap.world_to_map(x, y)
+    # A robot already in inscribed space may drive out of it: then only lethal cells count.
+    wall = INSCRIBED_INFLATED_OBSTACLE
+    if here is not None and costmap.get_cost(*here) == INSCRIBED_INFLATED_OBSTACLE:
+        wall = LETHAL_OBSTACLE
+    t, travelled = 0.0, 0.0
+    while t < horizon and travelled < carrot_dist:
+        t += step
+        x += linear * step * math.cos(yaw)
+        y += linear * step * math.sin(yaw)
+        yaw += angular * step
+        travelled += abs(linear) * step
+        cell = costmap.world_to_map(x, y)
+        if cell is None:
+            return True
+        cost = costmap.get_cost(*cell)
+        if wall <= cost < NO_INFORMATION:
+            return True
+    return False

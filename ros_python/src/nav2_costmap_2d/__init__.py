@@ -1,0 +1,23 @@
+"""nav2_costmap_2d: a 2D costmap (static layer + inflation layer) as Nav2 computes one.
+
+Pure numpy in :mod:`nav2_costmap_2d.costmap_2d`; the ROS wrapper
+(``Costmap2DROS``: the ``global_costmap`` / ``local_costmap`` node that
+publishes ``<name>/costmap`` and answers ``clear_entirely_<name>`` and
+``get_costmap``) in :mod:`nav2_costmap_2d.costmap_2d_ros`.
+"""
+
+from nav2_costmap_2d.cost_values import (
+    FREE_SPACE,
+    INSCRIBED_INFLATED_OBSTACLE,
+    LETHAL_OBSTACLE,
+    MAX_NON_OBSTACLE,
+    NO_INFORMATION,
+)
+
+__all__ = [
+    "FREE_SPACE",
+    "INSCRIBED_INFLATED_OBSTACLE",
+    "LETHAL_OBSTACLE",
+    "MAX_NON_OBSTACLE",
+    "NO_INFORMATION",
+]
