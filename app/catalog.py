@@ -621,6 +621,16 @@ ENTRIES: tuple[CatalogEntry, ...] = (
     ),
     # --- localization and navigation (issue 40): Nav2's servers, our Python versions ---
     CatalogEntry(
+        "office_map_world",
+        "static_transform_publisher",
+        "/office_map_world",
+        "map -> world, the identity, on /tf_static: the office's map was drawn in the "
+        "simulator's world frame, so its walls and the robot on the map line up.",
+        args=("--frame-id", "map", "--child-frame-id", "world"),
+        ros_args=("-r", "__node:=office_map_world"),
+        package="tf2_ros",
+    ),
+    CatalogEntry(
         "amcl",
         "amcl",
         "/amcl",
@@ -674,6 +684,13 @@ ENTRIES: tuple[CatalogEntry, ...] = (
             "node_names:=[map_server,amcl,planner_server,controller_server,bt_navigator]",
         ),
         package="nav2_lifecycle_manager",
+    ),
+    CatalogEntry(
+        "go_to_pose",
+        "go_to_pose",
+        "/basic_navigator",
+        "Nav2's Python API (nav2_simple_commander's BasicNavigator): go to X Y on the map.",
+        args=("0", "0"),
     ),
     CatalogEntry(
         "map_saver_cli",
@@ -817,6 +834,7 @@ GROUPS: tuple[LaunchGroup, ...] = (
         (
             "sim_office_mapping",
             "sim_robot_state_publisher",
+            "office_map_world",
             "map_server_office",
             "amcl_office",
             "planner_server",

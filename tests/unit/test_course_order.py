@@ -16,9 +16,10 @@ COURSE_ORDER = [
     "11_lifecycle", "12_launch", "13_executors", "14_images_opencv", "15_frames_and_arm",
     "16_tf2_turtlesim", "17_tf2_time", "18_urdf_robot", "19_wheeled_robot",
     "20_workspaces_packages", "21_bags", "22_slam_capstone", "23_maps",
+    "24_navigation",
 ]  # fmt: skip
 # After the capstone that closes the core course, units that go on towards navigation.
-BEYOND_THE_CAPSTONE = {"23_maps"}
+BEYOND_THE_CAPSTONE = {"23_maps", "24_navigation"}
 MOST_STEPS = 12
 # Longer on purpose: its second half changes the package its first half built.
 LONG_ON_PURPOSE = {"20_workspaces_packages"}

@@ -8,8 +8,13 @@ import threading
 import time
 from typing import TYPE_CHECKING
 
+from rclpy.exceptions import InvalidHandle
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+
 from app.lessons.registry import register_action
 from app.ros.convert import fill, import_type
+
+RCLError = _rclpy.RCLError
 
 if TYPE_CHECKING:
     from app.lessons.runtime import LessonRuntime
@@ -37,7 +42,10 @@ def perform(rt: LessonRuntime, action: Spec) -> str:
         for index in range(times):
             if index:
                 time.sleep(period)
-            publisher.publish(message)
+            try:
+                publisher.publish(message)
+            except (InvalidHandle, RCLError):  # the dashboard is closing: the burst ends here
+                return
 
     threading.Thread(target=send, name=f"lesson-publish-{key[0]}", daemon=True).start()
     return f"Publishing {times} message(s) on {action['topic']}."
