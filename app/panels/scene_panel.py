@@ -32,9 +32,13 @@ from app.scene.images import ImageLayer
 from app.scene.laser_scan import LaserScanLayer
 from app.scene.markers import MarkerLayer
 from app.scene.namespaced_robots import NamespacedRobots
+from app.scene.nav_path import PathLayer
 from app.scene.occupancy_grid import OccupancyGridLayer
+from app.scene.particle_cloud import TYPES as PARTICLE_TYPES
+from app.scene.particle_cloud import ParticleCloudLayer
 from app.scene.plots import JointPlot
 from app.scene.pointclouds import PointCloudLayer
+from app.scene.pose_tools import PoseTools
 from app.scene.sim_world import TOPICS as WORLD_TOPICS
 from app.scene.sim_world import WorldLayer
 from app.scene.stamped import StampedLayer
@@ -80,6 +84,17 @@ MAPS = _Offer(
     "nav_msgs/msg/OccupancyGrid topics (rviz's Map)",
     ("/map",),
     latched=True,
+)
+PARTICLES = _Offer(
+    PARTICLE_TYPES,
+    "nav2_msgs/msg/ParticleCloud or geometry_msgs/msg/PoseArray topics (amcl's guesses)",
+    ("/particle_cloud",),
+)
+PATHS = _Offer(
+    ("nav_msgs/msg/Path",),
+    "nav_msgs/msg/Path topics (the planner's plan)",
+    ("/plan",),
+    latched=True,  # a plan comes once per goal: silence after it is normal
 )
 # Where new browsers start: close to the lesson-13 desk, or over the whole simulated world.
 DESK_VIEW = ((1.3, -1.4, 1.1), (0.25, 0.0, 0.25))
@@ -169,6 +184,16 @@ class ScenePanel:
                 node, server, frame_known=lambda frame: frame in self.tf_view.frame_names()
             )
             self._map_info = MarkdownView(gui)
+        with gui.add_folder("Particles"):
+            self._particle_row = _TopicRow(gui, "Particle topic", PARTICLES)
+            self.particles = ParticleCloudLayer(node, server, frame_known=self._frame_known)
+            self._particle_info = MarkdownView(gui)
+        with gui.add_folder("Path"):
+            self._path_row = _TopicRow(gui, "Path topic", PATHS)
+            self.path = PathLayer(node, server, frame_known=self._frame_known)
+            self._path_info = MarkdownView(gui)
+        with gui.add_folder("Navigation"):
+            self.pose_tools = PoseTools(gui, ui, node, server, self._frame_pose)
 
         with gui.add_folder("Point cloud"):
             self._cloud_row = _TopicRow(gui, "Cloud topic", CLOUDS)
@@ -248,6 +273,8 @@ class ScenePanel:
         self._cloud_row.on_pick(ui, self.clouds.select)
         self._scan_row.on_pick(ui, self.scan.select)
         self._map_row.on_pick(ui, self.map.select)
+        self._particle_row.on_pick(ui, self.particles.select)
+        self._path_row.on_pick(ui, self.path.select)
         self._image_row.on_pick(ui, self.images.select)
         self._marker_row.on_pick(ui, self.markers.select)
         self._joint_row.on_pick(ui, self._select_joints)
@@ -281,6 +308,8 @@ class ScenePanel:
             (self._cloud_row, self.clouds.select),
             (self._scan_row, self.scan.select),
             (self._map_row, self.map.select),
+            (self._particle_row, self.particles.select),
+            (self._path_row, self.path.select),
             (self._image_row, self.images.select),
             (self._marker_row, self.markers.select),
             (self._joint_row, self._select_joints),
@@ -295,6 +324,10 @@ class ScenePanel:
         self.tf_view.forget_unpublished(graph.publishers("/robot_description") > 0)
         if not self._world_shown:
             self.drive.move_cameras(*(np.asarray(v, dtype=float) for v in DESK_VIEW))
+
+    def _frame_known(self, frame: str) -> bool:
+        """Whether TF has ``frame`` now (any thread)."""
+        return frame in self.tf_view.frame_names()
 
     def _frame_pose(self, frame: str) -> np.ndarray | None:
         """A TF frame's pose in the Fixed Frame, as the TF view last drew it (any thread)."""
@@ -447,6 +480,8 @@ class ScenePanel:
             (self._cloud_row, self.clouds.worker, self.clouds.topic),
             (self._scan_row, self.scan.worker, self.scan.topic),
             (self._map_row, self.map.worker, self.map.topic),
+            (self._particle_row, self.particles.worker, self.particles.topic),
+            (self._path_row, self.path.worker, self.path.topic),
             (self._image_row, self.images.worker, self.images.topic),
             (self._marker_row, self.markers.worker, self.markers.topic),
             (self._joint_row, self.arm.worker, self.arm.topic),
@@ -469,6 +504,8 @@ class ScenePanel:
         )
         self._scan_info.show(self.scan.note)
         self._map_info.show(self.map.describe())
+        self._particle_info.show(self.particles.describe())
+        self._path_info.show(self.path.describe())
         self._cloud_status.show(self.clouds.describe())
         camera = self.images.tf_camera
         note = camera.note if camera is not None else ""
@@ -491,7 +528,8 @@ class ScenePanel:
     def close(self) -> None:
         layers = (self.clouds, self.images, self.markers, self.arm, self.stamped, self.params)
         sim = (self.scan, self.map, self.world, self.more_robots, self.drive)
-        for layer in (*layers, *sim, self.tf_view, self.joint_sliders):
+        nav = (self.particles, self.path, self.pose_tools)
+        for layer in (*layers, *sim, *nav, self.tf_view, self.joint_sliders):
             layer.close()
         if self.images.tf_camera is not None:
             self.images.tf_camera.close()
