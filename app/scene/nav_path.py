@@ -17,19 +17,13 @@ the worker converts and draws; the UI thread picks the topic.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 import viser
 from nav_msgs.msg import Path
 from rclpy.node import Node
-from rclpy.subscription import Subscription
 
-from app.ros.qos import matching_qos
-from app.scene.latest import LatestWorker
-from app.scene.qos import SCENE_CALLBACK_GROUP
-from app.scene.tf_view import TF_PATH, scene_name
-from app.scene.topic_picker import NONE
+from app.scene.framed_layer import FramedLayer, frame_of
 
 MAX_HZ = 5.0
 TYPES = ("nav_msgs/msg/Path",)
@@ -61,8 +55,11 @@ def path_length(points: np.ndarray) -> float:
     return float(np.linalg.norm(np.diff(p[:, :2], axis=0), axis=1).sum())
 
 
-class PathLayer:
+class PathLayer(FramedLayer):
     """Draws the Path topic picked (``select``) under its TF frame."""
+
+    NODE_NAME = NODE_NAME
+    MSG_TYPE = Path
 
     def __init__(
         self,
@@ -70,88 +67,29 @@ class PathLayer:
         server: viser.ViserServer,
         frame_known: Callable[[str], bool] | None = None,
     ) -> None:
-        self._node = node
-        self._server = server
-        self._frame_known = frame_known or (lambda _frame: True)
-        self._subscription: Subscription | None = None
-        self._handle: Any = None
-        self._path = ""
-        self.topic = NONE
-        self.note = ""
-        self._frame: str | None = None  # the drawn path's frame; None: nothing drawn
-        self.poses_shown = 0
-        self.worker = LatestWorker("nav-path", self.draw, MAX_HZ)
-
-    # --- UI thread ---
-    def select(self, topic: str) -> None:
-        """Draw ``topic`` from now on ("(none)": nothing)."""
-        if topic == self.topic:
-            return
-        self.topic = topic
-        if self._subscription is not None:
-            self._node.destroy_subscription(self._subscription)
-            self._subscription = None
-        self.worker.reset()
-        self._forget()
-        if topic != NONE:
-            qos = matching_qos(self._node, topic, depth=1, latched=True)
-            self._subscription = self._node.create_subscription(
-                Path, topic, self.worker.offer, qos, callback_group=SCENE_CALLBACK_GROUP
-            )
-
-    def _forget(self) -> None:
-        self._forget_drawing()
-        self.note = ""
-        self._frame = None
+        super().__init__(node, server, "nav-path", MAX_HZ, frame_known)
         self.poses_shown = 0
 
-    def close(self) -> None:
-        self.select(NONE)
-        self.worker.stop()
+    def forget(self) -> None:
+        super().forget()
+        self.poses_shown = 0
 
     # --- worker thread ---
     def draw(self, msg: Path) -> None:
-        frame = msg.header.frame_id.strip().lstrip("/")
+        frame = frame_of(msg.header.frame_id)
         points = path_points(msg)
         left_out = len(msg.poses) - len(points)
+        self.poses_shown = len(points)
         if len(points) < 2:
-            self._forget_drawing()
-            self._frame = None
-            self.poses_shown = len(points)
-            self.note = (
+            self.nothing_drawn(
                 "an empty path (no plan)"
                 if not msg.poses
                 else f"{len(msg.poses)} pose(s): nothing to join into a line"
             )
             return
-        parent = f"{TF_PATH}/frames/{scene_name(frame)}" if frame else TF_PATH
-        path = f"{parent}/{NODE_NAME}"
-        segments = polyline_segments(points)
-        handle = self._handle
-        if path != self._path or handle is None or len(handle.points) != len(segments):
-            self._forget_drawing()
-            self._path = path
-            self._handle = self._server.scene.add_line_segments(
-                path, segments, COLOUR, thickness=THICKNESS, thickness_units="screen"
-            )
-        else:
-            handle.points = segments
-        self.poses_shown = len(points)
-        self._frame = frame
-        self.note = f"{len(points)} poses, {path_length(points):.1f} m" + (
-            f" ({left_out} with a NaN or inf left out)" if left_out else ""
+        self.show_segments(frame, polyline_segments(points), COLOUR, THICKNESS)
+        self.drawn(
+            frame,
+            f"{len(points)} poses, {path_length(points):.1f} m"
+            + (f" ({left_out} with a NaN or inf left out)" if left_out else ""),
         )
-
-    def _forget_drawing(self) -> None:
-        handle, self._handle = self._handle, None
-        if handle is not None:
-            handle.remove()
-
-    def describe(self) -> str:
-        """What was drawn and where; asked again at each refresh (TF may bring the frame later)."""
-        note, frame = self.note, self._frame
-        if frame is None:
-            return note
-        if not frame or not self._frame_known(frame):
-            return f"{note}, ⚠️ frame `{frame or '(empty)'}` is not on TF: drawn at the origin"
-        return f"{note}, in `{frame}`"

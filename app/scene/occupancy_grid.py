@@ -10,30 +10,24 @@ mode) are greys in between. The map's origin (its lower-left cell) and its
 turn about z are honoured. A frame not on TF yet: the map is drawn at the
 Fixed Frame's origin until the frame comes, and ``describe()`` says so.
 
-Maps are latched (reliable, transient local): the subscription asks for that
-whenever every publisher offers it, so a map published once (map_server)
-still arrives when the topic is picked later.
-
-Threads: the executor hands the newest map to a worker (at most twice a
-second); the worker converts and draws; the UI thread picks the topic.
+Maps are latched (reliable, transient local), and the subscription asks for
+that (app/scene/framed_layer.py, which also places the picture and says
+where), so a map published once (map_server) still arrives when the topic
+is picked later. At most two maps a second are drawn.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 import viser
 from nav_msgs.msg import OccupancyGrid
 from rclpy.node import Node
-from rclpy.subscription import Subscription
 
-from app.ros.qos import matching_qos
-from app.scene.latest import LatestWorker
-from app.scene.qos import SCENE_CALLBACK_GROUP
-from app.scene.tf_view import TF_PATH, scene_name
-from app.scene.topic_picker import NONE
+from app.scene.framed_layer import FramedLayer, frame_of
 
 MAX_HZ = 2.0
 TYPES = ("nav_msgs/msg/OccupancyGrid",)
@@ -78,86 +72,48 @@ def placement(
     return (x, y, info.origin.position.z + LIFT), (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
 
 
-class OccupancyGridLayer:
+class OccupancyGridLayer(FramedLayer):
     """Draws the OccupancyGrid topic picked (``select``) under its TF frame.
 
     ``frame_known(frame)`` says whether TF has that frame now (the note warns
     when not); by default every frame counts as known.
     """
 
+    NODE_NAME = NODE_NAME
+    MSG_TYPE = OccupancyGrid
+
     def __init__(
         self,
         node: Node,
         server: viser.ViserServer,
-        frame_known: Any = None,
+        frame_known: Callable[[str], bool] | None = None,
     ) -> None:
-        self._node = node
-        self._server = server
-        self._frame_known = frame_known or (lambda _frame: True)
-        self._subscription: Subscription | None = None
-        self._handle: Any = None
-        self._path = ""
-        self.topic = NONE
-        self.note = ""
-        self._frame: str | None = None  # the drawn map's frame; None: nothing drawn
-        self.cells_known = 0
-        self.worker = LatestWorker("occupancy-grid", self.draw, MAX_HZ)
-
-    # --- UI thread ---
-    def select(self, topic: str) -> None:
-        """Draw ``topic`` from now on ("(none)": nothing)."""
-        if topic == self.topic:
-            return
-        self.topic = topic
-        if self._subscription is not None:
-            self._node.destroy_subscription(self._subscription)
-            self._subscription = None
-        self.worker.reset()
-        self._forget()
-        if topic != NONE:
-            qos = matching_qos(self._node, topic, depth=1, latched=True)
-            self._subscription = self._node.create_subscription(
-                OccupancyGrid, topic, self.worker.offer, qos, callback_group=SCENE_CALLBACK_GROUP
-            )
-
-    def _forget(self) -> None:
-        handle, self._handle = self._handle, None
-        if handle is not None:
-            handle.remove()
-        self.note = ""
-        self._frame = None
+        super().__init__(node, server, "occupancy-grid", MAX_HZ, frame_known)
         self.cells_known = 0
 
-    def close(self) -> None:
-        self.select(NONE)
-        self.worker.stop()
+    def forget(self) -> None:
+        super().forget()
+        self.cells_known = 0
 
     # --- worker thread ---
     def draw(self, msg: OccupancyGrid) -> None:
         info = msg.info
         width, height = int(info.width), int(info.height)
-        frame = msg.header.frame_id.strip().lstrip("/")
-        self._frame = None
+        frame = frame_of(msg.header.frame_id)
         if width * height == 0 or len(msg.data) != width * height:
-            self.note = (
+            self.nothing_drawn(
                 f"⚠️ not drawn: {len(msg.data)} cells for a {width} x {height} map"
                 if width * height
                 else "an empty map (0 cells)"
             )
             return
         if not (math.isfinite(info.resolution) and info.resolution > 0.0):
-            self.note = f"⚠️ not drawn: resolution {info.resolution} m is not positive"
+            self.nothing_drawn(f"⚠️ not drawn: resolution {info.resolution} m is not positive")
             return
-        image = grid_image(msg.data, width, height)
         position, wxyz = placement(msg)
-        parent = f"{TF_PATH}/frames/{scene_name(frame)}" if frame else TF_PATH
-        path = f"{parent}/{NODE_NAME}"
-        if path != self._path and self._handle is not None:
-            self._handle.remove()  # the map moved to another frame
-        self._path = path
-        self._handle = self._server.scene.add_image(
-            path,
-            image,
+        self.show_image(
+            frame,
+            image=grid_image(msg.data, width, height),
             render_width=width * info.resolution,
             render_height=height * info.resolution,
             format="png",
@@ -168,18 +124,9 @@ class OccupancyGridLayer:
         )
         known = int((np.asarray(msg.data) >= 0).sum())
         self.cells_known = known
-        self._frame = frame
-        self.note = (
+        self.drawn(
+            frame,
             f"{width} x {height} cells of {info.resolution:g} m "
             f"({width * info.resolution:.1f} m x {height * info.resolution:.1f} m), "
-            f"{100.0 * known / (width * height):.0f} % known"
+            f"{100.0 * known / (width * height):.0f} % known",
         )
-
-    def describe(self) -> str:
-        """What was drawn and where; asked again at each refresh (TF may bring the frame later)."""
-        note, frame = self.note, self._frame
-        if frame is None:
-            return note
-        if not frame or not self._frame_known(frame):
-            return f"{note}, ⚠️ frame `{frame or '(empty)'}` is not on TF: drawn at the origin"
-        return f"{note}, in `{frame}`"

@@ -27,7 +27,6 @@ from __future__ import annotations
 import math
 import struct
 from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 import viser
@@ -38,10 +37,8 @@ from rclpy.serialization import deserialize_message
 from rclpy.subscription import Subscription
 
 from app.ros.qos import matching_qos
-from app.scene.latest import LatestWorker
+from app.scene.framed_layer import FramedLayer, frame_of
 from app.scene.qos import SCENE_CALLBACK_GROUP
-from app.scene.tf_view import TF_PATH, scene_name
-from app.scene.topic_picker import NONE
 
 MAX_HZ = 4.0
 TYPES = ("nav2_msgs/msg/ParticleCloud", "geometry_msgs/msg/PoseArray")
@@ -159,12 +156,15 @@ def poses_of(msg: ParticleCloud | PoseArray) -> tuple[np.ndarray, np.ndarray | N
     return table, weights
 
 
-class ParticleCloudLayer:
+class ParticleCloudLayer(FramedLayer):
     """Draws the ParticleCloud or PoseArray topic picked (``select``) under its TF frame.
 
     ``frame_known(frame)`` says whether TF has that frame now (the note warns
     when not); by default every frame counts as known.
     """
+
+    NODE_NAME = NODE_NAME
+    LATCHED = False  # amcl publishes a new cloud with each update, best effort
 
     def __init__(
         self,
@@ -172,55 +172,26 @@ class ParticleCloudLayer:
         server: viser.ViserServer,
         frame_known: Callable[[str], bool] | None = None,
     ) -> None:
-        self._node = node
-        self._server = server
-        self._frame_known = frame_known or (lambda _frame: True)
-        self._subscription: Subscription | None = None
-        self._handle: Any = None
-        self._path = ""
-        self.topic = NONE
-        self.note = ""
-        self._frame: str | None = None  # the drawn cloud's frame; None: nothing drawn
-        self.particles_shown = 0
-        self.worker = LatestWorker("particle-cloud", self.draw, MAX_HZ)
-
-    # --- UI thread ---
-    def select(self, topic: str, type_name: str | None = None) -> None:
-        """Draw ``topic`` from now on ("(none)": nothing), as its advertised type unless given."""
-        if topic == self.topic:
-            return
-        self.topic = topic
-        if self._subscription is not None:
-            self._node.destroy_subscription(self._subscription)
-            self._subscription = None
-        self.worker.reset()
-        self._forget()
-        if topic != NONE:
-            if type_name is None:
-                types = dict(self._node.get_topic_names_and_types()).get(topic, [])
-                type_name = types[0] if types else TYPES[0]
-            msg_type = PoseArray if type_name == TYPES[1] else ParticleCloud
-            qos = matching_qos(self._node, topic, depth=1, latched=False)
-            self._subscription = self._node.create_subscription(
-                msg_type,
-                topic,
-                lambda data: self.worker.offer((msg_type, data)),
-                qos,
-                callback_group=SCENE_CALLBACK_GROUP,
-                raw=True,
-            )
-
-    def _forget(self) -> None:
-        handle, self._handle = self._handle, None
-        if handle is not None:
-            handle.remove()
-        self.note = ""
-        self._frame = None
+        super().__init__(node, server, "particle-cloud", MAX_HZ, frame_known)
         self.particles_shown = 0
 
-    def close(self) -> None:
-        self.select(NONE)
-        self.worker.stop()
+    def forget(self) -> None:
+        super().forget()
+        self.particles_shown = 0
+
+    def subscribe(self, topic: str) -> Subscription:
+        """The topic's serialized bytes (read with numpy on the worker), of its advertised type."""
+        types = dict(self._node.get_topic_names_and_types()).get(topic, [])
+        msg_type = PoseArray if (types[0] if types else TYPES[0]) == TYPES[1] else ParticleCloud
+        qos = matching_qos(self._node, topic, depth=1, latched=False)
+        return self._node.create_subscription(
+            msg_type,
+            topic,
+            lambda data: self.worker.offer((msg_type, data)),
+            qos,
+            callback_group=SCENE_CALLBACK_GROUP,
+            raw=True,
+        )
 
     # --- worker thread ---
     def draw(self, msg: ParticleCloud | PoseArray | tuple[type, bytes]) -> None:
@@ -234,12 +205,12 @@ class ParticleCloudLayer:
                 frame, rows = decoded
                 weights = rows[:, 7].copy() if msg_type is ParticleCloud else None
                 kind = "particles" if msg_type is ParticleCloud else "poses"
-                self._draw_rows(frame.strip().lstrip("/"), rows[:, :7], weights, kind)
+                self._draw_rows(frame_of(frame), rows[:, :7], weights, kind)
                 return
         assert not isinstance(msg, tuple)
         kind = "particles" if isinstance(msg, ParticleCloud) else "poses"
         table, weights = poses_of(msg)
-        self._draw_rows(msg.header.frame_id.strip().lstrip("/"), table, weights, kind)
+        self._draw_rows(frame_of(msg.header.frame_id), table, weights, kind)
 
     def _draw_rows(
         self, frame: str, table: np.ndarray, weights: np.ndarray | None, kind: str
@@ -250,41 +221,19 @@ class ParticleCloudLayer:
         if weights is not None:
             weights = weights[finite]
         n = len(table)
-        parent = f"{TF_PATH}/frames/{scene_name(frame)}" if frame else TF_PATH
-        path = f"{parent}/{NODE_NAME}"
         if n == 0:
-            self._forget_drawing()
-            self._frame = None
-            self.note = f"no {kind} in the last message" + (f" ({bad} not finite)" if bad else "")
+            self.particles_shown = 0
+            self.nothing_drawn(
+                f"no {kind} in the last message" + (f" ({bad} not finite)" if bad else "")
+            )
             return
         x, y = table[:, 0], table[:, 1]
         yaw = yaws_of(table[:, 3], table[:, 4], table[:, 5], table[:, 6])
-        segments = arrow_segments(x, y, yaw, arrow_lengths(weights, n))
-        handle = self._handle
-        if path != self._path or handle is None or len(handle.points) != len(segments):
-            self._forget_drawing()
-            self._path = path
-            self._handle = self._server.scene.add_line_segments(
-                path, segments, COLOUR, thickness=THICKNESS, thickness_units="screen"
-            )
-        else:
-            handle.points = segments
+        self.show_segments(frame, arrow_segments(x, y, yaw, arrow_lengths(weights, n)), COLOUR,
+                           THICKNESS)  # fmt: skip
         self.particles_shown = n
-        self._frame = frame
-        self.note = f"{n} {kind}, spread {spread(x, y, weights):.2f} m" + (
-            f" ({bad} with a NaN or inf left out)" if bad else ""
+        self.drawn(
+            frame,
+            f"{n} {kind}, spread {spread(x, y, weights):.2f} m"
+            + (f" ({bad} with a NaN or inf left out)" if bad else ""),
         )
-
-    def _forget_drawing(self) -> None:
-        handle, self._handle = self._handle, None
-        if handle is not None:
-            handle.remove()
-
-    def describe(self) -> str:
-        """What was drawn and where; asked again at each refresh (TF may bring the frame later)."""
-        note, frame = self.note, self._frame
-        if frame is None:
-            return note
-        if not frame or not self._frame_known(frame):
-            return f"{note}, ⚠️ frame `{frame or '(empty)'}` is not on TF: drawn at the origin"
-        return f"{note}, in `{frame}`"
