@@ -19,11 +19,13 @@ import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import trimesh
-import yourdfpy
 from robot_state_publisher.urdf_tree import UrdfError, parse_urdf
+
+if TYPE_CHECKING:  # imported when a robot is first drawn: trimesh brings scipy (1-2 s)
+    import trimesh
 
 MAX_DESCRIPTION_BYTES = 4 * 1024 * 1024
 MAX_MESH_BYTES = 50 * 1024 * 1024
@@ -90,6 +92,9 @@ def build_drawing(text: str) -> RobotDrawing:
             f"to {MAX_DESCRIPTION_BYTES / 1e6:.0f} MB"
         )
     model = parse_urdf(text)
+    import trimesh
+    import yourdfpy
+
     warnings: list[str] = []
     handler = _CollectingHandler()
     logger = logging.getLogger("yourdfpy")
