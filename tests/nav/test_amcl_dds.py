@@ -214,6 +214,20 @@ def test_amcl_localizes_tracks_a_drive_recovers_from_a_kidnapping_and_survives_b
     with watcher.lock:
         cloud, edges = watcher.cloud, set(watcher.edges)
     assert cloud is not None and len(cloud.particles) >= 500 and cloud.header.frame_id == "map"
+    # The cloud is the filter's particles: weights summing to 1, headings as unit quaternions
+    # about z, and (converged) around the pose amcl published.
+    weights = np.array([p.weight for p in cloud.particles])
+    q = np.array([[p.pose.orientation.x, p.pose.orientation.y, p.pose.orientation.z,
+                   p.pose.orientation.w] for p in cloud.particles])  # fmt: skip
+    assert math.isclose(float(weights.sum()), 1.0, rel_tol=1e-9)
+    np.testing.assert_allclose(np.linalg.norm(q, axis=1), 1.0, atol=1e-9)
+    assert not q[:, :2].any()
+    xs = np.array([p.pose.position.x for p in cloud.particles])
+    ys = np.array([p.pose.position.y for p in cloud.particles])
+    with watcher.lock:
+        assert watcher.pose is not None
+        px, py, _ = watcher.pose
+    assert math.hypot(float(weights @ xs) - px, float(weights @ ys) - py) < 0.25
     assert ("map", "odom") in edges and ("world", "odom") not in edges
 
     # Kidnapped: to the office room; global reinitialisation spreads the particles.

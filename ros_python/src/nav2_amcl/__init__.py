@@ -15,6 +15,7 @@ step.
 - ``nav2_amcl.sensor_model``: the likelihood field laser model;
 - ``nav2_amcl.particle_filter``: the filter (initialisation, resampling,
   the adaptive particle count, recovery, the pose estimate);
+- ``nav2_amcl.cloud``: /particle_cloud written from the filter's arrays as CDR bytes;
 - ``nav2_amcl.amcl_node``: the lifecycle node ``amcl``.
 """
 

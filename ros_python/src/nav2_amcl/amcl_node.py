@@ -43,7 +43,7 @@ import numpy as np
 import rclpy
 from geometry_msgs.msg import PoseWithCovarianceStamped, TransformStamped
 from lifecycle_msgs.msg import State
-from nav2_msgs.msg import Particle, ParticleCloud
+from nav2_msgs.msg import ParticleCloud
 from nav2_msgs.srv import SetInitialPose
 from nav2_util.lifecycle_node import LifecycleNode
 from nav_msgs.msg import OccupancyGrid
@@ -62,6 +62,7 @@ from sensor_msgs.msg import LaserScan
 from std_srvs.srv import Empty
 from tf2_ros import Buffer, TransformBroadcaster, TransformListener
 
+from nav2_amcl.cloud import particle_cloud_cdr
 from nav2_amcl.map import FREE, AmclMap
 from nav2_amcl.motion_model import angle_diff
 from nav2_amcl.particle_filter import FilterParameters, ParticleFilter
@@ -430,7 +431,7 @@ class AmclNode(LifecycleNode):
                     throttle_duration_sec=5.0,
                 )
             return False
-        started = time.perf_counter()
+        started, started_cpu = time.perf_counter(), time.thread_time()
         update = self.force_update
         if self.pf_init:
             dx = pose[0] - self.pf_odom_pose[0]
@@ -483,8 +484,10 @@ class AmclNode(LifecycleNode):
             self.send_map_to_odom(msg)
         if update:
             self.last_update_ms = (time.perf_counter() - started) * 1e3
+            cpu_ms = (time.thread_time() - started_cpu) * 1e3  # without the waits on a busy machine
             self.get_logger().debug(
-                f"filter update: {self.last_update_ms:.1f} ms with {pf.count} particles"
+                f"filter update: {self.last_update_ms:.1f} ms ({cpu_ms:.1f} ms CPU) with "
+                f"{pf.count} particles"
             )
         return True
 
@@ -492,21 +495,12 @@ class AmclNode(LifecycleNode):
     def publish_particle_cloud(self, scan: LaserScan) -> None:
         if self.pf is None or self.cloud_pub is None:
             return
-        cloud = ParticleCloud()
-        cloud.header.stamp = scan.header.stamp
-        cloud.header.frame_id = self.map_frame
-        poses, weights = self.pf.poses, self.pf.weights
-        half = poses[:, 2] / 2.0
-        sz, cw = np.sin(half), np.cos(half)
-        particles = []
-        for k in range(len(poses)):
-            particle = Particle(weight=float(weights[k]))
-            particle.pose.position.x = float(poses[k, 0])
-            particle.pose.position.y = float(poses[k, 1])
-            particle.pose.orientation.z = float(sz[k])
-            particle.pose.orientation.w = float(cw[k])
-            particles.append(particle)
-        cloud.particles = particles
+        # Written from the filter's arrays as bytes (nav2_amcl.cloud): the same message as
+        # ParticleCloud(particles=[Particle(...), ...]), without 2000 Python objects a time.
+        stamp = scan.header.stamp
+        cloud = particle_cloud_cdr(
+            stamp.sec, stamp.nanosec, self.map_frame, self.pf.poses, self.pf.weights
+        )
         self.cloud_pub.publish(cloud)
 
     def publish_amcl_pose(self, scan: LaserScan, estimate: Any) -> None:
