@@ -14,6 +14,7 @@ listener is not (one key press, one key).
 from __future__ import annotations
 
 import json
+import time
 from collections.abc import Callable
 
 import viser
@@ -34,6 +35,7 @@ NO_SIM = (
     "_turtlesim_node is not running._ Start it from the lesson's button, "
     "**Run › Turtlesim**, or type `ros2 run turtlesim turtlesim_node` in **Run › Console**."
 )
+LOOK_EVERY = 1.0  # s between looks for a sim started since
 KEY_HINT = (
     "Arrow keys drive turtle1 while this window is shown (turtle_teleop_key must run: "
     "**Run › Turtlesim** starts it); G B V C D E R T turn it, F cancels the turn."
@@ -68,6 +70,9 @@ class TurtlesimStage:
         self._node = node
         self._active = False
         self._keys: Publisher | None = None
+        self._sims: list[str] = []  # the sims running at the last look
+        self._seen: set[str] = set()  # every sim seen since the stage was built
+        self._next_look = 0.0
         self._box = gui.add_folder(None, visible=False)
         with self._box:
             self._status = MarkdownView(gui, NO_SIM)
@@ -99,25 +104,42 @@ class TurtlesimStage:
     def set_active(self, active: bool) -> None:
         self._active = active
         self._box.visible = active
+        self._next_look = 0.0
         if not active:
             self._feed.follow(None)
 
-    def _find_sim(self, graph: GraphSnapshot) -> str | None:
-        """The first node publishing a trails topic that the graph lists."""
-        return next((s for s in find_sims(self._node) if graph.has_node(s)), None)
+    def _choose_sim(self, graph: GraphSnapshot) -> None:
+        """Follow the sim the learner started last; keep the followed one while it runs.
+
+        A lesson that launches two more sims (``multisim``) while the first still
+        runs is about the new ones: a sim not seen before takes the stage.
+        """
+        now = time.monotonic()
+        followed = self._feed.sim
+        if followed is not None and graph.has_node(followed) and now < self._next_look:
+            return
+        self._next_look = now + LOOK_EVERY  # asking DDS for every topic is not free
+        self._sims = [s for s in find_sims(self._node) if graph.has_node(s)]
+        new = [s for s in self._sims if s not in self._seen]
+        self._seen.update(self._sims)
+        if new:
+            self._feed.follow(new[0])
+        elif followed is None or followed not in self._sims:
+            self._feed.follow(self._sims[0] if self._sims else None)
 
     def refresh(self, graph: GraphSnapshot) -> None:
         if not self._active:
             return
-        if self._feed.sim is None or not graph.has_node(self._feed.sim):
-            self._feed.follow(self._find_sim(graph))
+        self._choose_sim(graph)
         sim = self._feed.sim
         self._feed.sync_turtles(pose_topics(graph, sim) if sim else {})
         if sim is None:
             self._status.show(NO_SIM)
         else:
             turtles = ", ".join(self._feed.turtles) or "none yet"
-            self._status.show(f"`{sim}` · turtles: {turtles}")
+            others = [f"`{s}`" for s in self._sims if s != sim and graph.has_node(s)]
+            also = f" · also running: {', '.join(others)}" if others else ""
+            self._status.show(f"`{sim}` · turtles: {turtles}{also}")
 
     def close(self) -> None:
         self.view.close()

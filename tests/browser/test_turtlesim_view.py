@@ -136,3 +136,18 @@ def test_keys_drive_spawn_shows_and_background_follows_the_parameter(page):
     assert after["corner"] == [150, 86, 255]
     # The trail stays on the new background, and the keys pressed elsewhere drove nothing.
     assert after["penPixels"] == settled
+
+
+def test_the_stage_follows_the_sims_the_learner_starts_last(page):
+    """Lesson 3's multisim, started while the first turtlesim still runs, takes the stage."""
+    from tests.browser.helpers import start_group, start_node
+
+    start_node(page, "turtlesim_node")
+    choose(page, "On stage", "Turtlesim")
+    expect_status(page, r"^/turtlesim · turtles: turtle1$")
+    start_group(page, "multisim")
+    choose(page, "On stage", "Turtlesim")
+    expect_status(page, r"^/turtlesim1/turtlesim · turtles: turtle1 · also running:")
+    status = page.get_by_text(re.compile(r"also running:")).locator("visible=true").first
+    others = status.inner_text().split("also running:")[1].split(",")
+    assert sorted(o.strip() for o in others) == ["/turtlesim", "/turtlesim2/turtlesim"], others
