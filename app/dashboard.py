@@ -18,7 +18,6 @@ from typing import cast
 import viser
 
 from app.catalog import UnknownNodeError, lookup
-from app.catalog import names as catalog_names
 from app.exercises.attempts import AttemptStore, attempts_root
 from app.exercises.editor_server import EditorHub
 from app.exercises.grader import Grader
@@ -104,7 +103,6 @@ class Dashboard:
         self.rosout = RosoutLog(runtime.node)
         self._stop = threading.Event()
         self.start_requests = StartRequests()  # Start clicks the stage shows at once
-        self._catalog_names = frozenset(catalog_names())
         self.graph = GraphSnapshot()
         self._tools: dict[str, Panel] = {}
         self._panels: list[Panel] = self._build_gui()
@@ -275,16 +273,13 @@ class Dashboard:
                 tool.inspect(kind, name, type_text)
 
     def _program_output(self) -> tuple[str, list[str]]:
-        """The learner's most recently started program (not a catalog node): its name and
-        state, and its last lines of output."""
-        own = [
-            status
-            for name, status in self.supervisor.statuses().items()
-            if name not in self._catalog_names
-        ]
-        if not own:
+        """The program started last, the learner's own or a lesson's (one still running
+        first): its name and state, and its last lines of output, for under the code."""
+        statuses = list(self.supervisor.statuses().values())
+        if not statuses:
             return "", []
-        latest = max(own, key=lambda status: status.started_at or 0.0)
+        running = [status for status in statuses if status.active]
+        latest = max(running or statuses, key=lambda status: status.started_at or 0.0)
         return f"{latest.name} · {latest.describe()}", self.supervisor.output(latest.name, 40)
 
     def _exercise_marks(self, lesson_id: str) -> str:

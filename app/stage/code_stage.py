@@ -1,5 +1,5 @@
 """Code on stage: the side window with the lesson's code (or the learner's own file), and
-under it what the learner's latest program printed.
+under it what the program started last (the lesson's node, or the learner's own) printed.
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ from app.ui import MarkdownView
 
 OUTPUT_LINES = 40
 NO_OUTPUT = (
-    "_Nothing has run yet._ **Run my node** (Learn › Exercise) runs your code; what it "
-    "prints and logs shows here."
+    "_Nothing has run yet._ Start the lesson's node, or **Run my node** (Learn › Exercise) "
+    "for your own code: what the program started last prints and logs shows here."
 )
 
 
@@ -25,13 +25,13 @@ class CodeStage:
         code_window: viser.PanelHandle,
         program_output: Callable[[], tuple[str, list[str]]] = lambda: ("", []),
     ) -> None:
-        """``program_output()``: the learner's latest program (its state) and its last
-        lines, shown under the code."""
+        """``program_output()``: the program started last (its name and state) and its
+        last lines, shown under the code."""
         self._program_output = program_output
         self.code_window = code_window
         self.output_window = gui.add_panel()
         self.output_window.dock_below(code_window)
-        with self.output_window.add_tab("Output of my node", viser.Icon.TERMINAL_2):
+        with self.output_window.add_tab("Program output", viser.Icon.TERMINAL_2):
             self._output = MarkdownView(gui, NO_OUTPUT)
 
     def set_active(self, active: bool) -> None:

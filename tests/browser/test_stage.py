@@ -71,7 +71,7 @@ def _on_stage(page: Page) -> list[str]:
         "bag": shown(page.get_by_text("Newest bag", exact=True)),  # its folder's title
         "replay": shown(page.get_by_text("Watch a recording", exact=True)),  # its folder's
         "code": shown(page.get_by_role("tab", name="Code of this lesson"))
-        and shown(page.get_by_role("tab", name="Output of my node")),
+        and shown(page.get_by_role("tab", name="Program output")),
         "turtlesim": shown(page.get_by_text("Arrow keys drive turtle1 while this window")),
         "tf": shown(page.locator("div.stage-tf")),
     }
@@ -455,3 +455,18 @@ def test_the_bag_stage_shows_a_recording_as_it_ends(browser, ros_env, tmp_path):
         page.screenshot(path=str(ARTIFACTS / "stage-bag.png"))
         page.context.close()
         dashboard.stop()
+
+
+def test_the_code_stage_shows_what_the_lessons_node_prints(page):
+    """Lesson 4: the node the step starts prints under its code, not 'Nothing has run yet'."""
+    lesson = next(les for les in load_course().lessons if les.id == "04_first_node")
+    open_lesson(page, lesson)
+    _wait_stage(page, "code")
+    click_next(page)  # step 2 starts the node
+    page.get_by_role("button", name="Start minimal_node").click()
+    expect(page.get_by_text(re.compile(r"^minimal_node · running")).first).to_be_visible(
+        timeout=30_000
+    )
+    expect(page.get_by_text(re.compile("Hello ROS2")).filter(visible=True).first).to_be_visible(
+        timeout=30_000
+    )
