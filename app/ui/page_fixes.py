@@ -37,6 +37,11 @@ _CSS = (
     ".mantine-Button-root{height:auto!important;min-height:var(--button-height)}"
     ".mantine-Button-label{white-space:normal!important;overflow:visible!important;"
     "line-height:1.3;padding:5px 0}"
+    # A code block wider than the column scrolls by itself, instead of widening the list
+    # item it sits in and cutting that item's text off at the column's edge.
+    # (Mantine's list item lays its label out in an inline flexbox: it may shrink too.)
+    "pre{max-width:100%;overflow-x:auto}"
+    ".mantine-List-itemWrapper{max-width:100%}.mantine-List-itemLabel{min-width:0;max-width:100%}"
 )
 
 _NAME_BUTTONS = """
