@@ -462,12 +462,15 @@ def cmd_exercise(args: argparse.Namespace) -> int:
 
 def cmd_lti(args: argparse.Namespace) -> int:
     """What to paste into an LMS to add the tool (app/lti/lms_setup.py); makes the key once."""
+    from app.lti.dynamic_registration import registration_url
     from app.lti.keys import DEFAULT_DIR, ToolKeys
     from app.lti.lms_setup import setup_text
     from app.lti.routes import ToolUrls
 
     urls = ToolUrls.from_base(args.base_url)
-    print(setup_text(urls, ToolKeys.load_or_create(args.keys_dir or DEFAULT_DIR)))
+    keys = ToolKeys.load_or_create(args.keys_dir or DEFAULT_DIR)
+    folder = args.lti_dir or Path(os.environ.get("CLASSROOM_LTI_DIR") or DEFAULT_DIR.parent)
+    print(setup_text(urls, keys, registration_url(urls, folder)))
     return 0
 
 
@@ -682,6 +685,13 @@ def build_parser(prog: str = "ros2-classroom") -> argparse.ArgumentParser:
     lti.add_argument("--base-url", required=True, help="where the LMS reaches this tool")
     lti.add_argument(
         "--keys-dir", type=Path, default=None, help="the tool key's folder (default var/lti/keys)"
+    )
+    lti.add_argument(
+        "--lti-dir",
+        type=Path,
+        default=None,
+        help="the LTI service's folder, for the registration URL's key "
+        "(default $CLASSROOM_LTI_DIR, else var/lti)",
     )
     lti.set_defaults(func=cmd_lti)
 

@@ -48,6 +48,10 @@ RUNS: tuple[tuple[str, list[str]], ...] = (
     ("stage_graph", ["--seconds", "5", "--rounds", "2"]),
     ("tf2_lookup", ["--seconds", "5", "--lookups", "3000"]),
     ("hub_spawn", ["--counts", "1,5", "--seconds", "6"]),  # 20 learners: run it alone
+    ("ws_traffic", ["--seconds", "20"]),
+    ("classroom_footprint", ["--counts", "20", "--seconds", "10"]),  # issue 43's class of 20
+    ("nav_mapping", []),  # the office tour mapped (issue 40): about 2 minutes
+    ("nav_localization", []),  # amcl along the same tour (issue 40): about 2 minutes
     ("colcon_build", ["--python-rounds", "4", "--interface-rounds", "2", "--run-rounds", "6"]),
     ("soak", ["--minutes", "3"]),  # the real soak: --bench soak --minutes 30
 )
@@ -559,7 +563,110 @@ HEADLINE = {
     "own_node_run_ratio": ("colcon_build", "own_node_run_ratio"),
     "soak_rss_growth_percent": ("soak", "soak_rss_growth_percent"),
     "soak_click_p95_ms": ("soak", "soak_click_p95_ms"),
+    "ws_idle_kBps": ("ws_traffic", "ws_idle_kBps"),
+    "ws_graph_kBps": ("ws_traffic", "ws_graph_kBps"),
+    "ws_scene_kBps": ("ws_traffic", "ws_scene_kBps"),
+    "classroom_dashboard_pss_mb": ("classroom_footprint", "classroom_dashboard_pss_mb"),
+    "classroom_dashboard_cpu_percent": ("classroom_footprint", "classroom_dashboard_cpu_percent"),
+    "classroom_learners_per_core": ("classroom_footprint", "classroom_learners_per_core"),
+    "classroom_learners_per_gb": ("classroom_footprint", "classroom_learners_per_gb"),
+    "map_agreement_percent": ("nav_mapping", "map_agreement_percent"),
+    "amcl_error_m": ("nav_localization", "amcl_error_m"),
 }
+
+ROWS += (
+    (
+        "The office mapped by grid_mapper on a tour: known cells that agree with the plan",
+        "nav_mapping",
+        "map_agreement_percent",
+        "%",
+        "≥ 95",
+        lambda v: v >= 95,
+    ),
+    (
+        "amcl on the office tour: position error, mean | p95",
+        "nav_localization",
+        "amcl_error_m|amcl_error_p95_m",
+        "m",
+        "mean ≤ 0.10",
+        lambda v: v <= 0.10,
+    ),
+    (
+        "amcl on the office tour: heading error, mean | p95",
+        "nav_localization",
+        "amcl_heading_error_deg|amcl_heading_error_p95_deg",
+        "°",
+        "",
+        None,
+    ),
+    (
+        "amcl: one filter update with /particle_cloud, CPU p50",
+        "nav_localization",
+        "amcl_update_cpu_ms_p50",
+        "ms",
+        "≤ 30",
+        lambda v: v <= 30,
+    ),
+)
+
+ROWS += (
+    (
+        "Network to one browser (server's sockets): idle on a lesson",
+        "ws_traffic",
+        "ws_idle_kBps",
+        "kB/s",
+        "",
+        None,
+    ),
+    (
+        "Network to one browser: the graph stage animating talker and listener",
+        "ws_traffic",
+        "ws_graph_kBps",
+        "kB/s",
+        "",
+        None,
+    ),
+    (
+        "Network to one browser: the 3D view of camera → transform → arm (lesson 15)",
+        "ws_traffic",
+        "ws_scene_kBps",
+        "kB/s",
+        "≤ 100",
+        lambda v: v <= 100,
+    ),
+    (
+        "Class of 20 (`classroom`, warm start), talker + listener each: PSS per dashboard",
+        "classroom_footprint",
+        "classroom_dashboard_pss_mb",
+        "MB",
+        "≤ 80",
+        lambda v: v <= 80,
+    ),
+    (
+        "Class of 20, talker + listener each: idle CPU per dashboard",
+        "classroom_footprint",
+        "classroom_dashboard_cpu_percent",
+        "% of a core",
+        "≤ 1.5",
+        lambda v: v <= 1.5,
+    ),
+    (
+        "Class of 20: a learner whole (dashboard, its nodes, a share of the class): PSS / idle CPU",
+        "classroom_footprint",
+        "classroom_learner_pss_mb|classroom_learner_cpu_percent",
+        "MB / % of a core",
+        "",
+        None,
+    ),
+    (
+        "Idle learners per core (half of each core kept free) / per GB (by PSS)",
+        "classroom_footprint",
+        "classroom_learners_per_core|classroom_learners_per_gb",
+        "learners",
+        "",
+        None,
+    ),
+)
 
 ROWS += (
     (
@@ -664,8 +771,12 @@ def last_json(output: str) -> dict[str, Any] | None:
 
 BENCH_TIMEOUT_SEC = 300
 # Benchmarks that run longer by design: their own time plus the same margin.
-# (soak: 3 minutes, and five software-WebGL pages to set up on a loaded machine)
-BENCH_TIMEOUTS = {"soak": 3 * 60 + 2 * BENCH_TIMEOUT_SEC}
+# (soak: 3 minutes, and five software-WebGL pages to set up on a loaded machine;
+# classroom_footprint: 20 dashboards and 40 nodes to start on 2 cores, then sampled)
+BENCH_TIMEOUTS = {
+    "soak": 3 * 60 + 2 * BENCH_TIMEOUT_SEC,
+    "classroom_footprint": 2 * BENCH_TIMEOUT_SEC,
+}
 
 
 def failure_reason(returncode: int, stdout: str, stderr: str) -> str:

@@ -43,6 +43,7 @@ from tornado.netutil import bind_sockets
 from app.hub.lti_gradebook import PAGE_PATH, gradebook_routes
 from app.hub.lti_service import DEFAULT_DIR, OUTBOX_POLL_SEC, LtiService, opening
 from app.lti.deep_linking import Activity
+from app.lti.dynamic_registration import registration_url
 from app.lti.rejection import LaunchRejected
 from app.lti.routes import ToolUrls
 from app.lti.state_file import save_json
@@ -249,6 +250,8 @@ def classroom_lti(
     tool = LtiTool(folder, urls)
     if not list(tool.registrations):
         log.warning("LTI: no LMS registered in %s: every launch will be refused", folder)
+    log.info("LTI: dynamic registration URL (paste it into the LMS): %s",
+             registration_url(urls, folder))  # fmt: skip
     lti = ClassroomLti(
         tool, Seats(folder, list(learner_urls)), learner_urls, teacher_url, site=site
     )

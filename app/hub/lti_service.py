@@ -40,13 +40,26 @@ from app import PROJECT_ROOT
 from app.hub.lti_catalog import course_activities
 from app.lti import claims
 from app.lti.deep_linking import Activity, DeepLinkingError
+from app.lti.dynamic_registration import (
+    RegistrationRefused,
+    close_page,
+    register,
+    registration_url,
+)
 from app.lti.gradebook import GradebookLine, gradebook
 from app.lti.handoff import Handoff, HandoffRefused, HandoffTickets
 from app.lti.launch import Launch
 from app.lti.learners import activity_of, hub_user_name
 from app.lti.pages import picker_page, refusal_page
 from app.lti.rejection import LaunchRejected
-from app.lti.routes import DEEP_LINK_PATH, JWKS_PATH, LAUNCH_PATH, LOGIN_PATH, ToolUrls
+from app.lti.routes import (
+    DEEP_LINK_PATH,
+    JWKS_PATH,
+    LAUNCH_PATH,
+    LOGIN_PATH,
+    REGISTER_PATH,
+    ToolUrls,
+)
 from app.lti.tool import GradedResult, LtiTool
 from app.teacher.record import LearnerRecord
 
@@ -265,6 +278,7 @@ class LtiService:
             (base + DEEP_LINK_PATH, LaunchHandler, args),
             (base + PICK_PATH, PickHandler, args),
             (base + JWKS_PATH, JwksHandler, args),
+            (base + REGISTER_PATH, RegisterHandler, args),
         ]
 
     def routes(self, prefix: str) -> list[tuple[str, type[web.RequestHandler], dict[str, Any]]]:
@@ -402,6 +416,31 @@ class JwksHandler(_LtiPage):
         self.finish(json.dumps(self.lti.tool.keys.public_jwks()))
 
 
+class RegisterHandler(_LtiPage):
+    """LTI Dynamic Registration: the LMS's administrator opens this from the LMS, once."""
+
+    async def get(self) -> None:
+        tool = self.lti.tool
+        loop = ioloop.IOLoop.current()
+        try:  # it asks the LMS twice over HTTP: not on the loop
+            registration = await loop.run_in_executor(
+                None, register, self.form(), tool.urls, tool.folder
+            )
+        except RegistrationRefused as refused:
+            self.refuse(str(refused), what="This registration from your LMS")
+            return
+        tool.registrations.add(registration)
+        log.info(
+            "LTI: registered %s client %s deployment %s (dynamic registration)",
+            registration.issuer,
+            registration.client_id,
+            ", ".join(sorted(registration.deployment_ids)),
+        )
+        self.set_header("Content-Type", "text/html; charset=utf-8")
+        self.set_header("Cache-Control", "no-store")
+        self.finish(close_page(registration))
+
+
 class HandoffHandler(_LtiPage):
     """The hub's authenticator trades a ticket for whom to log in and where to send them."""
 
@@ -444,4 +483,6 @@ def from_environment(service_prefix: str) -> LtiService | None:
         tool.keys.kid,
         folder,
     )
+    log.info("LTI: dynamic registration URL (paste it into the LMS): %s",
+             registration_url(urls, folder))  # fmt: skip
     return service

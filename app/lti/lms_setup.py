@@ -42,12 +42,22 @@ def canvas_json(urls: ToolUrls) -> JSONObject:
     }
 
 
-def setup_text(urls: ToolUrls, keys: ToolKeys) -> str:
+def setup_text(urls: ToolUrls, keys: ToolKeys, registration_url: str = "") -> str:
+    """The values to paste into an LMS; ``registration_url``: the dynamic registration's."""
     jwks = json.dumps(keys.public_jwks(), indent=2)
     redirects = "\n".join(f"      {uri}" for uri in urls.redirect_uris)
+    by_url = (
+        f"""
+An LMS that registers tools by URL (LTI Dynamic Registration: Moodle 4.1+,
+Canvas, Brightspace) needs only this, and fills in everything below itself:
+  Registration URL:           {registration_url}
+"""
+        if registration_url
+        else ""
+    )
     return f"""\
 {TOOL_TITLE} as an LTI 1.3 tool at {urls.base}
-
+{by_url}
   Login initiation URL:       {urls.login}
   Launch (redirect) URL:      {urls.launch}
   Deep-linking URL:           {urls.deep_link}

@@ -45,6 +45,10 @@ class Registrations:
     def __iter__(self) -> Iterator[PlatformRegistration]:
         return iter(self._all)
 
+    def add(self, registration: PlatformRegistration) -> None:
+        """One more platform, live (dynamic registration): the next login already finds it."""
+        self._all = (*self._all, registration)
+
     def for_issuer(self, issuer: str) -> list[PlatformRegistration]:
         return [r for r in self._all if r.issuer == issuer]
 

@@ -15,6 +15,7 @@ LOGIN_PATH = "/lti/login"
 LAUNCH_PATH = "/lti/launch"
 JWKS_PATH = "/lti/jwks"
 DEEP_LINK_PATH = "/lti/deep-link"
+REGISTER_PATH = "/lti/register"  # LTI Dynamic Registration: the LMS opens it once
 
 
 @dataclass(frozen=True)
@@ -53,6 +54,10 @@ class ToolUrls:
     @property
     def deep_link(self) -> str:
         return self.base + DEEP_LINK_PATH
+
+    @property
+    def register(self) -> str:
+        return self.base + REGISTER_PATH
 
     @property
     def redirect_uris(self) -> tuple[str, str]:

@@ -13,8 +13,11 @@ BASE = "https://hub.example.edu/services/classroom"
 
 
 def test_lti_config_prints_the_urls_and_the_public_key(tmp_path: Path) -> None:
-    keys_dir = tmp_path / "keys"
-    result = run_cli("lti", "config", "--base-url", BASE + "/", "--keys-dir", str(keys_dir))
+    keys_dir, lti_dir = tmp_path / "keys", tmp_path / "lti"
+    result = run_cli(
+        "lti", "config", "--base-url", BASE + "/", "--keys-dir", str(keys_dir),
+        "--lti-dir", str(lti_dir),
+    )  # fmt: skip
     assert result.returncode == 0, result.stderr
     out = result.stdout
     for line in (
@@ -37,8 +40,15 @@ def test_lti_config_prints_the_urls_and_the_public_key(tmp_path: Path) -> None:
     assert {p["target_link_uri"] for p in canvas["extensions"][0]["settings"]["placements"]} == {
         f"{BASE}/lti/deep-link"
     }
-    again = run_cli("lti", "config", "--base-url", BASE, "--keys-dir", str(keys_dir))
+    # Dynamic registration: the URL carries this deployment's registration key, kept private.
+    key = (lti_dir / "registration-key").read_text().strip()
+    assert f"Registration URL:           {BASE}/lti/register?key={key}" in out
+    assert stat.S_IMODE((lti_dir / "registration-key").stat().st_mode) == 0o600
+    again = run_cli(
+        "lti", "config", "--base-url", BASE, "--keys-dir", str(keys_dir), "--lti-dir", str(lti_dir)
+    )
     assert f"Key id (kid):               {keys.kid}" in again.stdout  # the same key, kept
+    assert f"?key={key}" in again.stdout
 
 
 def test_lti_config_refuses_plain_http_to_another_host(tmp_path: Path) -> None:
