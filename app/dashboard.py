@@ -61,6 +61,10 @@ log = logging.getLogger(__name__)
 
 UI_PERIOD_SEC = 0.2  # panels refresh at 5 Hz
 GRAPH_CHECK_SEC = 0.02  # ...and within 20 ms of a node joining/leaving or an intent
+# With no browser connected nobody sees a frame: checks and progress still move on, once
+# a second, at a tenth of the idle cost (a class's dashboards idle while learners are away).
+UNWATCHED_PERIOD_SEC = 1.0
+UNWATCHED_CHECK_SEC = 0.5
 # Runs in the page (app.ui.page_script): what the address asks to open, reported once per
 # page load to the page link of its kind (values the links take: a-z, 0-9, '_', '.', '-').
 _OPEN_FROM_ADDRESS = """
@@ -297,7 +301,8 @@ class Dashboard:
         last_nodes: list[tuple[str, str]] | None = None
         due = 0.0
         while not self._stop.is_set():
-            woken = self.ui.wait(GRAPH_CHECK_SEC)
+            watched = bool(self.server.get_clients())
+            woken = self.ui.wait(GRAPH_CHECK_SEC if watched else UNWATCHED_CHECK_SEC)
             applied = self.ui.apply_pending()
             try:
                 nodes = self.runtime.node.get_node_names_and_namespaces()
@@ -306,7 +311,7 @@ class Dashboard:
             now = time.monotonic()
             if nodes == last_nodes and now < due and not (woken or applied):
                 continue
-            last_nodes, due = nodes, now + UI_PERIOD_SEC
+            last_nodes, due = nodes, now + (UI_PERIOD_SEC if watched else UNWATCHED_PERIOD_SEC)
             try:
                 self.graph = snapshot(self.runtime.node)
                 self.supervisor.note_visible_nodes(self.graph.nodes)
