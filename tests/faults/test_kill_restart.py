@@ -573,6 +573,7 @@ def check_files(var: Path, learner: Learner, course: Course, number: int) -> dic
     for name, versions in learner.files.items():
         path = ws / name
         if versions.acked < 0 and not path.exists():
+            versions.sent = []  # killed before its first save landed: the file never was
             continue
         assert path.exists(), f"round {number}: {name} lost"
         text = path.read_text(encoding="utf-8")

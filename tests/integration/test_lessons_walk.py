@@ -213,6 +213,10 @@ FAILING_CHECKS = [
     Spec("sim_time_stamps", {"frame": "carrot1"}),
     Spec("sim_paused", {}),
     Spec("sim_time_factor", {"requested": 2.0}),
+    Spec("map_matches_world", {"coverage": 80, "agreement": 95}),
+    Spec("map_file", {"path": "~/no/such/map.yaml"}),
+    Spec("localized", {"within": 0.2}),
+    Spec("robot_near", {"x": 1.0, "y": 2.0, "within": 0.3}),
     Spec("quiz", {"question": "2+2?", "options": ["3", "4"], "answer": "4"}),
 ]
 
