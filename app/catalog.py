@@ -670,6 +670,14 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         package="nav2_bt_navigator",
     ),
     CatalogEntry(
+        "waypoint_follower",
+        "waypoint_follower",
+        "/waypoint_follower",
+        "Nav2's waypoint follower (lifecycle): follow_waypoints sends each pose to "
+        "navigate_to_pose in turn (stop_on_failure, wait_at_waypoint).",
+        package="nav2_waypoint_follower",
+    ),
+    CatalogEntry(
         "lifecycle_manager",
         "lifecycle_manager",
         "/lifecycle_manager_navigation",
@@ -681,7 +689,8 @@ ENTRIES: tuple[CatalogEntry, ...] = (
             "-p",
             "autostart:=true",
             "-p",
-            "node_names:=[map_server,amcl,planner_server,controller_server,bt_navigator]",
+            "node_names:=[map_server,amcl,planner_server,controller_server,bt_navigator,"
+            "waypoint_follower]",
         ),
         package="nav2_lifecycle_manager",
     ),
@@ -840,6 +849,7 @@ GROUPS: tuple[LaunchGroup, ...] = (
             "planner_server",
             "controller_server",
             "bt_navigator",
+            "waypoint_follower",
             "lifecycle_manager",
         ),
     ),

@@ -52,6 +52,7 @@ RUNS: tuple[tuple[str, list[str]], ...] = (
     ("classroom_footprint", ["--counts", "20", "--seconds", "10"]),  # issue 43's class of 20
     ("nav_mapping", []),  # the office tour mapped (issue 40): about 2 minutes
     ("nav_localization", []),  # amcl along the same tour (issue 40): about 2 minutes
+    ("nav_navigation", ["--goals", "10"]),  # Nav2 to random office goals: 2-3 minutes
     ("colcon_build", ["--python-rounds", "4", "--interface-rounds", "2", "--run-rounds", "6"]),
     ("soak", ["--minutes", "3"]),  # the real soak: --bench soak --minutes 30
 )
@@ -572,7 +573,52 @@ HEADLINE = {
     "classroom_learners_per_gb": ("classroom_footprint", "classroom_learners_per_gb"),
     "map_agreement_percent": ("nav_mapping", "map_agreement_percent"),
     "amcl_error_m": ("nav_localization", "amcl_error_m"),
+    "nav_success_percent": ("nav_navigation", "nav_success_percent"),
+    "nav_plan_ratio": ("nav_navigation", "nav_plan_ratio"),
 }
+
+ROWS += (
+    (
+        "Nav2 in the office: random goals reached (SUCCEEDED, within 0.3 m)",
+        "nav_navigation",
+        "nav_success_percent",
+        "%",
+        "≥ 95",
+        lambda v: v >= 95,
+    ),
+    (
+        "Nav2 in the office: collisions with the floor plan (ground truth)",
+        "nav_navigation",
+        "nav_collisions",
+        "",
+        "0",
+        lambda v: v == 0,
+    ),
+    (
+        "Nav2 in the office: driven path over the optimal grid path",
+        "nav_navigation",
+        "nav_path_ratio",
+        "x",
+        "≤ 1.2",
+        lambda v: v <= 1.2,
+    ),
+    (
+        "Nav2 planning through the action over the same planner in-process",
+        "nav_navigation",
+        "nav_plan_ratio",
+        "x",
+        "≤ 1.5",
+        lambda v: v <= 1.5,
+    ),
+    (
+        "Nav2 stack CPU while driving (map_server, amcl, planner, controller, navigator)",
+        "nav_navigation",
+        "nav_stack_cpu_percent",
+        "% of a core",
+        "≤ 100",
+        lambda v: v <= 100,
+    ),
+)
 
 ROWS += (
     (

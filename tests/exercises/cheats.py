@@ -15,6 +15,7 @@ import textwrap
 from typing import Any
 
 from app.exercises.model import Exercise
+from tests.exercises.cheats_grid import GENERATORS as GRID_GENERATORS
 from tests.exercises.cheats_sim import GENERATORS as SIM_GENERATORS
 
 _MAIN = """
@@ -541,6 +542,7 @@ GENERATORS = {
     "joint_motion": _joint_motion,
     "depth_cloud": _depth_cloud,
     **SIM_GENERATORS,  # the "Drive a robot" unit's (they replay the example drive)
+    **GRID_GENERATORS,  # unit 24's grid planner (it answers with the statement's example)
 }
 
 # Exercises for which no cheat can be generated, each with the reason (none today).

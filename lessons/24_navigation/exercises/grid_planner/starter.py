@@ -1,0 +1,127 @@
+"""Exercise: plan shortest paths with A* on the grid from /map, answering GetPlan on /plan_path."""
+
+import heapq
+import math
+
+import rclpy
+from geometry_msgs.msg import PoseStamped
+from nav_msgs.msg import OccupancyGrid
+from nav_msgs.srv import GetPlan
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile
+
+SQRT2 = math.sqrt(2.0)
+# (column step, row step, length in cells): the 8 neighbours of a cell.
+MOVES = [
+    (1, 0, 1.0),
+    (-1, 0, 1.0),
+    (0, 1, 1.0),
+    (0, -1, 1.0),
+    (1, 1, SQRT2),
+    (1, -1, SQRT2),
+    (-1, 1, SQRT2),
+    (-1, -1, SQRT2),
+]
+
+
+def is_free(value):
+    """0 to 49 is free; -1 (unknown) and 50 or more are blocked."""
+    # TODO 1: say whether a cell with this value is free.
+    return False
+
+
+def heuristic(cell, goal):
+    """The length of the path to the goal if nothing were in the way (never too long)."""
+    dx, dy = abs(cell[0] - goal[0]), abs(cell[1] - goal[1])
+    return max(dx, dy) + (SQRT2 - 1.0) * min(dx, dy)
+
+
+def a_star(free, start, goal):
+    """The cells (col, row) of a shortest path from start to goal, [] when there is none.
+
+    free(col, row) says whether a cell is inside the map and free.
+    """
+    if not free(*start) or not free(*goal):
+        return []
+    came_from = {start: None}
+    cost = {start: 0.0}
+    frontier = [(heuristic(start, goal), start)]
+    while frontier:
+        _, cell = heapq.heappop(frontier)
+        if cell == goal:
+            # TODO 2: follow came_from back from the goal to the start (its entry is
+            #         None) and return the cells in order, from start to goal.
+            return []
+        col, row = cell
+        for dc, dr, step in MOVES:
+            nxt = (col + dc, row + dr)
+            # TODO 3: skip nxt unless it is free; a diagonal move (dc and dr both not 0)
+            #         also needs both cells beside it free: (col + dc, row) and (col, row + dr).
+            new = cost[cell] + step
+            if new < cost.get(nxt, math.inf):
+                cost[nxt] = new
+                came_from[nxt] = cell
+                heapq.heappush(frontier, (new + heuristic(nxt, goal), nxt))
+    return []
+
+
+class GridPlanner(Node):
+    def __init__(self):
+        super().__init__("grid_planner")
+        self.map = None
+        latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        self.create_subscription(OccupancyGrid, "/map", self.on_map, latched)
+        self.service = self.create_service(GetPlan, "/plan_path", self.on_plan)
+
+    def on_map(self, msg):
+        self.map = msg
+
+    def cell_of(self, position):
+        # TODO 4: the (col, row) of the cell this position (x, y) lies in, from
+        #         self.map.info.origin.position and self.map.info.resolution (floor, not round).
+        return 0, 0
+
+    def centre_of(self, col, row):
+        # TODO 5: the (x, y) of the centre of cell (col, row), in metres in the map frame.
+        origin = self.map.info.origin.position
+        return origin.x, origin.y
+
+    def on_plan(self, request, response):
+        response.plan.header.frame_id = "map"
+        response.plan.header.stamp = self.get_clock().now().to_msg()
+        if self.map is None:
+            self.get_logger().warn("no map yet: empty plan")
+            return response
+        data, width, height = self.map.data, self.map.info.width, self.map.info.height
+
+        def free(col, row):
+            return 0 <= col < width and 0 <= row < height and is_free(data[row * width + col])
+
+        start = self.cell_of(request.start.pose.position)
+        goal = self.cell_of(request.goal.pose.position)
+        cells = a_star(free, start, goal)
+        for col, row in cells:
+            pose = PoseStamped()
+            pose.header = response.plan.header
+            pose.pose.position.x, pose.pose.position.y = self.centre_of(col, row)
+            pose.pose.orientation.w = 1.0
+            response.plan.poses.append(pose)
+        self.get_logger().info(f"{start} -> {goal}: {len(cells)} cells")
+        return response
+
+
+def main():
+    rclpy.init()
+    node = GridPlanner()
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == "__main__":
+    main()

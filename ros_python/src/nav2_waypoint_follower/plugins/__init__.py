@@ -1,0 +1,1 @@
+"""Waypoint task executors: what the follower does on arriving at a waypoint."""
