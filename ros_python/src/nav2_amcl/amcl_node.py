@@ -237,21 +237,6 @@ class AmclNode(LifecycleNode):
         self.active = False
         return super().on_deactivate(state)
 
-    def on_cleanup(self, state: LifecycleState) -> TransitionCallbackReturn:
-        self.get_logger().info("Cleaning up")
-        self.release()
-        return TransitionCallbackReturn.SUCCESS
-
-    def on_shutdown(self, state: LifecycleState) -> TransitionCallbackReturn:
-        self.get_logger().info("Shutting down")
-        self.release()
-        return TransitionCallbackReturn.SUCCESS
-
-    def on_error(self, state: LifecycleState) -> TransitionCallbackReturn:
-        self.get_logger().error(f"Error in state '{state.label}': released everything")
-        self.release()
-        return TransitionCallbackReturn.SUCCESS
-
     def release(self) -> None:
         self.active = False
         for thing in self._made:

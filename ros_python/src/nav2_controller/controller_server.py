@@ -148,21 +148,6 @@ class ControllerServer(LifecycleNode):
         self.costmap_ros.on_deactivate()
         return super().on_deactivate(state)
 
-    def on_cleanup(self, state: LifecycleState) -> TransitionCallbackReturn:
-        self.get_logger().info("Cleaning up")
-        self.release()
-        return TransitionCallbackReturn.SUCCESS
-
-    def on_shutdown(self, state: LifecycleState) -> TransitionCallbackReturn:
-        self.get_logger().info("Shutting down")
-        self.release()
-        return TransitionCallbackReturn.SUCCESS
-
-    def on_error(self, state: LifecycleState) -> TransitionCallbackReturn:
-        self.get_logger().error(f"Error in state '{state.label}': released everything")
-        self.release()
-        return TransitionCallbackReturn.SUCCESS
-
     def release(self) -> None:
         with self.lock:
             self.current = None

@@ -104,21 +104,6 @@ class MapServer(LifecycleNode):
         self.get_logger().info("Deactivating")
         return super().on_deactivate(state)
 
-    def on_cleanup(self, state: LifecycleState) -> TransitionCallbackReturn:
-        self.get_logger().info("Cleaning up")
-        self.release()
-        return TransitionCallbackReturn.SUCCESS
-
-    def on_shutdown(self, state: LifecycleState) -> TransitionCallbackReturn:
-        self.get_logger().info("Shutting down")
-        self.release()
-        return TransitionCallbackReturn.SUCCESS
-
-    def on_error(self, state: LifecycleState) -> TransitionCallbackReturn:
-        self.get_logger().error(f"Error in state '{state.label}': released everything")
-        self.release()
-        return TransitionCallbackReturn.SUCCESS
-
     def release(self) -> None:
         if self.occ_pub is not None:
             self.destroy_lifecycle_publisher(self.occ_pub)

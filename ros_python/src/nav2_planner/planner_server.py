@@ -144,21 +144,6 @@ class PlannerServer(LifecycleNode):
         self.costmap_ros.on_deactivate()
         return super().on_deactivate(state)
 
-    def on_cleanup(self, state: LifecycleState) -> TransitionCallbackReturn:
-        self.get_logger().info("Cleaning up")
-        self.release()
-        return TransitionCallbackReturn.SUCCESS
-
-    def on_shutdown(self, state: LifecycleState) -> TransitionCallbackReturn:
-        self.get_logger().info("Shutting down")
-        self.release()
-        return TransitionCallbackReturn.SUCCESS
-
-    def on_error(self, state: LifecycleState) -> TransitionCallbackReturn:
-        self.get_logger().error(f"Error in state '{state.label}': released everything")
-        self.release()
-        return TransitionCallbackReturn.SUCCESS
-
     def release(self) -> None:
         if self.action_server is not None:
             self.action_server.destroy()

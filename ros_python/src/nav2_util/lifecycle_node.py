@@ -21,6 +21,7 @@ from typing import Any
 import rclpy.lifecycle
 from lifecycle_msgs.srv import ChangeState
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+from rclpy.lifecycle import LifecycleState, TransitionCallbackReturn
 
 Handler = Callable[[ChangeState.Request, ChangeState.Response], ChangeState.Response]
 
@@ -60,3 +61,22 @@ class LifecycleNode(rclpy.lifecycle.LifecycleNode):
             self.get_logger().error(f"Transition {asked} from '{state}' failed: {exc}")
             response.success = False
             return response
+
+    # --- leaving: every Nav2 server says so and lets go of what configure made ---
+    def release(self) -> None:
+        """Give back what ``on_configure`` made; a server that made something says what."""
+
+    def on_cleanup(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.get_logger().info("Cleaning up")
+        self.release()
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_shutdown(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.get_logger().info("Shutting down")
+        self.release()
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_error(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.get_logger().error(f"Error in state '{state.label}': released everything")
+        self.release()
+        return TransitionCallbackReturn.SUCCESS
