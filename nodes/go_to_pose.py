@@ -19,6 +19,8 @@ from geometry_msgs.msg import PoseStamped
 from nav2_simple_commander.robot_navigator import BasicNavigator, TaskResult
 from rclpy.executors import ExternalShutdownException
 
+from nodes.common.run import run_program
+
 
 def main(argv: list[str] | None = None) -> int:
     words = rclpy.utilities.remove_ros_args(sys.argv if argv is None else argv)[1:]
@@ -63,11 +65,11 @@ def main(argv: list[str] | None = None) -> int:
         print(words_for.get(result, "Goal has an invalid return status!"), flush=True)
         return 0 if result == TaskResult.SUCCEEDED else 1
     except (KeyboardInterrupt, ExternalShutdownException):
-        return 1
+        return 0  # stopped on request (Ctrl+C, SIGTERM), as any node
     finally:
         navigator.destroy_node()
         rclpy.try_shutdown()
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    run_program(main)  # Ctrl+C and SIGTERM end it quietly, even while it starts

@@ -14,6 +14,7 @@ listener is not (one key press, one key).
 from __future__ import annotations
 
 import json
+import math
 import time
 from collections.abc import Callable
 
@@ -36,6 +37,7 @@ NO_SIM = (
     "**Run › Turtlesim**, or type `ros2 run turtlesim turtlesim_node` in **Run › Console**."
 )
 LOOK_EVERY = 1.0  # s between looks for a sim started since
+BURST_SEC = 1.5  # s: sims first seen this close together came from one launch
 KEY_HINT = (
     "Arrow keys drive turtle1 while this window is shown (turtle_teleop_key must run: "
     "**Run › Turtlesim** starts it); G B V C D E R T turn it, F cancels the turn."
@@ -73,6 +75,7 @@ class TurtlesimStage:
         self._sims: list[str] = []  # the sims running at the last look
         self._seen: set[str] = set()  # every sim seen since the stage was built
         self._next_look = 0.0
+        self._adopted_at = -math.inf  # when a new sim last took the stage
         self._box = gui.add_folder(None, visible=False)
         with self._box:
             self._status = MarkdownView(gui, NO_SIM)
@@ -123,7 +126,13 @@ class TurtlesimStage:
         new = [s for s in self._sims if s not in self._seen]
         self._seen.update(self._sims)
         if new:
-            self._feed.follow(new[0])
+            # One launch starts several sims whose discovery order varies: within a burst
+            # the first by name keeps the stage (multisim: turtlesim1, not turtlesim2).
+            if followed in self._sims and now - self._adopted_at < BURST_SEC:
+                new = sorted([*new, followed])
+            if new[0] != followed:
+                self._feed.follow(new[0])
+                self._adopted_at = now
         elif followed is None or followed not in self._sims:
             self._feed.follow(self._sims[0] if self._sims else None)
 

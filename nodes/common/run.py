@@ -20,7 +20,7 @@ import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from types import FrameType
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import rclpy
 from rclpy.exceptions import InvalidHandle
@@ -250,6 +250,7 @@ def run_program(main: Callable[[], int | None]) -> None:
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, interrupt_outside_imports)
     spin_threads_end_quietly()
+    sys.unraisablehook = _quiet_half_built
     code: int | None = 0
     global _ending
     try:
@@ -267,6 +268,15 @@ def run_program(main: Callable[[], int | None]) -> None:
         for sig in (signal.SIGINT, signal.SIGTERM):
             signal.signal(sig, signal.SIG_IGN)
     sys.exit(code)
+
+
+def _quiet_half_built(unraisable: Any) -> None:
+    """Once the program ends on a signal, an rclpy object the signal interrupted while it
+    was being made (an executor without its attributes) fails in ``__del__``: not news."""
+    owner = getattr(unraisable.object, "__module__", "") or ""
+    if _ending and isinstance(unraisable.exc_value, AttributeError) and owner.startswith("rclpy"):
+        return
+    sys.__unraisablehook__(unraisable)
 
 
 RETRY_SIGNAL_SEC = 0.05

@@ -147,7 +147,9 @@ def test_the_stage_follows_the_sims_the_learner_starts_last(page):
     expect_status(page, r"^/turtlesim · turtles: turtle1$")
     start_group(page, "multisim")
     choose(page, "On stage", "Turtlesim")
-    expect_status(page, r"^/turtlesim1/turtlesim · turtles: turtle1 · also running:")
-    status = page.get_by_text(re.compile(r"also running:")).locator("visible=true").first
-    others = status.inner_text().split("also running:")[1].split(",")
-    assert sorted(o.strip() for o in others) == ["/turtlesim", "/turtlesim2/turtlesim"], others
+    # The two sims of one launch may be discovered a second apart: the first by name stays.
+    expect_status(
+        page,
+        r"^/turtlesim1/turtlesim · turtles: turtle1 · also running: "
+        r"/turtlesim, /turtlesim2/turtlesim$",
+    )
