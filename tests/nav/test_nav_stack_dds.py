@@ -13,18 +13,16 @@ localization, planning and control all work together.
 from __future__ import annotations
 
 import math
-import threading
 import time
-from typing import Any
 
 import pytest
 import rclpy
-from geometry_msgs.msg import PoseStamped
 from nav2_simple_commander.robot_navigator import BasicNavigator, TaskResult
 from nav_msgs.msg import Odometry
 
 from app.catalog import lookup_group
 from tests.conftest import wait_until
+from tests.nav.commander_helpers import in_thread, map_pose
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(300)]
 
@@ -33,33 +31,6 @@ GOAL = (4.0, 1.7, math.pi / 2)  # the meeting room, through its door at x = 3.7.
 # m: the goal checker's 0.25 plus what amcl may be off (a loaded run ended 0.48 m away:
 # amcl dropped scans while the cores were busy)
 REACHED = 0.6
-
-
-def goal_pose(nav: BasicNavigator, x: float, y: float, yaw: float) -> PoseStamped:
-    pose = PoseStamped()
-    pose.header.frame_id = "map"
-    pose.header.stamp = nav.get_clock().now().to_msg()
-    pose.pose.position.x, pose.pose.position.y = x, y
-    pose.pose.orientation.z, pose.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
-    return pose
-
-
-def in_thread(work: Any, timeout: float, what: str, logs: Any) -> None:
-    """Run a blocking commander call (it waits forever, as upstream's do) with a deadline."""
-    failure: list[BaseException] = []
-
-    def run() -> None:
-        try:
-            work()
-        except BaseException as exc:  # carried to the test's thread
-            failure.append(exc)
-
-    worker = threading.Thread(target=run, daemon=True)
-    worker.start()
-    worker.join(timeout)
-    assert not worker.is_alive(), f"{what} after {timeout:.0f} s\n{logs()}"
-    if failure:
-        raise failure[0]
 
 
 def test_basic_navigator_drives_the_office_robot_through_a_door(ros_env, supervisor):
@@ -86,11 +57,11 @@ def test_basic_navigator_drives_the_office_robot_through_a_door(ros_env, supervi
         in_thread(nav.waitUntilNav2Active, 120, "Nav2 did not become active", logs)
         up = time.monotonic() - started
 
-        path = nav.getPath(goal_pose(nav, 0.0, 0.0, 0.0), goal_pose(nav, *GOAL), use_start=True)
+        path = nav.getPath(map_pose(nav, 0.0, 0.0, 0.0), map_pose(nav, *GOAL), use_start=True)
         assert path is not None and len(path.poses) > 20, logs()
 
         driving = time.monotonic()
-        assert nav.goToPose(goal_pose(nav, *GOAL)), logs()
+        assert nav.goToPose(map_pose(nav, *GOAL)), logs()
         distances: list[float] = []
 
         def until_done() -> None:

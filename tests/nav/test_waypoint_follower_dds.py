@@ -20,13 +20,11 @@ with the others. BasicNavigator, in this process as a learner's script:
 from __future__ import annotations
 
 import math
-import threading
 import time
 from typing import Any
 
 import pytest
 import rclpy
-from geometry_msgs.msg import PoseStamped
 from nav2_msgs.action import ComputePathToPose
 from nav2_simple_commander.robot_navigator import BasicNavigator, TaskResult
 from nav_msgs.msg import Odometry
@@ -34,6 +32,7 @@ from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
 
 from app.catalog import lookup_group
+from tests.nav.commander_helpers import in_thread, map_pose
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(240)]
 
@@ -58,38 +57,11 @@ class Truth:
         self.speed = math.hypot(msg.twist.twist.linear.x, msg.twist.twist.linear.y)
 
 
-def pose(nav: BasicNavigator, x: float, y: float, yaw: float) -> PoseStamped:
-    p = PoseStamped()
-    p.header.frame_id = "map"
-    p.header.stamp = nav.get_clock().now().to_msg()
-    p.pose.position.x, p.pose.position.y = x, y
-    p.pose.orientation.z, p.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
-    return p
-
-
-def in_thread(work: Any, timeout: float, what: str, logs: Any) -> None:
-    """Run a blocking commander call (it waits forever, as upstream's do) with a deadline."""
-    failure: list[BaseException] = []
-
-    def run() -> None:
-        try:
-            work()
-        except BaseException as exc:  # carried to the test's thread
-            failure.append(exc)
-
-    worker = threading.Thread(target=run, daemon=True)
-    worker.start()
-    worker.join(timeout)
-    assert not worker.is_alive(), f"{what} after {timeout:.0f} s\n{logs()}"
-    if failure:
-        raise failure[0]
-
-
 def follow(
     nav: BasicNavigator, waypoints: list[tuple[float, float, float]], timeout: float, logs: Any
 ) -> tuple[TaskResult, Any, list[int]]:
     """followWaypoints until done: the TaskResult, the result message, the feedback seen."""
-    assert nav.followWaypoints([pose(nav, *w) for w in waypoints]), logs()
+    assert nav.followWaypoints([map_pose(nav, *w) for w in waypoints]), logs()
     seen: list[int] = []
 
     def until_done() -> None:
@@ -187,7 +159,7 @@ def test_follow_waypoints_with_basic_navigator(ros_env, supervisor):
         assert "Failed to process waypoint 0, moving to next." in out, out
 
         # 4. Cancelled on the way: CANCELED, and the robot stops.
-        assert nav.followWaypoints([pose(nav, *FAR_WEST)])
+        assert nav.followWaypoints([map_pose(nav, *FAR_WEST)])
         deadline = time.monotonic() + 30
         while truth.speed < 0.1:
             assert time.monotonic() < deadline, ("the robot did not drive off", logs())
