@@ -61,3 +61,36 @@ def wait_for_output(supervisor, name: str, text: str, timeout: float = DISCOVERY
 
 def node_names(probe) -> set[str]:
     return {f"{ns.rstrip('/')}/{n}" for n, ns in probe.node.get_node_names_and_namespaces()}
+
+
+def wait_node_gone(probe, name: str) -> None:
+    """Wait until node ``name`` has left the graph, as a fresh ``ros2 node list`` would see it.
+
+    The probe's own graph cache is asked first. Fast DDS can keep a stopped
+    node there for good (a late discovery-info message re-adds a participant
+    that was just removed; ci of 124208b: /my_turtle listed 30 s after it
+    exited). So if the probe still lists it after half the timeout, a new
+    participant is asked, once it sees the probe itself (so its discovery is done).
+    """
+    from app.ros.runtime import RosRuntime
+
+    deadline = time.monotonic() + DISCOVERY_TIMEOUT / 2
+    while time.monotonic() < deadline:
+        if name not in node_names(probe):
+            return
+        time.sleep(0.05)
+    witness = probe.node.get_fully_qualified_name()
+    fresh = RosRuntime("test_fresh_probe", quiet=True)
+    try:
+        wait_until(
+            lambda: witness in node_names(fresh),
+            timeout=DISCOVERY_TIMEOUT,
+            what=f"a fresh participant to see {witness}",
+        )
+        wait_until(
+            lambda: name not in node_names(fresh),
+            timeout=DISCOVERY_TIMEOUT / 2,
+            what=lambda: f"{name} to leave the graph: a fresh participant sees {node_names(fresh)}",
+        )
+    finally:
+        fresh.shutdown()

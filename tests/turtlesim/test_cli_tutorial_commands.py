@@ -20,7 +20,7 @@ import pytest
 import yaml
 
 from tests.conftest import wait_until
-from tests.integration.core_helpers import DISCOVERY_TIMEOUT, node_names
+from tests.integration.core_helpers import DISCOVERY_TIMEOUT, node_names, wait_node_gone
 from tests.turtlesim.test_ros2_run import console  # noqa: F401  (the Console fixture)
 
 pytestmark = pytest.mark.ros
@@ -329,10 +329,10 @@ def test_services_parameters_actions_and_logs_tutorials(
 
     # ...and its --log-level, and the parameters tutorial's --params-file, on fresh turtlesims
     ok(console, "ros2 run --stop /turtlesim")  # (ours) Ctrl+C in turtlesim's terminal
-    wait_until(lambda: "/turtlesim" not in node_names(probe), timeout=DISCOVERY_TIMEOUT)
+    wait_node_gone(probe, "/turtlesim")
     out = ok(console, "ros2 run turtlesim turtlesim_node --ros-args --log-level WARN")
     assert not any("[INFO]" in line for line in out), out
     ok(console, "ros2 run --stop /turtlesim")  # (ours)
-    wait_until(lambda: "/turtlesim" not in node_names(probe), timeout=DISCOVERY_TIMEOUT)
+    wait_node_gone(probe, "/turtlesim")
     ok(console, "ros2 run turtlesim turtlesim_node --ros-args --params-file turtlesim.yaml")
     assert ok(console, "ros2 param get /turtlesim background_r") == ["Integer value is: 150"]

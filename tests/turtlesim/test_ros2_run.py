@@ -7,7 +7,7 @@ import pytest
 from app.ros.context import CONSOLE_LIMITS, CallContext
 from app.ros2cli import run_text
 from tests.conftest import wait_until
-from tests.integration.core_helpers import DISCOVERY_TIMEOUT, node_names
+from tests.integration.core_helpers import DISCOVERY_TIMEOUT, node_names, wait_node_gone
 
 pytestmark = pytest.mark.ros
 
@@ -66,7 +66,7 @@ def test_turtlesim_runs_renamed_remapped_and_with_parameters(console, probe, sup
 
     code, out = console("ros2 run --stop /my_turtle")
     assert code == 0 and out == ["/my_turtle: stopped (exit code 0)"], out
-    wait_until(lambda: "/my_turtle" not in node_names(probe), timeout=DISCOVERY_TIMEOUT)
+    wait_node_gone(probe, "/my_turtle")
     assert "/turtlesim" in node_names(probe)
 
 
