@@ -224,6 +224,9 @@ class TfPanel:
             )
             self._picture = gui.add_html("")
         self._picked = False
+        # The pair the panel itself put in the dropdowns: any other pair was the
+        # learner's, even when their pick reaches refresh before its callback.
+        self._auto_pair = (PICK, PICK)
         self._shown_picture: tuple[Path, float] | None = None
         self._target.on_update(ui.callback(self._on_pick))
         self._source.on_update(ui.callback(self._on_pick))
@@ -248,9 +251,12 @@ class TfPanel:
             self._options = options
             set_options(self._target, list(options))
             set_options(self._source, list(options))
+        if (str(self._target.value), str(self._source.value)) != self._auto_pair:
+            self._picked = True
         if not self._picked:  # until the learner picks, follow the deepest frame
             target, source = default_pair(frames)
-            if target and (self._target.value, self._source.value) != (target, source):
+            if target and self._auto_pair != (target, source):
+                self._auto_pair = (target, source)
                 assign(self._target, target)
                 assign(self._source, source)
         target, source = str(self._target.value), str(self._source.value)
