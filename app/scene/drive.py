@@ -53,6 +53,12 @@ VIEW_FROM = np.array([-0.45, -0.7, 0.6])  # the overview looks at the room from 
 # distance to the right of what they show, so it sits in the part of the canvas left visible.
 PANEL_SHIFT = 0.25
 OVERVIEW_DISTANCE = 0.85  # the overview's distance, in room sizes
+# A building (the 10 m x 8 m office) seen from the room's corner angle fills half the
+# stage's height and hides its rooms behind walls: it is looked at from higher up, as
+# rviz shows a map, so the map, the particles and the plan on its floor read at a glance.
+WIDE_WORLD = 6.0  # m: a world at least this long on the floor is seen from above
+VIEW_FROM_ABOVE = np.array([-0.12, -0.45, 1.0])
+ABOVE_DISTANCE = 0.8
 
 HELP = (
     "**Drive the robot** with the buttons, or with the arrow keys while this tab is open "
@@ -94,9 +100,14 @@ def overview(low: np.ndarray, high: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     """(camera position, look-at point) that show a box (a room) whole, from above a corner."""
     centre = (np.asarray(low, dtype=float) + np.asarray(high, dtype=float)) / 2.0
     centre[2] = float(low[2])  # look at the floor's middle
-    size = float(np.linalg.norm(np.asarray(high, dtype=float) - np.asarray(low, dtype=float)))
-    direction = VIEW_FROM / np.linalg.norm(VIEW_FROM)
-    position = centre + direction * max(size, 1.0) * OVERVIEW_DISTANCE
+    extent = np.asarray(high, dtype=float) - np.asarray(low, dtype=float)
+    size = float(np.linalg.norm(extent))
+    wide = float(max(extent[0], extent[1])) >= WIDE_WORLD
+    view_from, distance = (
+        (VIEW_FROM_ABOVE, ABOVE_DISTANCE) if wide else (VIEW_FROM, OVERVIEW_DISTANCE)
+    )
+    direction = view_from / np.linalg.norm(view_from)
+    position = centre + direction * max(size, 1.0) * distance
     shift = panel_shift(position, centre)
     return position + shift, centre + shift
 

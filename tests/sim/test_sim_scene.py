@@ -64,6 +64,19 @@ def test_the_overview_looks_down_on_the_whole_room_from_a_corner():
     assert 4.0 < np.linalg.norm(back) < 8.0
 
 
+def test_a_building_is_seen_from_higher_up_than_a_room():
+    room = overview(np.array([-2.5, -2.5, 0.0]), np.array([2.5, 2.5, 0.5]))
+    office = overview(np.array([-1.0, -4.0, 0.0]), np.array([9.0, 4.0, 1.0]))
+
+    def pitch(view: tuple[np.ndarray, np.ndarray]) -> float:  # degrees below the horizon
+        back = view[0] - view[1]
+        return math.degrees(math.atan2(back[2], float(np.linalg.norm(back[:2]))))
+
+    assert pitch(room) < 45.0 < pitch(office)  # the office's rooms show over their walls
+    back = office[0] - office[1]
+    assert back[1] < 0 and 8.0 < np.linalg.norm(back) < 14.0  # from the south, all of it
+
+
 def test_only_namespaced_descriptions_with_a_publisher_are_followed():
     topics = (
         TopicInfo("/robot_description", ("std_msgs/msg/String",), 1, 1),
