@@ -20,6 +20,7 @@ from rclpy.node import Node
 
 from app.exercises import runner
 from app.exercises.attempts import AttemptStore
+from app.exercises.check_traces import check_traces
 from app.exercises.model import Exercise
 from app.exercises.probes import ProbeContext, run_probe
 from app.exercises.report import Report, Result
@@ -159,7 +160,8 @@ class Grader:
                 return report
             verdicts = wait_checks(exercise.checks, CHECK_WAIT_SEC)
             for check, (passed, detail) in zip(exercise.checks, verdicts, strict=True):
-                record(Result(_check_name(check), passed, detail))
+                traces = check_traces(lessons, for_learner(check), passed, detail)
+                record(Result(_check_name(check), passed, detail, traces))
             programs = _Programs(self.supervisor, exercise)
             probe_ctx = ProbeContext(
                 call,

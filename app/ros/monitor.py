@@ -372,6 +372,10 @@ class TopicMonitor(Generic[M]):
             samples = samples[start:]
         return samples
 
+    def samples(self, window_sec: float | None = None) -> list[Sample]:
+        """The kept samples (arrival, size, source stamp, sequence, writer), oldest first."""
+        return self._window(window_sec)
+
     def wait_for_count(self, count: int, timeout: float) -> bool:
         """Block (not the executor thread) until ``count`` messages arrived in total."""
         with self._cond:
