@@ -42,6 +42,7 @@ RUNS: tuple[tuple[str, list[str]], ...] = (
     ("bag_record", ["--seconds", "10"]),
     ("foxglove_latency", ["--seconds", "10"]),
     ("attempt_overhead", ["--rounds", "2"]),
+    ("lti_passback", ["--passes", "30", "--learners", "200", "--speed", "20"]),  # issue 42
     ("turtlesim_rate", ["--seconds", "8"]),
     ("sim_world", ["--seconds", "8"]),
     ("urdf_draw", ["--seconds", "5"]),
@@ -575,6 +576,9 @@ HEADLINE = {
     "amcl_error_m": ("nav_localization", "amcl_error_m"),
     "nav_success_percent": ("nav_navigation", "nav_success_percent"),
     "nav_plan_ratio": ("nav_navigation", "nav_plan_ratio"),
+    "lti_score_latency_p95_s": ("lti_passback", "lti_score_latency_p95_s"),
+    "lti_burst_lost": ("lti_passback", "lti_burst_lost"),
+    "lti_burst_duplicated": ("lti_passback", "lti_burst_duplicated"),
 }
 
 ROWS += (
@@ -797,6 +801,57 @@ ROWS += (
         "ms",
         "< 150",
         lambda v: v < 150,
+    ),
+)
+
+ROWS += (
+    (
+        "LTI grade passback: a dashboard reports a pass → score stored by the LMS's AGS, p95 / p50",
+        "lti_passback",
+        "lti_score_latency_p95_s|lti_score_latency_p50_s",
+        "s",
+        "≤ 5",
+        lambda v: v <= 5,
+    ),
+    (
+        "The same score POSTed bare to the same endpoint, no outbox (baseline), p95 / p50",
+        "lti_passback",
+        "lti_baseline_latency_p95_s|lti_baseline_latency_p50_s",
+        "s",
+        "",
+        None,
+    ),
+    (
+        "LTI grade passback p95 over the bare POST's",
+        "lti_passback",
+        "lti_score_latency_ratio",
+        "x",
+        "",
+        None,
+    ),
+    (
+        "200 learners pass in a minute, LMS answers 503 to a third of score posts: scores lost",
+        "lti_passback",
+        "lti_burst_lost",
+        "scores",
+        "0",
+        lambda v: v == 0,
+    ),
+    (
+        "The same burst: scores the LMS holds twice",
+        "lti_passback",
+        "lti_burst_duplicated",
+        "scores",
+        "0",
+        lambda v: v == 0,
+    ),
+    (
+        "The same burst: 503s answered / 409s answered (resends of a score the LMS had kept)",
+        "lti_passback",
+        "lti_burst_503|lti_burst_409",
+        "posts",
+        "",
+        None,
     ),
 )
 
