@@ -5,6 +5,7 @@ for its subscription, sending one input and reading the answer to it, and why no
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from typing import Any
 
 from rclpy.node import Node
@@ -52,6 +53,26 @@ def wait_subscribed(ctx: ProbeContext, publisher: Any, topic: str) -> str:
             return f"nothing subscribes to {topic} (waited {MATCH_WAIT_SEC:g} s)"
         ctx.call.sleep(0.05)
     ctx.call.sleep(0.3)  # let the learner's publisher find our reader too
+    return ""
+
+
+def wait_matched(ctx: ProbeContext, ours: Sequence[tuple[Any, str]], theirs: str) -> str:
+    """'' once the node subscribes to each of ``ours`` (publisher, topic), else why not; then
+    up to a second more for its publisher on ``theirs`` to show (it may have none: the
+    grading then says so), and a little for its writer to match our reader."""
+    node = ctx.call.node
+    deadline = time.monotonic() + MATCH_WAIT_SEC
+    while True:
+        missing = [topic for pub, topic in ours if not others_subscribed(node, pub, topic)]
+        if not missing:
+            break
+        if time.monotonic() > deadline:
+            return f"nothing subscribes to {missing[0]} (waited {MATCH_WAIT_SEC:g} s)"
+        ctx.call.sleep(0.05)
+    deadline = time.monotonic() + 1.0
+    while not node.count_publishers(theirs) and time.monotonic() < deadline:
+        ctx.call.sleep(0.05)
+    ctx.call.sleep(0.1)
     return ""
 
 

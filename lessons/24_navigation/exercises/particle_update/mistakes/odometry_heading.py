@@ -1,0 +1,95 @@
+"""Mistake: each particle moves along the odometry's heading instead of its own."""
+
+import math
+import random
+
+import rclpy
+from geometry_msgs.msg import Pose, PoseArray
+from nav_msgs.msg import Odometry
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+
+# How noisy the wheels are: rotation from rotation, rotation from translation,
+# translation from translation, translation from rotation.
+ALPHA1, ALPHA2, ALPHA3, ALPHA4 = 0.05, 0.01, 0.02, 0.01
+
+
+def yaw_of(q):
+    """The heading (rad) of a quaternion that turns about z only."""
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def normalize(angle):
+    """The same angle between -pi and pi."""
+    return math.atan2(math.sin(angle), math.cos(angle))
+
+
+def motion_between(before, after):
+    """(rot1, trans, rot2): the odometry's step from pose (x, y, yaw) before to after."""
+    dx, dy = after[0] - before[0], after[1] - before[1]
+    rot1 = normalize(math.atan2(dy, dx) - before[2])
+    trans = math.hypot(dx, dy)
+    rot2 = normalize(after[2] - before[2] - rot1)
+    return rot1, trans, rot2
+
+
+def move(particle, rot1, trans, rot2, odom_yaw):
+    """One particle (x, y, yaw) moved by the step, each part with noise of its own."""
+    x, y, yaw = particle
+    r1 = rot1 + random.gauss(0.0, math.sqrt(ALPHA1 * rot1**2 + ALPHA2 * trans**2))
+    t = trans + random.gauss(0.0, math.sqrt(ALPHA3 * trans**2 + ALPHA4 * (rot1**2 + rot2**2)))
+    r2 = rot2 + random.gauss(0.0, math.sqrt(ALPHA1 * rot2**2 + ALPHA2 * trans**2))
+    heading = odom_yaw + r1  # the odometry's heading, not the particle's
+    return x + t * math.cos(heading), y + t * math.sin(heading), normalize(yaw + r1 + r2)
+
+
+class ParticleUpdate(Node):
+    def __init__(self):
+        super().__init__("particle_update")
+        self.particles = []  # (x, y, yaw) in the map frame
+        self.frame_id = "map"
+        self.last_odom = None
+        self.publisher = self.create_publisher(PoseArray, "/particles_moved", 10)
+        self.create_subscription(PoseArray, "/particles", self.on_particles, 10)
+        self.create_subscription(Odometry, "/odom", self.on_odom, 10)
+
+    def on_particles(self, msg):
+        self.frame_id = msg.header.frame_id
+        self.particles = [(p.position.x, p.position.y, yaw_of(p.orientation)) for p in msg.poses]
+
+    def on_odom(self, msg):
+        p = msg.pose.pose
+        odom = (p.position.x, p.position.y, yaw_of(p.orientation))
+        if self.last_odom is not None and self.particles:
+            rot1, trans, rot2 = motion_between(self.last_odom, odom)
+            self.particles = [move(q, rot1, trans, rot2, self.last_odom[2]) for q in self.particles]
+            out = PoseArray()
+            out.header.stamp = msg.header.stamp
+            out.header.frame_id = self.frame_id
+            for x, y, yaw in self.particles:
+                pose = Pose()
+                pose.position.x, pose.position.y = x, y
+                pose.orientation.z, pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
+                out.poses.append(pose)
+            self.publisher.publish(out)
+            self.get_logger().info(
+                f"moved {len(self.particles)} particles by rot1 {rot1:.2f}, "
+                f"trans {trans:.2f}, rot2 {rot2:.2f}"
+            )
+        self.last_odom = odom
+
+
+def main():
+    rclpy.init()
+    node = ParticleUpdate()
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == "__main__":
+    main()
