@@ -303,7 +303,10 @@ class ExercisePanel:
                 )
                 if not report.problem:
                     self._workspace.record_check(
-                        exercise, report.passed, mistake=matched_mistake(exercise, report)
+                        exercise,
+                        report.passed,
+                        mistake=matched_mistake(exercise, report),
+                        seed=report.seed,
                     )
                 return CheckOutcome(report, False, _plot_images(report))
             self._hub.flush(exercise.slug)
@@ -311,7 +314,10 @@ class ExercisePanel:
             report = self._grader.grade(exercise, script, on_result)
             if not report.problem:
                 self._workspace.record_check(
-                    exercise, report.passed, mistake=matched_mistake(exercise, report)
+                    exercise,
+                    report.passed,
+                    mistake=matched_mistake(exercise, report),
+                    seed=report.seed,
                 )
             ran = script.read_text(encoding="utf-8") if script.is_file() else ""
             return CheckOutcome(report, ran != self._workspace.code(exercise), _plot_images(report))

@@ -103,15 +103,20 @@ class Workspace:
         write_atomically(script, self.code(exercise))
         return script
 
-    def record_check(self, exercise: Exercise, passed: bool, mistake: str = "") -> dict:
+    def record_check(
+        self, exercise: Exercise, passed: bool, mistake: str = "", seed: int | None = None
+    ) -> dict:
         """One grading: counted, and on a failure the mistake it matched
-        (``app.exercises.mistakes``), kept until the exercise passes."""
+        (``app.exercises.mistakes``), kept until the exercise passes; the first
+        pass keeps its ``seed`` (the grade's comment in the LMS names it)."""
         changes: dict = {"attempts": Added(1), "last_checked": time.time()}
         if passed:
             changes["last_mistake"] = None  # removed: a pass leaves no mistake behind
             record = self.progress.exercise(exercise.slug)
             if "passed_at" not in record:
                 changes["passed_at"] = time.time()
+                if seed is not None:
+                    changes["passed_seed"] = seed
                 start = record.get("first_opened", time.time())
                 changes["seconds_to_pass"] = round(time.time() - start, 1)
         else:

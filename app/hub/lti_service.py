@@ -109,10 +109,22 @@ def results_in(record: LearnerRecord) -> list[GradedResult]:
                 f"Exercise {record.exercise} passed: the grader ran its checks and probes "
                 "against the learner's own node on a live ROS 2 graph "
                 f"({record.exercise_attempts_here} grading run(s), {failed} failed check(s) "
-                "before the pass).",
+                f"before the pass).{_replay(record)}",
             )
         )
     return found
+
+
+def _replay(record: LearnerRecord) -> str:
+    """The words that let a teacher replay the passing grading, when its seed is known."""
+    seed = record.exercise_passed_seed
+    if not seed:
+        return ""
+    return (
+        f" Its hidden inputs came from seed {seed}: `ros2-classroom exercise check "
+        f"{record.exercise} FILE --seed {seed}`, with the learner's code as FILE, "
+        "replays that grading."
+    )
 
 
 class OutboxPump:

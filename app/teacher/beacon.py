@@ -185,6 +185,7 @@ class ProgressBeacon:
                 exercise_attempts_here=here.get("attempts", 0),
                 exercise_failed_here=here.get("failed_checks", 0),
                 exercise_passed_here="passed_at" in here,
+                exercise_passed_seed=int(here.get("passed_seed") or 0),
                 exercise_mistake=clip(str(here.get("last_mistake") or ""), MAX_MISTAKE),
                 code_excerpt=clip(s.workspace.code(exercise), MAX_CODE),
                 last_error=clip(self._last_error(exercise, here), MAX_ERROR),

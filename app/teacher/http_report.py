@@ -33,6 +33,7 @@ _TEXT_LIMITS = {
 _INTS = {
     "domain_id", "unit", "step", "steps", "steps_passed", "exercises_passed",
     "exercise_attempts", "exercise_attempts_here", "exercise_failed_here",
+    "exercise_passed_seed",
 }  # fmt: skip
 _FLOATS = {"last_activity", "last_progress"}
 _LISTS = {

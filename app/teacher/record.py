@@ -69,6 +69,7 @@ class LearnerRecord:
     exercise_attempts_here: int = 0
     exercise_failed_here: int = 0
     exercise_passed_here: bool = False
+    exercise_passed_seed: int = 0  # the passing grading's seed (0: none kept): replays it
     # What the last failed check of it matched: a recorded mistake's name
     # ("front_is_index_zero") or, when none matched, the failed result's name
     # ("stop before the wall"); '' when it passed or never failed.

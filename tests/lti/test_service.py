@@ -152,6 +152,7 @@ def exercise_record(name: str, passed: bool, slug: str = EXERCISE) -> LearnerRec
         exercise_attempts_here=4,
         exercise_failed_here=3 if passed else 4,
         exercise_passed_here=passed,
+        exercise_passed_seed=4242 if passed else 0,
         last_activity=time.time(),
     )
 
@@ -379,6 +380,7 @@ def test_a_passed_exercise_reaches_its_line_item_once_and_a_worse_result_never_r
     assert f"Exercise {EXERCISE} passed" in score["comment"]
     assert "live ROS 2 graph" in score["comment"]
     assert "(4 grading run(s), 3 failed check(s) before the pass)" in score["comment"]
+    assert f"exercise check {EXERCISE} FILE --seed 4242`" in score["comment"]
     assert "+00:00" in score["timestamp"]
 
     # Later: the exercise shows as not passed (reset), then passed again; and a learner who

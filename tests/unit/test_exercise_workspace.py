@@ -51,9 +51,11 @@ def test_attempts_time_and_when_the_solution_may_show(workspace):
         workspace.record_check(EXERCISE, passed=False)
     assert not workspace.may_see_solution(EXERCISE)
     assert workspace.may_see_solution(EXERCISE, reveal_after=1)  # the teacher's number wins
-    record = workspace.record_check(EXERCISE, passed=True)
+    record = workspace.record_check(EXERCISE, passed=True, seed=4242)
     assert record["attempts"] == EXERCISE.reveal_after
-    assert record["seconds_to_pass"] >= 0
+    assert record["seconds_to_pass"] >= 0 and record["passed_seed"] == 4242
+    # A later pass keeps the first one's seed, as it keeps the first one's time.
+    assert workspace.record_check(EXERCISE, passed=True, seed=7)["passed_seed"] == 4242
     assert workspace.passed(EXERCISE) and workspace.may_see_solution(EXERCISE)
 
 

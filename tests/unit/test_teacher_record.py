@@ -129,6 +129,7 @@ def test_message_round_trip_clips_to_the_bounds():
         nodes_running=("talker", "listener"),
         exercise="wall_stop",
         exercise_mistake="front_is_index_zero",
+        exercise_passed_seed=987654,
     )
     msg = wire.to_message(record)
     back = wire.from_message(msg, received_at=NOW)
@@ -137,6 +138,7 @@ def test_message_round_trip_clips_to_the_bounds():
     assert len(back.check_states) == 16 == len(back.check_reasons)
     assert back.nodes_running == ("talker", "listener")
     assert back.exercise_mistake == "front_is_index_zero"
+    assert back.exercise_passed_seed == 987654
     long_name = "log of your node contains " + "'beat' " * 40  # a failed check's name
     clipped = wire.from_message(wire.to_message(_learner(exercise_mistake=long_name)))
     assert len(clipped.exercise_mistake) == 120 and clipped.exercise_mistake.endswith("…")
