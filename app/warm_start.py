@@ -145,6 +145,7 @@ STARTUP_VARS = re.compile(
 IMPORT_TIMEOUT_SEC = 120.0  # a warm parent's imports on a busy 2-core machine
 REPLY_TIMEOUT_SEC = 15.0  # two forks of a ~200 MB process, under load
 ADOPT_TIMEOUT_SEC = 5.0  # the middle process ends at once; this is for a stalled machine
+LAST_WORDS_WAIT_SEC = 2.0  # for the lines a warm parent printed as it ended to be read
 ANNOUNCE_TIMEOUT_SEC = 5.0  # after a failed start: time to hear from a learner forked anyway
 MAX_RESTARTS = 3  # within RESTART_WINDOW_SEC, then warm start is off for this classroom
 RESTART_WINDOW_SEC = 600.0
@@ -689,9 +690,10 @@ class WarmStarter:
         finally:
             theirs.close()
         assert importer.stdout is not None
-        threading.Thread(
+        pump = threading.Thread(
             target=self._pump, args=(importer.stdout, tail), name="warm-parent-log", daemon=True
-        ).start()
+        )
+        pump.start()
         ready: dict[str, Any] = {}
         try:
             said = self._receive(ours, IMPORT_TIMEOUT_SEC, importer)
@@ -713,6 +715,9 @@ class WarmStarter:
             if isinstance(adopted, int) and _parent_of(adopted) == os.getpid():
                 WarmChild(adopted, []).wait(ADOPT_TIMEOUT_SEC)
             if isinstance(exc, WarmStartError):
+                # Its last lines may still be in the pipe when its end is seen (ci21: the
+                # reason, "No module named ...", was missing): read them to the end first.
+                pump.join(LAST_WORDS_WAIT_SEC)
                 last = next((line.strip() for line in reversed(tail) if line.strip()), "")
                 words = f"; its last words: {last}" if last and last not in str(exc) else ""
                 raise WarmStartError(f"{exc}{words}") from None
