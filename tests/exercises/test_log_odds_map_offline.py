@@ -10,7 +10,6 @@ Nothing here starts DDS.
 
 from __future__ import annotations
 
-import importlib.util
 import random
 import types
 from pathlib import Path
@@ -26,6 +25,7 @@ from app.exercises.probes.log_odds_map import (
     map_info,
     messages,
 )
+from tests.exercises.stand_in_node import load_solution, node_of
 
 EXERCISE = load_exercises().get("log_odds_mapper")
 PROBE = next(p for p in EXERCISE.probes if p.kind == "log_odds_map")
@@ -36,56 +36,6 @@ FRAME = Frame(
 SEEDS = range(8)
 
 
-class _Publisher:
-    def __init__(self, qos) -> None:
-        self.qos = qos
-        self.sent: list = []
-
-    def publish(self, msg) -> None:
-        self.sent.append(msg)
-
-
-@pytest.fixture
-def stand_in(monkeypatch):
-    """rclpy's Node without a participant: subscriptions and publishers kept by topic."""
-    from rclpy.node import Node
-
-    def init(self, name, *args, **kwargs):
-        self.handlers, self.publishers_by_topic = {}, {}
-
-    def create_publisher(self, _type, topic, qos, *args, **kwargs):
-        self.publishers_by_topic[topic] = _Publisher(qos)
-        return self.publishers_by_topic[topic]
-
-    def create_subscription(self, _type, topic, callback, _qos, *args, **kwargs):
-        self.handlers[topic] = callback
-
-    logger = types.SimpleNamespace(info=lambda *_a: None, warn=lambda *_a: None)
-    monkeypatch.setattr(Node, "__init__", init)
-    monkeypatch.setattr(Node, "create_publisher", create_publisher)
-    monkeypatch.setattr(Node, "create_subscription", create_subscription)
-    monkeypatch.setattr(Node, "get_logger", lambda self: logger)
-
-
-def _module(path: Path) -> types.ModuleType:
-    spec = importlib.util.spec_from_file_location(f"log_odds_mapper_{path.stem}", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-def _node(module: types.ModuleType):
-    from rclpy.node import Node
-
-    [cls] = [
-        v
-        for v in vars(module).values()
-        if isinstance(v, type) and issubclass(v, Node) and v is not Node
-    ]
-    return cls()
-
-
 def _grade(module: types.ModuleType, seed: int) -> str:
     """The failure the probe would report for this solution ('' when it passes)."""
     from rclpy.qos import DurabilityPolicy
@@ -93,7 +43,7 @@ def _grade(module: types.ModuleType, seed: int) -> str:
     rng = random.Random(seed)
     boxes, poses = rng.randint(*PROBE["boxes"]), rng.randint(*PROBE["poses"])
     task = draw_task(rng, FRAME, boxes, poses, PROBE["beams"])
-    node = _node(module)
+    node = node_of(module)
     out = node.publishers_by_topic[PROBE["topic"]]
     for number, scan in enumerate(task.scans, start=1):
         pose, msg = messages(scan, number)
@@ -117,18 +67,20 @@ def _grade(module: types.ModuleType, seed: int) -> str:
 
 @pytest.mark.parametrize("path", [EXERCISE.path / "reference.py", *ACCEPTED], ids=lambda p: p.stem)
 def test_the_reference_and_the_accepted_solutions_pass_every_seed(stand_in, path):
-    module = _module(path)
+    module = load_solution(path, "log_odds_mapper")
     for seed in SEEDS:
         assert _grade(module, seed) == "", seed
 
 
 def test_the_starter_fails(stand_in):
-    assert "volatile durability" in _grade(_module(EXERCISE.path / "starter.py"), 1)
+    assert "volatile durability" in _grade(
+        load_solution(EXERCISE.path / "starter.py", "log_odds_mapper"), 1
+    )
 
 
 @pytest.mark.parametrize("mistake", EXERCISE.mistakes, ids=lambda m: m.path.stem)
 def test_each_mistake_fails_every_seed_for_its_reason(stand_in, mistake):
-    module = _module(mistake.path)
+    module = load_solution(mistake.path, "log_odds_mapper")
     for seed in SEEDS:
         why = _grade(module, seed)
         assert mistake.reason in why, f"seed {seed}: {why or 'passed'}"
@@ -137,7 +89,7 @@ def test_each_mistake_fails_every_seed_for_its_reason(stand_in, mistake):
 def test_the_statements_example_is_what_the_reference_maps():
     from sensor_msgs.msg import LaserScan
 
-    reference = _module(EXERCISE.path / "reference.py")
+    reference = load_solution(EXERCISE.path / "reference.py", "log_odds_mapper")
     example = EXERCISE.example
     x, y, yaw = example["pose"]
     scan = LaserScan(angle_min=example["angle_min"], angle_increment=0.0)

@@ -12,7 +12,6 @@ starts DDS.
 
 from __future__ import annotations
 
-import importlib.util
 import random
 import types
 from pathlib import Path
@@ -30,6 +29,7 @@ from app.exercises.probes.particle_motion import (
     odom_message,
     poses_of,
 )
+from tests.exercises.stand_in_node import load_solution, node_of
 
 EXERCISE = load_exercises().get("particle_update")
 PROBE = next(p for p in EXERCISE.probes if p.kind == "particle_motion")
@@ -39,61 +39,12 @@ SPREAD = (PROBE["spread_low"], PROBE["spread_high"])
 SEEDS = range(10)
 
 
-class _Publisher:
-    def __init__(self) -> None:
-        self.sent: list = []
-
-    def publish(self, msg) -> None:
-        self.sent.append(msg)
-
-
-@pytest.fixture
-def stand_in(monkeypatch):
-    """rclpy's Node without a participant: subscriptions and publishers kept by topic."""
-    from rclpy.node import Node
-
-    def init(self, name, *args, **kwargs):
-        self.handlers, self.publishers_by_topic = {}, {}
-
-    def create_publisher(self, _type, topic, _qos, *args, **kwargs):
-        self.publishers_by_topic[topic] = _Publisher()
-        return self.publishers_by_topic[topic]
-
-    def create_subscription(self, _type, topic, callback, _qos, *args, **kwargs):
-        self.handlers[topic] = callback
-
-    logger = types.SimpleNamespace(info=lambda *_a: None, warn=lambda *_a: None)
-    monkeypatch.setattr(Node, "__init__", init)
-    monkeypatch.setattr(Node, "create_publisher", create_publisher)
-    monkeypatch.setattr(Node, "create_subscription", create_subscription)
-    monkeypatch.setattr(Node, "get_logger", lambda self: logger)
-
-
-def _module(path: Path) -> types.ModuleType:
-    spec = importlib.util.spec_from_file_location(f"particle_update_{path.stem}", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-def _node(module: types.ModuleType):
-    from rclpy.node import Node
-
-    [cls] = [
-        v
-        for v in vars(module).values()
-        if isinstance(v, type) and issubclass(v, Node) and v is not Node
-    ]
-    return cls()
-
-
 def _grade(module: types.ModuleType, seed: int) -> str:
     """The first failure the probe would report for this solution ('' when it passes)."""
     random.seed(seed)
     np.random.seed(seed)
     rng = random.Random(seed)
-    node = _node(module)
+    node = node_of(module)
     out = node.publishers_by_topic[PROBE["output"]]
     last = first_odom(rng)
     node.handlers[PROBE["odom"]](odom_message(last, 1))
@@ -116,25 +67,27 @@ def _grade(module: types.ModuleType, seed: int) -> str:
 
 @pytest.mark.parametrize("path", [EXERCISE.path / "reference.py", *ACCEPTED], ids=lambda p: p.stem)
 def test_the_reference_and_the_accepted_solutions_pass_every_seed(stand_in, path):
-    module = _module(path)
+    module = load_solution(path, "particle_update")
     for seed in SEEDS:
         assert _grade(module, seed) == "", seed
 
 
 def test_the_starter_fails(stand_in):
-    assert "did not move" in _grade(_module(EXERCISE.path / "starter.py"), 1)
+    assert "did not move" in _grade(
+        load_solution(EXERCISE.path / "starter.py", "particle_update"), 1
+    )
 
 
 @pytest.mark.parametrize("mistake", EXERCISE.mistakes, ids=lambda m: m.path.stem)
 def test_each_mistake_fails_every_seed_for_its_reason(stand_in, mistake):
-    module = _module(mistake.path)
+    module = load_solution(mistake.path, "particle_update")
     for seed in SEEDS:
         why = _grade(module, seed)
         assert mistake.reason in why, f"seed {seed}: {why or 'passed'}"
 
 
 def test_the_statements_example_is_what_the_reference_computes(monkeypatch):
-    reference = _module(EXERCISE.path / "reference.py")
+    reference = load_solution(EXERCISE.path / "reference.py", "particle_update")
     example = EXERCISE.example
     step = reference.motion_between(example["odom_before"], example["odom_after"])
     assert [round(v, 2) for v in step] == example["step"]
