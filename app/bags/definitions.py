@@ -3,12 +3,15 @@
 A bag carries each type's full definition (nested types appended) so that
 any reader can decode it without the package installed. rosbags knows every
 Jazzy core type; our own interface packages (tutorial_interfaces, turtlesim)
-are read from their installed ``share/<pkg>/msg/*.msg`` files.
+are read from their installed ``share/<pkg>/msg/*.msg`` files. A service's
+request and response (``service_definitions``), as the Foxglove bridge
+advertises them, come from its installed ``.srv`` file.
 """
 
 from __future__ import annotations
 
 import os
+import re
 import sys
 import threading
 from pathlib import Path
@@ -96,3 +99,68 @@ def definition(msgtype: str) -> tuple[str, str]:
             _register(store, msgtype)
         msgdef, _ = store.generate_msgdef(msgtype, ros_version=2)
         return msgdef, store.hash_rihs01(msgtype)
+
+
+SEPARATOR = "=" * 80  # between a ros2msg definition and each nested type's
+_PRIMITIVES = frozenset(
+    "bool byte char float32 float64 int8 uint8 int16 uint16 int32 uint32 int64 uint64 "
+    "string wstring".split()
+)
+_FIELD_TYPE = re.compile(r"^([A-Za-z][A-Za-z0-9_]*)(?:/(?:msg/)?([A-Za-z][A-Za-z0-9_]*))?")
+
+
+def service_definitions(srvtype: str) -> tuple[str, str]:
+    """ros2msg texts of 'pkg/srv/Name''s request and response, nested types appended.
+
+    Read from the installed ``share/<pkg>/srv/<Name>.srv`` (BagError if none),
+    with comments dropped as rosbag2 drops them.
+    """
+    pkg, _, name = srvtype.partition("/srv/")
+    if not pkg or not name or "/" in name:
+        raise BagError(f"{srvtype} is not a service type (pkg/srv/Name)")
+    path = next(
+        (
+            found
+            for prefix in _prefixes()
+            if (found := prefix / "share" / pkg / "srv" / f"{name}.srv").is_file()
+        ),
+        None,
+    )
+    if path is None:
+        raise BagError(f"no definition of {srvtype} is installed here")
+    halves = re.split(r"^---[ \t]*$", path.read_text(encoding="utf-8"), flags=re.MULTILINE)
+    if len(halves) != 2:
+        raise BagError(f"{srvtype}: its .srv file is not a request and a response")
+    request, response = (_with_nested(half, pkg) for half in halves)
+    return request, response
+
+
+def _with_nested(text: str, pkg: str) -> str:
+    lines: list[str] = []
+    nested: list[str] = []
+    for raw in text.splitlines():
+        line = raw.strip()
+        if "=" not in line:  # a constant's string value may hold a '#'
+            line = line.split("#", 1)[0].strip()
+        if not line or line.startswith("#"):
+            continue
+        found = _FIELD_TYPE.match(line)
+        if found is not None and found[2]:
+            nested.append(f"{found[1]}/msg/{found[2]}")
+        elif found is not None and found[1] not in _PRIMITIVES:
+            # A type of the service's own package: named in full, as the nested ones are.
+            nested.append(f"{pkg}/msg/{found[1]}")
+            line = f"{pkg}/{line}"
+        lines.append(line)
+    blocks: dict[str, str] = {}
+    for msgtype in nested:
+        full, _digest = definition(msgtype)
+        own, *rest = full.split(f"{SEPARATOR}\n")
+        blocks.setdefault(msgtype.replace("/msg/", "/"), own)
+        for block in rest:
+            header, _, body = block.partition("\n")
+            blocks.setdefault(header.removeprefix("MSG: "), body)
+    out = "\n".join(lines) + "\n"
+    for name, body in blocks.items():
+        out += f"{SEPARATOR}\nMSG: {name}\n{body}"
+    return out

@@ -47,6 +47,21 @@ class BridgeLimits:
     gone_after_sec: float = 2.0
     # The same refusal is said to clients at most this often.
     repeat_note_sec: float = 2.0
+    # ROS services advertised at once (the rest are left out, and said).
+    max_services: int = 128
+    # Service calls waiting for their answer: per client, and for all clients together.
+    # Each one holds a thread of the server's blocking pool until it ends.
+    calls_per_client: int = 4
+    max_calls: int = 16
+    # One request's bytes (an AddTwoInts request is 20), and how long a call may take.
+    max_request_bytes: int = 64 * 1024
+    call_timeout_sec: float = 5.0
+    # Nodes whose parameters are cached (three ROS clients each), the parameters read per
+    # node, how often they are read again, and parameter sets waiting to be applied.
+    max_parameter_nodes: int = 32
+    max_parameters_per_node: int = 256
+    parameter_refresh_sec: float = 5.0
+    pending_parameter_sets: int = 64
 
 
 def ros_message_type(schema_name: str) -> str | None:

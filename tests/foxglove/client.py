@@ -8,10 +8,15 @@ only one foxglove-sdk 0.30's server accepts; Foxglove's app offers it) and
 ``@foxglove/ws-protocol`` 0.8 offers).
 
 Server to client: JSON ``serverInfo``, ``advertise``, ``unadvertise``,
-``status``; binary opcode 1 (message data): u32 subscription id, u64 log time
-(ns), payload; all little-endian. Client to server: JSON ``subscribe``,
-``unsubscribe``, ``advertise``, ``unadvertise``; binary opcode 1 (client
-message data): u32 client channel id, payload.
+``status``, ``advertiseServices``, ``unadvertiseServices``,
+``serviceCallFailure``, ``parameterValues``; binary opcode 1 (message data): u32 subscription id,
+u64 log time (ns), payload; binary opcode 3 (service call response): u32
+service id, u32 call id, u32 encoding length, encoding, payload; all
+little-endian. Client to server: JSON ``subscribe``, ``unsubscribe``,
+``advertise``, ``unadvertise``; binary opcode 1 (client message data): u32
+client channel id, payload; binary opcode 2 (service call request), laid out
+as the response; JSON ``getParameters``, ``setParameters`` (each with an id the
+``parameterValues`` answer repeats).
 """
 
 from __future__ import annotations
@@ -32,7 +37,20 @@ from websockets.typing import Subprotocol
 
 SUBPROTOCOLS = [Subprotocol("foxglove.sdk.v1"), Subprotocol("foxglove.websocket.v1")]
 MESSAGE_DATA = 0x01
+SERVICE_CALL_REQUEST = 0x02  # client to server
+SERVICE_CALL_RESPONSE = 0x03  # server to client
 KEEP = 2000  # messages kept per subscription (the count goes on)
+
+
+@dataclass(frozen=True)
+class CallResult:
+    """How a service call ended: a response (payload) or a failure (message)."""
+
+    service: int
+    call: int
+    encoding: str = ""
+    payload: bytes | None = None
+    failure: str | None = None
 
 
 @dataclass(frozen=True)
@@ -64,9 +82,13 @@ class FoxgloveClient:
         self.channels: dict[int, dict[str, Any]] = {}
         self.statuses: list[dict[str, Any]] = []
         self.received: dict[int, deque[Received]] = {}
+        self.services: dict[int, dict[str, Any]] = {}
+        self.call_results: dict[int, CallResult] = {}  # by call id
+        self.parameter_values: list[dict[str, Any]] = []  # parameterValues messages, in order
         self.counts: dict[int, int] = {}
         self._subscription_ids = itertools.count(1)
         self._channel_ids = itertools.count(1)
+        self._call_ids = itertools.count(1)
         self.closed = threading.Event()
         self._reader = threading.Thread(target=self._read, name="foxglove-client", daemon=True)
         self._reader.start()
@@ -86,6 +108,12 @@ class FoxgloveClient:
                         self.counts[sub] = self.counts.get(sub, 0) + 1
                     if self._on_message is not None:
                         self._on_message(got)
+                elif frame and frame[0] == SERVICE_CALL_RESPONSE and len(frame) >= 13:
+                    service, call, length = struct.unpack_from("<III", frame, 1)
+                    encoding = bytes(frame[13 : 13 + length]).decode()
+                    result = CallResult(service, call, encoding, bytes(frame[13 + length :]))
+                    with self._lock:
+                        self.call_results[call] = result
         except ConnectionClosed:
             pass
         finally:
@@ -104,6 +132,19 @@ class FoxgloveClient:
                     self.channels.pop(channel_id, None)
             elif op == "status":
                 self.statuses.append(message)
+            elif op == "advertiseServices":
+                for service in message["services"]:
+                    self.services[service["id"]] = service
+            elif op == "unadvertiseServices":
+                for service_id in message["serviceIds"]:
+                    self.services.pop(service_id, None)
+            elif op == "parameterValues":
+                self.parameter_values.append(message)
+            elif op == "serviceCallFailure":
+                call = message["callId"]
+                self.call_results[call] = CallResult(
+                    message["serviceId"], call, failure=message.get("message", "")
+                )
 
     # ------------------------------------------------------------------ queries
 
@@ -122,6 +163,14 @@ class FoxgloveClient:
     def count(self, subscription: int) -> int:
         with self._lock:
             return self.counts.get(subscription, 0)
+
+    def service(self, name: str) -> dict[str, Any] | None:
+        with self._lock:
+            return next((s for s in self.services.values() if s["name"] == name), None)
+
+    def call_result(self, call: int) -> CallResult | None:
+        with self._lock:
+            return self.call_results.get(call)
 
     def status_texts(self) -> list[str]:
         with self._lock:
@@ -176,6 +225,37 @@ class FoxgloveClient:
 
     def publish(self, channel_id: int, payload: bytes) -> None:
         self.ws.send(struct.pack("<BI", MESSAGE_DATA, channel_id) + payload)
+
+    def call_service(self, service_id: int, payload: bytes, encoding: str = "cdr") -> int:
+        """Send a serviceCallRequest; the answer lands in ``call_results`` by the id returned."""
+        call = next(self._call_ids)
+        raw = encoding.encode()
+        header = struct.pack("<BIII", SERVICE_CALL_REQUEST, service_id, call, len(raw))
+        self.ws.send(header + raw + payload)
+        return call
+
+    def call(self, service_id: int, payload: bytes, timeout: float = 15.0) -> CallResult:
+        """A service call, waited for."""
+        call = self.call_service(service_id, payload)
+        return self.wait_for(lambda: self.call_result(call), timeout, f"the answer to call {call}")
+
+    def get_parameters(self, names: list[str], timeout: float = 10.0) -> dict[str, Any]:
+        """getParameters, waited for: {name: value} (no names: every parameter known)."""
+        request = f"get-{next(self._call_ids)}"
+        self.send_json({"op": "getParameters", "parameterNames": names, "id": request})
+        answer = self.wait_for(lambda: self._parameters_answer(request), timeout, request)
+        return {p["name"]: p.get("value") for p in answer["parameters"]}
+
+    def set_parameters(self, values: dict[str, Any]) -> str:
+        """setParameters with an id (the server answers with parameterValues)."""
+        request = f"set-{next(self._call_ids)}"
+        parameters = [{"name": name, "value": value} for name, value in values.items()]
+        self.send_json({"op": "setParameters", "parameters": parameters, "id": request})
+        return request
+
+    def _parameters_answer(self, request: str) -> dict[str, Any] | None:
+        with self._lock:
+            return next((m for m in self.parameter_values if m.get("id") == request), None)
 
     def close(self) -> None:
         self.ws.close()
