@@ -57,14 +57,16 @@ def inside(col, row):
 def scan_cells(x, y, yaw, scan):
     """(hits, misses) of one scan: the cells beams end in, and the cells they only cross."""
     hits, crossed = set(), set()
-    start = cell_of(x, y)
     for i, r in enumerate(scan.ranges):
         if not scan.range_min <= r <= scan.range_max:  # inf and nan fail this test too
             continue
-        # TODO 2: the beam's angle in the map (the robot's heading counts), the point
-        #         where it ends, and that point's cell. line_cells(*start, *end) gives
-        #         the cells from the robot to it: the last one is a hit (add it to hits
-        #         if it is inside the map), the others are crossed (those inside the map).
+        angle = scan.angle_min + i * scan.angle_increment  # the beam's, seen from the robot
+        # TODO 2: the beam's angle in the map (add the robot's heading yaw), the point where
+        #         it ends, r metres from (x, y), and that point's cell. With start =
+        #         cell_of(x, y), line_cells(*start, *end) gives the cells from the robot to
+        #         it: the last one is a hit (add it to hits if it is inside the map), the
+        #         others are crossed (those inside the map).
+        del angle  # (remove this line once you use it)
     return hits, crossed - hits
 
 

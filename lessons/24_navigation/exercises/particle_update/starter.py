@@ -35,10 +35,10 @@ def motion_between(before, after):
 def move(particle, rot1, trans, rot2):
     """One particle (x, y, yaw) moved by the step, each part with noise of its own."""
     x, y, yaw = particle
-    # TODO 2: add noise to each part with random.gauss(0.0, sigma), where sigma is the
-    #         square root of the variance the statement gives for that part.
-    r1, t, r2 = rot1, trans, rot2
-    # TODO 3: turn the particle's own heading by r1, move t along it, then turn by r2.
+    # TODO 2: add noise to each part (rot1, trans, rot2) with random.gauss(0.0, sigma),
+    #         where sigma is the square root of the variance the statement gives for it.
+    # TODO 3: turn the particle's own heading by the noisy rot1, move the noisy trans
+    #         along it, then turn by the noisy rot2.
     return x, y, yaw
 
 
