@@ -21,7 +21,8 @@ Parameters are named as Foxglove's ROS 2 bridge names them,
 ``/node_name.param_name``. The SDK asks for them synchronously, on a
 client's socket thread, so the answer comes from a cache: the bridge's thread
 reads the nodes' parameters through their services (asynchronously, bounded,
-again every ``parameter_refresh_sec`` and soon after a client asks). A set is
+again every ``parameter_refresh_sec`` and soon after a client asks; nothing is
+read before a client first asks). A set is
 queued for the bridge's thread; the values first returned are the known ones,
 and the new ones follow to subscribed clients once the node accepted them (a
 refusal is said as a status).
@@ -274,6 +275,7 @@ class FoxgloveBridge:
         self._sent: list[_Call] = []  # calls on their way, or waiting for their server
         self._param_nodes: dict[str, _ParamNode] = {}
         self._nodes_read_at = 0.0
+        self._params_wanted = False  # a client has asked for or set parameters
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -890,6 +892,11 @@ class FoxgloveBridge:
             asked, self._params_asked = self._params_asked, False
             sets = list(self._param_sets)
             self._param_sets.clear()
+        # Nothing is read until a client shows it wants parameters: a learner who only
+        # watches topics costs no parameter clients on every node.
+        self._params_wanted = self._params_wanted or asked or bool(sets)
+        if not self._params_wanted:
+            return
         if now >= self._nodes_read_at + limits.refresh_sec:
             self._nodes_read_at = now
             live = {
