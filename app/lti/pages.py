@@ -148,6 +148,60 @@ def _gradebook_row(line: GradebookLine, now: float, seats: bool) -> str:
     return f'<tr data-state="{html.escape(line.state)}">{"".join(cells)}</tr>'
 
 
+# A learner and an activity with several links (two courses): the cell shows the best.
+_STATE_ORDER = ("sent", "waiting", "refused", "not done", "no grade column")
+_CELL_MARKS = {
+    "sent": "✓",
+    "waiting": "…",
+    "refused": "✗",
+    "not done": "○",
+    "no grade column": "–",
+}
+
+
+def class_grid(lines: Sequence[GradebookLine]) -> str:
+    """The class at a glance: a row per learner, a column per activity, a mark per cell.
+
+    A teacher of 200 reads who is done and what waits without reading 200 lines;
+    a click on a cell shows that learner's lines of that activity in the table
+    below (the filter), where the LMS's answer and the next try are.
+    """
+    if not lines:
+        return ""
+    activities = sorted({line.activity for line in lines if line.activity})
+    learners: dict[str, str] = {}
+    best: dict[tuple[str, str], GradebookLine] = {}
+    for line in lines:
+        learners.setdefault(line.learner, line.lms_name or line.learner)
+        key = (line.learner, line.activity)
+        held = best.get(key)
+        if held is None or _STATE_ORDER.index(line.state) < _STATE_ORDER.index(held.state):
+            best[key] = line
+    head = "".join(f"<th>{html.escape(activity)}</th>" for activity in activities)
+    rows = []
+    for learner, shown in sorted(learners.items(), key=lambda item: item[1].lower()):
+        cells = []
+        for activity in activities:
+            line = best.get((learner, activity))
+            if line is None:
+                cells.append("<td></td>")
+                continue
+            title = f"{_STATE_MARKS[line.state]} {line.score}".strip()
+            cells.append(
+                f'<td class="{line.state.replace(" ", "-")}" title="{html.escape(title)}">'
+                f'<a href="#gradebook" data-show="{html.escape(learner, quote=True)}">'
+                f"{_CELL_MARKS[line.state]} {html.escape(line.score)}</a></td>"
+            )
+        rows.append(f"<tr><th>{html.escape(shown)}</th>{''.join(cells)}</tr>")
+    key = " · ".join(f"{_CELL_MARKS[state]} {state}" for state in _STATE_ORDER)
+    return (
+        "<h2>The class at a glance</h2>\n"
+        f"<p>{html.escape(key)}. A click on a cell shows its lines below.</p>\n"
+        f'<table id="class-grid"><thead><tr><th>Learner</th>{head}</tr></thead>'
+        f"<tbody>\n{chr(10).join(rows)}\n</tbody></table>\n"
+    )
+
+
 def gradebook_page(
     lines: Sequence[GradebookLine],
     *,
@@ -186,7 +240,7 @@ def gradebook_page(
         f"{retry_form}"
         f'<button type="submit">Retry the outbox now ({retryable} waiting or refused)</button>'
         ' <label>Show only <input id="filter" placeholder="a name, an activity, a state"></label>'
-        "</form>\n"
+        "</form>\n" + class_grid(lines) + "<h2>Every line</h2>\n"
         '<table id="gradebook"><thead><tr>'
         + "".join(f"<th>{h}</th>" for h in head)
         + f"</tr></thead><tbody>\n{rows}\n</tbody></table>\n"
@@ -196,5 +250,7 @@ def gradebook_page(
         'const f=document.getElementById("filter");f.oninput=()=>{const q=f.value.toLowerCase();'
         'for(const r of document.querySelectorAll("#gradebook tbody tr"))'
         "r.hidden=q&&!r.textContent.toLowerCase().includes(q);};"
+        'for(const a of document.querySelectorAll("#class-grid a"))'
+        "a.onclick=()=>{f.value=a.dataset.show;f.oninput();};"
         "</script>",
     )

@@ -154,8 +154,9 @@ def test_the_gradebook_is_the_teachers_by_token(room: Room, platform: TestPlatfo
         assert refused.status == 403 and "Ada Lovelace" not in refused.body, url
     page = request("GET", room.server.gradebook_url)
     assert page.status == 200, page.body
-    [row] = re.findall(r"<tbody>(.*?)</tbody>", page.body, re.S)
-    text = html.unescape(re.sub(r"<[^>]+>", " ", row))
+    grid, lines = re.findall(r"<tbody>(.*?)</tbody>", page.body, re.S)  # the class, every line
+    assert "Ada Lovelace" in grid and "… " in html.unescape(grid)
+    text = html.unescape(re.sub(r"<[^>]+>", " ", lines))
     assert "Ada Lovelace" in text and "learner1" in text and "… waiting" in text
     assert "HTTP 503" in text and "maintenance" in text
     [cookie] = [name for name in page.cookies if name.startswith("classroom_lti_teacher_")]

@@ -60,8 +60,8 @@ def gradebook_lines(service: ServiceUnderTest, token: str) -> list[dict[str, Any
 
 
 def rows(page: str) -> list[str]:
-    """The gradebook table's rows as plain text, one string each."""
-    body = page.split("<tbody>", 1)[1].split("</tbody>", 1)[0]
+    """The gradebook table's rows (every line, not the class grid) as plain text, one each."""
+    body = page.split('<table id="gradebook"', 1)[1].split("<tbody>", 1)[1].split("</tbody>", 1)[0]
     found = re.findall(r"<tr[^>]*>(.*?)</tr>", body, re.S)
     return [html.unescape(re.sub(r"<[^>]+>", " ", row)) for row in found]
 
