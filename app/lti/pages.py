@@ -182,21 +182,22 @@ def class_grid(lines: Sequence[GradebookLine]) -> str:
     for learner, shown in sorted(learners.items(), key=lambda item: item[1].lower()):
         cells = []
         for activity in activities:
-            line = best.get((learner, activity))
-            if line is None:
+            shown_line = best.get((learner, activity))
+            if shown_line is None:
                 cells.append("<td></td>")
                 continue
-            title = f"{_STATE_MARKS[line.state]} {line.score}".strip()
+            state, score = shown_line.state, shown_line.score
+            title = f"{_STATE_MARKS[state]} {score}".strip()
             cells.append(
-                f'<td class="{line.state.replace(" ", "-")}" title="{html.escape(title)}">'
+                f'<td class="{state.replace(" ", "-")}" title="{html.escape(title)}">'
                 f'<a href="#gradebook" data-show="{html.escape(learner, quote=True)}">'
-                f"{_CELL_MARKS[line.state]} {html.escape(line.score)}</a></td>"
+                f"{_CELL_MARKS[state]} {html.escape(score)}</a></td>"
             )
         rows.append(f"<tr><th>{html.escape(shown)}</th>{''.join(cells)}</tr>")
-    key = " · ".join(f"{_CELL_MARKS[state]} {state}" for state in _STATE_ORDER)
+    legend = " · ".join(f"{_CELL_MARKS[state]} {state}" for state in _STATE_ORDER)
     return (
         "<h2>The class at a glance</h2>\n"
-        f"<p>{html.escape(key)}. A click on a cell shows its lines below.</p>\n"
+        f"<p>{html.escape(legend)}. A click on a cell shows its lines below.</p>\n"
         f'<table id="class-grid"><thead><tr><th>Learner</th>{head}</tr></thead>'
         f"<tbody>\n{chr(10).join(rows)}\n</tbody></table>\n"
     )
