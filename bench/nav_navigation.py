@@ -75,7 +75,12 @@ STACK = {  # catalog member -> the process name in cpu_by_node
 
 
 def office_costmap() -> Any:
-    """The office map as the planner server's global costmap (the same layers and parameters)."""
+    """The office map as the planner server's global costmap (the same parameters).
+
+    Its static and inflation layers; the server's obstacle layer adds what /scan sees off
+    the map, and in the office with the robot standing that is the mapped walls again (a
+    cell thicker here and there, as far as localization is off).
+    """
     import numpy as np
     from nav2_costmap_2d.costmap_2d import costmap_from_grid
     from nav2_map_server.map_io import load_map_from_yaml

@@ -16,6 +16,7 @@ import pytest
 from nav2_amcl import AmclMap, FilterParameters, ParticleFilter, ScanBeams
 from nav2_amcl.cloud import particle_cloud_cdr
 from nav2_amcl.map import distance_field
+from nav2_amcl.sensor_model import LikelihoodFieldProbModel
 from nav2_msgs.msg import Particle, ParticleCloud
 from rclpy.serialization import deserialize_message, serialize_message
 
@@ -283,3 +284,67 @@ def test_the_particle_cloud_of_2000_particles_takes_well_under_a_millisecond():
         particle_cloud_cdr(0, 0, "map", poses, weights)
         times.append(time.perf_counter() - started)
     assert float(np.median(times)) < 0.002  # the objects took 10-20 ms (and 70 under load)
+
+
+def test_the_product_of_the_beams_tracks_tighter_and_beam_skipping_ignores_a_box_off_the_map():
+    # likelihood_field_prob (amcl's node default here) on the same drive as the first test,
+    # then with a box in the room that the map does not have: beams that hit it are left out.
+    commands = [(0.3, 0.0)] * 67 + [(0.0, math.pi / 4)] * 20 + [(0.3, 0.0)] * 60
+    commands += [(0.2, 0.5)] * 30
+    results = {}
+    for case in ("prob", "box, beam skipping"):
+        rng = np.random.default_rng(7)
+        grid = room()
+        seen = grid.copy()
+        if case != "prob":
+            seen[int(1.6 / RES) : int(2.0 / RES), int(3.6 / RES) : int(4.0 / RES)] = 100
+        params = FilterParameters(
+            laser_model_type="likelihood_field_prob", do_beamskip=True, beam_skip_distance=0.2
+        )
+        pf = ParticleFilter(params, make_map(grid), seed=3)
+        truth = (0.8, 1.0, 0.0)
+        pf.init_gaussian((0.9, 0.95, 0.05), np.diag([0.04, 0.04, 0.01]))
+        skipped = 0
+        errors, last_odom, odom = [], truth, truth
+        for v, w in commands:
+            truth = drive(truth, v, w, 0.1)
+            odom = drive(odom, v * (1 + rng.normal(0, 0.03)), w * (1 + rng.normal(0, 0.03)), 0.1)
+            delta = step_between(last_odom, odom)
+            if abs(delta[0]) > 0.25 or abs(delta[1]) > 0.25 or abs(delta[2]) > 0.2:
+                pf.update_action(odom, delta)
+                pf.update(beams(cast(seen, truth, rng)[0], params))
+                assert isinstance(pf.sensor, LikelihoodFieldProbModel)
+                skipped += pf.sensor.skipped
+                last_odom = odom
+                errors.append(error(pf.estimate(), truth))
+        settled = errors[3:]
+        results[case] = (
+            max(d for d, _ in settled),
+            math.degrees(max(a for _, a in settled)),
+            skipped,
+        )
+    print(f"\n{results}")
+    assert results["prob"][0] < 0.08 and results["prob"][1] < 3.0
+    assert results["box, beam skipping"][0] < 0.12 and results["box, beam skipping"][1] < 5.0
+    # the box's beams were left out, on top of the few any scan has
+    assert results["box, beam skipping"][2] > results["prob"][2] + 20
+
+
+def test_a_global_spread_survives_the_first_scans_with_the_product_model():
+    # The product of 60 beams would keep one or two hypotheses of a global spread after one
+    # scan; a spread filter weighs with the sum of cubes until the scans have gathered it.
+    rng = np.random.default_rng(11)
+    grid = room()
+    params = FilterParameters(laser_model_type="likelihood_field_prob")
+    pf = ParticleFilter(params, make_map(grid), seed=5)
+    pf.init_uniform()
+    for _ in range(2):
+        pf.update(beams(cast(grid, (2.8, 1.0, 2.0), rng)[0], params))
+        assert not pf.gathered
+        assert np.hypot(pf.poses[:, 0].std(), pf.poses[:, 1].std()) > 1.0
+    # Given where it is (an initial pose), the particles are gathered: the product weighs.
+    pf.init_gaussian((2.8, 1.0, 2.0), np.diag([0.01, 0.01, 0.005]))
+    assert pf.gathered
+    weights_before = pf.weights.copy()
+    pf.update_sensor(beams(cast(grid, (2.8, 1.0, 2.0), rng)[0], params))
+    assert pf.weights.max() / weights_before.max() > 10  # far sharper than the sum of cubes

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 from nav2_controller.regulated_pure_pursuit import RPPParameters, compute_velocity
-from nav2_costmap_2d import INSCRIBED_INFLATED_OBSTACLE
-from nav2_costmap_2d.costmap_2d import costmap_from_grid
+from nav2_costmap_2d import INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE
+from nav2_costmap_2d.costmap_2d import Costmap2D, costmap_from_grid
 from nav2_planner.navfn_planner import PlannerOptions, create_plan, path_length
 from nav2_planner.planner_exceptions import (
     GoalOccupied,
@@ -17,6 +17,7 @@ from nav2_planner.planner_exceptions import (
 )
 
 RES = 0.05
+Pose2D = tuple[float, float, float]
 
 
 def room_with_a_block():
@@ -67,3 +68,69 @@ def test_pure_pursuit_turns_towards_the_path():
     behind = [(-0.1 * i, 0.0, math.pi) for i in range(1, 20)]  # the path is behind: turn first
     turn = compute_velocity((0.0, 0.0, 0.0), behind, (0.0, 0.0), RPPParameters())
     assert turn.linear == 0.0 and turn.angular != 0.0
+
+
+def corridor_with_a_box():
+    """A corridor 1.5 m wide and 8 m long, a 0.3 m box in its middle 3 m along."""
+    grid = np.zeros((40, 160), np.int8)  # 8 m x 2 m
+    grid[:6, :] = grid[-5:, :] = 100  # walls: the corridor is y = 0.3..1.75
+    grid[:, 0] = grid[:, -1] = 100
+    grid[17:23, 60:66] = 100  # the box: x = 3.0..3.3, y = 0.85..1.15
+    return costmap_from_grid(grid, RES, (0.0, 0.0))
+
+
+def drive(
+    costmap: Costmap2D,
+    start: Pose2D,
+    goal: Pose2D,
+    params: RPPParameters,
+    seconds: float = 30.0,
+) -> tuple[list[Pose2D], str]:
+    """Plan once a (simulated) second, follow at 10 Hz; the poses driven, and how it ended."""
+    pose, speed, path, index = start, (0.0, 0.0), [start], 0
+    poses: list[Pose2D] = []
+    for step in range(int(seconds * 10)):
+        if step % 10 == 0:
+            path, index = create_plan(costmap, pose, goal), 0
+        index = min(range(index, len(path)), key=lambda i: math.dist(path[i][:2], pose[:2]))
+        if math.dist(pose[:2], goal[:2]) < 0.15:
+            return poses, "reached"
+        command = compute_velocity(
+            pose, path[index:], speed, params, goal_dist_tol=0.15, costmap=costmap, dt=0.1
+        )
+        for _ in range(10):
+            x, y, yaw = pose
+            v, w = command.linear, command.angular
+            pose = (x + v * 0.01 * math.cos(yaw), y + v * 0.01 * math.sin(yaw), yaw + w * 0.01)
+            poses.append(pose)
+        speed = (command.linear, command.angular)
+    return poses, "timed out"
+
+
+def test_pure_pursuit_swerves_round_a_box_close_ahead_without_entering_inscribed_space():
+    # The robot stands 0.5 m short of a box it has just seen, on a straight line into it:
+    # the new path swerves round, and the far carrot's arc would cut into the box.
+    costmap = corridor_with_a_box()
+    poses, ended = drive(costmap, (2.5, 1.0, 0.0), (6.0, 1.0, 0.0), RPPParameters())
+    assert ended == "reached"
+    costs = [costmap.get_cost(*costmap.world_to_map(x, y)) for x, y, _ in poses]
+    assert max(costs) < INSCRIBED_INFLATED_OBSTACLE
+    # With Nav2's fixed 0.6 m lookahead the arc cuts the corner and Nav2 gives up ("collision
+    # ahead"); the nearer carrots take the robot round, touching no lethal cell.
+    fixed = RPPParameters(use_velocity_scaled_lookahead_dist=False)
+    poses, ended = drive(costmap, (2.5, 1.0, 0.0), (6.0, 1.0, 0.0), fixed)
+    assert ended == "reached"
+    costs = [costmap.get_cost(*costmap.world_to_map(x, y)) for x, y, _ in poses]
+    assert max(costs) < LETHAL_OBSTACLE
+
+
+def test_pure_pursuit_slows_near_obstacles_as_nav2_regulates_by_cost():
+    costmap = corridor_with_a_box()
+    straight = [(1.0 + 0.05 * i, 1.0, 0.0) for i in range(40)]
+    open_floor = compute_velocity((1.0, 1.0, 0.0), straight, (0.5, 0.0), RPPParameters(),
+                                  costmap=costmap)  # fmt: skip
+    near_wall = [(1.0 + 0.05 * i, 0.6, 0.0) for i in range(40)]
+    slow = compute_velocity((1.0, 0.6, 0.0), near_wall, (0.5, 0.0), RPPParameters(),
+                            costmap=costmap)  # fmt: skip
+    assert open_floor.linear == pytest.approx(0.5)
+    assert RPPParameters().regulated_linear_scaling_min_speed <= slow.linear < 0.45

@@ -4,7 +4,9 @@
   its covariance (an ``/initialpose``); ``init_uniform``: spread over the
   map's free cells, any heading (``reinitialize_global_localization``).
 - ``update_action``: the motion model moves every particle.
-- ``update_sensor``: the sensor model multiplies every weight; the average
+- ``update_sensor``: the sensor model multiplies every weight (with
+  ``likelihood_field_prob``, ours: only once the particles have gathered,
+  ``update_gathered``; a spread is weighed with the sum of cubes); the average
   weight feeds two running averages, ``w_slow`` and ``w_fast``
   (``recovery_alpha_slow`` / ``recovery_alpha_fast``). When the short-term
   average falls below the long-term one the scans fit worse than they used
@@ -29,11 +31,14 @@ import numpy as np
 
 from nav2_amcl.map import AmclMap
 from nav2_amcl.motion_model import DifferentialMotionModel, OmniMotionModel, normalize
-from nav2_amcl.sensor_model import LikelihoodFieldModel, ScanBeams
+from nav2_amcl.sensor_model import LikelihoodFieldModel, LikelihoodFieldProbModel, ScanBeams
 
 BIN_SIZE = (0.5, 0.5, math.radians(10.0))  # the kd-tree's cells (m, m, rad)
 DIFFERENTIAL = ("nav2_amcl::DifferentialMotionModel", "differential")
 OMNI = ("nav2_amcl::OmniMotionModel", "omnidirectional", "omni")
+LASER_MODELS = ("likelihood_field", "likelihood_field_prob")
+CONVERGED_SPREAD = 0.5  # m: every particle this close to the mean in x and y (Nav2's pf)
+GATHERED_SPREAD = 0.5  # m: the particles' spread (x and y std combined) of a filter that tracks
 
 
 @dataclass
@@ -62,6 +67,11 @@ class FilterParameters:
     z_rand: float = 0.5
     z_max: float = 0.05
     z_short: float = 0.05
+    laser_model_type: str = "likelihood_field"
+    do_beamskip: bool = False
+    beam_skip_distance: float = 0.5
+    beam_skip_threshold: float = 0.3
+    beam_skip_error_threshold: float = 0.9
 
     def check(self) -> str:
         """Why these values cannot work ('' when they can)."""
@@ -104,6 +114,11 @@ class FilterParameters:
             return (
                 f"recovery_alpha_fast ({self.recovery_alpha_fast}) must be larger than "
                 f"recovery_alpha_slow ({self.recovery_alpha_slow}) for recovery to work"
+            )
+        if self.laser_model_type not in LASER_MODELS:
+            return (
+                f"laser_model_type '{self.laser_model_type}' is not implemented here: use "
+                f"'{LASER_MODELS[0]}' or '{LASER_MODELS[1]}'"
             )
         if self.robot_model_type not in DIFFERENTIAL + OMNI:
             return (
@@ -203,13 +218,27 @@ class ParticleFilter:
             self.motion = DifferentialMotionModel(
                 params.alpha1, params.alpha2, params.alpha3, params.alpha4
             )
-        self.sensor = LikelihoodFieldModel(
-            params.z_hit,
-            params.z_rand,
-            params.sigma_hit,
-            params.laser_likelihood_max_dist,
-            amcl_map,
-        )
+        self.sensor: LikelihoodFieldModel
+        if params.laser_model_type == "likelihood_field_prob":
+            self.sensor = LikelihoodFieldProbModel(
+                params.z_hit,
+                params.z_rand,
+                params.sigma_hit,
+                params.laser_likelihood_max_dist,
+                amcl_map,
+                params.do_beamskip,
+                params.beam_skip_distance,
+                params.beam_skip_threshold,
+                params.beam_skip_error_threshold,
+            )
+        else:
+            self.sensor = LikelihoodFieldModel(
+                params.z_hit,
+                params.z_rand,
+                params.sigma_hit,
+                params.laser_likelihood_max_dist,
+                amcl_map,
+            )
         self.free = amcl_map.free_cells()
         if len(self.free) == 0:
             raise ValueError("the map has no free cell: there is nowhere to localize")
@@ -218,6 +247,7 @@ class ParticleFilter:
         self.w_slow = self.w_fast = 0.0
         self.resample_count = 0
         self.converged = False
+        self.gathered = False
 
     @property
     def count(self) -> int:
@@ -237,6 +267,7 @@ class ParticleFilter:
         self.weights = np.full(n, 1.0 / n)
         self.w_slow = self.w_fast = 0.0
         self.converged = False
+        self.update_gathered()
 
     def random_poses(self, n: int) -> np.ndarray:
         """Poses at the centres of random free cells, any heading."""
@@ -250,6 +281,7 @@ class ParticleFilter:
         self.weights = np.full(n, 1.0 / n)
         self.w_slow = self.w_fast = 0.0
         self.converged = False
+        self.update_gathered()
 
     # --- the updates ---
     def update_action(
@@ -259,10 +291,30 @@ class ParticleFilter:
 
     def update_sensor(self, scan: ScanBeams) -> float:
         """Weigh the particles by the scan; the total weight before normalising."""
-        self.weights = self.weights * self.sensor.weights(self.poses, scan)
-        total = float(self.weights.sum())
-        if total > 0.0 and math.isfinite(total):
+        if isinstance(self.sensor, LikelihoodFieldProbModel) and self.gathered:
+            # A product of many beams' pz is tiny: weigh in logs, so that the relative
+            # weights survive where the absolute ones would underflow to 0.
+            with np.errstate(divide="ignore"):
+                log_w = np.log(self.weights)
+            log_w = log_w + self.sensor.log_weights(self.poses, scan, self.converged)
+            top = float(log_w.max())
+            if not math.isfinite(top):
+                self.weights = np.full(self.count, 1.0 / self.count)
+                return 0.0
+            scaled = np.exp(log_w - top)
+            kept = float(scaled.sum())
+            self.weights = scaled / kept
+            total = math.exp(top) * kept  # 0.0 when it underflows: no average from this scan
+        else:
+            # LikelihoodFieldModel's own weights: the sum of cubes, whichever model was chosen
+            cubes = LikelihoodFieldModel.weights(self.sensor, self.poses, scan)
+            self.weights = self.weights * cubes
+            total = float(self.weights.sum())
+            if not (total > 0.0 and math.isfinite(total)):
+                self.weights = np.full(self.count, 1.0 / self.count)
+                return total
             self.weights /= total
+        if total > 0.0 and math.isfinite(total):
             # The average likelihood of the scan (the weights summed to 1 before). Nav2 divides
             # this by the particle count too, which makes KLD's changing count look like a
             # change of fit; the textbook's average does not.
@@ -276,8 +328,6 @@ class ParticleFilter:
                 self.w_fast = w_avg
             else:
                 self.w_fast += p.recovery_alpha_fast * (w_avg - self.w_fast)
-        else:
-            self.weights = np.full(self.count, 1.0 / self.count)
         return total
 
     def update(self, scan: ScanBeams) -> bool:
@@ -316,6 +366,30 @@ class ParticleFilter:
         self.weights = np.full(count, 1.0 / count)
         if w_diff > 0.0:
             self.w_slow = self.w_fast = 0.0
+        self.update_converged()
+        self.update_gathered()
+
+    def update_gathered(self) -> bool:
+        """The particles gather round one pose: likelihood_field_prob may weigh them.
+
+        Ours (Nav2 weighs with the product whenever it is chosen): from a spread (a global
+        reinitialisation, a rough initial pose) the product of 60 beams keeps one or two of
+        thousands of hypotheses after a single scan, often the wrong ones; the sum of cubes
+        (likelihood_field) lets the scans rule them out over a few metres. So a spread
+        filter weighs with the sum of cubes, a gathered one with the product.
+        """
+        spread = math.hypot(float(self.poses[:, 0].std()), float(self.poses[:, 1].std()))
+        gathered = spread < GATHERED_SPREAD
+        if gathered != self.gathered:  # the two models' likelihoods are not comparable
+            self.w_slow = self.w_fast = 0.0
+        self.gathered = gathered
+        return gathered
+
+    def update_converged(self) -> bool:
+        """Every particle within CONVERGED_SPREAD of the mean in x and y (beam skipping's cue)."""
+        mean = self.poses[:, :2].mean(axis=0)
+        self.converged = bool(np.all(np.abs(self.poses[:, :2] - mean) <= CONVERGED_SPREAD))
+        return self.converged
 
     # --- the answer ---
     def estimate(self) -> PoseEstimate:

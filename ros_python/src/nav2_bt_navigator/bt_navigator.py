@@ -9,19 +9,36 @@ this one runs the same steps as plain code, no behaviour tree (nor its XML,
    (``replanning_period``, the tree's RateController at 1 Hz) while driving;
 2. follow each new path with the controller server's ``follow_path``
    (``controller_id`` ``FollowPath``);
-3. when following fails, count a recovery (``number_of_recoveries``), plan
-   again and carry on, at most ``number_of_retries`` (6) times, as the tree's
-   RecoveryNode; then the goal ends aborted with the failing server's error
-   code and message (e.g. ComputePathToPose's ``GOAL_OCCUPIED`` 206,
-   FollowPath's ``FAILED_TO_MAKE_PROGRESS`` 105). A first plan that fails
-   ends the goal at once.
+3. when following fails (the controller saw a collision ahead, or made no
+   progress), count a recovery (``number_of_recoveries``), run the next of
+   the recovery actions in turn (the tree's RoundRobin), plan again and carry
+   on, at most ``number_of_retries`` (6) times, as the tree's RecoveryNode;
+   then the goal ends aborted with the failing server's error code and
+   message (e.g. ComputePathToPose's ``GOAL_OCCUPIED`` 206, FollowPath's
+   ``FAILED_TO_MAKE_PROGRESS`` 105). A first plan that fails ends the goal
+   (``NO_VALID_PATH`` 208 when an obstacle the scans saw closes the way;
+   after one more try ``recovery_wait`` later for the codes a planner
+   recovery may help with, at once for the others, e.g. ``GOAL_OCCUPIED``);
+   so do three replans in a row that fail.
+
+The recovery actions, in turn: *wait* ``recovery_wait`` (1 s: the costmaps
+take in what the scans show, so the next plan goes round a new obstacle);
+*back up* ``backup_dist`` (0.30 m) at ``backup_speed`` (0.15 m/s) on
+``cmd_vel``, as Nav2's BackUp behavior, unless the local costmap
+(``/local_costmap/costmap``) shows an obstacle behind; *clear* both costmaps'
+obstacle layers (``clear_entirely_*``: what was seen may be gone). Nav2 runs
+its behaviors (spin, wait, back up) in a behavior server; this navigator does
+these three itself and has no spin, and waits first where the tree clears
+first: a cleared costmap would forget the very obstacle the controller just
+stopped for.
 
 Feedback as Nav2 sends it: ``current_pose`` (TF ``map -> base_link``),
 ``navigation_time``, ``estimated_time_remaining`` (distance over speed),
 ``number_of_recoveries``, ``distance_remaining`` (along the path), and
 ``number_of_poses_remaining`` for ``navigate_through_poses`` (a pose counts
 as passed within 0.5 m, as RemovePassedGoals). Cancelling stops the
-controller, hence the robot. A new goal preempts the running one.
+controller, hence the robot: the cancel is passed on to the controller the
+moment it arrives. A new goal preempts the running one.
 """
 
 from __future__ import annotations
@@ -32,13 +49,14 @@ import threading
 import time
 from typing import Any
 
-from geometry_msgs.msg import PoseStamped
+from geometry_msgs.msg import PoseStamped, Twist
 from lifecycle_msgs.msg import State
-from nav2_costmap_2d.costmap_2d_ros import yaw_of
+from nav2_costmap_2d.costmap_2d_ros import LATCHED, stop_listener, yaw_of
 from nav2_msgs.action import ComputePathToPose, FollowPath, NavigateThroughPoses, NavigateToPose
+from nav2_msgs.srv import ClearEntireCostmap
 from nav2_util.lifecycle_node import LifecycleNode
 from nav2_util.server_main import spin_server
-from nav_msgs.msg import Odometry, Path
+from nav_msgs.msg import OccupancyGrid, Path
 from rclpy.action import ActionClient, ActionServer, CancelResponse, GoalResponse
 from rclpy.action.client import ClientGoalHandle
 from rclpy.callback_groups import ReentrantCallbackGroup
@@ -50,6 +68,52 @@ from tf2_ros.buffer import Buffer
 from tf2_ros.transform_listener import TransformListener
 
 SUCCEEDED, CANCELED, ABORTED = 4, 5, 6  # action_msgs/GoalStatus
+RECOVERIES = ("wait", "back up", "clear costmaps")  # in turn, as the tree's RoundRobin
+LETHAL = 100  # an obstacle on a published costmap (OccupancyGrid values)
+# ComputePathToPose's codes a planner recovery may help with (Nav2's WouldAPlannerRecoveryHelp)
+PLANNER_RETRY = (
+    ComputePathToPose.Result.UNKNOWN,
+    ComputePathToPose.Result.NO_VALID_PATH,
+    ComputePathToPose.Result.TIMEOUT,
+)
+COSTMAPS = (
+    "local_costmap/clear_entirely_local_costmap",
+    "global_costmap/clear_entirely_global_costmap",
+)
+
+
+class _ActionClient(ActionClient):
+    """rclpy's ActionClient with its request bookkeeping under one lock.
+
+    rclpy 7.1.6 sends a request and only then files its sequence number; an
+    executor thread that takes the response in between finds nothing filed,
+    logs "Ignoring unexpected goal response" and the request's future never
+    completes (seen here: the navigator waited out its 10 s for a planner that
+    had answered). Sending (from the navigation thread) and taking responses
+    (in the executor) are serialized here.
+    """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        self._bookkeeping = threading.RLock()
+        super().__init__(*args, **kwargs)
+
+    def send_goal_async(self, *args: Any, **kwargs: Any) -> Future:
+        with self._bookkeeping:
+            return super().send_goal_async(*args, **kwargs)
+
+    def _cancel_goal_async(self, goal_handle: Any) -> Future:
+        with self._bookkeeping:
+            return super()._cancel_goal_async(goal_handle)
+
+    def _get_result_async(self, goal_handle: Any) -> Future:
+        with self._bookkeeping:
+            return super()._get_result_async(goal_handle)
+
+    async def execute(self, taken_data: Any) -> None:
+        # The parent's execute only awaits feedback callbacks, plain functions here: it runs
+        # through without suspending, so the lock is never held across a suspension.
+        with self._bookkeeping:
+            await super().execute(taken_data)
 
 
 class NavigationFailed(Exception):
@@ -93,21 +157,34 @@ class BtNavigator(LifecycleNode):
         p("global_frame", "map")
         p("robot_base_frame", "base_link")
         p("transform_tolerance", 0.1)
-        p("odom_topic", "odom")
+        p("odom_topic", "odom")  # Nav2's, for its odometry smoother; speed comes from FollowPath
         p("replanning_period", 1.0)
         p("number_of_retries", 6)
         p("planner_id", "GridBased")
         p("controller_id", "FollowPath")
         p("goal_reached_tol", 0.5)  # RemovePassedGoals' radius for navigate_through_poses
+        p("recovery_wait", 1.0)
+        p("backup_dist", 0.30)  # the tree's BackUp
+        p("backup_speed", 0.15)
+        p("robot_radius", 0.15)  # the costmaps' robot_radius: the room backing up needs
+        p("local_costmap_topic", "local_costmap/costmap")
         self.group = ReentrantCallbackGroup()
         self.lock = threading.Lock()
         self.current: Any = None
+        self.following: Any = None  # the running follow_path goal, for a cancel to reach it
         self.speed = 0.0
+        self.local_costmap: OccupancyGrid | None = None
+        self.cmd_vel: Any = None
+        self.costmap_sub: Any = None
+        self.clear_clients: list[Any] = []
         self.servers: list[ActionServer] = []
         self.action_clients: list[ActionClient] = []
-        self.odom_sub: Any = None
         self.tf_buffer = Buffer(node=self)
-        self.tf_listener = TransformListener(self.tf_buffer, self)
+        # As Nav2's C++ listener: a node and a thread of its own (transform_listener_impl_*).
+        # /tf comes at 60-80 messages a wall second with the world at twice real time; each
+        # one through this node's multi-threaded executor cost a wake-up of its whole wait
+        # set (about a third of the process's CPU), through a one-node executor very little.
+        self.tf_listener = TransformListener(self.tf_buffer)
 
     # --- transitions ---
     def on_configure(self, state: LifecycleState) -> TransitionCallbackReturn:
@@ -115,14 +192,23 @@ class BtNavigator(LifecycleNode):
         g = self.get_parameter
         self.global_frame = str(g("global_frame").value)
         self.robot_base_frame = str(g("robot_base_frame").value)
-        self.planner = ActionClient(
+        self.planner = _ActionClient(
             self, ComputePathToPose, "compute_path_to_pose", callback_group=self.group
         )
-        self.controller = ActionClient(self, FollowPath, "follow_path", callback_group=self.group)
+        self.controller = _ActionClient(self, FollowPath, "follow_path", callback_group=self.group)
         self.action_clients = [self.planner, self.controller]
-        self.odom_sub = self.create_subscription(
-            Odometry, str(g("odom_topic").value), self.on_odom, 10, callback_group=self.group
+        self.cmd_vel = self.create_lifecycle_publisher(Twist, "cmd_vel", 1)
+        self.costmap_sub = self.create_subscription(
+            OccupancyGrid,
+            str(g("local_costmap_topic").value),
+            self.on_local_costmap,
+            LATCHED,
+            callback_group=self.group,
         )
+        self.clear_clients = [
+            self.create_client(ClearEntireCostmap, name, callback_group=self.group)
+            for name in COSTMAPS
+        ]
         for action_type, name, execute in (
             (NavigateToPose, "navigate_to_pose", self.navigate_to_pose),
             (NavigateThroughPoses, "navigate_through_poses", self.navigate_through_poses),
@@ -135,7 +221,7 @@ class BtNavigator(LifecycleNode):
                     execute_callback=execute,
                     goal_callback=self.on_goal,
                     handle_accepted_callback=self.on_accepted,
-                    cancel_callback=lambda _goal: CancelResponse.ACCEPT,
+                    cancel_callback=self.on_cancel,
                     callback_group=self.group,
                 )
             )
@@ -159,15 +245,27 @@ class BtNavigator(LifecycleNode):
         for client in self.action_clients:
             client.destroy()
         self.servers, self.action_clients = [], []
-        if getattr(self, "odom_sub", None) is not None:
-            self.destroy_subscription(self.odom_sub)
-            self.odom_sub = None
+        for client in self.clear_clients:
+            self.destroy_client(client)
+        self.clear_clients = []
+        if self.costmap_sub is not None:
+            self.destroy_subscription(self.costmap_sub)
+            self.costmap_sub = None
+        self.local_costmap = None
+        if self.cmd_vel is not None:
+            self.destroy_lifecycle_publisher(self.cmd_vel)
+            self.cmd_vel = None
 
     def active(self) -> bool:
         return self._state_machine.current_state[0] == State.PRIMARY_STATE_ACTIVE
 
-    def on_odom(self, msg: Odometry) -> None:
-        self.speed = math.hypot(msg.twist.twist.linear.x, msg.twist.twist.linear.y)
+    def on_follow_feedback(self, message: Any) -> None:
+        # The controller's odometry speed: no /odom subscription of our own (60 messages a
+        # second with the world at twice real time, each a wake-up of this node's executor).
+        self.speed = abs(float(message.feedback.speed))
+
+    def on_local_costmap(self, msg: OccupancyGrid) -> None:
+        self.local_costmap = msg
 
     def robot_pose(self) -> tuple[float, float, float] | None:
         try:
@@ -197,6 +295,22 @@ class BtNavigator(LifecycleNode):
             self.get_logger().info("Received goal preemption request")
         handle.execute()
 
+    def on_cancel(self, handle: Any) -> CancelResponse:
+        # Stop the robot now: the navigation loop only looks every 0.1 s, and a plan it may
+        # be waiting for takes longer still.
+        with self.lock:
+            following = self.following if handle is self.current else None
+        if following is not None:
+            following.handle.cancel_goal_async()
+        return CancelResponse.ACCEPT
+
+    def finished(self, handle: Any) -> None:
+        """The goal ended: no longer the current one (a next goal is no preemption)."""
+        with self.lock:
+            if self.current is handle:
+                self.current = None
+                self.following = None
+
     def navigate_to_pose(self, handle: Any) -> Any:
         goal = handle.request.pose
         return self.navigate(handle, [goal], NavigateToPose)
@@ -205,6 +319,12 @@ class BtNavigator(LifecycleNode):
         return self.navigate(handle, list(handle.request.poses), NavigateThroughPoses)
 
     def navigate(self, handle: Any, goals: list[PoseStamped], action: Any) -> Any:
+        try:
+            return self._navigate(handle, goals, action)
+        finally:
+            self.finished(handle)
+
+    def _navigate(self, handle: Any, goals: list[PoseStamped], action: Any) -> Any:
         result = action.Result()
         started = time.monotonic()
         through = action is NavigateThroughPoses
@@ -232,8 +352,17 @@ class BtNavigator(LifecycleNode):
         try:
             period = float(self.get_parameter("replanning_period").value)
             retries = int(self.get_parameter("number_of_retries").value)
-            path = self.plan(goals, stop)
-            follow = self.follow(path, stop)
+            try:
+                path = self.plan(goals, stop)
+            except NavigationFailed as exc:
+                # The tree plans again after a failure a recovery may mend (its costmap may
+                # hold what a scan got wrong): here once, after the costmaps' next update.
+                if exc.code not in PLANNER_RETRY or stop():
+                    raise
+                self.get_logger().warning(f"Planning failed ({exc.code}: {exc}); once more")
+                self.recover("wait", stop)
+                path = self.plan(goals, stop)
+            follow = self.follow(path, stop, handle)
             state["path"] = [(p.pose.position.x, p.pose.position.y) for p in path.poses]
             last_plan = time.monotonic()
             failures = 0
@@ -255,14 +384,17 @@ class BtNavigator(LifecycleNode):
                     message = outcome.result.error_msg if outcome is not None else ""
                     if state["recoveries"] >= retries:
                         raise NavigationFailed(code, message or "Following the path failed")
+                    recovery = RECOVERIES[state["recoveries"] % len(RECOVERIES)]
                     state["recoveries"] += 1
                     self.get_logger().warning(
                         f"Following the path failed ({code}: {message}); "
-                        f"recovery {state['recoveries']} of {retries}: planning again"
+                        f"recovery {state['recoveries']} of {retries}: {recovery}, then planning "
+                        "again"
                     )
-                    time.sleep(0.2)
+                    self.recover(recovery, stop)
                     last_plan = 0.0
                     follow = None
+                    continue
                 pose = self.robot_pose()
                 if through and pose is not None:
                     tol = float(self.get_parameter("goal_reached_tol").value)
@@ -279,11 +411,12 @@ class BtNavigator(LifecycleNode):
                     try:
                         path = self.plan(goals, stop)
                         failures = 0
-                        follow = self.follow(path, stop)
+                        follow = self.follow(path, stop, handle)
                         state["path"] = [(p.pose.position.x, p.pose.position.y) for p in path.poses]
                     except NavigationFailed:
                         failures += 1
                         if follow is None or failures >= 3:
+                            self.cancel_follow(follow)
                             raise
                 self.send_feedback(handle, action, pose, started, state, goals)
                 time.sleep(0.1)
@@ -303,6 +436,61 @@ class BtNavigator(LifecycleNode):
             result.error_msg = str(exc)
             handle.abort()
             return result
+
+    # --- recovery actions ---
+    def recover(self, action: str, stop: Any) -> None:
+        if action == "wait":
+            deadline = time.monotonic() + float(self.get_parameter("recovery_wait").value)
+            while time.monotonic() < deadline and not stop():
+                time.sleep(0.05)
+        elif action == "back up":
+            self.back_up(stop)
+        else:
+            for client in self.clear_clients:
+                if client.wait_for_service(timeout_sec=1.0):
+                    wait_for(client.call_async(ClearEntireCostmap.Request()), 5.0, stop)
+
+    def back_up(self, stop: Any) -> None:
+        """Drive backwards ``backup_dist`` at ``backup_speed`` while the costmap has room."""
+        distance = abs(float(self.get_parameter("backup_dist").value))
+        speed = abs(float(self.get_parameter("backup_speed").value))
+        start = self.robot_pose()
+        if start is None or speed <= 0.0 or self.cmd_vel is None:
+            return
+        deadline = time.monotonic() + distance / speed + 2.0
+        backwards = Twist()
+        backwards.linear.x = -speed
+        try:
+            while not stop() and time.monotonic() < deadline:
+                pose = self.robot_pose()
+                if pose is None or math.dist(pose[:2], start[:2]) >= distance:
+                    break
+                if not self.room_behind(pose):
+                    self.get_logger().warning("Backing up stopped: an obstacle behind the robot")
+                    break
+                self.cmd_vel.publish(backwards)
+                time.sleep(0.05)
+        finally:
+            self.cmd_vel.publish(Twist())
+
+    def room_behind(self, pose: tuple[float, float, float]) -> bool:
+        """No lethal cell of the local costmap where the robot's back will be 5 cm on."""
+        grid = self.local_costmap
+        if grid is None:
+            return False  # blind: do not back into what may be there
+        info = grid.info
+        reach = float(self.get_parameter("robot_radius").value) + 0.05
+        back = pose[2] + math.pi
+        for turn in (-1.0, -0.5, 0.0, 0.5, 1.0):  # the rear arc, +-57 degrees
+            x = pose[0] + reach * math.cos(back + turn)
+            y = pose[1] + reach * math.sin(back + turn)
+            mx = int((x - info.origin.position.x) / info.resolution)
+            my = int((y - info.origin.position.y) / info.resolution)
+            if not (0 <= mx < info.width and 0 <= my < info.height):
+                return False
+            if grid.data[my * info.width + mx] >= LETHAL:
+                return False
+        return True
 
     def send_feedback(
         self,
@@ -370,26 +558,36 @@ class BtNavigator(LifecycleNode):
             raise NavigationFailed(0, f"{name} did not finish")
         return done.result()
 
-    def follow(self, path: Path, stop: Any) -> Any:
+    def follow(self, path: Path, stop: Any, owner: Any) -> Any:
         """Send the path to the controller; a future-like handle on its result."""
         request = FollowPath.Goal()
         request.path = path
         request.controller_id = str(self.get_parameter("controller_id").value)
         if not self.controller.wait_for_server(timeout_sec=5.0):
             raise NavigationFailed(0, "Action server follow_path is not available")
-        sent = self.controller.send_goal_async(request)
+        sent = self.controller.send_goal_async(request, feedback_callback=self.on_follow_feedback)
         if not wait_for(sent, 10.0, stop):
             raise NavigationFailed(0, "follow_path did not answer the goal")
         goal_handle = sent.result()
         if not goal_handle.accepted:
             raise NavigationFailed(0, "follow_path rejected the goal")
-        return _Following(goal_handle, goal_handle.get_result_async())
+        following = _Following(goal_handle, goal_handle.get_result_async())
+        with self.lock:
+            if self.current is owner:
+                self.following = following
+        if owner.is_cancel_requested:  # cancelled while the path was on its way
+            goal_handle.cancel_goal_async()
+        return following
 
     def cancel_follow(self, follow: Any) -> None:
         if follow is None:
             return
         cancel = follow.handle.cancel_goal_async()
         wait_for(cancel, 2.0)
+
+    def destroy_node(self) -> None:
+        stop_listener(self.tf_listener)
+        super().destroy_node()
 
 
 class _Following:

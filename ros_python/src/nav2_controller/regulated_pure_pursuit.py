@@ -15,7 +15,11 @@ and the turn rate ``v * curvature``. Nav2's *regulated* version then
   goal's heading once within the goal tolerance;
 - checks the arc it is about to drive against the costmap for
   ``max_allowed_time_to_collision_up_to_carrot`` seconds and refuses to move
-  into an obstacle ("detected collision ahead!").
+  into an obstacle ("detected collision ahead!"); ours first tries nearer
+  carrots, then turning on the spot (see ``compute_velocity``).
+
+Defaults are Nav2's (its code's: cost regulation on, ``cost_scaling_dist``
+0.6 m) but for ``use_velocity_scaled_lookahead_dist``, on here.
 
 No ROS here: poses are (x, y, yaw) tuples in the costmap's frame.
 """
@@ -50,20 +54,22 @@ class RPPParameters:
     min_lookahead_dist: float = 0.3
     max_lookahead_dist: float = 0.9
     lookahead_time: float = 1.5
-    use_velocity_scaled_lookahead_dist: bool = False
+    # Ours (Nav2: false): the lookahead shrinks as the robot slows near obstacles, so the arc
+    # cuts less of the corner round a box or through a door.
+    use_velocity_scaled_lookahead_dist: bool = True
     rotate_to_heading_angular_vel: float = 1.8
     use_rotate_to_heading: bool = True
     rotate_to_heading_min_angle: float = 0.785
     max_angular_accel: float = 3.2
     use_regulated_linear_velocity_scaling: bool = True
-    use_cost_regulated_linear_velocity_scaling: bool = False
+    use_cost_regulated_linear_velocity_scaling: bool = True
     regulated_linear_scaling_min_radius: float = 0.9
     regulated_linear_scaling_min_speed: float = 0.25
     approach_velocity_scaling_dist: float = 0.6
     min_approach_linear_velocity: float = 0.05
     use_collision_detection: bool = True
     max_allowed_time_to_collision_up_to_carrot: float = 1.0
-    cost_scaling_dist: float = 0.3
+    cost_scaling_dist: float = 0.6
     cost_scaling_gain: float = 1.0
     inflation_cost_scaling_factor: float = 3.0
 
@@ -134,20 +140,71 @@ def compute_velocity(
     goal_dist_tol: float = 0.25,
     costmap: Costmap2D | None = None,
     dt: float = 0.05,
+    inscribed_radius: float = 0.15,
 ) -> Command:
-    """The velocity command (``computeVelocityCommands``) for a pruned path from the robot on."""
+    """The velocity command (``computeVelocityCommands``) for a pruned path from the robot on.
+
+    Ours, beyond Nav2's: when the arc to the carrot would hit something, nearer carrots are
+    tried (down to two costmap cells) before giving up, and when none will do, the robot
+    turns on the spot towards the nearest one (a round robot can always turn). A path that
+    swerves round an obstacle just seen makes the far carrot's arc cut the corner into it;
+    Nav2 gives up there ("detected collision ahead!") and leaves it to its recovery behaviours,
+    which replan the same swerve from the same place.
+    """
     if not path:
         raise ControllerException("Path is empty.")
-    v_now, w_now = speed
+    v_now, _w_now = speed
     lookahead = params.lookahead_dist
     if params.use_velocity_scaled_lookahead_dist:
         lookahead = abs(v_now) * params.lookahead_time
         lookahead = min(max(lookahead, params.min_lookahead_dist), params.max_lookahead_dist)
     path_robot = [to_robot_frame(robot, p[0], p[1]) for p in path]
+
+    def at(distance: float) -> Command:
+        return _command(
+            robot, path, path_robot, speed, params, distance, goal_dist_tol, costmap, dt,
+            inscribed_radius,
+        )  # fmt: skip
+
+    def free(command: Command) -> bool:
+        assert costmap is not None
+        turn = (command.linear, command.angular, command.carrot)
+        return not in_collision_ahead(robot, *turn, params, costmap)
+
+    command = at(lookahead)
+    if not params.use_collision_detection or costmap is None or free(command):
+        return command
+    # Down to two cells: a carrot that near keeps the robot on the path, which is clear.
+    floor = min(params.min_lookahead_dist, 2.0 * costmap.resolution)
+    shorter = lookahead
+    while shorter > floor + 1e-6:
+        shorter = max(shorter * 0.7, floor)
+        command = at(shorter)
+        if free(command):
+            return command
+    bearing = math.atan2(command.carrot[1], command.carrot[0])
+    if params.use_rotate_to_heading and abs(bearing) > 0.1:
+        return Command(0.0, rotate_to(bearing, speed[1], params, dt), command.carrot, shorter)
+    raise NoValidControl("RegulatedPurePursuitController detected collision ahead!")
+
+
+def _command(
+    robot: Pose2D,
+    path: list[Pose2D],
+    path_robot: list[tuple[float, float]],
+    speed: tuple[float, float],
+    params: RPPParameters,
+    lookahead: float,
+    goal_dist_tol: float,
+    costmap: Costmap2D | None,
+    dt: float,
+    inscribed_radius: float,
+) -> Command:
+    """Nav2's command for one lookahead distance: turn on the spot, or drive the arc."""
     carrot = lookahead_point(path_robot, lookahead)
     carrot_dist2 = carrot[0] ** 2 + carrot[1] ** 2
     curvature = 2.0 * carrot[1] / carrot_dist2 if carrot_dist2 > 0.001 else 0.0
-
+    w_now = speed[1]
     goal = path[-1]
     goal_dist = math.hypot(goal[0] - robot[0], goal[1] - robot[1])
     linear = params.desired_linear_vel
@@ -162,11 +219,8 @@ def compute_velocity(
         angular = rotate_to(math.atan2(carrot[1], carrot[0]), w_now, params, dt)
         linear = 0.0
     else:
-        linear = regulate(linear, curvature, path, robot, params, costmap)
+        linear = regulate(linear, curvature, path, robot, params, costmap, inscribed_radius)
         angular = linear * curvature
-    if params.use_collision_detection and costmap is not None:
-        if in_collision_ahead(robot, linear, angular, carrot, params, costmap):
-            raise NoValidControl("RegulatedPurePursuitController detected collision ahead!")
     return Command(linear, angular, carrot, lookahead)
 
 
@@ -188,33 +242,32 @@ def regulate(
     robot: Pose2D,
     params: RPPParameters,
     costmap: Costmap2D | None,
+    inscribed_radius: float = 0.15,
 ) -> float:
     """The desired speed after Nav2's curvature, cost and approach regulation."""
-    v = linear
+    curvature_v = cost_v = linear
     if params.use_regulated_linear_velocity_scaling and abs(curvature) > 1e-9:
         radius = abs(1.0 / curvature)
         if radius < params.regulated_linear_scaling_min_radius:
-            v *= radius / params.regulated_linear_scaling_min_radius
+            curvature_v = linear * radius / params.regulated_linear_scaling_min_radius
     if params.use_cost_regulated_linear_velocity_scaling and costmap is not None:
         cell = costmap.world_to_map(robot[0], robot[1])
-        if cell is not None:
-            cost = costmap.get_cost(*cell)
-            if 0 < cost < INSCRIBED_INFLATED_OBSTACLE:
-                dist = -math.log(cost / (INSCRIBED_INFLATED_OBSTACLE - 1)) / max(
-                    params.inflation_cost_scaling_factor, 1e-6
-                )
-                if dist < params.cost_scaling_dist:
-                    v *= params.cost_scaling_gain * dist / params.cost_scaling_dist
-    v = max(v, params.regulated_linear_scaling_min_speed)
+        cost = costmap.get_cost(*cell) if cell is not None else NO_INFORMATION
+        if cost not in (NO_INFORMATION, 0):
+            # The distance to the obstacle the cost came from, inverting the inflation.
+            factor = max(params.inflation_cost_scaling_factor, 1e-6)
+            distance = (
+                inscribed_radius + (math.log(INSCRIBED_INFLATED_OBSTACLE) - math.log(cost)) / factor
+            )
+            if distance < params.cost_scaling_dist:
+                cost_v = linear * params.cost_scaling_gain * distance / params.cost_scaling_dist
+    v = max(min(curvature_v, cost_v), params.regulated_linear_scaling_min_speed)
     remaining = path_length([(robot[0], robot[1], 0.0), *path])
-    if remaining < params.approach_velocity_scaling_dist:
-        v = min(
-            v,
-            max(
-                params.desired_linear_vel * remaining / params.approach_velocity_scaling_dist,
-                params.min_approach_linear_velocity,
-            ),
-        )
+    if remaining < params.approach_velocity_scaling_dist and path:
+        # Slow down on the last stretch, by the straight distance to the end.
+        left = math.hypot(path[-1][0] - robot[0], path[-1][1] - robot[1])
+        approach = v * left / params.approach_velocity_scaling_dist
+        v = min(v, max(approach, params.min_approach_linear_velocity))
     return min(v, params.desired_linear_vel)
 
 

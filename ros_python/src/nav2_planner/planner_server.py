@@ -5,12 +5,13 @@ lifecycle manager (or ``ros2 lifecycle set /planner_server configure`` then
 ``activate``) brings it up. Then
 
 - ``/global_costmap/global_costmap`` (in this process, as in Nav2) turns
-  ``/map`` into ``/global_costmap/costmap`` (:mod:`nav2_costmap_2d.costmap_2d_ros`);
+  ``/map`` and the obstacles ``/scan`` sees into ``/global_costmap/costmap``
+  (:mod:`nav2_costmap_2d.costmap_2d_ros`);
 - the action ``compute_path_to_pose`` (nav2_msgs/action/ComputePathToPose)
   plans from the robot (TF ``map -> base_link``; or ``start`` with
   ``use_start``) to ``goal`` with the planner ``planner_id`` names (``""``:
-  the only one, ``GridBased``), publishes the path on ``/plan``
-  (nav_msgs/Path) and answers with it and ``planning_time``; a failure ends
+  the only one, ``GridBased``), answers with the path and ``planning_time``
+  and publishes it on ``/plan`` (nav_msgs/Path) right after; a failure ends
   the goal aborted with Jazzy's error code (``START_OUTSIDE_MAP``,
   ``GOAL_OUTSIDE_MAP``, ``GOAL_OCCUPIED``, ``NO_VALID_PATH``,
   ``INVALID_PLANNER``, ``TF_ERROR``...) and ``error_msg``.
@@ -83,8 +84,13 @@ class PlannerServer(LifecycleNode):
         self.declare_parameter("GridBased.tolerance", 0.5)
         self.declare_parameter("GridBased.use_astar", False)
         self.declare_parameter("GridBased.allow_unknown", True)
-        # As Nav2: the costmap is a node of its own, in this process.
-        self.costmap_ros = Costmap2DROS("global_costmap", self.get_namespace())
+        # As Nav2: the costmap is a node of its own, in this process, at the rates Nav2's
+        # nav2_params.yaml gives the global costmap (update and publish once a second).
+        self.costmap_ros = Costmap2DROS(
+            "global_costmap",
+            self.get_namespace(),
+            defaults={"update_frequency": 1.0, "publish_frequency": 1.0},
+        )
         self.planner_ids: list[str] = []
         self.max_planner_duration = 0.0
         self.plan_publisher: LifecyclePublisher | None = None
@@ -202,8 +208,7 @@ class PlannerServer(LifecycleNode):
             result.path = path_message(
                 poses, self.costmap_ros.global_frame, self.get_clock().now().to_msg()
             )
-            if self.plan_publisher is not None:
-                self.plan_publisher.publish(result.path)
+            self.publish_plan_soon(result.path)
             duration = time.monotonic() - started
             result.planning_time = Duration(seconds=duration).to_msg()
             if self.max_planner_duration and duration > self.max_planner_duration:
@@ -231,6 +236,26 @@ class PlannerServer(LifecycleNode):
             result.error_msg = str(exc)
             handle.abort()
             return result
+
+    def publish_plan_soon(self, path: Path) -> None:
+        """/plan just after the result goes out, not before it (ours; Nav2 publishes first).
+
+        /plan is for the eyes (rviz, the dashboard); the client waits for the result, and
+        turning a path of a few hundred poses into bytes takes milliseconds of Python.
+        """
+        publisher = self.plan_publisher
+        if publisher is None:
+            return
+
+        def publish() -> None:
+            try:
+                publisher.publish(path)
+            except Exception:  # destroyed meanwhile (cleanup, shutdown): nobody to show it to
+                pass
+
+        timer = threading.Timer(0.01, publish)
+        timer.daemon = True
+        timer.start()
 
     def wait_for_costmap(self) -> Any:
         deadline = time.monotonic() + 5.0
