@@ -24,6 +24,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from app.catalog import lookup
 from tests.conftest import wait_until
+from tests.integration.core_helpers import wait_for_output
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(120)]
 
@@ -117,6 +118,7 @@ def test_map_server_serves_a_hand_made_map_and_answers_bad_files_with_result_cod
     assert answer.map.info.resolution == pytest.approx(0.1)
     wait_until(lambda: maps[-1].info.resolution == pytest.approx(0.1), what="the new /map")
     assert supervisor.status("map_server").active
+    wait_for_output(supervisor, "map_server", "no such file")
     log = "\n".join(supervisor.output("map_server"))
     assert "Traceback" not in log
     assert "nowhere.pgm" in log and "no such file" in log
@@ -133,8 +135,10 @@ def test_a_map_server_whose_file_is_malformed_stays_unconfigured_and_running(
     node = probe.node
     assert not transition(node, "/bad_map", Transition.TRANSITION_CONFIGURE)
     assert state(node, "/bad_map") == State.PRIMARY_STATE_UNCONFIGURED
+    # Logged before the answer, but read from the node's pipe a moment later.
+    wait_for_output(supervisor, "bad_map_server", "positive number")
     log = "\n".join(supervisor.output("bad_map_server"))
-    assert "Failed to load map yaml file" in log and "positive number" in log, log
+    assert "Failed to load map yaml file" in log, log
     assert "Traceback" not in log
     # Fixed: the same node configures now.
     write_map(tmp_path, "bad")
