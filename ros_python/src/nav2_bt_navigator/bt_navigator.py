@@ -54,6 +54,7 @@ from lifecycle_msgs.msg import State
 from nav2_costmap_2d.costmap_2d_ros import LATCHED, stop_listener, yaw_of
 from nav2_msgs.action import ComputePathToPose, FollowPath, NavigateThroughPoses, NavigateToPose
 from nav2_msgs.srv import ClearEntireCostmap
+from nav2_util.action_client import SerializedActionClient
 from nav2_util.lifecycle_node import LifecycleNode
 from nav2_util.server_main import spin_server
 from nav_msgs.msg import OccupancyGrid, Path
@@ -80,40 +81,6 @@ COSTMAPS = (
     "local_costmap/clear_entirely_local_costmap",
     "global_costmap/clear_entirely_global_costmap",
 )
-
-
-class _ActionClient(ActionClient):
-    """rclpy's ActionClient with its request bookkeeping under one lock.
-
-    rclpy 7.1.6 sends a request and only then files its sequence number; an
-    executor thread that takes the response in between finds nothing filed,
-    logs "Ignoring unexpected goal response" and the request's future never
-    completes (seen here: the navigator waited out its 10 s for a planner that
-    had answered). Sending (from the navigation thread) and taking responses
-    (in the executor) are serialized here.
-    """
-
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
-        self._bookkeeping = threading.RLock()
-        super().__init__(*args, **kwargs)
-
-    def send_goal_async(self, *args: Any, **kwargs: Any) -> Future:
-        with self._bookkeeping:
-            return super().send_goal_async(*args, **kwargs)
-
-    def _cancel_goal_async(self, goal_handle: Any) -> Future:
-        with self._bookkeeping:
-            return super()._cancel_goal_async(goal_handle)
-
-    def _get_result_async(self, goal_handle: Any) -> Future:
-        with self._bookkeeping:
-            return super()._get_result_async(goal_handle)
-
-    async def execute(self, taken_data: Any) -> None:
-        # The parent's execute only awaits feedback callbacks, plain functions here: it runs
-        # through without suspending, so the lock is never held across a suspension.
-        with self._bookkeeping:
-            await super().execute(taken_data)
 
 
 class NavigationFailed(Exception):
@@ -192,10 +159,12 @@ class BtNavigator(LifecycleNode):
         g = self.get_parameter
         self.global_frame = str(g("global_frame").value)
         self.robot_base_frame = str(g("robot_base_frame").value)
-        self.planner = _ActionClient(
+        self.planner = SerializedActionClient(
             self, ComputePathToPose, "compute_path_to_pose", callback_group=self.group
         )
-        self.controller = _ActionClient(self, FollowPath, "follow_path", callback_group=self.group)
+        self.controller = SerializedActionClient(
+            self, FollowPath, "follow_path", callback_group=self.group
+        )
         self.action_clients = [self.planner, self.controller]
         self.cmd_vel = self.create_lifecycle_publisher(Twist, "cmd_vel", 1)
         self.costmap_sub = self.create_subscription(

@@ -41,6 +41,7 @@ import rclpy
 from lifecycle_msgs.msg import State
 from nav2_msgs.action import FollowWaypoints, NavigateToPose
 from nav2_msgs.msg import MissedWaypoint
+from nav2_util.action_client import SerializedActionClient
 from nav2_util.lifecycle_node import LifecycleNode
 from nav2_util.server_main import spin_server
 from rcl_interfaces.msg import SetParametersResult
@@ -161,7 +162,7 @@ class WaypointFollower(LifecycleNode):
             f"Created waypoint_task_executor : {executor_id} of type {executor_type}"
         )
         self.task_executor.initialize(self, executor_id)
-        self.nav_to_pose_client = ActionClient(
+        self.nav_to_pose_client = SerializedActionClient(
             self, NavigateToPose, "navigate_to_pose", callback_group=self.group
         )
         self.action_server = ActionServer(
