@@ -115,11 +115,16 @@ def _left_in_namespace() -> list[tuple[int, str]]:
 def _another_run(proc: Path) -> bool:
     """A process of another run whose namespace got a number this run's had: the kernel
     reuses a namespace's number once it is gone (seen: a run's keeper ended the workers
-    of a run started beside it). A run's processes inherit its NAMESPACES file's name."""
+    of a run started beside it, and another run's keeper). A run's processes inherit
+    its NAMESPACES file's name; its keeper, which names that file only after it started,
+    is known by KEEPER in the environment it started with (this run's own keeper is
+    this process, and it took KEEPER out before starting anything)."""
     try:
         environ = (proc / "environ").read_bytes().split(b"\0")
     except OSError:
         return False
+    if f"{KEEPER}=1".encode() in environ:
+        return True
     prefix = f"{NAMESPACES}=".encode()
     theirs = next((v[len(prefix) :] for v in environ if v.startswith(prefix)), None)
     return theirs is not None and theirs.decode(errors="replace") != os.environ.get(NAMESPACES)

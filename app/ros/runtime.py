@@ -18,7 +18,9 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
+import sys
 import threading
+import traceback
 from collections.abc import Iterator
 from contextlib import contextmanager, suppress
 
@@ -65,6 +67,8 @@ class RosRuntime:
         )
         self.executor = SingleThreadedExecutor(context=self.context)
         self.lost_waits = 0  # waits lost to an entity destroyed meanwhile (see _spin)
+        self.callback_errors = 0  # callbacks that raised; each place is told once (see _spin)
+        self._reported: set[tuple[str, str, int]] = set()
         self.executor.add_node(self.node)
         self._thread = threading.Thread(target=self._spin, name=f"ros-{node_name}", daemon=True)
         self._thread.start()
@@ -82,6 +86,20 @@ class RosRuntime:
                 # the handler is skipped when entered but still added to the set, which
                 # raises here. Only that one wait is lost: spin on, never die silently.
                 self.lost_waits += 1
+            except Exception as exc:
+                # One faulty callback (ours, on a message we did not expect) would otherwise
+                # stop every panel, check and 3D view at once. Say it, once per place, on
+                # stderr (the dashboard's log) and spin on.
+                self.callback_errors += 1
+                where = _where_raised(exc)
+                if where not in self._reported:
+                    self._reported.add(where)
+                    print(
+                        f"[ERROR] a callback of /{self.node.get_name()} raised (spinning on):\n"
+                        + "".join(traceback.format_exception(exc)),
+                        file=sys.stderr,
+                        flush=True,
+                    )
 
     def shutdown(self, timeout: float = 2.0, teardown_sec: float = TEARDOWN_SEC) -> None:
         """Executor first, then the node, then the context: never unbounded.
@@ -100,6 +118,13 @@ class RosRuntime:
             if not self._thread.is_alive():
                 self.node.destroy_node()
             try_shutdown(context=self.context)
+
+
+def _where_raised(exc: BaseException) -> tuple[str, str, int]:
+    """The exception's type and the innermost line that raised it."""
+    frames = traceback.extract_tb(exc.__traceback__)
+    last = frames[-1] if frames else None
+    return (type(exc).__name__, last.filename if last else "", last.lineno or 0 if last else 0)
 
 
 @contextmanager
