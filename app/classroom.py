@@ -208,6 +208,7 @@ def start_lti(
         port=port,
         records=records,
         folder=Path(env.get(LTI_DIR_ENV) or DEFAULT_DIR),
+        progress_root=teacher.progress_root,  # each seat's attempts: <root>/bags/<seat>/
     )
     server.start()
     return server

@@ -17,6 +17,9 @@ tool folder (key, platforms.toml, launches, outbox). What differs from the hub:
   machine's classroom is graded as its LMS learner's.
 - **Who is a teacher for the gradebook.** Whoever brings the teacher page's
   token (``?token=``, then a cookie of this server).
+- **Where a learner's attempts are.** Every seat's dashboard keeps its graded
+  attempts in the classroom's progress folder on this machine, where the
+  gradebook's history reads them, dashboard running or not.
 
 All of it runs on the server's one tornado thread, as in the hub's service;
 the outbox sends on a thread of its own.
@@ -31,7 +34,7 @@ import logging
 import os
 import threading
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from dataclasses import replace
+from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 from urllib.parse import urlsplit
@@ -44,11 +47,13 @@ from app.hub.lti_gradebook import PAGE_PATH, gradebook_routes
 from app.hub.lti_service import DEFAULT_DIR, OUTBOX_POLL_SEC, LtiService, opening
 from app.lti.deep_linking import Activity
 from app.lti.dynamic_registration import registration_url
+from app.lti.history import Attempt, AttemptSource, valid_names
 from app.lti.rejection import LaunchRejected
 from app.lti.routes import ToolUrls
 from app.lti.state_file import save_json
 from app.lti.tool import LtiTool
-from app.teacher.record import LearnerRecord
+from app.teacher.attempt_files import AttemptReader, exercise_folder
+from app.teacher.record import MAX_HISTORY, LearnerRecord
 
 log = logging.getLogger(__name__)
 
@@ -132,12 +137,15 @@ class ClassroomLti(LtiService):
         teacher_url: str,
         *,
         site: str,
+        progress_root: Path | None = None,
         catalog: Sequence[Activity] | None = None,
         poll_sec: float = OUTBOX_POLL_SEC,
     ) -> None:
         super().__init__(tool, service_prefix="/", catalog=catalog, poll_sec=poll_sec)
         self.seats, self.learner_urls = seats, dict(learner_urls)
         self.teacher_url, self.site = teacher_url, site
+        self.progress_root = progress_root  # classroom's --progress-dir: seats' folders in it
+        self._reader = AttemptReader()
 
     def learner_destination(self, name: str, activity: tuple[str, str] | None = None) -> str:
         return opening(self.learner_urls[self.seats.take(name)], activity)
@@ -147,6 +155,40 @@ class ClassroomLti(LtiService):
 
     def seat_of(self, name: str) -> str:
         return self.seats.seat_of(name) or ""
+
+    def attempts_source(self, name: str, slug: str) -> AttemptSource:
+        """The seat's own attempt folder, read where its dashboard keeps it (app/cli.py)."""
+        replay = (
+            "it would run the learner's code on the classroom's server, outside their "
+            "dashboard's limits, and their code as it is now, not as it was graded (an "
+            "attempt keeps what the grader sent and what came back, not the code)"
+        )
+        seat = self.seats.seat_of(name)
+        if seat is None or self.progress_root is None or not valid_names(seat, slug):
+            where = (
+                f"{name} has no dashboard of this classroom now, so no attempt folder to read."
+                if seat is None
+                else "This classroom was started without a progress folder to read them from."
+            )
+            return AttemptSource((), where=where, replay=replay)
+        folder = exercise_folder(self.progress_root / "bags" / seat, slug)
+        kept = self._reader.newest(folder, MAX_HISTORY)
+        code = self.progress_root / seat / f"{seat}.code" / f"{slug}.py"
+        return AttemptSource(
+            tuple(Attempt(**asdict(each)) for each in kept),
+            where=(
+                f"Read from the attempts {seat}'s dashboard keeps on this machine (its newest "
+                f"{MAX_HISTORY} gradings of each exercise), whether or not it runs now."
+            ),
+            replay=replay,
+            code_file=str(code),
+            recordings=(
+                f"Each of these gradings is recorded in {folder} (a folder per attempt, named "
+                "by its time, seed and verdict, with an MCAP file of what the grader sent and "
+                "what came back): open one in Foxglove or Lichtblick, or ask the learner to "
+                "pick it under Attempt in their Exercise tab and press Watch this attempt."
+            ),
+        )
 
     def on_seat_records(self, records: Iterable[LearnerRecord]) -> int:
         """The roster's records: each seat of ours that an LMS learner holds is graded as theirs."""
@@ -244,6 +286,7 @@ def classroom_lti(
     port: int,
     records: Callable[[], Iterable[LearnerRecord]],
     folder: Path = DEFAULT_DIR,
+    progress_root: Path | None = None,
 ) -> ClassroomLtiServer:
     """The classroom's LTI server, not yet started; ``ValueError``/``OSError`` say what is wrong."""
     urls = ToolUrls.from_base(base_url)
@@ -253,6 +296,11 @@ def classroom_lti(
     log.info("LTI: dynamic registration URL (paste it into the LMS): %s",
              registration_url(urls, folder))  # fmt: skip
     lti = ClassroomLti(
-        tool, Seats(folder, list(learner_urls)), learner_urls, teacher_url, site=site
+        tool,
+        Seats(folder, list(learner_urls)),
+        learner_urls,
+        teacher_url,
+        site=site,
+        progress_root=progress_root,
     )
     return ClassroomLtiServer(lti, host, port, teacher_token, records)

@@ -1,11 +1,15 @@
 """The teacher's gradebook page: what went to the LMS, what waits in the outbox, and Retry.
 
-Three routes under the LTI service's prefix, for teachers only:
+Four routes under the LTI service's prefix, for teachers only:
 
 - ``gradebook`` (GET): the page (app/lti/pages.py draws it);
 - ``gradebook.json`` (GET): the same lines as data;
 - ``gradebook/retry`` (POST, with the XSRF field): every score not yet
-  delivered is tried now, then back to the page.
+  delivered is tried now, then back to the page;
+- ``gradebook/attempts?learner=NAME&activity=KIND:SLUG`` (GET): what a cell of
+  the class grid opens, one learner's history of one activity (their graded
+  attempts with the seeds that replay them, and the LMS's side). An address
+  that names no learner and activity of the gradebook gets a page that says so.
 
 Who counts as a teacher is the deployment's business, so the handlers here
 carry no authentication of their own: ``gradebook_routes`` mixes in the
@@ -22,7 +26,8 @@ from typing import TYPE_CHECKING, Any
 
 from tornado import web
 
-from app.lti.pages import gradebook_page, refusal_page
+from app.lti.gradebook import GradebookLine, lines_of
+from app.lti.pages import HISTORY_PATH, attempts_page, gradebook_page, not_found_page, refusal_page
 
 if TYPE_CHECKING:
     from app.hub.lti_service import LtiService
@@ -92,6 +97,52 @@ class GradebookRetry(_GradebookBase):
         self.redirect(f"{page}?retried={count}", status=303)
 
 
+_KINDS = ("lesson", "exercise")
+
+
+def _shown(text: str) -> str:
+    return repr(text if len(text) <= 80 else text[:79] + "…")
+
+
+class GradebookAttempts(_GradebookBase):
+    @web.authenticated
+    def get(self) -> None:
+        learner = self.get_argument("learner", "")
+        kind, _, slug = self.get_argument("activity", "").partition(":")
+        lines = self.lti.gradebook()
+        found = lines_of(lines, learner, kind, slug)
+        if not found:
+            self._not_found(learner, kind, slug, [ln for ln in lines if ln.learner == learner])
+            return
+        source = self.lti.attempts_source(learner, slug) if kind == "exercise" else None
+        page = attempts_page(
+            found, learner=learner, kind=kind, slug=slug, source=source, now=time.time()
+        )
+        self.set_header("Content-Type", "text/html; charset=utf-8")
+        self.finish(page)
+
+    def _not_found(self, learner: str, kind: str, slug: str, theirs: list[GradebookLine]) -> None:
+        if kind not in _KINDS or not slug:
+            sentence = (
+                "this address names no activity: it needs activity=exercise:SLUG or "
+                "activity=lesson:ID, as the class grid's cells link it"
+            )
+        elif not learner:
+            sentence = "this address names no learner: it needs learner=NAME (an lti-... name)"
+        elif not theirs:
+            sentence = f"no learner {_shown(learner)} has opened anything from the LMS here"
+        else:
+            who = theirs[0].lms_name or learner
+            opened = sorted({ln.activity for ln in theirs if ln.activity})
+            sentence = (
+                f"{who} has no LMS link to {kind} {_shown(slug)} (it may be another course's "
+                f"activity); they opened {', '.join(opened) or 'no activity of ours'}"
+            )
+        self.set_status(404)
+        self.set_header("Content-Type", "text/html; charset=utf-8")
+        self.finish(not_found_page(sentence))
+
+
 def gradebook_routes(
     prefix: str,
     lti: LtiService,
@@ -99,7 +150,7 @@ def gradebook_routes(
     *,
     back: tuple[str, str] | None = None,
 ) -> list[tuple[str, type[web.RequestHandler], dict[str, Any]]]:
-    """The three routes, each handler behind ``auth`` (a mixin that names the teacher).
+    """The four routes, each handler behind ``auth`` (a mixin that names the teacher).
 
     ``back`` is the link from the gradebook to the teacher's page: (address, text).
     """
@@ -111,5 +162,6 @@ def gradebook_routes(
             (PAGE_PATH, GradebookPage),
             (JSON_PATH, GradebookJson),
             (RETRY_PATH, GradebookRetry),
+            (HISTORY_PATH, GradebookAttempts),
         )
     ]

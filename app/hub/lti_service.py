@@ -17,8 +17,10 @@ Served under the service's prefix (``/services/classroom-teacher/``):
 Progress reports (``api/progress``) come through ``on_record``: a finished
 lesson or a passed exercise of a learner who launched it from an LMS becomes
 a score in the outbox, which a thread of its own empties, scheduled from
-tornado's loop. Checking a launch may fetch the LMS's keys, so it too runs
-off the loop. Everything else runs on the loop's thread.
+tornado's loop; the graded attempts a report carries are kept for the
+gradebook's history of that learner and exercise (app/lti/history.py).
+Checking a launch may fetch the LMS's keys, so it too runs off the loop.
+Everything else runs on the loop's thread.
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ import os
 from asyncio import Future
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import replace
+from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 from urllib.parse import quote, urlencode, urlsplit, urlunsplit
@@ -48,6 +50,7 @@ from app.lti.dynamic_registration import (
 )
 from app.lti.gradebook import GradebookLine, gradebook
 from app.lti.handoff import Handoff, HandoffRefused, HandoffTickets
+from app.lti.history import Attempt, AttemptHistory, AttemptSource
 from app.lti.launch import Launch
 from app.lti.learners import activity_of, hub_user_name
 from app.lti.pages import picker_page, refusal_page
@@ -61,7 +64,7 @@ from app.lti.routes import (
     ToolUrls,
 )
 from app.lti.tool import GradedResult, LtiTool
-from app.teacher.record import LearnerRecord
+from app.teacher.record import MAX_HISTORY, LearnerRecord
 
 log = logging.getLogger(__name__)
 
@@ -193,6 +196,7 @@ class LtiService:
         self.catalog = list(catalog) if catalog is not None else course_activities()
         self.tickets = HandoffTickets()
         self.pump = OutboxPump(tool, poll_sec)
+        self.history = AttemptHistory(tool.folder)
 
     def start(self) -> None:
         self.pump.start()
@@ -243,7 +247,13 @@ class LtiService:
         return self.handoff_url(Handoff(name, self.service_prefix, teacher=True))
 
     def on_record(self, record: LearnerRecord) -> int:
-        """A learner's progress report: queue the scores it earns; the number queued."""
+        """A learner's progress report: queue the scores it earns; the number queued.
+
+        The graded attempts it carries are kept for the gradebook, for any learner
+        who came from the LMS (graded link or not)."""
+        if record.exercise_history and self.tool.book.learner(record.learner) is not None:
+            attempts = (Attempt(**asdict(each)) for each in record.exercise_history)
+            self.history.add(record.learner, record.exercise, attempts)
         if not self.tool.graded_items(record.learner):
             return 0
         queued = sum(self.tool.submit(record.learner, result) for result in results_in(record))
@@ -265,6 +275,33 @@ class LtiService:
         titles = {(a.kind, a.slug): a.title for a in self.catalog}
         lines = gradebook(self.tool.book.learners(), self.tool.outbox.entries(), titles)
         return [replace(line, seat=self.seat_of(line.learner)) for line in lines]
+
+    def attempts_source(self, name: str, slug: str) -> AttemptSource:
+        """A learner's graded attempts at an exercise, as the gradebook's history shows them.
+
+        On a hub, only what the learner's progress reports brought: each carries the
+        newest attempts of the exercise the dashboard is on (app/teacher/beacon.py).
+        """
+        return AttemptSource(
+            self.history.of(name, slug),
+            where=(
+                "As the learner's dashboard reported them: it sends the newest "
+                f"{MAX_HISTORY} gradings of the exercise it is on, and this service keeps "
+                f"the newest {self.history.keep} of each exercise, also once the learner "
+                "moved on or their server stopped. A grading made while the dashboard "
+                "could not reach this service arrives when the learner is next on that "
+                "exercise, if it is still among the newest there."
+            ),
+            replay=(
+                "the teacher service runs no ROS 2 graph and has no copy of the learner's "
+                "code (gradings run in the learner's own server)"
+            ),
+            recordings=(
+                "Every grading is also recorded (an MCAP file of what the grader sent and "
+                "what came back) in the learner's own server: the learner opens one under "
+                "Attempt in their Exercise tab and presses Watch this attempt."
+            ),
+        )
 
     def lms_names(self) -> dict[str, str]:
         """Each LMS learner's name as the LMS gave it at launch, by hub user name."""

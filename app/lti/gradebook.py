@@ -37,6 +37,9 @@ class GradebookLine:
     next_try: float | None  # when a waiting score is tried again
     launched_at: float
     seat: str = ""  # the classroom mode's learner dashboard this learner sits at
+    comment: str = ""  # what the score told the LMS (what was checked, the seed)
+    kind: str = ""  # "lesson" or "exercise" ('' : a score whose link no launch names now)
+    slug: str = ""  # the lesson's id or the exercise's slug
 
     def to_json(self) -> dict[str, object]:
         return {name: getattr(self, name) for name in self.__dataclass_fields__}
@@ -89,6 +92,9 @@ def _line(
         attempts=entry.attempts if entry else 0,
         next_try=entry.next_try if entry and entry.status == "pending" else None,
         launched_at=item.launched_at if item else 0.0,
+        comment=entry.score.comment if entry else "",
+        kind=item.kind if item else "",
+        slug=item.slug if item else "",
     )
 
 
@@ -112,6 +118,13 @@ def gradebook(
         name = hub_user_name(entry.issuer, entry.score.user_id)
         lines.append(_line(book.get(name), name, None, entry, titles))
     return sorted(lines, key=lambda x: (x.lms_name.lower() or "~", x.learner, x.activity))
+
+
+def lines_of(
+    lines: Iterable[GradebookLine], learner: str, kind: str, slug: str
+) -> list[GradebookLine]:
+    """One learner's lines for one activity: a line per LMS link (course) that opens it."""
+    return [ln for ln in lines if (ln.learner, ln.kind, ln.slug) == (learner, kind, slug)]
 
 
 def counts(lines: Iterable[GradebookLine]) -> dict[State, int]:

@@ -1,19 +1,22 @@
 """The few HTML pages LTI shows a person: a refusal, the activity picker, the gradebook.
 
 Server-rendered and self-contained (no outside file; script only for the
-picker's one line and the gradebook's local times and filter), since they
-open inside an LMS frame or a new tab before any of our other pages. Every
-value from a request or an LMS is escaped.
+picker's one line, the gradebook's local times and filter, and the attempt
+history's Copy buttons), since they open inside an LMS frame or a new tab
+before any of our other pages. Every value from a request or an LMS is escaped.
 """
 
 from __future__ import annotations
 
 import html
+import shlex
 from collections.abc import Sequence
 from datetime import datetime, timezone
+from urllib.parse import urlencode
 
 from app.lti.deep_linking import Activity
 from app.lti.gradebook import GradebookLine, counts
+from app.lti.history import Attempt, AttemptSource
 
 _STYLE = (
     "body{font-family:system-ui,sans-serif;margin:1.5em;max-width:52em;line-height:1.4}"
@@ -112,15 +115,19 @@ def _wait(seconds: float) -> str:
     return f"in {seconds / 60:.0f} min"
 
 
-def _gradebook_row(line: GradebookLine, now: float, seats: bool) -> str:
-    who = html.escape(line.lms_name or "(no name from the LMS)")
-    hub_name = f'<span class="hub nowrap">{html.escape(line.learner)}</span>'
-    cells = [f"<td><b>{who}</b><br>{hub_name}</td>"]
-    if seats:
-        cells.append(f"<td>{html.escape(line.seat)}</td>")
+def _gradebook_row(line: GradebookLine, now: float, seats: bool, whose: bool = True) -> str:
+    """One line of the gradebook; ``whose``: with its learner and activity (the full table)."""
+    cells = []
+    if whose:
+        who = html.escape(line.lms_name or "(no name from the LMS)")
+        hub_name = f'<span class="hub nowrap">{html.escape(line.learner)}</span>'
+        cells.append(f"<td><b>{who}</b><br>{hub_name}</td>")
+        if seats:
+            cells.append(f"<td>{html.escape(line.seat)}</td>")
+        activity = line.activity or "(a grade column no launch names now)"
+        cells.append(f"<td>{html.escape(activity)}</td>")
     column = html.escape(line.lineitem or "")
     cells += [
-        f"<td>{html.escape(line.activity or '(a grade column no launch names now)')}</td>",
         f'<td>{html.escape(line.link)}<br><span class="hub url">{column}</span></td>',
         f'<td class="{line.state.replace(" ", "-")} nowrap">{_STATE_MARKS[line.state]}</td>',
         f"<td>{html.escape(line.score)}</td>",
@@ -159,12 +166,21 @@ _CELL_MARKS = {
 }
 
 
+HISTORY_PATH = "gradebook/attempts"  # beside the gradebook page, under the tool's address
+
+
+def history_link(learner: str, kind: str, slug: str) -> str:
+    """The address of one learner's history of one activity, relative to the gradebook page."""
+    return f"{HISTORY_PATH}?{urlencode({'learner': learner, 'activity': f'{kind}:{slug}'})}"
+
+
 def class_grid(lines: Sequence[GradebookLine]) -> str:
     """The class at a glance: a row per learner, a column per activity, a mark per cell.
 
     A teacher of 200 reads who is done and what waits without reading 200 lines;
-    a click on a cell shows that learner's lines of that activity in the table
-    below (the filter), where the LMS's answer and the next try are.
+    a click on a cell opens that learner's history of that activity (each graded
+    attempt, its seed, and what the LMS has), a click on a name shows their
+    lines in the table below (the filter).
     """
     if not lines:
         return ""
@@ -187,17 +203,25 @@ def class_grid(lines: Sequence[GradebookLine]) -> str:
                 cells.append("<td></td>")
                 continue
             state, score = shown_line.state, shown_line.score
-            title = f"{_STATE_MARKS[state]} {score}".strip()
+            title = f"{_STATE_MARKS[state]} {score}: {shown}, {activity}; its attempts"
+            link = history_link(learner, shown_line.kind, shown_line.slug)
+            tip = html.escape(title, quote=True)
             cells.append(
-                f'<td class="{state.replace(" ", "-")}" title="{html.escape(title)}">'
-                f'<a href="#gradebook" data-show="{html.escape(learner, quote=True)}">'
+                f'<td class="{state.replace(" ", "-")}">'
+                f'<a href="{html.escape(link, quote=True)}" title="{tip}">'
                 f"{_CELL_MARKS[state]} {html.escape(score)}</a></td>"
             )
-        rows.append(f"<tr><th>{html.escape(shown)}</th>{''.join(cells)}</tr>")
+        name = (
+            f'<a href="#gradebook" data-show="{html.escape(learner, quote=True)}">'
+            f"{html.escape(shown)}</a>"
+        )
+        rows.append(f"<tr><th>{name}</th>{''.join(cells)}</tr>")
     legend = " · ".join(f"{_CELL_MARKS[state]} {state}" for state in _STATE_ORDER)
     return (
         "<h2>The class at a glance</h2>\n"
-        f"<p>{html.escape(legend)}. A click on a cell shows its lines below.</p>\n"
+        f"<p>{html.escape(legend)}. A click on a cell opens that learner's attempts at it "
+        "(each grading, its seed, what went to the LMS); a click on a name shows their "
+        "lines below.</p>\n"
         f'<table id="class-grid"><thead><tr><th>Learner</th>{head}</tr></thead>'
         f"<tbody>\n{chr(10).join(rows)}\n</tbody></table>\n"
     )
@@ -251,7 +275,157 @@ def gradebook_page(
         'const f=document.getElementById("filter");f.oninput=()=>{const q=f.value.toLowerCase();'
         'for(const r of document.querySelectorAll("#gradebook tbody tr"))'
         "r.hidden=q&&!r.textContent.toLowerCase().includes(q);};"
-        'for(const a of document.querySelectorAll("#class-grid a"))'
+        'for(const a of document.querySelectorAll("#class-grid a[data-show]"))'
         "a.onclick=()=>{f.value=a.dataset.show;f.oninput();};"
         "</script>",
+    )
+
+
+_VERDICTS = {"pass": "✓ passed", "fail": "✗ failed", "problem": "⚠ not graded"}
+
+
+def replay_command(slug: str, seed: int, code_file: str = "") -> str:
+    """The command that replays one grading: the learner's code as FILE, the same seed."""
+    file = shlex.quote(code_file) if code_file else "FILE"
+    return f"ros2-classroom exercise check {slug} {file} --seed {seed}"
+
+
+def _attempt_row(attempt: Attempt, slug: str, code_file: str) -> str:
+    verdict = _VERDICTS.get(attempt.verdict, attempt.verdict)
+    checks = f"{attempt.passed} of {attempt.total}" if attempt.total else "–"
+    if attempt.failed:
+        why = "<ul>" + "".join(f"<li>{html.escape(f)}</li>" for f in attempt.failed) + "</ul>"
+    elif attempt.verdict == "problem":
+        why = html.escape(attempt.summary or "grading could not start")
+    elif attempt.verdict == "fail" and not attempt.total:
+        why = "(its result lines could not be read: the recording is damaged)"
+    else:
+        why = ""
+    if attempt.seed and attempt.verdict != "problem":
+        command = replay_command(slug, attempt.seed, code_file)
+        quoted = html.escape(command, quote=True)
+        replay = (
+            f"<code>{html.escape(command)}</code> "
+            f'<button type="button" class="copy" data-copy="{quoted}">Copy</button>'
+        )
+        seed = str(attempt.seed)
+    else:
+        replay, seed = "nothing to replay" if attempt.verdict == "problem" else "no seed kept", "–"
+    cells = [
+        f'<td class="nowrap">{_time(attempt.at)}</td>',
+        f'<td class="{attempt.verdict} nowrap">{html.escape(verdict)}</td>',
+        f"<td>{checks}</td>",
+        f"<td>{why}</td>",
+        f'<td class="seed">{seed}</td>',
+        f"<td>{replay}</td>",
+    ]
+    return f'<tr data-verdict="{html.escape(attempt.verdict)}">{"".join(cells)}</tr>'
+
+
+def attempts_page(
+    lines: Sequence[GradebookLine],
+    *,
+    learner: str,
+    kind: str,
+    slug: str,
+    source: AttemptSource | None,
+    now: float,
+) -> str:
+    """One learner's history of one activity: every graded attempt, and what the LMS has.
+
+    ``lines`` are the learner's gradebook lines for it (a line per LMS link, so one
+    per course that links it); ``source`` the attempts and where they come from
+    (None for a lesson, which has no graded attempts).
+    """
+    first = lines[0] if lines else None
+    shown = (first.lms_name if first else "") or learner
+    activity = (first.activity if first else "") or f"{kind} {slug}"
+    seat = f" · dashboard {html.escape(first.seat)}" if first and first.seat else ""
+    head = ["LMS link and grade column", "Grade", "Score", "When", "The LMS's answer", "Next try"]
+    lms_rows = "\n".join(_gradebook_row(line, now, False, whose=False) for line in lines)
+    told = [
+        f"<li>{html.escape(line.link or 'LMS link')}: <q>{html.escape(line.comment)}</q></li>"
+        for line in lines
+        if line.comment
+    ]
+    parts = [
+        "<style>body{max-width:none}.url{display:inline-block;max-width:22em;"
+        "word-break:break-all}.nowrap{white-space:nowrap}.fail{color:#b91c1c}"
+        ".pass{color:#166534}td ul{margin:0;padding-left:1.1em}</style>",
+        f"<h1>{html.escape(shown)}: {html.escape(activity)}</h1>",
+        f'<p><span class="hub">{html.escape(learner)}</span>{seat} · '
+        '<a href="../gradebook">Back to the gradebook</a></p>',
+        "<h2>In the LMS</h2>",
+        '<table id="lms"><thead><tr>'
+        + "".join(f"<th>{h}</th>" for h in head)
+        + f"</tr></thead><tbody>\n{lms_rows}\n</tbody></table>",
+    ]
+    if told:
+        parts.append(f"<p>What the score told the LMS:</p><ul>{''.join(told)}</ul>")
+    if source is None:
+        parts += [
+            "<h2>Attempts</h2>",
+            "<p>A lesson has no graded attempts: it counts as done when the learner is on "
+            "its last step and every check of that step passes on their live ROS 2 graph. "
+            "The teacher's page shows the step they are on and its checks.</p>",
+        ]
+        return _page(f"{shown}: {activity}", "\n".join(parts))
+    parts += [
+        "<h2>Graded attempts, newest first</h2>",
+        f"<p>{html.escape(source.where)}</p>",
+    ]
+    if source.attempts:
+        passes = sum(a.verdict == "pass" for a in source.attempts)
+        fails = sum(a.verdict == "fail" for a in source.attempts)
+        parts.append(
+            f"<p>{len(source.attempts)} shown: {passes} passed, {fails} failed, "
+            f"{len(source.attempts) - passes - fails} not graded.</p>"
+        )
+        rows = "\n".join(_attempt_row(a, slug, source.code_file) for a in source.attempts)
+        head = ["When", "Verdict", "Checks passed", "What failed, and why", "Seed", "Replay it"]
+        parts.append(
+            '<table id="attempts"><thead><tr>'
+            + "".join(f"<th>{h}</th>" for h in head)
+            + f"</tr></thead><tbody>\n{rows}\n</tbody></table>"
+        )
+    else:
+        parts.append(f"<p><b>No graded attempt of {html.escape(slug)} is known here yet.</b></p>")
+    parts.append(
+        '<h2 id="replay">Replaying a grading</h2>'
+        "<p>The command beside an attempt grades the learner's code again with the hidden "
+        "inputs drawn from that attempt's seed, so the probes send the same values. "
+        f"There is no replay button here: {html.escape(source.replay)}. Run it in a "
+        "terminal on a machine with the classroom installed"
+        + (
+            f", where <code>{html.escape(source.code_file)}</code> is the learner's code"
+            if source.code_file
+            else ", with the learner's code saved as FILE (the teacher's page shows it "
+            "under the learner)"
+        )
+        + ". It grades the code as it is now: if the learner changed it since that "
+        "attempt, the result may differ.</p>"
+    )
+    if source.recordings:
+        parts.append(f"<p>{html.escape(source.recordings)}</p>")
+    parts.append(
+        "<script>"
+        'for(const t of document.querySelectorAll("time"))'
+        "t.textContent=new Date(t.dateTime).toLocaleString();"
+        'for(const b of document.querySelectorAll("button.copy")){'
+        "if(!navigator.clipboard){b.hidden=true;continue;}"
+        "b.onclick=()=>navigator.clipboard.writeText(b.dataset.copy)"
+        '.then(()=>{b.textContent="Copied";});}'
+        "</script>"
+    )
+    return _page(f"{shown}: {activity}", "\n".join(parts))
+
+
+def not_found_page(sentence: str) -> str:
+    """What a history address that names no learner or activity of the gradebook shows."""
+    return _page(
+        "Not in the gradebook: ROS 2 Classroom",
+        "<h1>Not in the gradebook</h1>\n"
+        f'<p class="why">{html.escape(sentence)}</p>\n'
+        '<p><a href="../gradebook">Back to the gradebook</a>: its class grid links each '
+        "learner's history of each activity.</p>",
     )

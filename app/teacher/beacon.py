@@ -23,6 +23,7 @@ import time
 from dataclasses import dataclass, replace
 
 from app.exercises import runner
+from app.exercises.attempts import attempts_root
 from app.exercises.model import Exercise, ExerciseBook
 from app.exercises.panel import ExerciseSettings
 from app.exercises.workspace import Workspace
@@ -31,6 +32,7 @@ from app.lessons.schema import Course
 from app.ros.side_participant import SideParticipant
 from app.supervisor import Supervisor
 from app.teacher import wire
+from app.teacher.attempt_files import AttemptReader
 from app.teacher.hub_link import HubLink, HubTarget, NoticeSink, ReportRefused, SettingsSink
 from app.teacher.record import (
     MAX_CODE,
@@ -85,6 +87,7 @@ class ProgressBeacon:
         self._stop = threading.Event()
         self._crash_key: tuple | None = None  # UI thread: the crash text read once per process
         self._crash_text = ""
+        self._attempts = AttemptReader()  # the beacon thread's: the kept attempts' folders
         self._link: DdsLink | HubLink
         if hub is not None:  # on a JupyterHub: HTTP to the teacher service
             self._link = HubLink(hub, self._on_notice, self._on_settings)
@@ -124,6 +127,7 @@ class ProgressBeacon:
                 continue
             if record is None:  # closing
                 return
+            record = self._with_history(record)
             now = time.time()
             changed = last is None or (
                 record.what_changed_ignoring_stamps() != last.what_changed_ignoring_stamps()
@@ -145,6 +149,17 @@ class ProgressBeacon:
                 except Exception:  # shutting down, or a bug: the dashboard keeps going
                     log.exception("publishing progress failed")
             last = record
+
+    def _with_history(self, record: LearnerRecord) -> LearnerRecord:
+        """The record with its exercise's newest graded attempts, read off the UI thread."""
+        if not record.exercise:
+            return record
+        try:
+            history = self._attempts.newest(attempts_root() / record.exercise)
+        except Exception:  # a folder being pruned under us: the next round reads it again
+            log.debug("reading the kept attempts failed", exc_info=True)
+            return record
+        return replace(record, exercise_history=history)
 
     # -- the UI thread --------------------------------------------------------------
 

@@ -15,9 +15,9 @@ from dataclasses import asdict, fields
 from typing import Any
 
 from app.teacher import record as rec
-from app.teacher.record import LearnerRecord, clip
+from app.teacher.record import GradedAttempt, LearnerRecord, clip
 
-MAX_BODY = 64 * 1024  # a record with the longest code excerpt is about 10 kB
+MAX_BODY = 128 * 1024  # the longest code excerpt and ten attempts: about 30 kB of ASCII
 
 _TEXT_LIMITS = {
     "site": rec.MAX_NAME,
@@ -92,7 +92,46 @@ def _field(name: str, value: object) -> object:
         if not isinstance(value, bool):
             raise ReportError(f"{name} must be true or false")
         return value
+    if name == "exercise_history":
+        if not isinstance(value, list):
+            raise ReportError(f"{name} must be a list of attempts")
+        return tuple(_attempt(item) for item in value[: rec.MAX_HISTORY])
     count, limit = _LISTS[name]
     if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
         raise ReportError(f"{name} must be a list of strings")
     return tuple(clip(v, limit) for v in value[:count])
+
+
+_ATTEMPT_FIELDS = tuple(f.name for f in fields(GradedAttempt))
+
+
+def _attempt(item: object) -> GradedAttempt:
+    """One attempt of ``exercise_history``, checked as strictly as the record around it."""
+    what = "each attempt of exercise_history"
+    if not isinstance(item, dict) or set(item) - set(_ATTEMPT_FIELDS) or "at" not in item:
+        raise ReportError(f"{what} must be an object with {', '.join(_ATTEMPT_FIELDS)}")
+    at = item["at"]
+    if isinstance(at, bool) or not isinstance(at, int | float) or not 0 <= at < 1e11:
+        raise ReportError(f"{what} needs its time in seconds since 1970 (at)")
+    verdict = item.get("verdict")
+    if verdict not in rec.VERDICTS:
+        raise ReportError(f"{what} needs a verdict of {', '.join(rec.VERDICTS)}")
+    numbers = {}
+    for key in ("seed", "passed", "total"):
+        number = item.get(key, 0)
+        if isinstance(number, bool) or not isinstance(number, int) or not 0 <= number < 2**32:
+            raise ReportError(f"{what}: {key} must be a whole number from 0 to 2^32-1")
+        numbers[key] = number
+    failed = item.get("failed", [])
+    if not isinstance(failed, list) or not all(isinstance(f, str) for f in failed):
+        raise ReportError(f"{what}: failed must be a list of strings")
+    summary = item.get("summary", "")
+    if not isinstance(summary, str):
+        raise ReportError(f"{what}: summary must be a string")
+    return GradedAttempt(
+        at=float(at),
+        verdict=verdict,
+        failed=tuple(clip(f, rec.MAX_REASON) for f in failed[: rec.MAX_FAILED]),
+        summary=clip(summary, rec.MAX_SUMMARY),
+        **numbers,
+    )

@@ -26,6 +26,9 @@ MAX_ERROR = 1000
 MAX_NODES = 32
 MAX_NOTICE = 280
 MAX_MISTAKE = 120
+MAX_HISTORY = 10  # graded attempts of the current exercise in a report (the dashboard keeps 10)
+MAX_FAILED = 8  # failed checks told per attempt
+MAX_SUMMARY = 300
 
 _MARKS = {"pass": "✓", "fail": "✗", "waiting": "…"}
 
@@ -45,6 +48,27 @@ def plain_markdown(text: str) -> str:
     so what arrives over it is shown, never interpreted.
     """
     return _MARKDOWN_SPECIAL.sub(r"\\\1", " ".join(text.split()))
+
+
+@dataclass(frozen=True)
+class GradedAttempt:
+    """One grading of an exercise, as the learner's dashboard kept it (its attempt folder).
+
+    What the teacher's gradebook shows of it: when, the verdict, how many checks
+    passed, each failed check with the short reason it gave, and the seed its
+    hidden inputs came from (``exercise check SLUG FILE --seed N`` replays it).
+    """
+
+    at: float  # when the grading ran (wall-clock seconds, UTC)
+    verdict: str  # "pass", "fail", or "problem" (not graded: the program did not run, ...)
+    seed: int = 0  # 0: none kept
+    passed: int = 0  # checks and probes passed ...
+    total: int = 0  # ... of this many
+    failed: tuple[str, ...] = ()  # "name: why", at most MAX_FAILED, each at most MAX_REASON
+    summary: str = ""  # the grader's last line, at most MAX_SUMMARY ("3 of 5 checks passed: ...")
+
+
+VERDICTS = ("pass", "fail", "problem")
 
 
 @dataclass(frozen=True)
@@ -74,6 +98,10 @@ class LearnerRecord:
     # ("front_is_index_zero") or, when none matched, the failed result's name
     # ("stop before the wall"); '' when it passed or never failed.
     exercise_mistake: str = ""
+    # Its newest graded attempts, newest first (at most MAX_HISTORY). Only the HTTP
+    # report (a hub) carries them; on the classroom domain the teacher's side reads
+    # them from the dashboards' folders on its own machine instead.
+    exercise_history: tuple[GradedAttempt, ...] = ()
     code_excerpt: str = ""
     last_error: str = ""
     nodes_running: tuple[str, ...] = ()

@@ -52,6 +52,7 @@ class Room:
     folder: Path
     platform: TestPlatform
     records: list[LearnerRecord] = field(default_factory=list)
+    progress_root: Path | None = None  # the classroom's --progress-dir (the seats' folders)
 
     def __post_init__(self) -> None:
         write_platforms(self.folder, self.platform)
@@ -66,6 +67,7 @@ class Room:
             port=port,
             records=lambda: list(self.records),
             folder=self.folder,
+            progress_root=self.progress_root,
         )
         self.server.start()
         self.platform.tool_jwks = json.loads(request("GET", self.urls.jwks).body)
@@ -80,7 +82,7 @@ class Room:
 
 @pytest.fixture
 def room(platform: TestPlatform, tmp_path: Path) -> Iterator[Room]:
-    running = Room(tmp_path / "lti", platform)
+    running = Room(tmp_path / "lti", platform, progress_root=tmp_path / "progress")
     yield running
     running.close()
 
@@ -171,6 +173,59 @@ def test_the_gradebook_is_the_teachers_by_token(room: Room, platform: TestPlatfo
     wait_for(lambda: bool(platform.scores["11"]), timeout=4, why="the retried score")
 
 
+def keep_attempt(folder: Path, name: str, results: list[tuple[str, bool, str]]) -> None:
+    """A graded attempt as a seat's dashboard keeps it (app/exercises/attempts.py)."""
+    (folder / name).mkdir(parents=True)
+    custom = {
+        "classroom.summary": f"{sum(r[1] for r in results)} of {len(results)} checks passed",
+        "classroom.results": json.dumps(
+            [{"name": n, "passed": p, "detail": d} for n, p, d in results]
+        ),
+    }
+    meta = {"rosbag2_bagfile_information": {"custom_data": custom}}
+    (folder / name / "metadata.yaml").write_text(json.dumps(meta))  # JSON is YAML too
+
+
+def test_a_cell_of_the_gradebook_opens_the_seats_attempts_read_from_its_folder(
+    room: Room, platform: TestPlatform
+) -> None:
+    link = graded_link(platform.lineitem_url("11"), {"exercise": EXERCISE, "score_maximum": "5"})
+    assert launch(room, platform, **link).location == at_exercise("learner1")  # Ada
+    assert room.progress_root is not None
+    attempts = room.progress_root / "bags" / "learner1" / "attempts" / EXERCISE
+    keep_attempt(attempts, "20261129-101500-seed1717-fail", [("probe /count", False, "got 4")])
+    keep_attempt(attempts, "20261129-102000-seed4242-pass", [("probe /count", True, "5")])
+    keep_attempt(attempts, "20261129-102500.recording", [])  # a grading under way
+    room.records.append(seat_record("learner1", passed=True))
+    wait_for(lambda: bool(platform.scores["11"]), why="Ada's score")
+    # No dashboard runs here at all: the attempts are read from the seat's folder.
+
+    grid = request("GET", room.server.gradebook_url)
+    [cell] = re.findall(r'href="(gradebook/attempts\?[^"]+)"', grid.body)
+    page = request("GET", f"{room.urls.base}/{html.unescape(cell)}&token={TEACHER_TOKEN}")
+    assert page.status == 200, page.body
+    words = html.unescape(re.sub(r"<[^>]+>", " ", page.body))
+    assert "Ada Lovelace" in words and "dashboard learner1" in words and "✓ sent" in words
+    code = room.progress_root / "learner1" / "learner1.code" / f"{EXERCISE}.py"
+    body = words.split("Graded attempts", 1)[1]
+    assert body.index("--seed 4242") < body.index("--seed 1717")  # newest first
+    assert f"ros2-classroom exercise check {EXERCISE} {code} --seed 4242" in words
+    assert "probe /count: got 4" in words and "2 shown: 1 passed, 1 failed" in words
+    assert f"recorded in {attempts}" in words
+    assert (
+        "no replay button here: it would run the learner's code on the classroom's server" in words
+    )
+
+    # Without the teacher's token: refused; a learner the classroom never seated: a page.
+    assert request("GET", f"{room.urls.base}/{html.unescape(cell)}").status == 403
+    nobody = request(
+        "GET",
+        f"{room.urls.base}/gradebook/attempts?learner=lti-nobody&activity=exercise:{EXERCISE}"
+        f"&token={TEACHER_TOKEN}",
+    )
+    assert nobody.status == 404 and "no learner 'lti-nobody'" in html.unescape(nobody.body)
+
+
 def test_the_classroom_serves_lti_only_when_given_its_address(tmp_path: Path) -> None:
     learners = plan(2, base_port=free_port(), base_domain=20, progress_root=tmp_path, site=SITE)
     room = Classroom(learners, {})
@@ -191,5 +246,6 @@ def test_the_classroom_serves_lti_only_when_given_its_address(tmp_path: Path) ->
         assert keys.status == 200 and json.loads(keys.body)["keys"]
         assert server.lti.learner_urls == {ln.name: ln.url("127.0.0.1") for ln in learners}
         assert server.lti.tool.folder == tmp_path / "lti" and (tmp_path / "lti" / "keys").is_dir()
+        assert server.lti.progress_root == tmp_path  # where each seat keeps its attempts
     finally:
         server.close()

@@ -12,6 +12,8 @@ import html
 import io
 import json
 import re
+import time
+import urllib.parse
 from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
@@ -21,6 +23,7 @@ import pytest
 
 from app.lti import claims
 from app.lti.learners import hub_user_name
+from app.teacher.record import GradedAttempt
 from tests.lti.platform import TestPlatform
 from tests.lti.service import PREFIX, Answer, ServiceUnderTest, request, wait_for
 from tests.lti.test_service import (
@@ -191,7 +194,8 @@ def test_a_learner_without_teacher_rights_is_refused_the_gradebook(
     tries = len(platform.score_requests)
 
     learner = service.hub.token_for(ada["name"])  # a real hub user, with no teacher scope
-    for path in ("gradebook", "gradebook.json", "", "progress.json"):
+    history = f"gradebook/attempts?learner={ada['name']}&activity=exercise:{EXERCISE}"
+    for path in ("gradebook", "gradebook.json", "", "progress.json", history):
         answer = as_user(service, learner, path)
         assert answer.status == 403, (path, answer.status)
         assert "Ada Lovelace" not in answer.body and "lineitems" not in answer.body
@@ -207,3 +211,95 @@ def test_a_learner_without_teacher_rights_is_refused_the_gradebook(
     # Without any hub login, the browser goes to the hub to sign in first.
     anonymous = request("GET", service.url + PREFIX + "gradebook")
     assert anonymous.status == 302 and "/oauth2/authorize" in anonymous.location
+
+
+def history_links(page: str) -> dict[str, str]:
+    """The class grid's cell links, by the activity each opens ("exercise:counter_publisher")."""
+    found = {}
+    for href in re.findall(r'href="(gradebook/attempts\?[^"]+)"', page):
+        href = html.unescape(href)
+        query = dict(urllib.parse.parse_qsl(urllib.parse.urlsplit(href).query))
+        found[f"{query['learner']} {query['activity']}"] = href
+    return found
+
+
+def page_text(body: str) -> str:
+    return html.unescape(re.sub(r"<[^>]+>", " ", body))
+
+
+def test_a_cell_opens_the_learners_graded_attempts_with_their_seeds_and_the_lms_state(
+    service: ServiceUnderTest, platform: TestPlatform
+) -> None:
+    link = graded_link(platform.lineitem_url("11"), {"exercise": EXERCISE, "score_maximum": "5"})
+    ada = hub_login(service, launch(service, platform, **link))
+    assert ada is not None
+    name = ada["name"]
+    now = time.time()
+    tried = (
+        GradedAttempt(now - 60, "pass", 4242, 3, 3, (), "3 of 3 checks passed: passed."),
+        GradedAttempt(
+            now - 300, "fail", 17, 2, 3, ("probe /count: sent 5, <got> 4",), "2 of 3 checks"
+        ),
+        GradedAttempt(now - 400, "problem", 0, 0, 0, (), "Not graded: your program is not running"),
+    )
+    # The dashboard reports its newest attempts while the learner is on the exercise.
+    record = replace(exercise_record(name, passed=True), exercise_history=tried)
+    assert service.report(record).status == 200
+    wait_for(lambda: bool(platform.scores["11"]), why="the score")
+    # Then moves on to another exercise: its history stays in the gradebook.
+    later = replace(exercise_record(name, passed=False, slug="wall_stop"), exercise_history=())
+    assert service.report(later).status == 200
+    teacher = service.hub.teacher_token("mrs-teacher")
+
+    grid = as_user(service, teacher, "gradebook")
+    cell = history_links(grid.body)[f"{name} exercise:{EXERCISE}"]
+    page = as_user(service, teacher, cell)
+    assert page.status == 200 and page.headers["content-type"].startswith("text/html")
+    assert page.headers["cache-control"] == "no-store"
+    words = page_text(page.body)
+    assert "Ada Lovelace: Exercise (lesson 5): A counter on a topic" in words
+    assert "✓ sent" in words and "5 of 5" in words  # what the LMS has
+    assert "seed 4242" in words  # ...and what the score told it
+    assert f"ros2-classroom exercise check {EXERCISE} FILE --seed 4242" in words
+    assert f"ros2-classroom exercise check {EXERCISE} FILE --seed 17" in words
+    assert "probe /count: sent 5, <got> 4" in words and "<got>" not in page.body
+    assert "⚠ not graded" in words and "your program is not running" in words
+    assert "no replay button here: the teacher service runs no ROS 2 graph" in words
+    assert "3 shown: 1 passed, 1 failed, 1 not graded" in words
+
+
+def test_an_address_naming_no_learner_or_activity_of_the_gradebook_gets_a_page(
+    service: ServiceUnderTest, platform: TestPlatform
+) -> None:
+    link = graded_link(platform.lineitem_url("11"), {"exercise": EXERCISE})
+    ada = hub_login(service, launch(service, platform, **link))
+    # Grace is in another course, whose link opens the lesson only.
+    other = graded_link(platform.lineitem_url("21"), {"lesson": LESSON}, "link-9")
+    other[claims.CONTEXT] = {"id": "course-2", "title": "Robotics 102"}
+    grace = hub_login(service, launch(service, platform, sub="learner-43", **other))
+    assert ada is not None and grace is not None
+    teacher = service.hub.teacher_token("mrs-teacher")
+    ada_name, grace_name = ada["name"], grace["name"]
+    cases = {
+        "gradebook/attempts": "names no activity",
+        f"gradebook/attempts?learner={ada_name}&activity=bogus": "names no activity",
+        f"gradebook/attempts?activity=exercise:{EXERCISE}": "names no learner",
+        f"gradebook/attempts?learner=lti-nobody&activity=exercise:{EXERCISE}": (
+            "no learner 'lti-nobody' has opened anything from the LMS here"
+        ),
+        f"gradebook/attempts?learner={ada_name}&activity=exercise:no_such": (
+            "Ada Lovelace has no LMS link to exercise 'no_such'"
+        ),
+        f"gradebook/attempts?learner={grace_name}&activity=exercise:{EXERCISE}": (
+            f"has no LMS link to exercise '{EXERCISE}' (it may be another course's activity); "
+            "they opened Lesson 5"
+        ),
+        "gradebook/attempts?learner=%3Cscript%3E&activity=exercise:x": "no learner '<script>'",
+    }
+    for path, sentence in cases.items():
+        answer = as_user(service, teacher, path)
+        assert answer.status == 404, (path, answer.status)
+        assert answer.headers["content-type"].startswith("text/html")
+        assert "Traceback" not in answer.body and "<script>" not in answer.body
+        found = re.search(r'<p class="why">(.*?)</p>', answer.body, re.S)
+        assert found and sentence in html.unescape(found.group(1)), (path, answer.body)

@@ -18,6 +18,7 @@ import re
 import time
 import urllib.parse
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -29,6 +30,7 @@ from app.lti.dynamic_registration import registration_url
 from app.lti.learners import hub_user_name
 from app.lti.registration import load_registrations
 from app.lti.tool import PLATFORMS_FILE
+from app.teacher.record import GradedAttempt
 from tests.lti.pypi_platform import DEPLOYMENT_ID, LaunchQuirk, PypiPlatform, key_pair
 from tests.lti.service import PREFIX, Answer, ServiceUnderTest, request, wait_for
 from tests.lti.test_service import EXERCISE, LESSON, exercise_record, hub_login, refusal
@@ -140,9 +142,15 @@ def test_a_teacher_adds_an_exercise_a_learner_passes_it_and_the_platform_gets_th
     user = hub_login(service, Answer(303, {"location": relative}, ""))
     assert user is not None and user["name"] == hub_user_name(lms.issuer, "learner-1")
 
-    # They pass the exercise on their dashboard: the score reaches the platform's AGS endpoint.
+    # They pass the exercise on their dashboard (after a failed grading): the score reaches
+    # the platform's AGS endpoint, and the report carries both gradings with their seeds.
+    tried = (
+        GradedAttempt(time.time() - 30, "pass", 4242, 3, 3, (), "3 of 3 checks passed: passed."),
+        GradedAttempt(time.time() - 90, "fail", 1717, 2, 3, ("probe /count: sent 5, got 4",)),
+    )
+    passed = replace(exercise_record(user["name"], passed=True), exercise_history=tried)
     started = time.monotonic()
-    assert service.report(exercise_record(user["name"], passed=True)).status == 200
+    assert service.report(passed).status == 200
     wait_for(lambda: bool(lms.scores[item]), why="the score at the platform")
     latency = time.monotonic() - started
     [score] = lms.scores[item]
@@ -153,6 +161,30 @@ def test_a_teacher_adds_an_exercise_a_learner_passes_it_and_the_platform_gets_th
     assert score["timestamp"].endswith("+00:00")
     assert latency < 5  # the lti_score_latency_p95_s bound, on one score
     assert lms.token_answers == [200] and lms.score_answers == [200]
+
+    # The teacher opens the gradebook and clicks the learner's cell of that exercise.
+    teacher = service.hub.teacher_token("mrs-teacher")
+    context = browser.new_context(extra_http_headers={"Authorization": f"token {teacher}"})
+    page = context.new_page()
+    try:
+        page.goto(service.url + PREFIX + "gradebook")
+        cell = page.locator("#class-grid tbody td a")
+        assert cell.inner_text().strip() == "✓ 5 of 5"
+        cell.click()
+        page.wait_for_url("**/gradebook/attempts?*")
+        rows = page.locator("#attempts tbody tr")
+        assert rows.count() == 2
+        newest, failed = rows.nth(0).inner_text(), rows.nth(1).inner_text()
+        assert "✓ passed" in newest and "4242" in newest
+        assert f"exercise check {EXERCISE} FILE --seed 4242" in newest
+        assert "✗ failed" in failed and "1717" in failed and "probe /count: sent 5, got 4" in failed
+        lms_side = page.locator("#lms").inner_text()
+        assert "✓ sent" in lms_side and "5 of 5" in lms_side
+        assert "no replay button here" in page.locator("#replay + p").inner_text()
+        page.get_by_role("link", name="Back to the gradebook").click()
+        page.locator("#class-grid").wait_for()
+    finally:
+        context.close()
 
 
 # Grades the platform refuses -----------------------------------------------------------------
