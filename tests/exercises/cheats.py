@@ -17,6 +17,7 @@ from typing import Any
 from app.exercises.model import Exercise
 from tests.exercises.cheats_grid import GENERATORS as GRID_GENERATORS
 from tests.exercises.cheats_mapping import GENERATORS as MAPPING_GENERATORS
+from tests.exercises.cheats_patrol import GENERATORS as PATROL_GENERATORS
 from tests.exercises.cheats_sim import GENERATORS as SIM_GENERATORS
 
 _MAIN = """
@@ -545,6 +546,7 @@ GENERATORS = {
     **SIM_GENERATORS,  # the "Drive a robot" unit's (they replay the example drive)
     **GRID_GENERATORS,  # unit 24's grid planner (it answers with the statement's example)
     **MAPPING_GENERATORS,  # unit 23's log-odds mapper and unit 24's particle motion update
+    **PATROL_GENERATORS,  # unit 24's Nav2 patrol (it teleports along the real route)
 }
 
 # Exercises for which no cheat can be generated, each with the reason (none today).

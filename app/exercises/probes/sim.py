@@ -208,9 +208,14 @@ def _wait_for_world(ctx: ProbeContext, recorder: Recorder) -> None:
 
 
 @contextmanager
-def simulation(ctx: ProbeContext, rtf: float) -> Iterator[tuple[World, Recorder]]:
+def simulation(
+    ctx: ProbeContext, rtf: float, learner_sim_time: bool = True
+) -> Iterator[tuple[World, Recorder]]:
     """The world, ready for trials; afterwards its parameters as before, the learner's node
-    left on simulation time (never turned off: that kills a multithreaded learner)."""
+    left on simulation time (never turned off: that kills a multithreaded learner).
+
+    ``learner_sim_time`` False leaves the learner's clock alone: a node that talks to
+    servers on the wall clock (the Nav2 stack as the catalog starts it) stays on it."""
     recorder = Recorder(ctx)
     services = Services(ctx)
     world: World | None = None
@@ -220,7 +225,8 @@ def simulation(ctx: ProbeContext, rtf: float) -> Iterator[tuple[World, Recorder]
         name = str(current.pop("world"))
         world = World(name, world_map(name), current, rtf, services)
         try:
-            services.set(ctx.learner_node, {"use_sim_time": True})  # already true: no change
+            if learner_sim_time:
+                services.set(ctx.learner_node, {"use_sim_time": True})  # already true: no change
         except Ros2Error as exc:
             raise Ros2Error(
                 f"could not set use_sim_time on {ctx.learner_node}: {exc} (is its executor busy?)"
