@@ -423,6 +423,13 @@ def teacher_page(browser: Browser, env: dict[str, str], tmp: str) -> None:
             raise
 
 
+def gradebook_pictures(browser: Browser, env: dict[str, str], tmp: str) -> None:
+    """The LTI gradebook (docs/gradebook_screenshot.py: it needs no DDS)."""
+    from docs.gradebook_screenshot import gradebook
+
+    gradebook(browser, IMAGES, tmp)
+
+
 def main() -> int:
     IMAGES.mkdir(parents=True, exist_ok=True)
     env = dict(os.environ, PYTHONUNBUFFERED="1")
@@ -432,7 +439,12 @@ def main() -> int:
             executable_path="/usr/bin/chromium", args=["--no-sandbox", "--disable-dev-shm-usage"]
         )
         only = sys.argv[1:]  # e.g. "gallery": one part; none: every picture
-        parts = {"dashboard": learner_dashboard, "teacher": teacher_page, "gallery": walked_gallery}
+        parts = {
+            "dashboard": learner_dashboard,
+            "teacher": teacher_page,
+            "gradebook": gradebook_pictures,
+            "gallery": walked_gallery,
+        }
         for name, take in parts.items():
             if not only or name in only:
                 take(browser, env, tmp)
