@@ -104,9 +104,12 @@ def _grade(grading_env, exercise: Exercise, code: str) -> Report:
     try:
         return _read_back(grader.grade(exercise, script, seed=7))
     finally:
+        # The verdict is in: the learner's program and the setup nodes are stopped at once
+        # (each still Ctrl+C, then escalated), not one after the other's reap.
+        stopping = [supervisor.stop(name) for name in exercise.setup]
         runner.stop(supervisor, exercise)
-        for name in exercise.setup:
-            supervisor.stop(name).result()
+        for future in stopping:
+            future.result()
         fail_on_leftover_nodes("this case")  # e.g. the nodes a launch file started
 
 
