@@ -42,7 +42,13 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
             if time.monotonic() > deadline:
                 return Result(name, False, f"nothing subscribes to {in_topic}")
             ctx.call.sleep(0.05)
-        ctx.call.sleep(0.3)  # let the learner's publisher match our reader too
+        # Its answers reach us only once its writer and our reader know each other: seen
+        # late on a loaded machine (the first answers were lost). Wait for our side to see
+        # its publisher (it may have none: the grading then says so), then a little more.
+        deadline = time.monotonic() + 3.0
+        while not node.count_publishers(out_topic) and time.monotonic() < deadline:
+            ctx.call.sleep(0.05)
+        ctx.call.sleep(0.5)
         before = monitor.count
         for value in inputs:
             publisher.publish(fill(in_type, {p["input_field"]: value}))
