@@ -141,10 +141,16 @@ def set_request(name: str, value: object) -> SetParameters.Request:
 
 
 def set_value(ctx: CallContext, fqn: str, name: str, value: object) -> tuple[bool, str]:
-    """(successful, reason) as the node answered."""
+    """(successful, reason) as the node answered.
+
+    Setting a value is safe to repeat, so an unanswered request is sent once more
+    (a new client's first answer can be lost while discovery lags: see call_service).
+    """
+    request = set_request(name, value)
+    service = _service(fqn, "set_parameters")
     response = cast(
         SetParameters.Response,
-        call_service(ctx, _service(fqn, "set_parameters"), SetParameters, set_request(name, value)),
+        call_service(ctx, service, SetParameters, request, resend_unanswered=True),
     )
     result = response.results[0]
     return bool(result.successful), result.reason
