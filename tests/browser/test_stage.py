@@ -372,9 +372,23 @@ def test_the_plot_stage_shows_the_executor_demo_starved_then_not(browser, dashbo
         charts = page.locator(".uplot canvas").filter(visible=True)
         expect(charts).to_have_count(2)
         picker = page.get_by_label("On stage").bounding_box()
-        for i in range(2):
-            box = charts.nth(i).bounding_box()
-            assert box and picker and box["width"] > 300 and box["x"] + box["width"] < picker["x"]
+        assert picker
+        right = picker["x"]
+
+        def charts_fill_the_stage() -> bool:  # a chart drawn a moment ago may still be resized
+            boxes = [charts.nth(i).bounding_box() for i in range(2)]
+            return all(
+                box and box["width"] > 300 and box["x"] + box["width"] < right for box in boxes
+            )
+
+        wait_until(
+            charts_fill_the_stage,
+            timeout=10,
+            what=lambda: (
+                f"both charts wider than 300 px left of x={right}: "
+                + str([charts.nth(i).bounding_box() for i in range(2)])
+            ),
+        )
     finally:
         page.screenshot(path=str(ARTIFACTS / "stage-plot-executors.png"))
         page.context.close()  # the dashboard ends its nodes with it

@@ -3,8 +3,11 @@
 sim_world (office, faster than real time, world -> odom on /tf), a static
 ``map -> world`` identity from the test (no AMCL here), map_server with the
 office map, planner_server, controller_server and bt_navigator, brought up
-by one lifecycle_manager (autostart). A plain rclpy ActionClient sends
-NavigateToPose goals as ``ros2 action send_goal`` or BasicNavigator would:
+by one lifecycle_manager (autostart). An ActionClient sends NavigateToPose
+goals as ``ros2 action send_goal`` or BasicNavigator would (the thread-safe
+one: this test sends from its own thread while the probe's executor takes
+the answers, the rclpy 7.1.6 race tests/integration/test_action_client_race.py
+shows; a result answer lost to it once left "the wall goal did not end"):
 from the corridor into the meeting room through its door (reached, feedback
 with a shrinking distance_remaining, never near a wall by ground truth),
 into a wall (an error code, the servers live on), and one that is cancelled
@@ -32,6 +35,7 @@ from tf2_msgs.msg import TFMessage
 from app import PROJECT_ROOT
 from app.catalog import lookup
 from app.lessons.checks._world_map import load_world_map
+from app.ros.action_client import ThreadSafeActionClient
 from nodes.common.occupancy_grid import plan_distance
 from tests.conftest import wait_until
 
@@ -140,7 +144,7 @@ def test_navigate_to_pose_through_a_door_a_wall_goal_and_a_cancel(probe, supervi
     static_pub.publish(TFMessage(transforms=[]))  # keeps the publisher referenced
 
     # The planner alone: a path from the robot into the meeting room, on /plan.
-    planner = ActionClient(node, ComputePathToPose, "/compute_path_to_pose")
+    planner = ThreadSafeActionClient(node, ComputePathToPose, "/compute_path_to_pose")
     assert planner.wait_for_server(timeout_sec=30)
     plan_goal = ComputePathToPose.Goal(goal=pose_stamped(*DOOR_GOAL))
     plan_handle = send(planner, plan_goal, [])
@@ -153,7 +157,7 @@ def test_navigate_to_pose_through_a_door_a_wall_goal_and_a_cancel(probe, supervi
     wait_until(lambda: plans, timeout=20, what="/plan")
 
     # Navigate into the meeting room.
-    navigator = ActionClient(node, NavigateToPose, "/navigate_to_pose")
+    navigator = ThreadSafeActionClient(node, NavigateToPose, "/navigate_to_pose")
     assert navigator.wait_for_server(timeout_sec=30)
     feedback: list[Any] = []
     t0 = time.monotonic()

@@ -9,7 +9,7 @@ navigator as the dashboard starts them, brought up by the lifecycle manager;
 where the robot is comes from the simulator (world -> odom) and the map is
 the world frame (no amcl: this is about the costmaps, the planner and the
 controller, and should not hang on localization). Then NavigateToPose goals
-from a plain ActionClient:
+from an ActionClient (the thread-safe one: see test_navigation_dds.py):
 
 - along the corridor past the box: the costmaps mark the box from /scan,
   the navigator's new plans go round it, the robot arrives and never comes
@@ -34,13 +34,13 @@ from geometry_msgs.msg import PoseStamped
 from nav2_msgs.action import ComputePathToPose, NavigateToPose
 from nav_msgs.msg import OccupancyGrid, Odometry
 from nav_msgs.msg import Path as PathMsg
-from rclpy.action import ActionClient
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_srvs.srv import Trigger
 
 from app import PROJECT_ROOT
 from app.catalog import lookup
 from app.lessons.checks._world_map import load_world_map
+from app.ros.action_client import ThreadSafeActionClient
 from nodes.common.occupancy_grid import plan_distance
 from tests.conftest import wait_until
 
@@ -178,7 +178,7 @@ def test_boxes_not_on_the_map_are_driven_round_or_reported_and_a_cancel_stops_at
     up = time.monotonic() - started
     # The world with the boxes is the one running (a later -p world:= wins).
     assert any(f"{world}' loaded" in line for line in supervisor.output("sim_office"))
-    navigator = ActionClient(node, NavigateToPose, "/navigate_to_pose")
+    navigator = ThreadSafeActionClient(node, NavigateToPose, "/navigate_to_pose")
     assert navigator.wait_for_server(timeout_sec=30)
 
     def send(goal: tuple[float, float, float]) -> Any:
