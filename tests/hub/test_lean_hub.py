@@ -138,8 +138,13 @@ def test_each_learner_lands_in_their_own_dashboard_through_the_hubs_oauth(hub, r
         expect(vertex(page, mine)).to_be_visible(timeout=30_000)
         expect(vertex(page, theirs)).to_have_count(0)
     # A stage box is a page link (classroom/act/...): it works under the hub's base path.
+    # Clicked once the picture is steady: the talker listed by DDS, its topic's rate drawn
+    # (each of those redraws the picture; a click across a redraw lands on no link).
+    expect(vertex(dora, "talker")).to_have_attribute("data-state", "on-graph", timeout=30_000)
+    expect(dora.locator("svg.stage-graph").get_by_text("2.0 Hz")).to_be_visible(timeout=30_000)
     vertex(dora, "talker").locator("a").click()
-    expect(dora.get_by_text("Node /talker", exact=True).filter(visible=True)).to_be_visible()
+    node_card = dora.get_by_text("Node /talker", exact=True).filter(visible=True)
+    expect(node_card).to_be_visible(timeout=20_000)
 
     # Progress reaches the teacher service as in the lab mode (HTTP with the hub's token).
     teacher = room.pages[TEACHER]

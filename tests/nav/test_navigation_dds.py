@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 import pytest
 from action_msgs.msg import GoalStatus
-from geometry_msgs.msg import PoseStamped, TransformStamped
+from geometry_msgs.msg import TransformStamped
 from nav2_msgs.action import ComputePathToPose, NavigateToPose
 from nav_msgs.msg import Odometry, Path
 from rclpy.action import ActionClient
@@ -38,6 +38,7 @@ from app.lessons.checks._world_map import load_world_map
 from app.ros.action_client import ThreadSafeActionClient
 from nodes.common.occupancy_grid import plan_distance
 from tests.conftest import wait_until
+from tests.nav.goal_helpers import pose_stamped, wait_future
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(240)]
 
@@ -77,21 +78,6 @@ class Truth:
         with self.lock:
             assert self.pose is not None
             return self.pose
-
-
-def pose_stamped(x: float, y: float, yaw: float) -> PoseStamped:
-    pose = PoseStamped()
-    pose.header.frame_id = "map"
-    pose.pose.position.x, pose.pose.position.y = x, y
-    pose.pose.orientation.z, pose.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
-    return pose
-
-
-def wait_future(future: Any, timeout: float, what: str) -> Any:
-    done = threading.Event()
-    future.add_done_callback(lambda _f: done.set())
-    assert done.wait(timeout), what
-    return future.result()
 
 
 def send(client: ActionClient, goal: Any, feedback: list[Any]) -> Any:

@@ -30,7 +30,6 @@ from typing import Any
 import numpy as np
 import pytest
 from action_msgs.msg import GoalStatus
-from geometry_msgs.msg import PoseStamped
 from nav2_msgs.action import ComputePathToPose, NavigateToPose
 from nav_msgs.msg import OccupancyGrid, Odometry
 from nav_msgs.msg import Path as PathMsg
@@ -43,6 +42,7 @@ from app.lessons.checks._world_map import load_world_map
 from app.ros.action_client import ThreadSafeActionClient
 from nodes.common.occupancy_grid import plan_distance
 from tests.conftest import wait_until
+from tests.nav.goal_helpers import pose_stamped, string_parameter, wait_future
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(180)]
 
@@ -118,21 +118,6 @@ class Truth:
             return self.pose
 
 
-def pose_stamped(x: float, y: float, yaw: float) -> PoseStamped:
-    pose = PoseStamped()
-    pose.header.frame_id = "map"
-    pose.pose.position.x, pose.pose.position.y = x, y
-    pose.pose.orientation.z, pose.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
-    return pose
-
-
-def wait_future(future: Any, timeout: float, what: Any) -> Any:
-    done = threading.Event()
-    future.add_done_callback(lambda _f: done.set())
-    assert done.wait(timeout), what() if callable(what) else what
-    return future.result()
-
-
 def cost_near(grid: OccupancyGrid, x: float, y: float, reach: float = 0.1) -> int:
     """The highest published cost within ``reach`` of a point (OccupancyGrid values)."""
     info = grid.info
@@ -177,7 +162,7 @@ def test_boxes_not_on_the_map_are_driven_round_or_reported_and_a_cancel_stops_at
     wait_until(active, timeout=90, what=logs)
     up = time.monotonic() - started
     # The world with the boxes is the one running (a later -p world:= wins).
-    assert any(f"{world}' loaded" in line for line in supervisor.output("sim_office"))
+    assert string_parameter(node, "/sim_world", "world") == str(world)
     navigator = ThreadSafeActionClient(node, NavigateToPose, "/navigate_to_pose")
     assert navigator.wait_for_server(timeout_sec=30)
 
