@@ -25,6 +25,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager, suppress
 
 import rclpy
+from rclpy._rclpy_pybind11 import RCLError
 from rclpy.context import Context
 from rclpy.exceptions import InvalidHandle
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
@@ -86,20 +87,30 @@ class RosRuntime:
                 # the handler is skipped when entered but still added to the set, which
                 # raises here. Only that one wait is lost: spin on, never die silently.
                 self.lost_waits += 1
+            except RCLError as exc:
+                # The same race for an action client (a goal's client destroyed by the
+                # worker that sent it): rclpy adds its freed handle to the wait set.
+                if _lost_wait(exc):
+                    self.lost_waits += 1
+                else:
+                    self._report(exc)
             except Exception as exc:
-                # One faulty callback (ours, on a message we did not expect) would otherwise
-                # stop every panel, check and 3D view at once. Say it, once per place, on
-                # stderr (the dashboard's log) and spin on.
-                self.callback_errors += 1
-                where = _where_raised(exc)
-                if where not in self._reported:
-                    self._reported.add(where)
-                    print(
-                        f"[ERROR] a callback of /{self.node.get_name()} raised (spinning on):\n"
-                        + "".join(traceback.format_exception(exc)),
-                        file=sys.stderr,
-                        flush=True,
-                    )
+                self._report(exc)
+
+    def _report(self, exc: BaseException) -> None:
+        """One faulty callback (ours, on a message we did not expect) would otherwise stop
+        every panel, check and 3D view at once. Say it, once per place, on stderr (the
+        dashboard's log); the caller spins on."""
+        self.callback_errors += 1
+        where = _where_raised(exc)
+        if where not in self._reported:
+            self._reported.add(where)
+            print(
+                f"[ERROR] a callback of /{self.node.get_name()} raised (spinning on):\n"
+                + "".join(traceback.format_exception(exc)),
+                file=sys.stderr,
+                flush=True,
+            )
 
     def shutdown(self, timeout: float = 2.0, teardown_sec: float = TEARDOWN_SEC) -> None:
         """Executor first, then the node, then the context: never unbounded.
@@ -118,6 +129,11 @@ class RosRuntime:
             if not self._thread.is_alive():
                 self.node.destroy_node()
             try_shutdown(context=self.context)
+
+
+def _lost_wait(exc: RCLError) -> bool:
+    """An entity freed by another thread while the executor built its wait set."""
+    return "to wait set" in str(exc) and "pointer is invalid" in str(exc)
 
 
 def _where_raised(exc: BaseException) -> tuple[str, str, int]:

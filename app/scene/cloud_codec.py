@@ -99,6 +99,8 @@ def decode_cloud(msg: PointCloud2, budget: int | None = None) -> DecodedCloud:
     stride = 1 if not budget or total <= budget else math.ceil(total / budget)
     n = (total + stride - 1) // stride
     view_step = step * stride
+    if n == 0:  # an empty cloud (a SLAM map before its first points): nothing to view into
+        return DecodedCloud(np.empty((0, 3), np.float32), np.empty((0, 3), np.uint8), 0, "height")
 
     def column(name: str) -> np.ndarray:
         return _field_view(raw, n, view_step, fields[name], bool(msg.is_bigendian))

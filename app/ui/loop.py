@@ -81,7 +81,9 @@ class UiLoop:
             try:
                 result = work()
             except Exception as exc:  # one line for the page, the traceback for the log
-                if not isinstance(exc, Ros2Error):
+                if self._closed:  # the dashboard is stopping: its node may be gone under it
+                    log.debug("job ended by the shutdown: %s", exc)
+                elif not isinstance(exc, Ros2Error):
                     log.exception("job failed")
                 if on_error is not None:
                     message = one_line(exc)

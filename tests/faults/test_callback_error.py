@@ -8,9 +8,14 @@ once, and spins on.
 
 from __future__ import annotations
 
+import threading
+import time
+
 import pytest
 from std_msgs.msg import String
+from tutorial_interfaces.action import Fibonacci
 
+from app.ros.action_client import ThreadSafeActionClient
 from tests.conftest import wait_until
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(60)]
@@ -39,3 +44,32 @@ def test_a_callback_that_raises_is_reported_once_and_the_node_spins_on(probe, ca
     err = capfd.readouterr().err
     assert err.count("a callback of /test_probe raised (spinning on)") == 1, err
     assert "ValueError: cannot read 'bad 0'" in err
+
+
+def test_action_clients_destroyed_beside_the_spinning_executor_lose_a_wait_not_a_callback(
+    probe, capfd
+):
+    """A worker thread makes and destroys a goal's action client while the executor
+    spins (as the Actions panel and the Nav2 Goal tool do): rclpy can add a freed
+    client to the wait set. That costs one wait, never an error in the log."""
+    stop = threading.Event()
+    made = [0]
+
+    def churn() -> None:
+        while not stop.is_set():
+            client = ThreadSafeActionClient(probe.node, Fibonacci, "/churn/fibonacci")
+            client.destroy()
+            made[0] += 1
+
+    workers = [threading.Thread(target=churn, daemon=True) for _ in range(2)]
+    for worker in workers:
+        worker.start()
+    time.sleep(8.0)
+    stop.set()
+    for worker in workers:
+        worker.join(timeout=5)
+    print(f"{made[0]} clients made and destroyed, {probe.lost_waits} waits lost")
+    assert made[0] > 100
+    err = capfd.readouterr().err
+    assert probe.callback_errors == 0, err
+    assert "raised (spinning on)" not in err, err

@@ -199,6 +199,28 @@ def test_a_failing_job_shows_one_line_and_the_loop_goes_on():
     assert sorted(map(str, shown)) == ["42", "RuntimeError: no such thing"]
 
 
+def test_a_job_that_fails_because_the_dashboard_stops_logs_no_error(caplog):
+    """A panel's call whose node is destroyed by the shutdown is no fault of the panel."""
+    ui = UiLoop()
+    ended = threading.Event()
+
+    def cut_off() -> None:
+        try:
+            raise RuntimeError("cannot use Destroyable because destruction was requested")
+        finally:
+            ended.set()
+
+    with caplog.at_level("DEBUG", logger="app.ui.loop"):
+        ui.run_job(lambda: 1 / 0)  # still running: a real fault, logged
+        drain(ui, until=lambda: any(r.levelname == "ERROR" for r in caplog.records))
+        ui.close()
+        caplog.clear()
+        ui.run_job(cut_off)
+        assert ended.wait(5)
+        time.sleep(0.05)  # the log line comes right after the work ended
+    assert [r.levelname for r in caplog.records] == ["DEBUG"], caplog.text
+
+
 def test_jobs_of_one_lane_run_in_the_order_posted():
     ui, order = UiLoop(), []
     for i in range(20):

@@ -86,6 +86,16 @@ def test_non_finite_points_are_dropped_with_their_colours():
     np.testing.assert_array_equal(cloud.colors, [[1, 2, 3], [7, 8, 9]])
 
 
+@pytest.mark.parametrize("budget", [None, 5])
+def test_an_empty_cloud_decodes_to_no_points(budget):
+    """A SLAM map before its first points, with and without a stored byte: nothing to draw."""
+    empty = encode_cloud(np.empty((0, 3), np.float32), np.empty((0, 3), np.uint8))
+    padded = _cloud([("x", 0, 7), ("y", 4, 7), ("z", 8, 7)], 16, b"", 0)
+    for msg in (empty, padded):
+        cloud = decode_cloud(msg, budget=budget)
+        assert (cloud.total, cloud.shown, cloud.colors.shape) == (0, 0, (0, 3))
+
+
 def test_cloud_without_xyz_is_refused():
     msg = _cloud([("intensity", 0, 7)], 4, b"\0" * 8, 2)
     with pytest.raises(CloudFormatError):
