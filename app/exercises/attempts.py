@@ -11,6 +11,11 @@ learner code cannot reach it): the probes' requests and the node's answers,
 line (rosbag2's ``custom_data``), so ``ros2 bag info`` and any MCAP tool
 (Foxglove opens the file as it is) show what was judged.
 
+The code that was graded is kept beside the bag (``graded.py``, or the
+package in ``graded/<package>/``), so ``exercise check`` can grade exactly
+that again with the same seed and get the same verdict. The folder's naming
+and reading live in app/exercises/attempt_folders.py (no ROS there).
+
 Bounded: the newest ``keep`` attempts of each exercise stay, and the oldest
 of all go first while the folder is over its size. Camera images and point
 clouds are left out (megabytes a second; the grader judges them by what it
@@ -24,17 +29,28 @@ import json
 import logging
 import shutil
 import threading
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
-import yaml
 from rclpy.node import Node
 
 from app.bags.errors import BagError
 from app.bags.folder import bags_dir
 from app.bags.recorder import Recorder
 from app.exercises import plots
+from app.exercises.attempt_folders import (
+    ATTEMPTS_FOLDER,
+    CUSTOM_PREFIX,
+    GRADED_FILE,
+    GRADED_PACKAGE,
+    ResultLine,
+    age_order,
+    custom_data,
+    finished_name,
+    unfinished_names,
+    verdict_of,
+)
+from app.exercises.model import package_files
 from app.exercises.report import Report
 
 log = logging.getLogger(__name__)
@@ -49,9 +65,8 @@ LEFT_OUT_TYPES = frozenset(
         "sensor_msgs/msg/PointCloud2",
     }
 )
-ATTEMPTS_FOLDER = "attempts"
-UNFINISHED = ".recording"  # a folder's suffix until its grading ended
-CUSTOM_PREFIX = "classroom."
+MAX_CODE_BYTES = 1024 * 1024  # of the code kept with an attempt (an exercise's is a few kB)
+MAX_CODE_FILES = 200
 TRACES_FILE = "traces.json"  # what the probes judged over time (app/exercises/trace.py)
 
 
@@ -81,13 +96,11 @@ class AttemptStore:
 
     def start(self, node: Node, slug: str) -> AttemptRecording:
         """Begin recording one grading of ``slug`` (never raises: see ``AttemptRecording``)."""
-        stamp = time.strftime("%Y%m%d-%H%M%S", time.gmtime())
         folder = self.root / slug
-        path = folder / f"{stamp}{UNFINISHED}"
-        for n in range(2, 100):  # two gradings within one second
+        for name in unfinished_names():  # two gradings within one second get -2, -3 ...
+            path = folder / name
             if not path.exists():
                 break
-            path = folder / f"{stamp}-{n}{UNFINISHED}"
         return AttemptRecording(self, node, path)
 
     def attempts(self, slug: str) -> list[Path]:
@@ -95,7 +108,7 @@ class AttemptStore:
         folder = self.root / slug
         if not folder.is_dir():
             return []
-        return sorted((p for p in folder.iterdir() if p.is_dir()), key=lambda p: p.name)
+        return sorted((p for p in folder.iterdir() if p.is_dir()), key=lambda p: age_order(p.name))
 
     def prune(self, slug: str, keeping: Path) -> None:
         """Drop the oldest attempts beyond ``keep`` for ``slug``, then beyond the size cap.
@@ -106,7 +119,7 @@ class AttemptStore:
             _remove(old)
         every = sorted(
             (p for folder in _dirs(self.root) for p in _dirs(folder)),
-            key=lambda p: (p == keeping, p.name),
+            key=lambda p: (p == keeping, age_order(p.name)),
         )
         sizes = {p: _size(p) for p in every}  # each folder walked once
         total = sum(sizes.values())
@@ -152,8 +165,11 @@ class AttemptRecording:
         while not self._stop.wait(POLL_SEC):
             self._poll_once()
 
-    def finish(self, report: Report) -> KeptAttempt:
-        """Write the verdict into the bag's metadata, close it and give it its final name."""
+    def finish(
+        self, report: Report, code: Path | None = None, package: bool = False
+    ) -> KeptAttempt:
+        """Write the verdict into the bag's metadata, close it and give it its final name;
+        keep ``code`` (the graded file, or a file of the graded package) beside it."""
         self._stop.set()
         if self._poller is not None:
             self._poller.join(timeout=2.0)
@@ -166,14 +182,13 @@ class AttemptRecording:
         failed = recorder.failed
         if failed:
             return KeptAttempt(None, f"attempt not kept: {failed}")
-        verdict = "problem" if report.problem else ("pass" if report.passed else "fail")
-        seed = f"-seed{report.seed}" if report.seed is not None else ""
-        name = self._path.name.removesuffix(UNFINISHED)
-        final = self._path.with_name(f"{name}{seed}-{verdict}")
+        verdict = verdict_of(report.passed, report.problem)
+        final = self._path.with_name(finished_name(self._path.name, report.seed, verdict))
         try:
             self._path.rename(final)
         except OSError as exc:
             return KeptAttempt(None, f"attempt not kept: cannot name {self._path}: {exc}")
+        lost_code = keep_graded_code(code, final, package=package) if code is not None else ""
         drawn = _keep_traces(report, final)
         try:
             self._store.prune(final.parent.name, final)
@@ -182,7 +197,43 @@ class AttemptRecording:
         if not final.exists():
             return KeptAttempt(None, f"attempt not kept: larger than {self._store.cap_bytes} bytes")
         log.info("attempt kept in %s (%d messages)", final, status.count)
-        return KeptAttempt(final, plots=drawn)
+        note = f"attempt kept in {final}, but not the code it graded: {lost_code}"
+        return KeptAttempt(final, note if lost_code else "", plots=drawn)
+
+
+def keep_graded_code(code: Path, folder: Path, *, package: bool = False) -> str:
+    """Copy what was graded into the attempt's ``folder``, so the attempt can be graded
+    again on exactly that code; '' once kept, else why not (never raises: a grading
+    must not fail for it).
+
+    One file goes to ``graded.py``. For a package exercise ``code`` is a file inside
+    the package (the grader's own copy, the one it built): the whole package goes to
+    ``graded/<package>/``, which ``exercise check`` takes as it takes the learner's.
+    """
+    try:
+        if not package:
+            if code.stat().st_size > MAX_CODE_BYTES:
+                return f"{code.name} is larger than {MAX_CODE_BYTES // 1024} kB"
+            shutil.copyfile(code, folder / GRADED_FILE)
+            return ""
+        root = next((p for p in code.parents if (p / "package.xml").is_file()), None)
+        if root is None:
+            return f"no package.xml above {code}"
+        files = package_files(root)
+        if len(files) > MAX_CODE_FILES or sum(f.stat().st_size for f in files) > MAX_CODE_BYTES:
+            return (
+                f"the package {root.name} has more than {MAX_CODE_FILES} files or "
+                f"{MAX_CODE_BYTES // 1024} kB"
+            )
+        target = folder / GRADED_PACKAGE / root.name
+        for path in files:
+            destination = target / path.relative_to(root)
+            destination.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(path, destination)
+        return ""
+    except Exception as exc:  # an unwritable folder, a file gone: the grading stands
+        log.warning("could not keep the graded code in %s: %s", folder, exc)
+        return str(exc) or type(exc).__name__
 
 
 def _keep_traces(report: Report, folder: Path) -> tuple[Path, ...]:
@@ -199,48 +250,10 @@ def _keep_traces(report: Report, folder: Path) -> tuple[Path, ...]:
         return ()
 
 
-def attempt_label(path: Path) -> str:
-    """How a kept attempt is listed: "2026-11-29 10:15 UTC · fail · seed 4242", or damaged."""
-    name = path.name
-    stamp = name[:15]
-    try:
-        when = time.strftime("%Y-%m-%d %H:%M:%S UTC", time.strptime(stamp, "%Y%m%d-%H%M%S"))
-    except ValueError:
-        when = name
-    if name.endswith(UNFINISHED):
-        return f"{when} · damaged: its recording never ended (ros2 bag reindex repairs it)"
-    parts = name[15:].split("-")
-    verdict = parts[-1] if parts and parts[-1] in ("pass", "fail", "problem") else "?"
-    seed = next((part[4:] for part in parts if part.startswith("seed")), "")
-    return f"{when} · {verdict}" + (f" · seed {seed}" if seed else "")
-
-
-def attempt_heading(path: Path) -> str:
-    """What a replay of a kept attempt says first: its verdict and result lines, as kept in
-    the bag's metadata ('' when they cannot be read: the bag is damaged)."""
-    try:
-        meta = yaml.safe_load((path / "metadata.yaml").read_text(encoding="utf-8"))
-        custom = meta["rosbag2_bagfile_information"].get("custom_data") or {}
-        lines = [
-            f"- {'✓' if r.get('passed') else '✗'} **{r.get('name', '')}**: {r.get('detail', '')}"
-            for r in json.loads(custom.get(CUSTOM_PREFIX + "results", "[]"))
-        ]
-    except (OSError, ValueError, KeyError, TypeError, AttributeError, yaml.YAMLError):
-        return ""
-    summary = custom.get(CUSTOM_PREFIX + "summary", "")
-    return "\n\n".join(part for part in (f"**{summary}**", "\n".join(lines)) if part.strip("*"))
-
-
 def _custom_data(report: Report) -> dict[str, str]:
-    return {
-        "exercise": report.slug,
-        "seed": "" if report.seed is None else str(report.seed),
-        "verdict": "not graded" if report.problem else ("pass" if report.passed else "fail"),
-        "summary": report.summary(),
-        "results": json.dumps(
-            [{"name": r.name, "passed": r.passed, "detail": r.detail} for r in report.results]
-        ),
-    }
+    lines = (ResultLine(r.name, r.passed, r.detail) for r in report.results)
+    verdict = verdict_of(report.passed, report.problem)
+    return custom_data(report.slug, report.seed, verdict, report.summary(), lines)
 
 
 def _dirs(folder: Path) -> list[Path]:

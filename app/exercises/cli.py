@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from app.exercises.attempt_folders import graded_code, replay_command
 from app.exercises.model import Exercise, ExerciseError, load_exercises
 from app.exercises.report import Report
 
@@ -132,12 +133,14 @@ def _print_verdict(exercise: Exercise, report: Report, graded: Path) -> int:
     print(report.summary())
     if report.attempt:
         print(f"recorded: {report.attempt}")
-    elif report.attempt_note:
+    if report.attempt_note:
         print(report.attempt_note)
     for plot in report.plots:
         print(f"plot: {plot}")
     if report.seed is not None and not report.problem:
-        print(f"replay: exercise check {exercise.slug} {graded} --seed {report.seed}")
+        # The copy kept with the attempt, when there is one: FILE may change after this.
+        kept = graded_code(Path(report.attempt)) if report.attempt else None
+        print(f"replay: {replay_command(exercise.slug, kept or graded, report.seed)}")
     return 0 if report.passed else EXIT_FAILED
 
 

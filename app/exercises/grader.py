@@ -183,7 +183,7 @@ class Grader:
         finally:
             lessons.close()
             if recording is not None:
-                kept = recording.finish(report)
+                kept = recording.finish(report, script, package=exercise.is_package)
                 report.attempt = str(kept.path or "")
                 report.attempt_note = kept.note
                 report.plots = [str(path) for path in kept.plots]

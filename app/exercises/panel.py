@@ -23,7 +23,7 @@ import viser
 from app.bags.folder import bags_dir
 from app.containment.policy import RunPolicy
 from app.exercises import code_assist, package_grading, plots, runner
-from app.exercises.attempts import attempt_heading, attempt_label
+from app.exercises.attempt_folders import attempt_heading, attempt_label
 from app.exercises.editor_server import EditorHub, editor_url
 from app.exercises.explain import panel_line
 from app.exercises.grader import Grader

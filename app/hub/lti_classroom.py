@@ -54,6 +54,8 @@ from app.lti.state_file import save_json
 from app.lti.tool import LtiTool
 from app.teacher.attempt_files import AttemptReader, exercise_folder
 from app.teacher.record import MAX_HISTORY, LearnerRecord
+from app.teacher.time_spent import activity_key, read_totals
+from app.teacher.time_spent import file_for as time_file_for
 
 log = logging.getLogger(__name__)
 
@@ -159,9 +161,8 @@ class ClassroomLti(LtiService):
     def attempts_source(self, name: str, slug: str) -> AttemptSource:
         """The seat's own attempt folder, read where its dashboard keeps it (app/cli.py)."""
         replay = (
-            "it would run the learner's code on the classroom's server, outside their "
-            "dashboard's limits, and their code as it is now, not as it was graded (an "
-            "attempt keeps what the grader sent and what came back, not the code)"
+            "it would run the learner's code on the classroom's server, outside the limits "
+            "and the containment their dashboard runs it in"
         )
         seat = self.seats.seat_of(name)
         if seat is None or self.progress_root is None or not valid_names(seat, slug):
@@ -189,6 +190,15 @@ class ClassroomLti(LtiService):
                 "pick it under Attempt in their Exercise tab and press Watch this attempt."
             ),
         )
+
+    def time_spent_of(self, name: str, kind: str, slug: str) -> int | None:
+        """The seat's own totals, read where its dashboard keeps them (the seats report over
+        DDS, whose message does not carry them); None without a seat or a progress folder."""
+        seat = self.seats.seat_of(name)
+        if seat is None or self.progress_root is None or not kind:
+            return None
+        totals = read_totals(time_file_for(self.progress_root / seat / f"{seat}.json"))
+        return totals.get(activity_key(kind, slug))
 
     def on_seat_records(self, records: Iterable[LearnerRecord]) -> int:
         """The roster's records: each seat of ours that an LMS learner holds is graded as theirs."""

@@ -63,6 +63,7 @@ from app.lti.routes import (
     REGISTER_PATH,
     ToolUrls,
 )
+from app.lti.time_book import TimeBook
 from app.lti.tool import GradedResult, LtiTool
 from app.teacher.record import MAX_HISTORY, LearnerRecord
 
@@ -197,12 +198,14 @@ class LtiService:
         self.tickets = HandoffTickets()
         self.pump = OutboxPump(tool, poll_sec)
         self.history = AttemptHistory(tool.folder)
+        self.time_book = TimeBook(tool.folder)
 
     def start(self) -> None:
         self.pump.start()
 
     def stop(self) -> None:
         self.pump.stop()
+        self.time_book.save()
 
     # -- where people are sent ----------------------------------------------------------
 
@@ -254,6 +257,8 @@ class LtiService:
         if record.exercise_history and self.tool.book.learner(record.learner) is not None:
             attempts = (Attempt(**asdict(each)) for each in record.exercise_history)
             self.history.add(record.learner, record.exercise, attempts)
+        if record.time_spent and self.tool.book.learner(record.learner) is not None:
+            self.time_book.update(record.learner, record.time_spent)
         if not self.tool.graded_items(record.learner):
             return 0
         queued = sum(self.tool.submit(record.learner, result) for result in results_in(record))
@@ -274,7 +279,19 @@ class LtiService:
     def gradebook(self) -> list[GradebookLine]:
         titles = {(a.kind, a.slug): a.title for a in self.catalog}
         lines = gradebook(self.tool.book.learners(), self.tool.outbox.entries(), titles)
-        return [replace(line, seat=self.seat_of(line.learner)) for line in lines]
+        return [
+            replace(
+                line,
+                seat=self.seat_of(line.learner),
+                time_spent=self.time_spent_of(line.learner, line.kind, line.slug),
+            )
+            for line in lines
+        ]
+
+    def time_spent_of(self, name: str, kind: str, slug: str) -> int | None:
+        """Active seconds on an activity, as the learner's progress reports last told
+        (app/teacher/time_spent.py); None when none told it."""
+        return self.time_book.of(name, kind, slug) if kind else None
 
     def attempts_source(self, name: str, slug: str) -> AttemptSource:
         """A learner's graded attempts at an exercise, as the gradebook's history shows them.

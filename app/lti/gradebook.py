@@ -40,6 +40,9 @@ class GradebookLine:
     comment: str = ""  # what the score told the LMS (what was checked, the seed)
     kind: str = ""  # "lesson" or "exercise" ('' : a score whose link no launch names now)
     slug: str = ""  # the lesson's id or the exercise's slug
+    # Active seconds the learner's dashboard counted on it (None: none reported). The
+    # same for each LMS link of one activity: it is the learner's time, not the link's.
+    time_spent: int | None = None
 
     def to_json(self) -> dict[str, object]:
         return {name: getattr(self, name) for name in self.__dataclass_fields__}

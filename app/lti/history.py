@@ -48,6 +48,7 @@ class Attempt:
     total: int = 0
     failed: tuple[str, ...] = ()  # "check: why", short
     summary: str = ""
+    graded_file: str = ""  # the code it graded, kept on the dashboard's machine ('' : not kept)
 
     @property
     def key(self) -> tuple[float, str, int]:

@@ -107,6 +107,25 @@ def _time(stamp: float | str | None) -> str:
     return f'<time datetime="{iso}">{when:%Y-%m-%d %H:%M:%S} UTC</time>'
 
 
+def duration(seconds: int | None) -> str:
+    """Time spent as a teacher reads it: '–' (none reported), '< 1 min', '12 min', '2 h 05 min'."""
+    if seconds is None:
+        return "–"
+    minutes = seconds // 60
+    if minutes < 1:
+        return "< 1 min"
+    if minutes < 60:
+        return f"{minutes} min"
+    return f"{minutes // 60} h {minutes % 60:02d} min"
+
+
+# The rule of app/teacher/time_spent.py (IDLE_AFTER_SEC), which this layer cannot import.
+TIME_SPENT_HELP = (
+    "Time spent: active time the learner's dashboard counted while this activity was "
+    "the one it was on and the learner had done something there in the last 5 minutes"
+)
+
+
 def _wait(seconds: float) -> str:
     if seconds <= 1:
         return "now"
@@ -132,6 +151,8 @@ def _gradebook_row(line: GradebookLine, now: float, seats: bool, whose: bool = T
         f'<td class="{line.state.replace(" ", "-")} nowrap">{_STATE_MARKS[line.state]}</td>',
         f"<td>{html.escape(line.score)}</td>",
     ]
+    if whose:
+        cells.append(f'<td class="time nowrap">{duration(line.time_spent)}</td>')
     if line.state == "sent":
         answer = line.lms_answer or "accepted"
         cells += [f"<td>{_time(line.sent_at)}</td>", f"<td>{html.escape(answer)}</td>", "<td></td>"]
@@ -203,7 +224,9 @@ def class_grid(lines: Sequence[GradebookLine]) -> str:
                 cells.append("<td></td>")
                 continue
             state, score = shown_line.state, shown_line.score
-            title = f"{_STATE_MARKS[state]} {score}: {shown}, {activity}; its attempts"
+            spent = duration(shown_line.time_spent)
+            title = f"{_STATE_MARKS[state]} {score}: {shown}, {activity}; time spent {spent}; "
+            title += "its attempts"
             link = history_link(learner, shown_line.kind, shown_line.slug)
             tip = html.escape(title, quote=True)
             cells.append(
@@ -221,7 +244,7 @@ def class_grid(lines: Sequence[GradebookLine]) -> str:
         "<h2>The class at a glance</h2>\n"
         f"<p>{html.escape(legend)}. A click on a cell opens that learner's attempts at it "
         "(each grading, its seed, what went to the LMS); a click on a name shows their "
-        "lines below.</p>\n"
+        "lines below. Hover a cell for the time spent on it.</p>\n"
         f'<table id="class-grid"><thead><tr><th>Learner</th>{head}</tr></thead>'
         f"<tbody>\n{chr(10).join(rows)}\n</tbody></table>\n"
     )
@@ -245,7 +268,12 @@ def gradebook_page(
     summary = " · ".join(f"{n} {state}" for state, n in found.items() if n) or "no launches yet"
     retryable = found["waiting"] + found["refused"]
     head = ["Learner", *(["Dashboard"] if seats else []), "Activity", "LMS link and grade column"]
-    head += ["Grade", "Score", "When", "The LMS's answer", "Next try"]
+    head += [
+        "Grade",
+        "Score",
+        f'<span title="{html.escape(TIME_SPENT_HELP, quote=True)}">Time spent</span>',
+    ]
+    head += ["When", "The LMS's answer", "Next try"]
     rows = "\n".join(_gradebook_row(line, now, seats) for line in lines)
     back_link = (
         f' · <a href="{html.escape(back[0], quote=True)}">{html.escape(back[1])}</a>'
@@ -302,7 +330,8 @@ def _attempt_row(attempt: Attempt, slug: str, code_file: str) -> str:
     else:
         why = ""
     if attempt.seed and attempt.verdict != "problem":
-        command = replay_command(slug, attempt.seed, code_file)
+        # The code this attempt graded, when its folder kept it: the verdict comes back.
+        command = replay_command(slug, attempt.seed, attempt.graded_file or code_file)
         quoted = html.escape(command, quote=True)
         replay = (
             f"<code>{html.escape(command)}</code> "
@@ -341,6 +370,7 @@ def attempts_page(
     shown = (first.lms_name if first else "") or learner
     activity = (first.activity if first else "") or f"{kind} {slug}"
     seat = f" · dashboard {html.escape(first.seat)}" if first and first.seat else ""
+    spent = first.time_spent if first else None
     head = ["LMS link and grade column", "Grade", "Score", "When", "The LMS's answer", "Next try"]
     lms_rows = "\n".join(_gradebook_row(line, now, False, whose=False) for line in lines)
     told = [
@@ -355,6 +385,10 @@ def attempts_page(
         f"<h1>{html.escape(shown)}: {html.escape(activity)}</h1>",
         f'<p><span class="hub">{html.escape(learner)}</span>{seat} · '
         '<a href="../gradebook">Back to the gradebook</a></p>',
+        f'<p id="time-spent"><b>Time spent on it: {duration(spent)}</b> '
+        f"({html.escape(TIME_SPENT_HELP[len('Time spent: ') :])}"
+        + ("" if spent is not None else "; none reported yet")
+        + ").</p>",
         "<h2>In the LMS</h2>",
         '<table id="lms"><thead><tr>'
         + "".join(f"<th>{h}</th>" for h in head)
@@ -402,8 +436,10 @@ def attempts_page(
             else ", with the learner's code saved as FILE (the teacher's page shows it "
             "under the learner)"
         )
-        + ". It grades the code as it is now: if the learner changed it since that "
-        "attempt, the result may differ.</p>"
+        + ". An attempt that kept the code it graded names that copy (a path in the "
+        "learner's bags folder, on the machine that graded it), and the command gives "
+        "its verdict again; for an older attempt it grades the code as it is now, and "
+        "if the learner changed it since, the result may differ.</p>"
     )
     if source.recordings:
         parts.append(f"<p>{html.escape(source.recordings)}</p>")

@@ -1,11 +1,12 @@
 """The graded attempts a learner's dashboard kept, read back as ``GradedAttempt``\\ s.
 
 Each grading leaves a folder ``<attempts>/<exercise>/<UTC time>-seed<N>-<verdict>``
-(app/exercises/attempts.py) whose ``metadata.yaml`` holds the grader's summary
-and each result line. Two readers need them as plain data: the dashboard's
-beacon, which sends the newest of the current exercise in its HTTP report (a
-hub's teacher service cannot reach the learner's files), and the classroom
-command's gradebook, which runs on the machine that holds every seat's folder.
+whose ``metadata.yaml`` holds the grader's summary and each result line
+(named and read by app/exercises/attempt_folders.py, which needs no ROS).
+Two readers need them as plain data: the dashboard's beacon, which sends the
+newest of the current exercise in its HTTP report (a hub's teacher service
+cannot reach the learner's files), and the classroom command's gradebook,
+which runs on the machine that holds every seat's folder.
 
 Reading never raises: a folder that is still being recorded is skipped, and
 one whose metadata cannot be read keeps what its name says.
@@ -13,55 +14,56 @@ one whose metadata cannot be read keeps what its name says.
 
 from __future__ import annotations
 
-import calendar
-import json
 import logging
-import re
-import time
 from pathlib import Path
 
-import yaml
-
-from app.teacher.record import MAX_FAILED, MAX_HISTORY, MAX_REASON, MAX_SUMMARY, GradedAttempt, clip
+from app.exercises.attempt_folders import (
+    ATTEMPTS_FOLDER,
+    UNFINISHED,
+    age_order,
+    graded_code,
+    parse_name,
+    read_verdict,
+)
+from app.teacher.record import (
+    MAX_FAILED,
+    MAX_GRADED_FILE,
+    MAX_HISTORY,
+    MAX_REASON,
+    MAX_SUMMARY,
+    GradedAttempt,
+    clip,
+)
 
 log = logging.getLogger(__name__)
-
-# As app/exercises/attempts.py names and fills them (that module needs rclpy: not imported).
-ATTEMPTS_FOLDER = "attempts"
-UNFINISHED = ".recording"
-CUSTOM_PREFIX = "classroom."
-_NAME = re.compile(r"(\d{8}-\d{6})(?:-\d+)?(?:-seed(\d+))?-(pass|fail|problem)")
 
 
 def attempt_from_folder(path: Path) -> GradedAttempt | None:
     """One kept attempt; None for a folder that is no finished attempt."""
-    found = _NAME.fullmatch(path.name)
-    if found is None:
+    name = parse_name(path.name)
+    if name is None:
         return None
-    stamp, seed, verdict = found.groups()
-    at = float(calendar.timegm(time.strptime(stamp, "%Y%m%d-%H%M%S")))
-    attempt = GradedAttempt(at=at, verdict=verdict, seed=int(seed or 0))
-    try:
-        meta = yaml.safe_load((path / "metadata.yaml").read_text(encoding="utf-8"))
-        custom = meta["rosbag2_bagfile_information"].get("custom_data") or {}
-        results = json.loads(custom.get(CUSTOM_PREFIX + "results", "[]"))
-        summary = str(custom.get(CUSTOM_PREFIX + "summary", ""))
-        failed = [
-            f"{r.get('name', '')}: {' '.join(str(r.get('detail', '')).split())}"
-            for r in results
-            if not r.get("passed")
-        ]
-        passed = sum(bool(r.get("passed")) for r in results)
-    except (OSError, ValueError, KeyError, TypeError, AttributeError, yaml.YAMLError):
+    code = graded_code(path)
+    attempt = GradedAttempt(
+        at=name.at,
+        verdict=name.verdict,
+        seed=name.seed or 0,
+        # A path cut short would name another file: a long one is left out.
+        graded_file=str(code) if code and len(str(code)) <= MAX_GRADED_FILE else "",
+    )
+    kept = read_verdict(path)
+    if kept is None:
         return attempt  # a damaged bag: what its name says
+    failed = [f"{r.name}: {' '.join(r.detail.split())}" for r in kept.results if not r.passed]
     return GradedAttempt(
-        at=at,
-        verdict=verdict,
-        seed=int(seed or 0),
-        passed=passed,
-        total=len(results),
+        at=attempt.at,
+        verdict=attempt.verdict,
+        seed=attempt.seed,
+        passed=sum(r.passed for r in kept.results),
+        total=len(kept.results),
         failed=tuple(clip(line, MAX_REASON) for line in failed[:MAX_FAILED]),
-        summary=clip(" ".join(summary.split()), MAX_SUMMARY),
+        summary=clip(" ".join(kept.summary.split()), MAX_SUMMARY),
+        graded_file=attempt.graded_file,
     )
 
 
@@ -76,7 +78,7 @@ class AttemptReader:
         try:
             names = sorted(
                 (p for p in folder.iterdir() if not p.name.endswith(UNFINISHED)),
-                key=lambda p: p.name,
+                key=lambda p: age_order(p.name),
                 reverse=True,
             )
         except OSError:  # no attempt yet, or not readable

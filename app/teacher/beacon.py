@@ -42,6 +42,7 @@ from app.teacher.record import (
     clip,
     plain_markdown,
 )
+from app.teacher.time_spent import IDLE_AFTER_SEC, TimeSpent, activity_key, file_for
 from app.ui import MarkdownView
 from app.ui.loop import UiLoop
 
@@ -83,11 +84,14 @@ class ProgressBeacon:
         self._notice_view = notice_view
         self._site, self._learner, self._domain_id = site, learner, domain_id
         self._key = f"{site}/{learner}"
-        self._records: queue.SimpleQueue[LearnerRecord | None] = queue.SimpleQueue()
+        # Each record with when its exercise was last opened, saved or checked.
+        self._records: queue.SimpleQueue[tuple[LearnerRecord, float] | None] = queue.SimpleQueue()
         self._stop = threading.Event()
         self._crash_key: tuple | None = None  # UI thread: the crash text read once per process
         self._crash_text = ""
         self._attempts = AttemptReader()  # the beacon thread's: the kept attempts' folders
+        # The beacon thread's too; kept beside the learner's progress across restarts.
+        self._time = TimeSpent(file_for(sources.workspace.progress.path))
         self._link: DdsLink | HubLink
         if hub is not None:  # on a JupyterHub: HTTP to the teacher service
             self._link = HubLink(hub, self._on_notice, self._on_settings)
@@ -109,6 +113,7 @@ class ProgressBeacon:
         self._stop.set()
         self._records.put(None)  # wake the beacon thread now
         self._thread.join(timeout=2.0)
+        self._time.save()
         self._link.close()
 
     # -- the beacon thread --------------------------------------------------------
@@ -116,28 +121,33 @@ class ProgressBeacon:
     def _run(self) -> None:
         last: LearnerRecord | None = None
         activity = progress = time.time()
+        acted = 0.0  # the last change the learner made (the start of the dashboard is none)
         sent_at = 0.0
         while not self._stop.wait(COLLECT_SEC):
             self._ui.post(self._collect, refresh=False)  # reads only: no redraw
             try:
-                record = self._records.get(timeout=COLLECT_SEC * 4)
+                collected = self._records.get(timeout=COLLECT_SEC * 4)
                 while not self._records.empty():  # only the newest counts
-                    record = self._records.get_nowait()
+                    collected = self._records.get_nowait()
             except queue.Empty:  # the UI thread is busy; try again next round
                 continue
-            if record is None:  # closing
+            if collected is None:  # closing
                 return
+            record, exercise_touched = collected
             record = self._with_history(record)
             now = time.time()
             changed = last is None or (
                 record.what_changed_ignoring_stamps() != last.what_changed_ignoring_stamps()
             )
             if last is not None and changed:
-                activity = now
+                activity = acted = now
                 if record.position() != last.position():
                     progress = now
+            self._time.tick(now, acted, _counted(record, exercise_touched, now))
             if changed or now - sent_at >= self._link.heartbeat_sec:
-                stamped = _with_stamps(record, activity, progress)
+                stamped = replace(
+                    _with_stamps(record, activity, progress), time_spent=self._time.totals()
+                )
                 try:
                     self._link.send(stamped)
                     sent_at = now
@@ -165,9 +175,18 @@ class ProgressBeacon:
 
     def _collect(self) -> None:
         try:
-            self._records.put(self._snapshot())
+            self._records.put(self._snapshot_with_touch())
         except Exception:  # a half-loaded course or a file read error: skip this round
             log.exception("collecting progress failed")
+
+    def _snapshot_with_touch(self) -> tuple[LearnerRecord, float]:
+        """The record, and when its exercise was last opened, saved or checked (0: never)."""
+        record = self._snapshot()
+        if not record.exercise:
+            return record, 0.0
+        exercise = self._sources.book.get(record.exercise)
+        progress = self._sources.workspace.progress.exercise(record.exercise)
+        return record, self._touched_at(exercise, progress)
 
     def _snapshot(self) -> LearnerRecord:
         s = self._sources
@@ -304,6 +323,15 @@ class DdsLink:
 
     def _on_settings(self, msg: wire.ClassroomSettings) -> None:
         self._on_settings_sink(msg.reveal_solution_after)
+
+
+def _counted(record: LearnerRecord, exercise_touched: float, now: float) -> list[str]:
+    """The activities whose time this moment counts for: the lesson the dashboard is on,
+    and its exercise while the learner works on it (opened, saved or checked lately)."""
+    counted = [activity_key("lesson", record.lesson_id)] if record.lesson_id else []
+    if record.exercise and now - exercise_touched <= IDLE_AFTER_SEC:
+        counted.append(activity_key("exercise", record.exercise))
+    return counted
 
 
 def _with_stamps(record: LearnerRecord, activity: float, progress: float) -> LearnerRecord:

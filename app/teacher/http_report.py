@@ -16,6 +16,8 @@ from typing import Any
 
 from app.teacher import record as rec
 from app.teacher.record import GradedAttempt, LearnerRecord, clip
+from app.teacher.time_spent import KEY as ACTIVITY_KEY
+from app.teacher.time_spent import MAX_ACTIVITIES
 
 MAX_BODY = 128 * 1024  # the longest code excerpt and ten attempts: about 30 kB of ASCII
 
@@ -92,6 +94,8 @@ def _field(name: str, value: object) -> object:
         if not isinstance(value, bool):
             raise ReportError(f"{name} must be true or false")
         return value
+    if name == "time_spent":
+        return _time_spent(value)
     if name == "exercise_history":
         if not isinstance(value, list):
             raise ReportError(f"{name} must be a list of attempts")
@@ -100,6 +104,24 @@ def _field(name: str, value: object) -> object:
     if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
         raise ReportError(f"{name} must be a list of strings")
     return tuple(clip(v, limit) for v in value[:count])
+
+
+def _time_spent(value: object) -> tuple[tuple[str, int], ...]:
+    """[["lesson:05_topics", 1234], ...]: named activities, whole seconds."""
+    what = "time_spent must be a list of [activity, seconds] pairs"
+    if not isinstance(value, list) or len(value) > MAX_ACTIVITIES:
+        raise ReportError(f"{what}, at most {MAX_ACTIVITIES}")
+    pairs = []
+    for pair in value:
+        if not isinstance(pair, list) or len(pair) != 2:
+            raise ReportError(what)
+        key, seconds = pair
+        if not isinstance(key, str) or not ACTIVITY_KEY.fullmatch(key):
+            raise ReportError(f"{what}: an activity is lesson:ID or exercise:SLUG")
+        if isinstance(seconds, bool) or not isinstance(seconds, int) or not 0 <= seconds < 2**31:
+            raise ReportError(f"{what}: seconds must be a whole number from 0 to 2^31-1")
+        pairs.append((key, seconds))
+    return tuple(pairs)
 
 
 _ATTEMPT_FIELDS = tuple(f.name for f in fields(GradedAttempt))
@@ -128,10 +150,20 @@ def _attempt(item: object) -> GradedAttempt:
     summary = item.get("summary", "")
     if not isinstance(summary, str):
         raise ReportError(f"{what}: summary must be a string")
+    graded_file = item.get("graded_file", "")
+    if (
+        not isinstance(graded_file, str)
+        or len(graded_file) > rec.MAX_GRADED_FILE
+        or not graded_file.isprintable()  # it ends up in a command a teacher copies
+    ):
+        raise ReportError(
+            f"{what}: graded_file must be a path of at most {rec.MAX_GRADED_FILE} characters"
+        )
     return GradedAttempt(
         at=float(at),
         verdict=verdict,
         failed=tuple(clip(f, rec.MAX_REASON) for f in failed[: rec.MAX_FAILED]),
         summary=clip(summary, rec.MAX_SUMMARY),
+        graded_file=graded_file,
         **numbers,
     )

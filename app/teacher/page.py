@@ -33,6 +33,7 @@ from websockets.datastructures import Headers
 from websockets.http11 import Request, Response
 
 from app.access import Handler, ProcessRequest, make_server
+from app.exercises.attempt_folders import ATTEMPTS_FOLDER, age_order, attempt_label, replay_of
 from app.teacher.record import (
     COLUMNS,
     MAX_NOTICE,
@@ -102,11 +103,11 @@ class LocalAttempts:
             _NAME.fullmatch(record.learner) and _SLUG.fullmatch(record.exercise)
         ):
             return None
-        from app.exercises.attempts import ATTEMPTS_FOLDER  # only on a page that lists them
-
         folder = self.bags_root / record.learner / ATTEMPTS_FOLDER / record.exercise
         try:
-            kept = sorted((p for p in folder.iterdir() if p.is_dir()), key=lambda p: p.name)
+            kept = sorted(
+                (p for p in folder.iterdir() if p.is_dir()), key=lambda p: age_order(p.name)
+            )
         except OSError:  # none yet, or not readable
             return None
         return kept[-1] if kept else None
@@ -114,15 +115,17 @@ class LocalAttempts:
 
 def attempt_text(path: Path) -> str:
     """Where the newest attempt is, for a teacher on this machine to open in Foxglove."""
-    from app.exercises.attempts import attempt_label
-
     mcap = sorted(path.glob("*.mcap"))
     opened = _code(str(mcap[0])) if mcap else "the .mcap file in it"
-    return (
+    text = (
         f"**Newest attempt** ({plain_markdown(attempt_label(path))}): {_code(str(path))}\n\n"
         f"Open {opened} in Foxglove or Lichtblick (Open local file), or ask the learner to "
         "pick it under **Attempt** in their Exercise tab and press **Watch this attempt**."
     )
+    command = replay_of(path)  # '' : no seed, or its code was not kept
+    if command:
+        text += f"\n\nIts grading again, on the code it graded: {_code(command)}"
+    return text
 
 
 def _code(text: str) -> str:

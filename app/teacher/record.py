@@ -29,6 +29,7 @@ MAX_MISTAKE = 120
 MAX_HISTORY = 10  # graded attempts of the current exercise in a report (the dashboard keeps 10)
 MAX_FAILED = 8  # failed checks told per attempt
 MAX_SUMMARY = 300
+MAX_GRADED_FILE = 300  # the path of an attempt's kept code (longer ones are not sent)
 
 _MARKS = {"pass": "✓", "fail": "✗", "waiting": "…"}
 
@@ -66,6 +67,9 @@ class GradedAttempt:
     total: int = 0  # ... of this many
     failed: tuple[str, ...] = ()  # "name: why", at most MAX_FAILED, each at most MAX_REASON
     summary: str = ""  # the grader's last line, at most MAX_SUMMARY ("3 of 5 checks passed: ...")
+    # The code it graded, as kept in its folder, on the dashboard's machine: what the
+    # replay command grades ('' : not kept, e.g. an attempt made before it was).
+    graded_file: str = ""
 
 
 VERDICTS = ("pass", "fail", "problem")
@@ -102,6 +106,10 @@ class LearnerRecord:
     # report (a hub) carries them; on the classroom domain the teacher's side reads
     # them from the dashboards' folders on its own machine instead.
     exercise_history: tuple[GradedAttempt, ...] = ()
+    # Seconds of active time per activity ("lesson:05_topics", "exercise:wall_stop"),
+    # counted by the dashboard (app/teacher/time_spent.py). HTTP report only, like the
+    # history; it grows every second, so it is no change by itself.
+    time_spent: tuple[tuple[str, int], ...] = ()
     code_excerpt: str = ""
     last_error: str = ""
     nodes_running: tuple[str, ...] = ()
@@ -115,7 +123,7 @@ class LearnerRecord:
 
     def what_changed_ignoring_stamps(self) -> tuple:
         """Everything a learner can change; equal tuples mean nothing happened."""
-        skip = {"last_activity", "last_progress", "received_at"}
+        skip = {"last_activity", "last_progress", "received_at", "time_spent"}
         return tuple(getattr(self, f.name) for f in fields(self) if f.name not in skip)
 
     def position(self) -> tuple:

@@ -16,7 +16,13 @@ import pytest
 import yaml
 
 from app.exercises import runner
-from app.exercises.attempts import AttemptStore, attempt_heading, attempt_label
+from app.exercises.attempt_folders import (
+    attempt_heading,
+    attempt_label,
+    graded_code,
+    replay_of,
+)
+from app.exercises.attempts import AttemptStore, keep_graded_code
 from app.exercises.grader import Grader
 from app.exercises.model import load_exercises
 from app.exercises.report import Report
@@ -74,6 +80,56 @@ def test_attempts_are_listed_by_time_verdict_and_seed_and_a_damaged_one_says_so(
     assert attempt_heading(kept) == ""
 
 
+def test_the_graded_file_is_kept_with_its_attempt_and_the_replay_names_it(tmp_path):
+    learner = tmp_path / "code" / f"{SLUG}.py"
+    learner.parent.mkdir()
+    learner.write_text("print('as graded')\n", encoding="utf-8")
+    kept = _attempt(tmp_path, SLUG, "20261129-101500-seed4242-fail")
+    assert keep_graded_code(learner, kept) == ""
+    learner.write_text("print('changed since')\n", encoding="utf-8")
+    assert graded_code(kept).read_text(encoding="utf-8") == "print('as graded')\n"
+    assert replay_of(kept) == (
+        f"ros2-classroom exercise check {SLUG} {kept / 'graded.py'} --seed 4242"
+    )
+
+
+def test_a_package_is_kept_whole_without_its_build_products(tmp_path):
+    package = tmp_path / "ws" / "src" / "py_doubler"
+    node = package / "py_doubler" / "doubler.py"
+    node.parent.mkdir(parents=True)
+    node.write_text("# node\n", encoding="utf-8")
+    (package / "package.xml").write_text("<package/>", encoding="utf-8")
+    (package / "setup.py").write_text("# setup\n", encoding="utf-8")
+    (package / "py_doubler" / "__pycache__").mkdir()
+    (package / "py_doubler" / "__pycache__" / "doubler.pyc").write_bytes(b"\0")
+    kept = _attempt(tmp_path, "package_doubler", "20261129-101500-seed7-pass")
+    assert keep_graded_code(node, kept, package=True) == ""
+    copy = graded_code(kept)
+    assert copy == kept / "graded" / "py_doubler"
+    assert sorted(str(p.relative_to(copy)) for p in copy.rglob("*") if p.is_file()) == [
+        "package.xml",
+        "py_doubler/doubler.py",
+        "setup.py",
+    ]
+    assert replay_of(kept).endswith(f"{copy} --seed 7")  # `exercise check` takes the folder
+    lonely = tmp_path / "lonely.py"
+    lonely.write_text("", encoding="utf-8")
+    assert "no package.xml" in keep_graded_code(lonely, kept, package=True)
+
+
+def test_code_that_cannot_be_kept_says_why_and_never_raises(tmp_path):
+    learner = tmp_path / f"{SLUG}.py"
+    learner.write_text("x = 1\n", encoding="utf-8")
+    blocker = tmp_path / "not_a_folder"
+    blocker.write_text("a file where the attempt folder should be", encoding="utf-8")
+    assert keep_graded_code(learner, blocker) != ""
+    assert keep_graded_code(tmp_path / "gone.py", tmp_path) != ""
+    big = tmp_path / "big.py"
+    big.write_bytes(b"#" * (2 * 1024 * 1024))
+    assert "larger than" in keep_graded_code(big, _attempt(tmp_path, SLUG, "x"))
+    assert graded_code(tmp_path / SLUG / "x") is None and replay_of(tmp_path / SLUG / "x") == ""
+
+
 @pytest.fixture(scope="module")
 def grading(tmp_path_factory):
     with grading_participant("attempt_test_grader", domain_id=78) as (node, supervisor):
@@ -102,6 +158,11 @@ def test_a_graded_attempt_is_a_bag_with_the_learners_log_seed_and_verdict(gradin
     bag = Path(report.attempt)
     assert bag.parent == tmp_path / "attempts" / SLUG
     assert bag.name.endswith("-seed4242-fail")
+    # The code it graded is kept beside it, and the replay grades that copy.
+    kept = graded_code(bag)
+    assert kept == bag / "graded.py"
+    assert kept.read_text(encoding="utf-8") == mistake.path.read_text(encoding="utf-8")
+    assert replay_of(bag).endswith(f"{kept} --seed 4242")
 
     meta = yaml.safe_load((bag / "metadata.yaml").read_text(encoding="utf-8"))
     custom = meta["rosbag2_bagfile_information"]["custom_data"]

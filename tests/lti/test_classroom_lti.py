@@ -198,7 +198,11 @@ def test_a_cell_of_the_gradebook_opens_the_seats_attempts_read_from_its_folder(
     keep_attempt(attempts, "20261129-102500.recording", [])  # a grading under way
     room.records.append(seat_record("learner1", passed=True))
     wait_for(lambda: bool(platform.scores["11"]), why="Ada's score")
-    # No dashboard runs here at all: the attempts are read from the seat's folder.
+    # No dashboard runs here at all: the attempts are read from the seat's folder, and
+    # the time the seat's dashboard counted from the file it keeps beside its progress.
+    totals = {"version": 1, "seconds": {f"exercise:{EXERCISE}": 754}}
+    (room.progress_root / "learner1").mkdir(parents=True, exist_ok=True)
+    (room.progress_root / "learner1" / "learner1.time.json").write_text(json.dumps(totals))
 
     grid = request("GET", room.server.gradebook_url)
     [cell] = re.findall(r'href="(gradebook/attempts\?[^"]+)"', grid.body)
@@ -211,6 +215,7 @@ def test_a_cell_of_the_gradebook_opens_the_seats_attempts_read_from_its_folder(
     assert body.index("--seed 4242") < body.index("--seed 1717")  # newest first
     assert f"ros2-classroom exercise check {EXERCISE} {code} --seed 4242" in words
     assert "probe /count: got 4" in words and "2 shown: 1 passed, 1 failed" in words
+    assert "Time spent on it: 12 min" in words
     assert f"recorded in {attempts}" in words
     assert (
         "no replay button here: it would run the learner's code on the classroom's server" in words

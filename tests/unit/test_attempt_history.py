@@ -12,17 +12,25 @@ from __future__ import annotations
 import html
 import json
 import re
+import subprocess
+import sys
 from dataclasses import asdict, replace
 from pathlib import Path
 
 import pytest
 import yaml
 
-from app.exercises import attempts as kept_attempts
+from app.exercises import attempt_folders
+from app.exercises.attempt_folders import ResultLine, custom_data, finished_name, unfinished_names
 from app.lti.gradebook import GradebookLine
 from app.lti.history import Attempt, AttemptHistory, AttemptSource
-from app.lti.pages import attempts_page, class_grid, history_link, not_found_page
-from app.teacher import attempt_files
+from app.lti.pages import (
+    attempts_page,
+    class_grid,
+    history_link,
+    not_found_page,
+    replay_command,
+)
 from app.teacher.attempt_files import AttemptReader, attempt_from_folder, exercise_folder
 from app.teacher.http_report import ReportError, from_json, to_json
 from app.teacher.record import MAX_HISTORY, MAX_REASON, GradedAttempt, LearnerRecord
@@ -52,10 +60,66 @@ def keep_attempt(
     return path
 
 
-def test_the_reader_follows_what_the_dashboard_writes() -> None:
-    assert attempt_files.ATTEMPTS_FOLDER == kept_attempts.ATTEMPTS_FOLDER
-    assert attempt_files.UNFINISHED == kept_attempts.UNFINISHED
-    assert attempt_files.CUSTOM_PREFIX == kept_attempts.CUSTOM_PREFIX
+def test_a_folder_named_and_filled_as_a_grading_does_reads_back_as_that_grading(
+    tmp_path: Path,
+) -> None:
+    """The names and the metadata the dashboard writes (app/exercises/attempts.py calls
+    these very functions) come back as the gradebook's attempt, second gradings too."""
+    folder = exercise_folder(tmp_path, SLUG)
+    when = 1795947600.0  # 2026-11-29 10:20:00 UTC
+    results = [ResultLine("stop", True, "ok"), ResultLine("wall", False, "0.21 m\nof it")]
+    names = iter(unfinished_names(when))
+    (folder / next(names)).mkdir(parents=True)  # a grading still being recorded
+    for seed, verdict in ((4242, "fail"), (None, "problem")):
+        unfinished = folder / next(names)
+        unfinished.mkdir()
+        custom = custom_data(SLUG, seed, verdict, f"{verdict} summary", results)
+        meta = {"rosbag2_bagfile_information": {"custom_data": {
+            attempt_folders.CUSTOM_PREFIX + k: v for k, v in custom.items()}}}  # fmt: skip
+        (unfinished / "metadata.yaml").write_text(yaml.safe_dump(meta), encoding="utf-8")
+        unfinished.rename(folder / finished_name(unfinished.name, seed, verdict))
+    assert sorted(p.name for p in folder.iterdir()) == [
+        "20261129-102000-2-seed4242-fail",
+        "20261129-102000-3-problem",
+        "20261129-102000.recording",
+    ]
+    problem, failed = AttemptReader().newest(folder)  # the later of one second first
+    assert (failed.at, failed.verdict, failed.seed, failed.passed, failed.total) == (
+        when, "fail", 4242, 1, 2)  # fmt: skip
+    assert failed.failed == ("wall: 0.21 m of it",) and failed.summary == "fail summary"
+    assert (problem.verdict, problem.seed, problem.summary) == ("problem", 0, "problem summary")
+    assert custom["verdict"] == "not graded"  # as `ros2 bag info` shows a problem
+    # The first grading of a second has no -n: it still sorts before the second one.
+    one_second = ["20261129-102000-2-problem", "20261129-102000-seed9-fail"]
+    assert sorted(one_second, key=attempt_folders.age_order) == one_second[::-1]
+
+
+def test_reading_attempts_needs_no_ros() -> None:
+    """A hub's teacher service reads them where rclpy is not installed."""
+    code = (
+        "import sys, app.teacher.attempt_files, app.exercises.attempt_folders; "
+        "print(sorted(m for m in sys.modules if m.split('.')[0] in ('rclpy', 'rosidl_parser')"
+        " or m.startswith('app.exercises.') and m != 'app.exercises.attempt_folders'))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
+
+
+def test_the_replay_commands_of_the_cli_and_the_gradebook_agree(tmp_path: Path) -> None:
+    kept = tmp_path / SLUG / "20261129-101500-seed4242-fail"
+    (kept / "graded.py").parent.mkdir(parents=True)
+    (kept / "graded.py").write_text("print('the code that was graded')")
+    command = attempt_folders.replay_of(kept)
+    assert command == replay_command(SLUG, 4242, str(kept / "graded.py"))
+    assert command.endswith(f"{kept / 'graded.py'} --seed 4242")
+    package = tmp_path / SLUG / "20261129-101600-seed5-pass"
+    (package / "graded" / "py_doubler").mkdir(parents=True)
+    assert attempt_folders.graded_code(package) == package / "graded" / "py_doubler"
+    assert attempt_folders.replay_of(tmp_path / SLUG / "20261129-101700-seed6-fail") == ""
+    spaced = tmp_path / "a b" / SLUG / "20261129-101500-seed1-fail"
+    spaced.mkdir(parents=True)
+    (spaced / "graded.py").write_text("")
+    assert f"'{spaced / 'graded.py'}'" in attempt_folders.replay_of(spaced)  # quoted
 
 
 def test_kept_attempts_read_back_newest_first_with_seed_verdict_and_failed_checks(
@@ -93,8 +157,8 @@ def test_kept_attempts_read_back_newest_first_with_seed_verdict_and_failed_check
     assert (damaged.total, damaged.failed) == (0, ())
     assert problem.summary == "Not graded: not running"
     # The dashboard's own reader agrees on what the folder says.
-    assert kept_attempts.attempt_label(passed).endswith("pass · seed 77")
-    assert "came within 0.21 m of the wall" in kept_attempts.attempt_heading(failing)
+    assert attempt_folders.attempt_label(passed).endswith("pass · seed 77")
+    assert "came within 0.21 m of the wall" in attempt_folders.attempt_heading(failing)
     assert AttemptReader().newest(folder, limit=2) == found[:2]
     assert AttemptReader().newest(tmp_path / "nowhere") == ()
 
@@ -151,6 +215,9 @@ GOOD = {"at": 1.0, "verdict": "fail", "seed": 3, "passed": 0, "total": 1, "faile
         ({**GOOD, "total": 2**32}, "total must be a whole number"),
         ({**GOOD, "failed": "a: b"}, "failed must be a list of strings"),
         ({**GOOD, "summary": 3}, "summary must be a string"),
+        ({**GOOD, "graded_file": 3}, "graded_file must be a path"),
+        ({**GOOD, "graded_file": "/x\n; rm -rf ~"}, "graded_file must be a path"),
+        ({**GOOD, "graded_file": "/x" * 200}, "graded_file must be a path"),
     ],
 )
 def test_a_bad_attempt_in_a_report_gets_its_reason(attempt: object, reason: str) -> None:
@@ -343,3 +410,38 @@ def test_the_attempt_types_share_their_fields() -> None:
     """The teacher's record carries them, the LTI layer shows them: one field list."""
     graded = RECORD.exercise_history[0]
     assert Attempt(**asdict(graded)).key == (graded.at, graded.verdict, graded.seed)
+
+
+def test_the_teacher_page_names_the_replay_of_the_newest_attempt_on_its_kept_code(
+    tmp_path: Path,
+) -> None:
+    from app.teacher.page import attempt_text
+
+    kept = keep_attempt(tmp_path / SLUG, "20261129-101500-seed4242-fail", [("stop", False, "x")])
+    assert "exercise check" not in attempt_text(kept)  # no code kept: nothing to name
+    (kept / "graded.py").write_text("print('graded')")
+    assert f"`ros2-classroom exercise check {SLUG} {kept / 'graded.py'} --seed 4242`" in (
+        attempt_text(kept)
+    )
+
+
+def test_an_attempt_that_kept_its_code_is_replayed_on_that_copy(tmp_path: Path) -> None:
+    folder = exercise_folder(tmp_path / "bags", SLUG)
+    kept = keep_attempt(folder, "20261129-102000-seed77-pass", [("stop", True, "ok")])
+    (kept / "graded.py").write_text("print('graded')")
+    keep_attempt(folder, "20261129-101500-seed4242-fail", [("stop", False, "too close")])
+    newest, older = AttemptReader().newest(folder)
+    assert (newest.graded_file, older.graded_file) == (str(kept / "graded.py"), "")
+    # The report carries it to a hub, the page names it; the older one names the code as now.
+    record = replace(RECORD, exercise_history=(newest, older))
+    carried = from_json(to_json(record), received_at=0.0).exercise_history
+    source = replace(
+        SOURCE, attempts=tuple(Attempt(**asdict(a)) for a in carried), code_file="/code/w.py"
+    )
+    page = attempts_page(
+        [line("sent")], learner="lti-abc", kind="exercise", slug=SLUG, source=source, now=0.0
+    )
+    passed, failed = attempt_rows(page)
+    assert f"exercise check {SLUG} {kept / 'graded.py'} --seed 77" in passed
+    assert f"exercise check {SLUG} /code/w.py --seed 4242" in failed
+    assert "gives its verdict again" in text(page)
