@@ -107,6 +107,7 @@ class Dashboard:
         self.rosout = RosoutLog(runtime.node)
         self._stop = threading.Event()
         self.start_requests = StartRequests()  # Start clicks the stage shows at once
+        self._lesson_since = time.time()  # when the current lesson was opened (UI thread)
         self.graph = GraphSnapshot()
         self._tools: dict[str, Panel] = {}
         self._panels: list[Panel] = self._build_gui()
@@ -248,6 +249,7 @@ class Dashboard:
         """Another lesson was opened (UI thread): the views forget what the last one left."""
         cast(ScenePanel, self._tools["3D view"]).forget_unpublished(self.graph)
         self._stage.forget()
+        self._lesson_since = time.time()
 
     def _starting_nodes(self) -> list[str]:
         """Catalog nodes that are starting: clicked (until the supervisor has the process),
@@ -277,9 +279,15 @@ class Dashboard:
                 tool.inspect(kind, name, type_text)
 
     def _program_output(self) -> tuple[str, list[str]]:
-        """The program started last, the learner's own or a lesson's (one still running
-        first): its name and state, and its last lines of output, for under the code."""
-        statuses = list(self.supervisor.statuses().values())
+        """The program started last in this lesson, the learner's own or a lesson's (one
+        still running first): its name and state, and its last lines of output, for under
+        the code. What an earlier lesson ran is not this lesson's output."""
+        since = self._lesson_since - 1.0  # a Start clicked as the lesson opened counts
+        statuses = [
+            status
+            for status in self.supervisor.statuses().values()
+            if (status.started_at or 0.0) >= since
+        ]
         if not statuses:
             return "", []
         running = [status for status in statuses if status.active]

@@ -65,12 +65,20 @@ class LearnerProgram:
     after_exit: Callable[[int], object] | None = field(default=None, compare=False)
     # Variables set on top of the supervisor's environment (e.g. AMENT_PREFIX_PATH for a launch).
     env: Mapping[str, str] | None = field(default=None, compare=False)
+    # False when ``node_name`` is only a label: a package's executable names its node in
+    # its own code, a build makes none. Such a program is running once the graph was
+    # looked at while it lived, never "starting" for as long as it runs.
+    names_its_node: bool = True
 
 
 Program = CatalogEntry | LearnerProgram
 
 # The key of a program of the learner's own workspace (`ros2 run <package> <executable>`).
 OWN_PROGRAM = "own:/"
+
+
+def _names_its_node(entry: Program) -> bool:
+    return not isinstance(entry, LearnerProgram) or entry.names_its_node
 
 
 def own_program_key(package: str, executable: str) -> str:
@@ -308,7 +316,9 @@ class Supervisor:
         seen = set(node_names)
         with self._lock:
             for proc in self._procs.values():
-                if proc.state is NodeState.STARTING and proc.entry.node_name in seen:
+                if proc.state is NodeState.STARTING and (
+                    proc.entry.node_name in seen or not _names_its_node(proc.entry)
+                ):
                     proc.state = NodeState.RUNNING
 
     def shutdown(self, timeout: float = 4.0) -> None:

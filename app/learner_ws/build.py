@@ -148,6 +148,7 @@ def colcon_program(workspace: LearnerWorkspace, words: list[str]) -> LearnerProg
     return LearnerProgram(
         name=f"{PROGRAM_PREFIX}{' '.join(words[:1])}",
         node_name="/_colcon_is_no_node",
+        names_its_node=False,
         argv=tuple(colcon_argv(workspace, words)),
         cwd=workspace.ensure().root,
         env=build_env(workspace),

@@ -73,6 +73,7 @@ def colcon_program(
     return LearnerProgram(
         name=f"{build.PROGRAM_PREFIX}{' '.join(words[:1])}",
         node_name="/_colcon_is_no_node",
+        names_its_node=False,
         argv=(*argv, str(workspace.root), *words),
         cwd=build_dir,
         env=build.build_env(workspace),

@@ -15,15 +15,14 @@ from typing import Final
 
 import viser
 
-from app import PROJECT_ROOT
 from app.catalog import UnknownNodeError, lookup_group
+from app.lessons import step_code
 from app.lessons.progress import ProgressStore
 from app.lessons.runtime import FAIL, PASS, WAITING, LessonRuntime
 from app.lessons.schema import IMAGE_TYPES, STATIC_DIR, Course, Lesson, Spec
 from app.ros.graph import GraphSnapshot
 from app.supervisor import OWN_PROGRAM, NodeStatus, own_program_key
 from app.ui import MarkdownView, assign
-from app.ui.code_view import python_listing
 from app.ui.loop import UiLoop
 from app.ui.starting import StartRequests
 
@@ -304,20 +303,13 @@ class LessonsPanel:
         self._text.show(_without_title(current.text))
         self._picture.show(picture_html(current.image, current.image_alt) if current.image else "")
         self._command.show(f"In a terminal: `{current.command}`" if current.command else "")
-        self._code.show(self._source_listing(lesson))
+        self._code.show(step_code.listing(lesson, current))
         self._show_stage(current.stage or lesson.stage)
         self._message.show("")
         self._rebuild_step_widgets()
         self._back.disabled = step == 0
         if reading:
             self._to_top()
-
-    def _source_listing(self, lesson: Lesson) -> str:
-        parts = [
-            python_listing(relative, (PROJECT_ROOT / relative).read_text(encoding="utf-8"))
-            for relative in lesson.code
-        ]
-        return "".join(parts) or "<p><em>This lesson shows no code.</em></p>"
 
     def _rebuild_step_widgets(self) -> None:
         for handle in self._dynamic:
@@ -427,6 +419,8 @@ class LessonsPanel:
             self._next.disabled = label == COURSE_END
         self._show_stops()
         self._checks.show(("**Checks** " + status + "\n\n" + "\n".join(lines)) if lines else status)
+        if step_code.workspace_sources(step):  # a button or the Console may have changed it
+            self._code.show(step_code.listing(lesson, step))
         self._outline.show(self._outline_text(lesson))
 
     def _show_stops(self) -> None:

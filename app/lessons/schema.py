@@ -71,6 +71,7 @@ class Step:
     image: str = ""  # a file in static/, shown under the text
     image_alt: str = ""  # what the picture shows, for a screen reader (required with image)
     stage: str = ""  # what the centre of the screen shows; "" = the unit's stage
+    code: tuple[str, ...] = ()  # project files this step is about; () = the lesson's code
 
 
 @dataclass(frozen=True)
@@ -239,11 +240,7 @@ def load_lesson(directory: Path) -> Lesson:
     goals = _require(data, "goals", list, where)
     if not all(isinstance(goal, str) for goal in goals):
         raise LessonError(f"{where}: field 'goals' must be a list of strings")
-    code = _require(data, "code", list, where) if "code" in data else []
-    for i, source in enumerate(code):
-        if not isinstance(source, str):
-            raise LessonError(f"{where}: code[{i}] must be a string")
-        inside(PROJECT_ROOT, source, f"{where}: code[{i}]")
+    code = _code_list(data, where)
     stage = _stage(data, where, DEFAULT_STAGE)
     raw_steps = _require(data, "steps", list, where)
     if not raw_steps:
@@ -275,6 +272,7 @@ def load_lesson(directory: Path) -> Lesson:
                 image=image,
                 image_alt=image_alt,
                 stage=_stage(raw, step_where, ""),
+                code=_code_list(raw, step_where),
             )
         )
     return Lesson(
@@ -288,6 +286,16 @@ def load_lesson(directory: Path) -> Lesson:
         stage=stage,
         path=directory,
     )
+
+
+def _code_list(raw: Mapping[str, object], where: str) -> tuple[str, ...]:
+    """A lesson's or a step's ``code``: project files, each checked to exist inside it."""
+    code = _require(raw, "code", list, where) if "code" in raw else []
+    for i, source in enumerate(code):
+        if not isinstance(source, str):
+            raise LessonError(f"{where}: code[{i}] must be a string")
+        inside(PROJECT_ROOT, source, f"{where}: code[{i}]")
+    return tuple(code)
 
 
 def load_course(root: Path = LESSONS_DIR) -> Course:

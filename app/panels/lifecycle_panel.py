@@ -27,6 +27,7 @@ from app.ui.page_links import SINK_FRAME, PageLinks
 
 NONE = "(no lifecycle node)"
 POLL_SEC = 2.0
+LOG_LINES = 5  # the node's newest /rosout lines under the diagram
 
 
 class LifecyclePanel:
@@ -185,8 +186,10 @@ class LifecyclePanel:
             + self._rates_text()
             + (f"\n\n{self._message}" if self._message else "")
         )
-        lines = [format_record(r) for r in self._rosout.records(target, last=12)]
-        self._log.show(f"Log of `{target}` (/rosout):\n\n" + code_block(lines))
+        # Few lines: on a laptop's screen the log sits under the diagram, and the newest
+        # (what the last transition said) must be in view without scrolling.
+        lines = [format_record(r) for r in self._rosout.records(target, last=LOG_LINES)]
+        self._log.show(f"Log of `{target}` (/rosout), newest last:\n\n" + code_block(lines))
 
     def _rates_text(self) -> str:
         parts = [

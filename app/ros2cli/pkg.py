@@ -364,7 +364,7 @@ def run_own(ctx: CallContext, package: str, executable: str, words: list[str]) -
     cwd = ws.root if ws is not None else Path.cwd()
     program = LearnerProgram(
         name=key, node_name=f"/{package}/{executable}", argv=(str(paths[0]), *tail), cwd=cwd,
-        env=overlay.child_env(),
+        env=overlay.child_env(), names_its_node=False,
     )  # fmt: skip
     if ws is not None:  # served to other machines: contained, or refused
         program = served.node_program(ws, program, programs.learner_policy)

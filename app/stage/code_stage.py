@@ -13,8 +13,9 @@ from app.ui import MarkdownView
 
 OUTPUT_LINES = 40
 NO_OUTPUT = (
-    "_Nothing has run yet._ Start the lesson's node, or **Run my node** (Learn › Exercise) "
-    "for your own code: what the program started last prints and logs shows here."
+    "_Nothing has run yet in this lesson._ Start the lesson's node, or **Run my node** "
+    "(Learn › Exercise) for your own code: what the program started last prints and logs "
+    "shows here."
 )
 
 

@@ -1,4 +1,4 @@
-"""Python source as the learner reads it: highlighted, with line numbers to point at.
+"""Source as the learner reads it: highlighted, with line numbers to point at.
 
 Lesson text can say "line 12 creates the publisher": the numbers beside the
 code are the file's own line numbers. Pygments writes inline styles, so the
@@ -11,7 +11,8 @@ import html
 
 from pygments import highlight
 from pygments.formatters import HtmlFormatter
-from pygments.lexers import PythonLexer
+from pygments.lexers import PythonLexer, TextLexer, get_lexer_for_filename
+from pygments.util import ClassNotFound
 
 _FORMATTER = HtmlFormatter(
     linenos="inline",
@@ -33,9 +34,18 @@ _NUMBER = (
 )
 
 
-def python_listing(title: str, source: str) -> str:
-    """One file: its name, then its code highlighted, numbered, wrapped at the edge."""
-    body = highlight(source, PythonLexer(), _FORMATTER)
+def python_listing(title: str, source: str, filename: str = "") -> str:
+    """One file: its name, then its code highlighted, numbered, wrapped at the edge.
+
+    Python unless ``filename`` names another kind (package.xml, CMakeLists.txt, Num.msg).
+    """
+    lexer = PythonLexer()
+    if filename and not filename.endswith(".py"):
+        try:
+            lexer = get_lexer_for_filename(filename, stripnl=False)
+        except ClassNotFound:
+            lexer = TextLexer(stripnl=False)
+    body = highlight(source, lexer, _FORMATTER)
     body = body.replace('<span id="L-', _LINE).replace("\n</span>", "</span>")
     body = body.replace(f'style="{_NUMBER_STYLE}"', _NUMBER)
     return (

@@ -484,3 +484,8 @@ def test_the_code_stage_shows_what_the_lessons_node_prints(page):
     expect(page.get_by_text(re.compile("Hello ROS2")).filter(visible=True).first).to_be_visible(
         timeout=30_000
     )
+    # Another lesson's code stage: what lesson 4 ran (still running) is not its output.
+    open_lesson(page, next(les for les in load_course().lessons if les.unit == 20))
+    _wait_stage(page, "code")
+    expect(page.get_by_text(re.compile("Nothing has run yet in this lesson"))).to_be_visible()
+    expect(page.get_by_text(re.compile(r"^minimal_node · running"))).to_have_count(0)
