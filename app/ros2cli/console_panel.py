@@ -55,6 +55,7 @@ class ConsolePanel:
         self._output = _Output()
         self._running: CallContext | None = None
         self._next: str | None = None  # a lesson's command, once the running one has stopped
+        self._running_text = ""  # the command that runs (or ran last)
         gui.add_markdown(
             "Type a command as the tutorials write it, e.g. `ros2 topic list -t`, "
             "`ros2 lifecycle get /lifecycle_talker`, `ros2 interface show std_msgs/msg/String`. "
@@ -77,17 +78,25 @@ class ConsolePanel:
             return
         self._output.start(f"$ {text.strip()}")
         ctx = CallContext(self._node, self._output.write, CONSOLE_LIMITS, programs=self._programs)
-        self._running = ctx
+        self._running, self._running_text = ctx, text.strip()
         self._run.disabled = True
         self._stop.disabled = False
         self._ui.run_job(lambda: run_text(ctx, text), self._finished, self._crashed)
 
     def run_for_lesson(self, text: str) -> None:
-        """A lesson button's command: what runs now is stopped (as Stop does), then ``text``."""
+        """A lesson button's command: what runs now is stopped (as Stop does), then ``text``.
+
+        A build is the exception: it ends by itself, and stopping it half way aborts the
+        package (a learner on a slow laptop clicked the next step's `source` while
+        colcon still built, and lost the build). ``text`` waits for it instead.
+        """
         if self._running is None:
             self.run(text)
+            return
+        self._next = text
+        if self._running_text.split()[:1] == ["colcon"]:
+            self._output.write(f"(colcon is still building: `{text.strip()}` runs when it ends)")
         else:
-            self._next = text
             self._cancel()
 
     def _finished(self, code: int) -> None:
