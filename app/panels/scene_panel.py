@@ -26,7 +26,7 @@ from app.scene import topic_picker as picker
 from app.scene import transforms as tf
 from app.scene.arm import ARM_PATH, ArmLayer
 from app.scene.camera_params import CameraParamSync
-from app.scene.drive import DriveControls, overview
+from app.scene.drive import DriveControls, grown_box, outgrown, overview, padded
 from app.scene.frames import CameraPose, FrameTree
 from app.scene.images import ImageLayer
 from app.scene.laser_scan import LaserScanLayer
@@ -99,6 +99,7 @@ PATHS = _Offer(
 # Where new browsers start: close to the lesson-13 desk, or over the whole simulated world.
 DESK_VIEW = ((1.3, -1.4, 1.1), (0.25, 0.0, 0.25))
 MIN_FRAMES_TO_FRAME = 3  # a robot's links with poses, before the cameras go to it
+REFRAME_ROOM_M = 1.0  # the room left round a moving robot's way when the cameras frame it
 JOINTS = _Offer(
     picker.JOINT_TYPES,
     "sensor_msgs/msg/JointState topics",
@@ -166,7 +167,9 @@ class ScenePanel:
         self.world = WorldLayer(node, server)
         self.more_robots = NamespacedRobots(node, server)
         self._world_shown = False
-        self._robot_framed = False  # the cameras were moved to a robot that came
+        # Where a robot that came has been (its frames' box) and the box the cameras show.
+        self._robot_box: tuple[np.ndarray, np.ndarray] | None = None
+        self._framed_box: tuple[np.ndarray, np.ndarray] | None = None
         self._desk_shown = (True, True)  # (the desk's frames and arm, its frustum)
         self._light = scene.add_light_ambient("/sim_world_light", intensity=0.9, visible=False)
 
@@ -398,22 +401,27 @@ class ScenePanel:
 
     def _follow_robot(self, graph: GraphSnapshot) -> None:
         """A robot from a robot_state_publisher came (no simulated world): the cameras go
-        to it and the frames around it, once (at the desk view the lesson-15 arm was 90 px
-        tall under a knot of labels). The learner's own camera moves stay theirs after."""
+        to it and the frames around it (at the desk view the lesson-15 arm was 90 px tall
+        under a knot of labels). A robot that drives about (the URDF lesson's R2-D2 circles
+        2 m round odom) is reframed to all the places it has been, until its whole way is in
+        view: then the learner's own camera moves stay theirs."""
         here = (
             not self._world_shown
             and graph.publishers("/robot_description") > 0
             and self.tf_view.robot_drawn
         )
         if not here:
-            self._robot_framed = False
+            self._robot_box = self._framed_box = None
             return
         poses = self.tf_view.poses()
-        if self._robot_framed or len(poses) < MIN_FRAMES_TO_FRAME:
+        if len(poses) < MIN_FRAMES_TO_FRAME:
             return
         points = np.array([pose[:3, 3] for pose in poses.values()])
-        low, high = points.min(axis=0), points.max(axis=0)
-        self._robot_framed = True
+        self._robot_box = grown_box(self._robot_box, points)
+        if not outgrown(self._framed_box, self._robot_box):
+            return
+        # Framed with room round it: the next reframe waits until the robot drove a metre.
+        self._framed_box = low, high = padded(self._robot_box, REFRAME_ROOM_M)
         position, look_at = overview(low, high)  # looks at the floor under the frames...
         lift = np.array([0.0, 0.0, (high[2] - low[2]) / 2.0])  # ...and here at their middle
         self.drive.move_cameras(position + lift, look_at + lift)

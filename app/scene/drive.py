@@ -112,6 +112,28 @@ def overview(low: np.ndarray, high: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     return position + shift, centre + shift
 
 
+Box = tuple[np.ndarray, np.ndarray]  # (low corner, high corner)
+
+
+def grown_box(box: Box | None, points: np.ndarray) -> Box:
+    """``box`` grown to hold ``points`` (N x 3): where a moving robot has been."""
+    low, high = points.min(axis=0), points.max(axis=0)
+    if box is not None:
+        low, high = np.minimum(low, box[0]), np.maximum(high, box[1])
+    return low, high
+
+
+def outgrown(framed: Box | None, box: Box) -> bool:
+    """Whether ``box`` reaches past what the cameras were framed on (or none was)."""
+    return framed is None or bool((box[0] < framed[0]).any() or (box[1] > framed[1]).any())
+
+
+def padded(box: Box, margin: float) -> Box:
+    """``box`` with ``margin`` more on each side, level with the floor (not up or down)."""
+    pad = np.array([margin, margin, 0.0])
+    return box[0] - pad, box[1] + pad
+
+
 def panel_shift(position: np.ndarray, look_at: np.ndarray) -> np.ndarray:
     """How far to move a camera right so that ``look_at`` shows left of the control panel."""
     back = np.asarray(position, dtype=float) - np.asarray(look_at, dtype=float)
