@@ -36,6 +36,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
+import yaml
 from rclpy.exceptions import InvalidHandle
 from rclpy.node import Node
 from rclpy.subscription import Subscription
@@ -48,7 +49,7 @@ from rosbags.rosbag2.storage_sqlite3 import Sqlite3Writer
 from app.bags import qos as bag_qos
 from app.bags.definitions import definition
 from app.bags.errors import BagError
-from app.bags.repair import reindex, truncate_storage
+from app.bags.repair import reindex, stamp_distro, truncate_storage
 from app.ros.convert import ConversionError, import_type
 from app.ros.monitor import MessageInfo
 from app.ros.names import QUIET_TOPICS, is_internal_topic
@@ -355,6 +356,8 @@ class Recorder:
                 done = self._write_batch(_in_time_order(batch), connections)
                 if done:
                     self._writer.close()
+                    with contextlib.suppress(OSError, KeyError, TypeError, yaml.YAMLError):
+                        stamp_distro(self.path)  # a bag without it is still a good bag
                     with self._lock:
                         self._flushed = sum(self._counts)
                     break

@@ -27,6 +27,8 @@ from app.bags.bagfile import first_line, storage_files
 from app.bags.definitions import definition
 from app.bags.errors import BagError
 
+ROS_DISTRO = "jazzy"  # the release these bags are for, as a rosbag2 of it writes
+
 MAGIC = b"\x89MCAP0\r\n"
 OP_FOOTER, OP_DATA_END, OP_MAX = 0x02, 0x0F, 0x10
 FOOTER_SIZE = 1 + 8 + 20 + len(MAGIC)
@@ -174,11 +176,23 @@ def write_metadata(folder: Path, storage: str, files: list[Path], summary: Summa
             for f in files
         ],
         "custom_data": None,
-        "ros_distro": "rosbags",
+        "ros_distro": ROS_DISTRO,
     }
     target = folder / "metadata.yaml"
     tmp = folder / ".metadata.yaml.tmp"
     tmp.write_text(yaml.safe_dump({"rosbag2_bagfile_information": info}, sort_keys=False))
+    tmp.replace(target)
+
+
+def stamp_distro(folder: Path) -> None:
+    """Name the ROS release in a closed bag's metadata, as rosbag2 does ('jazzy'): the
+    writer library puts its own name there, which ``ros2 bag info`` then showed as the
+    distro. Raises OSError or yaml.YAMLError when the file cannot be rewritten."""
+    target = folder / "metadata.yaml"
+    data = yaml.safe_load(target.read_text(encoding="utf-8"))
+    data["rosbag2_bagfile_information"]["ros_distro"] = ROS_DISTRO
+    tmp = folder / ".metadata.yaml.tmp"
+    tmp.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
     tmp.replace(target)
 
 

@@ -56,6 +56,7 @@ def test_record_talker_read_independently_and_replay_without_talker(supervisor, 
     assert code == 0, out
     assert out[0].startswith("Files:") and out[0].endswith(".mcap")
     assert f"Messages:          {len(recorded)}" in out
+    assert "ROS Distro:        jazzy" in out, out  # the release, as rosbag2 of Jazzy writes
     assert any(
         f"Topic: /chatter | Type: std_msgs/msg/String | Count: {len(recorded)} |" in line
         for line in out
