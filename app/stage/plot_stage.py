@@ -72,14 +72,24 @@ class History:
         return (t, *(rows[:, i] for i in range(len(self.names))))
 
 
+TEACHER_REPORTS = "/classroom/"  # the progress the dashboard sends its teacher: not a lesson's
+
+
 def plotted_topics(graph: GraphSnapshot) -> dict[str, str]:
-    """Topic -> type of what the plot measures: topics a node other than the dashboard
-    publishes, without ROS's plumbing and without images and clouds (large to count)."""
+    """Topic -> type of what the plot measures: topics something publishes, without ROS's
+    plumbing, the dashboard's reports to the teacher, and images and clouds (large to count).
+
+    What the dashboard publishes for the learner counts: a bag played or a ``ros2 topic
+    pub`` typed in the Console runs on the dashboard's own node (the bags lesson plots
+    /chatter played from a bag, with no talker running).
+    """
     out: dict[str, str] = {}
     for topic in graph.topics:
         if topic.name in QUIET_TOPICS or is_internal_topic(topic.name) or not topic.types:
             continue
-        if topic.publishers <= topic.own_publishers or topic.types[0] in HEAVY_TYPES:
+        if topic.publishers == 0 or topic.types[0] in HEAVY_TYPES:
+            continue
+        if topic.name.startswith(TEACHER_REPORTS) and topic.publishers <= topic.own_publishers:
             continue
         out[topic.name] = topic.types[0]
     return dict(sorted(out.items())[:MAX_SERIES])

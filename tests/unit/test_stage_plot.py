@@ -10,15 +10,16 @@ def _topic(name: str, kind: str, publishers: int = 1, own: int = 0) -> TopicInfo
     return TopicInfo(name, (kind,), publishers, 0, own_publishers=own)
 
 
-def test_it_plots_what_nodes_publish_without_plumbing_images_or_the_dashboards_own():
+def test_it_plots_what_is_published_without_plumbing_images_or_the_teachers_reports():
     graph = GraphSnapshot(
         topics=(
-            _topic("/chatter", "std_msgs/msg/String"),
+            _topic("/chatter", "std_msgs/msg/String", 1, own=1),  # a bag the Console plays
             _topic("/executor_demo/fast_rate", "std_msgs/msg/Float64"),
             _topic("/rosout", "rcl_interfaces/msg/Log", 3),
             _topic("/parameter_events", "rcl_interfaces/msg/ParameterEvent", 3),
             _topic("/camera/image_raw", "sensor_msgs/msg/Image"),
-            _topic("/turtle1/cmd_vel", "geometry_msgs/msg/Twist", 1, own=1),  # ours alone
+            _topic("/classroom/progress", "classroom_interfaces/msg/LearnerProgress", 1, own=1),
+            _topic("/sim_teleop_key/_key", "std_msgs/msg/String", 1, own=1),  # hidden
             _topic("/nobody", "std_msgs/msg/String", 0),
         )
     )
