@@ -52,6 +52,7 @@ class Edge:
     target: str
     label: str = ""
     dashed: bool = False  # a client (service or action) rather than a server
+    blocked: str = ""  # why nothing arrives on it (topic -> subscriber: incompatible QoS)
 
 
 @dataclass(frozen=True)

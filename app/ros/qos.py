@@ -1,11 +1,19 @@
-"""QoS: choosing a subscription that matches the publishers, and printing a profile."""
+"""QoS: choosing a subscription that matches the publishers, printing a profile, and
+finding subscribers no publisher can deliver to."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import (
+    DurabilityPolicy,
+    HistoryPolicy,
+    QoSCompatibility,
+    QoSProfile,
+    ReliabilityPolicy,
+    qos_check_compatible,
+)
 from rclpy.topic_endpoint_info import TopicEndpointInfo
 
 # Measuring (hz, bw, rates) subscribes best effort: it must never slow a
@@ -70,3 +78,26 @@ def qos_lines(qos: QoSProfile) -> list[str]:
         f"  Liveliness: {policy(qos.liveliness)}",
         f"  Liveliness lease duration: {duration(qos.liveliness_lease_duration)}",
     ]
+
+
+def undelivered(node: Node, topic: str) -> dict[str, str]:
+    """The subscribers of ``topic`` (by node, fully qualified) that none of its publishers
+    can deliver to, each with why in rclpy's words ("Best effort publisher and reliable
+    subscription"); {} while it has no publisher (nothing to deliver is no mismatch)."""
+    publishers = node.get_publishers_info_by_topic(topic)
+    if not publishers:
+        return {}
+    out: dict[str, str] = {}
+    for sub in node.get_subscriptions_info_by_topic(topic):
+        reasons = []
+        for pub in publishers:
+            compatible, why = qos_check_compatible(pub.qos_profile, sub.qos_profile)
+            if compatible != QoSCompatibility.ERROR:
+                break
+            reasons.append(why.removeprefix("ERROR:").strip().rstrip(";"))
+        else:
+            if sub.node_name == "_NODE_NAME_UNKNOWN_":  # discovered before its node: next time
+                continue
+            name = f"{sub.node_namespace.rstrip('/')}/{sub.node_name}"
+            out.setdefault(name, reasons[0])
+    return out

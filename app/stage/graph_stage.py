@@ -8,12 +8,14 @@ from __future__ import annotations
 import html
 import time
 from collections.abc import Callable
+from dataclasses import replace
 
 import viser
 from rclpy.node import Node
 
 from app.panels.graph_svg import Edge, Vertex, graph_picture, topics_to_measure
 from app.ros.graph import GraphSnapshot, NodeEndpoints, node_endpoints
+from app.ros.qos import undelivered
 from app.ros.rates import RateBoard, RateHold, SharedRatesClient, rate_text
 from app.stage.graph_view import (
     PER_ROW,
@@ -41,6 +43,7 @@ _TOOLS_FOR: dict[str, tuple[tuple[str, str], ...]] = {
 }
 STAGE_PADDING = 40  # the stage window's borders, folder margins and scroll bar
 OWN_DETAIL = "this dashboard"
+BLOCKED_LABEL = "QoS mismatch: nothing arrives"
 ONLY_OWN = "Only this dashboard's own node is on the graph: start a node and watch it join."
 
 
@@ -152,6 +155,7 @@ class GraphStage:
         rates = {topic: self._steady_rate(topic) for topic in self._rates.watched()}
         labels = {topic: rate_text(rate) for topic, rate in rates.items()}
         vertices, edges = graph_picture(endpoints, labels, show_quiet=quiet)
+        edges = self._mark_undelivered(edges)
         vertices += [Vertex("node", name, STARTING) for name in starting]
         note = ""
         if not vertices:  # the dashboard is a node too: say so rather than 'nothing'
@@ -192,6 +196,22 @@ class GraphStage:
             self._svg = svg
             self._picture.content = svg
         self._inspector.show(self._inspection(labels))
+
+    def _mark_undelivered(self, edges: list[Edge]) -> list[Edge]:
+        """A subscription no publisher can deliver to (incompatible QoS) is drawn as such:
+        drawn plainly, with the topic's rate on it, it said the opposite of the QoS lesson."""
+        checked: dict[str, dict[str, str]] = {}
+        marked = []
+        for edge in edges:
+            kind, _, topic = edge.source.partition(":")
+            if kind == "topic" and edge.target.startswith("node:"):
+                if topic not in checked:
+                    checked[topic] = undelivered(self._node, topic)
+                why = checked[topic].get(edge.target.partition(":")[2], "")
+                if why:
+                    edge = replace(edge, label=BLOCKED_LABEL, blocked=why)
+            marked.append(edge)
+        return marked
 
     def _caller(self, pulse: Pulse, edges: list[Edge]) -> str:
         """The node drawn as the one who called or sent the goal; '' when unknown."""

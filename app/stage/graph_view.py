@@ -155,6 +155,7 @@ STAGE_CSS = (
     ".stage-graph .sg-edge{stroke:var(--sg-edge)}.stage-graph .sg-head{fill:var(--sg-edge)}"
     ".stage-graph .sg-rate,.stage-graph .sg-note{fill:var(--sg-text);stroke:var(--sg-halo)}"
     ".stage-graph .sg-dot{fill:var(--sg-dot);stroke:var(--sg-halo)}"
+    ".stage-graph path.sg-blocked{stroke:#e03131}.stage-graph text.sg-blocked{fill:#e03131}"
     ".stage-graph .sg-pulse rect{fill:var(--sg-pulse);stroke:var(--sg-pulse-line)}"
     ".stage-graph .sg-pulse text{fill:var(--sg-text)}"
     + "".join(
@@ -291,13 +292,20 @@ def stage_svg(
             else:
                 servers.setdefault(b.vertex.name, []).append(path)
         topic = next((v.name for v in (a.vertex, b.vertex) if v.kind == "topic"), "")
-        dash = ' stroke-dasharray="5,4"' if edge.dashed else ""
-        parts.append(
-            f'<path class="sg-edge" data-source="{escape(a.vertex.name)}" '
-            f'data-target="{escape(b.vertex.name)}" d="{path}" fill="none" '
-            f'stroke-width="1.4"{dash} marker-end="url(#sg-arrow)"/>'
+        dash = ' stroke-dasharray="5,4"' if edge.dashed or edge.blocked else ""
+        blocked = (
+            f' data-blocked="{escape(edge.blocked)}"><title>{escape(edge.blocked)}</title></path>'
+            if edge.blocked
+            else "/>"
         )
-        for duration, begin, share in dot_timing(rates.get(topic, 0.0)):
+        parts.append(
+            f'<path class="sg-edge{" sg-blocked" if edge.blocked else ""}" '
+            f'data-source="{escape(a.vertex.name)}" '
+            f'data-target="{escape(b.vertex.name)}" d="{path}" fill="none" '
+            f'stroke-width="1.4"{dash} marker-end="url(#sg-arrow)"{blocked}'
+        )
+        # Nothing travels an edge no publisher can deliver on: no dots on it.
+        for duration, begin, share in dot_timing(0.0 if edge.blocked else rates.get(topic, 0.0)):
             timing = (
                 f'keyPoints="0;1;1" keyTimes="0;{share:.3f};1" calcMode="linear" '
                 if share < 1.0
@@ -312,7 +320,8 @@ def stage_svg(
             )
         if edge.label:
             labels.append(
-                f'<text class="sg-rate" x="{mx:.0f}" y="{my + 4:.0f}" font-size="11" '
+                f'<text class="sg-rate{" sg-blocked" if edge.blocked else ""}" '
+                f'x="{mx:.0f}" y="{my + 4:.0f}" font-size="11" '
                 'text-anchor="middle" stroke-width="3" '
                 f'paint-order="stroke">{escape(edge.label)}</text>'
             )
@@ -364,5 +373,6 @@ def stage_legend() -> str:
         f'font-size:12px;line-height:1.9">{chips}<br>'
         "publisher → topic → subscriber; server → service/action; dashed: client. "
         "Dots are messages, at the rate written on the edge; a labelled pulse is a service "
-        "call (request, response) or an action's goal, feedback and result.</div>"
+        "call (request, response) or an action's goal, feedback and result. A red dashed "
+        "edge is a subscription no publisher's QoS can deliver to.</div>"
     )

@@ -133,6 +133,21 @@ def test_dots_follow_the_rate_and_are_capped():
     assert len(dot_timing(1000.0)) == MAX_DOTS
 
 
+def test_an_edge_no_publisher_can_deliver_on_is_red_dashed_and_carries_no_dots():
+    """The QoS lesson's mismatch: the topic has its rate, the listener hears nothing."""
+    vertices = [Vertex("node", "/talker"), Vertex("topic", "/chatter"), Vertex("node", "/l")]
+    why = "Best effort publisher and reliable subscription"
+    edges = [
+        Edge("node:/talker", "topic:/chatter", "2.0 Hz"),
+        Edge("topic:/chatter", "node:/l", "QoS mismatch: nothing arrives", blocked=why),
+    ]
+    svg = stage_svg(StablePlaces().place(vertices, edges), edges, {"/chatter": 2.0})
+    assert svg.count('data-edge="/talker>/chatter"') == 2  # the publisher's side moves
+    assert 'data-edge="/chatter>/l"' not in svg  # nothing travels to the listener
+    assert 'class="sg-edge sg-blocked"' in svg and f"<title>{why}</title>" in svg
+    assert re.search(r'class="sg-rate sg-blocked"[^>]*>QoS mismatch: nothing arrives<', svg)
+
+
 def test_the_svg_animates_dots_on_both_edges_of_a_topic():
     vertices = [Vertex("node", "/talker"), Vertex("topic", "/chatter"), Vertex("node", "/l")]
     edges = [Edge("node:/talker", "topic:/chatter", "2.0 Hz"), Edge("topic:/chatter", "node:/l")]

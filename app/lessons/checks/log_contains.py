@@ -45,7 +45,10 @@ def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
     lines = [line for line in [*rt.supervisor.output(name), *launched] if c["text"] in line]
     needed = c.get("at_least", 1)
     if len(lines) >= needed:
-        return CheckResult(PASS, f"{len(lines)} log lines contain {c['text']!r}")
+        said = "1 line contains" if len(lines) == 1 else f"{len(lines)} lines contain"
+        return CheckResult(PASS, f"{name}'s log: {said} {c['text']!r}")
     if not rt.supervisor.status(name).active and not launching:
         return CheckResult(FAIL, f"{name} is not running")
-    return CheckResult(WAITING, f"{len(lines)} of {needed} log lines contain {c['text']!r} so far")
+    return CheckResult(
+        WAITING, f"{name}'s log: {len(lines)} of {needed} lines contain {c['text']!r} so far"
+    )
