@@ -84,11 +84,18 @@ class StampedLayer:
         self._followers: dict[str, _StampedTopic] = {}
 
     def refresh(self, graph: GraphSnapshot | None) -> None:
-        """Follow every new stamped point/pose topic (UI thread)."""
+        """Follow every new published stamped point/pose topic, and stop drawing those whose
+        publishers all left (UI thread): a stopped node's point stood on, looking current
+        (a learner compared a moving arm's point with a tf2 one stopped a step before)."""
+        if graph is None:
+            return
+        self.forget_unpublished(graph)
         points = picker.drawable_topics(graph, picker.POINT_TYPES)
         poses = picker.drawable_topics(graph, picker.POSE_TYPES)
         for topic, is_pose in [(t, False) for t in points] + [(t, True) for t in poses]:
             if topic in self._followers or len(self._followers) >= MAX_TOPICS:
+                continue
+            if graph.publishers(topic) == 0:  # a subscriber alone lists it: nothing to draw
                 continue
             colour = _COLOURS[len(self._followers) % len(_COLOURS)]
             self._followers[topic] = _StampedTopic(self, topic, is_pose, colour)

@@ -185,12 +185,17 @@ def test_the_desk_shows_only_while_a_node_feeds_it(page, probe):
         return msg
 
     repeater = Repeater(publisher, point, 0.1)
+    drawn = "/base_link/camera/stamped/pos_in_cam_frame"
     try:
         page.wait_for_function(DESK_SHOWN_JS, polling=200, timeout=30_000)
+        page.wait_for_function(HAS_NODE_JS, arg=drawn, polling=200, timeout=30_000)
     finally:
         repeater.stop()
         probe.node.destroy_publisher(publisher)
     page.wait_for_function(f"() => !({DESK_SHOWN_JS})()", polling=200, timeout=30_000)
+    # Its publisher gone, the point goes too: a stopped node's point does not stand on.
+    gone = "(n) => !(window.__viserMutable.nodeRefFromName[n] || {}).visible"
+    page.wait_for_function(gone, arg=drawn, polling=200, timeout=30_000)
 
 
 def test_a_map_published_once_is_drawn_on_the_floor_of_its_frame(page, probe):
