@@ -213,13 +213,19 @@ def edge_path(a: Placed, b: Placed) -> tuple[str, float, float]:
     if y3 > y0:
         dy = (y3 - y0) / 2
         c1, c2 = (x0, y0 + dy), (x3, y3 - dy)
-    else:  # upward or sideways: bulge out to the right so the arrow stays visible
+    elif a.y == b.y and a.x != b.x:  # side by side: straight across the gap between them
+        y0 = y3 = a.y + BOX_H / 2
+        x0, x3 = (a.x + BOX_W, b.x) if b.x > a.x else (a.x, b.x + BOX_W)
+        c1, c2 = (x0 + (x3 - x0) / 3, y0), (x0 + 2 * (x3 - x0) / 3, y3)
+    else:  # upward: bulge out to the right so the arrow stays visible
         x0, y0 = a.x + BOX_W, a.y + BOX_H / 2
         x3, y3 = b.x + BOX_W, b.y + BOX_H / 2
         reach = 40 + abs(y3 - y0) / 4
         c1, c2 = (x0 + reach, y0), (x3 + reach, y3)
     mid_x = (x0 + 3 * c1[0] + 3 * c2[0] + x3) / 8
     mid_y = (y0 + 3 * c1[1] + 3 * c2[1] + y3) / 8
+    if a.y == b.y and a.x != b.x:  # the gap is narrow: the label goes above the two boxes
+        mid_y = a.y - 10
     path = f"M{x0:.0f},{y0:.0f} C{c1[0]:.0f},{c1[1]:.0f} {c2[0]:.0f},{c2[1]:.0f} {x3:.0f},{y3:.0f}"
     return path, mid_x, mid_y
 

@@ -29,3 +29,8 @@ def is_hidden_node(fqn: str) -> bool:
 def is_internal_topic(topic: str) -> bool:
     """Action internals and hidden topics ('/_...') are nothing a learner publishes."""
     return ACTION_MARKER in topic or "/_" in topic
+
+
+# The classroom's own topics (a dashboard's progress reports to its teacher, the teacher's
+# notices): not a lesson's, so the stage neither plots nor draws the dashboard for them.
+CLASSROOM_TOPICS = "/classroom/"

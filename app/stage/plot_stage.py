@@ -19,7 +19,7 @@ import viser.uplot as uplot
 
 from app.panels.graph_svg import HEAVY_TYPES
 from app.ros.graph import GraphSnapshot
-from app.ros.names import QUIET_TOPICS, is_internal_topic
+from app.ros.names import CLASSROOM_TOPICS, QUIET_TOPICS, is_internal_topic
 from app.ros.rates import MAX_RATE_WINDOW_SEC, SharedRatesClient, rate_text
 from app.ui import MarkdownView
 
@@ -72,26 +72,26 @@ class History:
         return (t, *(rows[:, i] for i in range(len(self.names))))
 
 
-TEACHER_REPORTS = "/classroom/"  # the progress the dashboard sends its teacher: not a lesson's
-
-
 def plotted_topics(graph: GraphSnapshot) -> dict[str, str]:
-    """Topic -> type of what the plot measures: topics something publishes, without ROS's
-    plumbing, the dashboard's reports to the teacher, and images and clouds (large to count).
+    """Topic -> type of what the plot measures: what another node publishes, or what the
+    dashboard publishes to another node, without ROS's plumbing, the classroom's own
+    topics, and images and clouds (large to count).
 
-    What the dashboard publishes for the learner counts: a bag played or a ``ros2 topic
-    pub`` typed in the Console runs on the dashboard's own node (the bags lesson plots
-    /chatter played from a bag, with no talker running).
+    A bag played or a ``ros2 topic pub`` typed in the Console runs on the dashboard's own
+    node: the bags lesson plots /chatter played to the listener, with no talker running. A
+    publisher the dashboard keeps with nobody listening (a lesson's earlier button) is not
+    plotted: it would be a row of 0 Hz left over from another lesson.
     """
     out: dict[str, str] = {}
     for topic in graph.topics:
         if topic.name in QUIET_TOPICS or is_internal_topic(topic.name) or not topic.types:
             continue
-        if topic.publishers == 0 or topic.types[0] in HEAVY_TYPES:
+        if topic.types[0] in HEAVY_TYPES or topic.name.startswith(CLASSROOM_TOPICS):
             continue
-        if topic.name.startswith(TEACHER_REPORTS) and topic.publishers <= topic.own_publishers:
-            continue
-        out[topic.name] = topic.types[0]
+        others_publish = topic.publishers > topic.own_publishers
+        sent_to_others = topic.publishers > 0 and topic.subscribers > topic.own_subscribers
+        if others_publish or sent_to_others:
+            out[topic.name] = topic.types[0]
     return dict(sorted(out.items())[:MAX_SERIES])
 
 

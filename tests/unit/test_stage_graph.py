@@ -238,3 +238,19 @@ def test_a_goals_result_pulse_is_never_crowded_out_by_its_feedback():
     assert kinds[-1] == "result" and kinds.count("feedback") < int(MAX_BEHIND_SEC / TRAVEL_SEC) + 3
     shown = [p.shown_at for p in watch._pulses]
     assert shown == sorted(shown)  # the result follows the feedback on screen
+
+
+def test_an_edge_between_boxes_side_by_side_runs_across_the_gap_with_its_rate_above():
+    """The bags lesson's replay: /chatter (no publisher drawn) beside /listener. The edge
+    bulged round the listener's far side and its rate sat on the listener's name."""
+    from app.panels.graph_svg import BOX_H, BOX_W, Placed, edge_path
+
+    topic = Placed(Vertex("topic", "/chatter"), 100.0, 50.0)
+    node = Placed(Vertex("node", "/listener"), 100.0 + BOX_W + 14, 50.0)
+    path, mx, my = edge_path(topic, node)
+    start, end = path.split()[0], path.split()[-1]
+    assert start == f"M{100 + BOX_W:.0f},{50 + BOX_H / 2:.0f}"  # the topic's right side
+    assert end == f"{100 + BOX_W + 14:.0f},{50 + BOX_H / 2:.0f}"  # the listener's left side
+    assert 100 + BOX_W <= mx <= 100 + BOX_W + 14 and my < 50  # in the gap, above the boxes
+    back, _mx, _my = edge_path(node, topic)  # right to left: the facing sides again
+    assert back.split()[0] == f"M{100 + BOX_W + 14:.0f},{50 + BOX_H / 2:.0f}"

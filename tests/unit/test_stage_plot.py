@@ -6,14 +6,17 @@ from app.ros.graph import GraphSnapshot, TopicInfo
 from app.stage.plot_stage import MAX_SERIES, WINDOW_SEC, History, plotted_topics
 
 
-def _topic(name: str, kind: str, publishers: int = 1, own: int = 0) -> TopicInfo:
-    return TopicInfo(name, (kind,), publishers, 0, own_publishers=own)
+def _topic(
+    name: str, kind: str, publishers: int = 1, own: int = 0, subscribers: int = 0
+) -> TopicInfo:
+    return TopicInfo(name, (kind,), publishers, subscribers, own_publishers=own)
 
 
 def test_it_plots_what_is_published_without_plumbing_images_or_the_teachers_reports():
     graph = GraphSnapshot(
         topics=(
-            _topic("/chatter", "std_msgs/msg/String", 1, own=1),  # a bag the Console plays
+            _topic("/chatter", "std_msgs/msg/String", 1, own=1, subscribers=1),  # a bag played
+            _topic("/turtle1/cmd_vel", "geometry_msgs/msg/Twist", 1, own=1),  # nobody listens
             _topic("/executor_demo/fast_rate", "std_msgs/msg/Float64"),
             _topic("/rosout", "rcl_interfaces/msg/Log", 3),
             _topic("/parameter_events", "rcl_interfaces/msg/ParameterEvent", 3),
