@@ -284,9 +284,17 @@ class LtiService:
                 line,
                 seat=self.seat_of(line.learner),
                 time_spent=self.time_spent_of(line.learner, line.kind, line.slug),
+                **self._graded_of(line),
             )
             for line in lines
         ]
+
+    def _graded_of(self, line: GradebookLine) -> dict[str, Any]:
+        """How many graded attempts at the line's exercise are known, and the newest's time."""
+        if line.kind != "exercise" or not line.slug:
+            return {}
+        attempts = self.attempts_source(line.learner, line.slug).attempts  # newest first
+        return {"graded": len(attempts), "last_graded": attempts[0].at if attempts else None}
 
     def time_spent_of(self, name: str, kind: str, slug: str) -> int | None:
         """Active seconds on an activity, as the learner's progress reports last told

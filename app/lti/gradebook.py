@@ -43,6 +43,10 @@ class GradebookLine:
     # Active seconds the learner's dashboard counted on it (None: none reported). The
     # same for each LMS link of one activity: it is the learner's time, not the link's.
     time_spent: int | None = None
+    # The graded attempts known here at an exercise (the attempt history's), and when the
+    # newest ran (None: none known, or a lesson, which has no graded attempts).
+    graded: int = 0
+    last_graded: float | None = None
 
     def to_json(self) -> dict[str, object]:
         return {name: getattr(self, name) for name in self.__dataclass_fields__}

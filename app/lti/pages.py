@@ -153,6 +153,9 @@ def _gradebook_row(line: GradebookLine, now: float, seats: bool, whose: bool = T
     ]
     if whose:
         cells.append(f'<td class="time nowrap">{duration(line.time_spent)}</td>')
+        graded = str(line.graded) if line.kind == "exercise" else "–"
+        last = f"<br>last {_time(line.last_graded)}" if line.last_graded else ""
+        cells.append(f'<td class="graded">{graded}{last}</td>')
     if line.state == "sent":
         answer = line.lms_answer or "accepted"
         cells += [f"<td>{_time(line.sent_at)}</td>", f"<td>{html.escape(answer)}</td>", "<td></td>"]
@@ -195,6 +198,17 @@ def history_link(learner: str, kind: str, slug: str) -> str:
     return f"{HISTORY_PATH}?{urlencode({'learner': learner, 'activity': f'{kind}:{slug}'})}"
 
 
+def _graded_words(line: GradebookLine) -> str:
+    """'3 graded attempts, the last 2026-11-29 10:15 UTC', for a cell's tooltip."""
+    if line.kind != "exercise":
+        return "a lesson: no graded attempts"
+    if not line.graded:
+        return "no graded attempt known"
+    when = datetime.fromtimestamp(line.last_graded or 0, timezone.utc).strftime("%Y-%m-%d %H:%M")
+    plural = "" if line.graded == 1 else "s"
+    return f"{line.graded} graded attempt{plural}, the last {when} UTC"
+
+
 def class_grid(lines: Sequence[GradebookLine]) -> str:
     """The class at a glance: a row per learner, a column per activity, a mark per cell.
 
@@ -226,7 +240,7 @@ def class_grid(lines: Sequence[GradebookLine]) -> str:
             state, score = shown_line.state, shown_line.score
             spent = duration(shown_line.time_spent)
             title = f"{_STATE_MARKS[state]} {score}: {shown}, {activity}; time spent {spent}; "
-            title += "its attempts"
+            title += f"{_graded_words(shown_line)}; its attempts"
             link = history_link(learner, shown_line.kind, shown_line.slug)
             tip = html.escape(title, quote=True)
             cells.append(
@@ -272,6 +286,7 @@ def gradebook_page(
         "Grade",
         "Score",
         f'<span title="{html.escape(TIME_SPENT_HELP, quote=True)}">Time spent</span>',
+        "Graded attempts",
     ]
     head += ["When", "The LMS's answer", "Next try"]
     rows = "\n".join(_gradebook_row(line, now, seats) for line in lines)

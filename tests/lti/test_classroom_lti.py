@@ -206,6 +206,8 @@ def test_a_cell_of_the_gradebook_opens_the_seats_attempts_read_from_its_folder(
 
     grid = request("GET", room.server.gradebook_url)
     [cell] = re.findall(r'href="(gradebook/attempts\?[^"]+)"', grid.body)
+    # The cell counts the finished gradings read from the folder (not the one under way).
+    assert "2 graded attempts, the last 2026-11-29 10:20 UTC" in html.unescape(grid.body)
     page = request("GET", f"{room.urls.base}/{html.unescape(cell)}&token={TEACHER_TOKEN}")
     assert page.status == 200, page.body
     words = html.unescape(re.sub(r"<[^>]+>", " ", page.body))

@@ -168,21 +168,28 @@ def text(page: str) -> str:
 def test_the_grid_the_table_and_the_history_show_the_time_spent() -> None:
     lesson = line(kind="lesson", slug=LESSON, activity="Lesson 5", state="not done", score="",
                   time_spent=None)  # fmt: skip
-    grid = class_grid([line(), lesson])
+    tried = line(graded=3, last_graded=1795947600.0)  # 2026-11-29 10:20 UTC
+    grid = class_grid([tried, lesson])
     tips = [
         html.unescape(t)
         for t in re.findall(r'<a href="gradebook/attempts[^"]+" title="([^"]+)"', grid)
     ]
     assert tips == [
-        "✓ sent 5 of 5: Ada, A counter on a topic; time spent 12 min; its attempts",
-        "not done yet : Ada, Lesson 5; time spent –; its attempts",
+        "✓ sent 5 of 5: Ada, A counter on a topic; time spent 12 min; "
+        "3 graded attempts, the last 2026-11-29 10:20 UTC; its attempts",
+        "not done yet : Ada, Lesson 5; time spent –; a lesson: no graded attempts; its attempts",
     ]
-    page = gradebook_page([line(), lesson], now=0.0, retry_form="<form>")
+    none_yet = class_grid([line()])
+    assert "no graded attempt known" in html.unescape(none_yet)
+    page = gradebook_page([tried, lesson], now=0.0, retry_form="<form>")
     head = text(page.split('<table id="gradebook"', 1)[1].split("</thead>", 1)[0]).split()
     assert "Time" in head and head.index("Score") + 1 == head.index("Time")
+    assert head.index("Graded") == head.index("spent") + 1  # "Time spent", then "Graded ..."
     body = page.split('<table id="gradebook"', 1)[1].split("<tbody>", 1)[1]
     cells = re.findall(r'<td class="time nowrap">([^<]*)</td>', body)
     assert cells == ["12 min", "–"]
+    graded = [text(c).split() for c in re.findall(r'<td class="graded">(.*?)</td>', body)]
+    assert graded[0][:2] == ["3", "last"] and graded[1] == ["–"]
     history = attempts_page([line()], learner="lti-abc", kind="exercise", slug=EXERCISE,
                             source=None, now=0.0)  # fmt: skip
     assert "Time spent on it: 12 min" in text(history)
