@@ -235,6 +235,32 @@ def _pulse_svg(pulse: PulseView, path: str, backwards: bool, begin: float) -> st
     )
 
 
+MAX_ZOOM = 1.6  # a small graph is drawn up to this much larger, to use the stage
+MAX_ZOOMED_HEIGHT = 520  # px: a zoomed graph stays about this tall at most (1366x768)
+# Room round the boxes in a zoomed view: rate labels above, edges that bulge to the right.
+ZOOM_ROOM = (24.0, 28.0, 70.0, 20.0)  # left, top, right, bottom
+
+
+def _zoomed_view(placed: list[Placed], width: float, height: float, note: str) -> tuple[str, float]:
+    """The viewBox and drawn height: a few boxes in one corner of a wide stage left most of
+    it white (a teacher read the course on a projector), so a small graph is enlarged, up
+    to ``MAX_ZOOM``, and centred; a large one (or one with a note line) stays 1:1."""
+    natural = f"0 0 {width:.0f} {height:.0f}"
+    if not placed or note:
+        return natural, height
+    left, top, right, bottom = ZOOM_ROOM
+    x0 = min(p.x for p in placed) - left
+    y0 = min(p.y for p in placed) - top
+    x1 = max(p.x for p in placed) + BOX_W + right
+    y1 = max(p.y for p in placed) + BOX_H + bottom
+    zoom = min(MAX_ZOOM, width / (x1 - x0), MAX_ZOOMED_HEIGHT / (y1 - y0))
+    if zoom <= 1.0:
+        return natural, height
+    view_w = width / zoom  # the stage's whole width, centred on the boxes
+    cx = (x0 + x1) / 2
+    return f"{cx - view_w / 2:.0f} {y0:.0f} {view_w:.0f} {y1 - y0:.0f}", (y1 - y0) * zoom
+
+
 def stage_svg(
     placed: list[Placed],
     edges: list[Edge],
@@ -249,8 +275,9 @@ def stage_svg(
     ``pulses`` are calls and goals on their way, ``starting`` the nodes drawn dashed
     because their process runs but the ROS graph does not list them yet.
 
-    Drawn at its natural size, never scaled down (the stage scrolls instead): at
-    least ``min_width`` px wide, so it fills the stage. ``note``: a line written
+    Drawn at its natural size or larger, never scaled down (the stage scrolls instead):
+    at least ``min_width`` px wide, so it fills the stage; a small graph is enlarged
+    (``_zoomed_view``). ``note``: a line written
     above the boxes (default: none, or that the graph is empty).
 
     ``link(i, content, title)`` wraps the i-th box (``placed`` order) in a link.
@@ -263,10 +290,11 @@ def stage_svg(
     right = max((p.x for p in placed), default=0) + BOX_W + MARGIN
     width = max(right, 2 * MARGIN + PER_ROW * BOX_W + (PER_ROW - 1) * GAP_X, min_width)
     height = max((p.y for p in placed), default=top) + (BOX_H + MARGIN if placed else 0) + 8
+    view, shown_height = _zoomed_view(placed, width, height, note)
     parts = [
         f'<svg class="stage-graph" xmlns="http://www.w3.org/2000/svg" role="group" '
-        f'aria-label="Live ROS graph: {len(placed)} items" viewBox="0 0 {width:.0f} '
-        f'{height:.0f}" width="{width:.0f}" height="{height:.0f}" '
+        f'aria-label="Live ROS graph: {len(placed)} items" viewBox="{view}" '
+        f'width="{width:.0f}" height="{shown_height:.0f}" '
         'style="font-family:sans-serif;display:block">',
         f"<style>{STAGE_CSS}</style>",
         '<defs><marker id="sg-arrow" viewBox="0 0 10 10" refX="9" refY="5" markerWidth="7" '
