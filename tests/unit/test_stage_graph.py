@@ -254,3 +254,20 @@ def test_an_edge_between_boxes_side_by_side_runs_across_the_gap_with_its_rate_ab
     assert 100 + BOX_W <= mx <= 100 + BOX_W + 14 and my < 50  # in the gap, above the boxes
     back, _mx, _my = edge_path(node, topic)  # right to left: the facing sides again
     assert back.split()[0] == f"M{100 + BOX_W + 14:.0f},{50 + BOX_H / 2:.0f}"
+
+
+def test_a_small_graph_is_enlarged_to_use_the_stage_and_a_large_one_stays_1_to_1():
+    """Three boxes in a column on an 800 px stage: drawn 1.6x, centred, not taller than
+    the stage; twelve rows of boxes: natural size (the stage scrolls)."""
+    small = [Vertex("node", "/talker"), Vertex("topic", "/chatter"), Vertex("node", "/l")]
+    edges = [Edge("node:/talker", "topic:/chatter"), Edge("topic:/chatter", "node:/l")]
+    svg = stage_svg(StablePlaces().place(small, edges), edges, {}, min_width=800)
+    view = [float(v) for v in re.search(r'viewBox="([^"]+)"', svg).group(1).split()]
+    drawn_w = float(re.search(r' width="([\d.]+)"', svg).group(1))
+    drawn_h = float(re.search(r' height="([\d.]+)"', svg).group(1))
+    assert drawn_w == 800 and drawn_w / view[2] == pytest.approx(1.6, abs=0.01)
+    assert drawn_h / view[3] == pytest.approx(1.6, abs=0.01) and drawn_h <= 520
+    chain = [Vertex("node", f"/n{i}") for i in range(12)]
+    links = [Edge(f"node:/n{i}", f"node:/n{i + 1}") for i in range(11)]
+    tall = stage_svg(StablePlaces().place(chain, links), links, {}, min_width=800)
+    assert re.search(r'viewBox="0 0 (\d+) (\d+)" width="\1" height="\2"', tall), tall[:300]
