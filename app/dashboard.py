@@ -282,11 +282,11 @@ class Dashboard:
         """The program started last in this lesson, the learner's own or a lesson's (one
         still running first): its name and state, and its last lines of output, for under
         the code. What an earlier lesson ran is not this lesson's output."""
-        since = self._lesson_since - 1.0  # a Start clicked as the lesson opened counts
+        # A program this lesson started was spawned after the click that opened it.
         statuses = [
             status
             for status in self.supervisor.statuses().values()
-            if (status.started_at or 0.0) >= since
+            if (status.started_at or 0.0) >= self._lesson_since
         ]
         if not statuses:
             return "", []
