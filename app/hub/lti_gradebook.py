@@ -1,9 +1,10 @@
 """The teacher's gradebook page: what went to the LMS, what waits in the outbox, and Retry.
 
-Four routes under the LTI service's prefix, for teachers only:
+Five routes under the LTI service's prefix, for teachers only:
 
 - ``gradebook`` (GET): the page (app/lti/pages.py draws it);
 - ``gradebook.json`` (GET): the same lines as data;
+- ``gradebook.csv`` (GET): the same lines for a spreadsheet;
 - ``gradebook/retry`` (POST, with the XSRF field): every score not yet
   delivered is tried now, then back to the page;
 - ``gradebook/attempts?learner=NAME&activity=KIND:SLUG`` (GET): what a cell of
@@ -26,7 +27,7 @@ from typing import TYPE_CHECKING, Any
 
 from tornado import web
 
-from app.lti.gradebook import GradebookLine, lines_of
+from app.lti.gradebook import GradebookLine, gradebook_csv, lines_of
 from app.lti.pages import HISTORY_PATH, attempts_page, gradebook_page, not_found_page, refusal_page
 
 if TYPE_CHECKING:
@@ -34,6 +35,7 @@ if TYPE_CHECKING:
 
 PAGE_PATH = "gradebook"
 JSON_PATH = "gradebook.json"
+CSV_PATH = "gradebook.csv"
 RETRY_PATH = "gradebook/retry"
 
 
@@ -87,6 +89,14 @@ class GradebookJson(_GradebookBase):
     @web.authenticated
     def get(self) -> None:
         self.finish({"lines": [line.to_json() for line in self.lti.gradebook()]})
+
+
+class GradebookCsv(_GradebookBase):
+    @web.authenticated
+    def get(self) -> None:
+        self.set_header("Content-Type", "text/csv; charset=utf-8")
+        self.set_header("Content-Disposition", 'attachment; filename="gradebook.csv"')
+        self.finish(gradebook_csv(self.lti.gradebook()))
 
 
 class GradebookRetry(_GradebookBase):
@@ -150,7 +160,7 @@ def gradebook_routes(
     *,
     back: tuple[str, str] | None = None,
 ) -> list[tuple[str, type[web.RequestHandler], dict[str, Any]]]:
-    """The four routes, each handler behind ``auth`` (a mixin that names the teacher).
+    """The five routes, each handler behind ``auth`` (a mixin that names the teacher).
 
     ``back`` is the link from the gradebook to the teacher's page: (address, text).
     """
@@ -161,6 +171,7 @@ def gradebook_routes(
         for path, handler in (
             (PAGE_PATH, GradebookPage),
             (JSON_PATH, GradebookJson),
+            (CSV_PATH, GradebookCsv),
             (RETRY_PATH, GradebookRetry),
             (HISTORY_PATH, GradebookAttempts),
         )

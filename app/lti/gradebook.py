@@ -10,8 +10,11 @@ outbox is hidden from the teacher. Pure data; app/lti/pages.py draws it.
 
 from __future__ import annotations
 
+import csv
+import io
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
+from datetime import datetime, timezone
 from typing import Literal
 
 from app.lti.learners import Kind, LaunchedItem, LearnerEntry, hub_user_name
@@ -139,3 +142,43 @@ def counts(lines: Iterable[GradebookLine]) -> dict[State, int]:
     for line in lines:
         found[line.state] += 1
     return found
+
+
+CSV_COLUMNS = (
+    "learner", "lms_name", "seat", "activity", "kind", "slug", "lms_link", "grade_column",
+    "state", "score", "time_spent_s", "graded_attempts", "last_graded_utc", "earned",
+    "sent_utc", "lms_answer", "tries",
+)  # fmt: skip
+
+
+def gradebook_csv(lines: Iterable[GradebookLine]) -> str:
+    """The gradebook as a spreadsheet takes it: a row per line, ``CSV_COLUMNS``.
+
+    A cell that a spreadsheet would run as a formula (an LMS's name starting with
+    '=', '+', '-' or '@') is written with a leading apostrophe: names come from the
+    LMS, and a teacher opens this file in a spreadsheet.
+    """
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(CSV_COLUMNS)
+    for line in lines:
+        row = (
+            line.learner, line.lms_name, line.seat, line.activity, line.kind, line.slug,
+            line.link, line.lineitem or "", line.state, line.score,
+            "" if line.time_spent is None else line.time_spent,
+            line.graded if line.kind == "exercise" else "",
+            _utc(line.last_graded), line.queued_at, _utc(line.sent_at), line.lms_answer,
+            line.attempts,
+        )  # fmt: skip
+        writer.writerow([_inert(cell) for cell in row])
+    return out.getvalue()
+
+
+def _utc(stamp: float | None) -> str:
+    return "" if not stamp else datetime.fromtimestamp(stamp, timezone.utc).isoformat()
+
+
+def _inert(cell: object) -> object:
+    if isinstance(cell, str) and cell[:1] in ("=", "+", "-", "@", "\t", "\r"):
+        return "'" + cell
+    return cell

@@ -300,7 +300,8 @@ def gradebook_page(
         "<style>body{max-width:none}.url{display:inline-block;max-width:22em;"
         "word-break:break-all}.nowrap{white-space:nowrap}</style>"
         "<h1>Grades sent to the LMS</h1>\n"
-        f'<p>{html.escape(summary)}{back_link} · <a href="gradebook">Reload</a></p>\n'
+        f'<p>{html.escape(summary)}{back_link} · <a href="gradebook">Reload</a> · '
+        '<a href="gradebook.csv">Download as CSV</a></p>\n'
         + (f'<p class="why">{html.escape(notice)}</p>\n' if notice else "")
         + "<p>One line per LMS link a learner opened. A finished lesson or passed exercise "
         "becomes a score that waits in the outbox until the LMS takes it; an LMS that is "

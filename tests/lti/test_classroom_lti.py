@@ -208,6 +208,11 @@ def test_a_cell_of_the_gradebook_opens_the_seats_attempts_read_from_its_folder(
     [cell] = re.findall(r'href="(gradebook/attempts\?[^"]+)"', grid.body)
     # The cell counts the finished gradings read from the folder (not the one under way).
     assert "2 graded attempts, the last 2026-11-29 10:20 UTC" in html.unescape(grid.body)
+    assert 'href="gradebook.csv"' in grid.body
+    table = request("GET", room.server.gradebook_url.replace("/gradebook?", "/gradebook.csv?"))
+    assert table.status == 200, table.body
+    assert table.body.splitlines()[0].startswith("learner,lms_name,seat,activity")
+    assert any(",exercise," in row and ",754," in row for row in table.body.splitlines()[1:])
     page = request("GET", f"{room.urls.base}/{html.unescape(cell)}&token={TEACHER_TOKEN}")
     assert page.status == 200, page.body
     words = html.unescape(re.sub(r"<[^>]+>", " ", page.body))

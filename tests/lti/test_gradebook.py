@@ -195,7 +195,7 @@ def test_a_learner_without_teacher_rights_is_refused_the_gradebook(
 
     learner = service.hub.token_for(ada["name"])  # a real hub user, with no teacher scope
     history = f"gradebook/attempts?learner={ada['name']}&activity=exercise:{EXERCISE}"
-    for path in ("gradebook", "gradebook.json", "", "progress.json", history):
+    for path in ("gradebook", "gradebook.json", "gradebook.csv", "", "progress.json", history):
         answer = as_user(service, learner, path)
         assert answer.status == 403, (path, answer.status)
         assert "Ada Lovelace" not in answer.body and "lineitems" not in answer.body

@@ -236,3 +236,25 @@ def test_a_learners_reported_time_reaches_the_gradebook(
         assert again.lti.time_spent_of(name, "exercise", EXERCISE) == 754
     finally:
         again.close()
+
+
+def test_the_gradebook_downloads_as_csv_with_formulas_made_inert() -> None:
+    """What a teacher opens in a spreadsheet: a row per line, and an LMS name that a
+    spreadsheet would run as a formula is written as text."""
+    import csv
+    import io
+
+    from app.lti.gradebook import CSV_COLUMNS, gradebook_csv
+
+    tried = line(graded=3, last_graded=1795947600.0, lms_name="=HYPERLINK(1)")
+    lesson = line(kind="lesson", slug=LESSON, activity="Lesson 5", state="not done", score="",
+                  time_spent=None)  # fmt: skip
+    rows = list(csv.DictReader(io.StringIO(gradebook_csv([tried, lesson]))))
+    assert list(rows[0]) == list(CSV_COLUMNS) and len(rows) == 2
+    first, second = rows
+    assert first["lms_name"].startswith("'=HYPERLINK")  # text, not a formula
+    assert (first["state"], first["score"], first["time_spent_s"]) == ("sent", "5 of 5", "754")
+    assert first["graded_attempts"] == "3" and first["last_graded_utc"].startswith(
+        "2026-11-29T10:20"
+    )
+    assert (second["kind"], second["time_spent_s"], second["graded_attempts"]) == ("lesson", "", "")
