@@ -108,6 +108,7 @@ class Dashboard:
         self._stop = threading.Event()
         self.start_requests = StartRequests()  # Start clicks the stage shows at once
         self._lesson_since = time.time()  # when the current lesson was opened (UI thread)
+        self._lesson_programs: frozenset[str] = frozenset()  # what its buttons start
         self.graph = GraphSnapshot()
         self._tools: dict[str, Panel] = {}
         self._panels: list[Panel] = self._build_gui()
@@ -245,11 +246,12 @@ class Dashboard:
         script = _OPEN_FROM_ADDRESS % json.dumps(hrefs)
         self.server.gui.add_html(page_script(script, "open what the address names"))
 
-    def _new_lesson(self) -> None:
+    def _new_lesson(self, programs: frozenset[str]) -> None:
         """Another lesson was opened (UI thread): the views forget what the last one left."""
         cast(ScenePanel, self._tools["3D view"]).forget_unpublished(self.graph)
         self._stage.forget()
         self._lesson_since = time.time()
+        self._lesson_programs = programs
 
     def _starting_nodes(self) -> list[str]:
         """Catalog nodes that are starting: clicked (until the supervisor has the process),
@@ -281,12 +283,14 @@ class Dashboard:
     def _program_output(self) -> tuple[str, list[str]]:
         """The program started last in this lesson, the learner's own or a lesson's (one
         still running first): its name and state, and its last lines of output, for under
-        the code. What an earlier lesson ran is not this lesson's output."""
+        the code. What an earlier lesson ran is not this lesson's output, unless it is one
+        of this lesson's own programs still running (the learner came back to the lesson)."""
         # A program this lesson started was spawned after the click that opened it.
         statuses = [
             status
             for status in self.supervisor.statuses().values()
             if (status.started_at or 0.0) >= self._lesson_since
+            or (status.active and status.name in self._lesson_programs)
         ]
         if not statuses:
             return "", []

@@ -171,16 +171,17 @@ class LessonsPanel:
         step_card: viser.GuiFolderHandle | None = None,
         open_tool: Callable[[str], None] = lambda _tool: None,
         start_requests: StartRequests | None = None,
-        new_lesson: Callable[[], None] = lambda: None,
+        new_lesson: Callable[[frozenset[str]], None] = lambda _programs: None,
         position: MarkdownView | None = None,
         to_top: Callable[[], None] = lambda: None,
     ) -> None:
         """``step_card``: a folder for the step's title, buttons, checks and Back/Next (the
         dashboard puts it above its tools, so they stay in view); made here when None.
         ``open_tool(name)`` brings a tool's tab into view (a step's `open_panel` button).
-        ``new_lesson()``: another lesson was opened (the dashboard clears what the last one
-        left in the views). ``position``: where the "Lesson i of n · Step j of m" line goes
-        (the dashboard puts it above the step card); made in the card when None.
+        ``new_lesson(programs)``: another lesson was opened, whose buttons start ``programs``
+        (the dashboard clears what the last one left in the views). ``position``: where the
+        "Lesson i of n · Step j of m" line goes (the dashboard puts it above the step card);
+        made in the card when None.
         ``to_top()``: the column back to its top, where a new step's text begins."""
         self._gui = gui
         self._ui = ui
@@ -287,7 +288,7 @@ class LessonsPanel:
             self._leftovers = sorted(
                 name for name, status in self._statuses().items() if status.active
             )
-            self._new_lesson()
+            self._new_lesson(lesson.programs)
         self._lesson, self._step = lesson, step
         self._progress.set_position(lesson.id, step)
         current = lesson.steps[step]

@@ -86,6 +86,16 @@ class Lesson:
     stage: str = DEFAULT_STAGE  # what the centre of the screen shows (app.stage.STAGES)
     path: Path = field(default=LESSONS_DIR, compare=False)
 
+    @property
+    def programs(self) -> frozenset[str]:
+        """The catalog programs this lesson's buttons start or stop (by catalog name)."""
+        return frozenset(
+            str(action.fields["catalog_node"])
+            for step in self.steps
+            for action in step.actions
+            if "catalog_node" in action.fields
+        )
+
 
 @dataclass(frozen=True)
 class Course:
@@ -288,13 +298,23 @@ def load_lesson(directory: Path) -> Lesson:
     )
 
 
+# A ``code`` entry ``launch/<group>.launch.py`` is a catalog launch group's launch file,
+# which the classroom writes for ``ros2 launch`` (app/launch.py), not a project file.
+LAUNCH_CODE = re.compile(r"launch/(?P<group>[A-Za-z0-9_]+)\.launch\.py")
+
+
 def _code_list(raw: Mapping[str, object], where: str) -> tuple[str, ...]:
-    """A lesson's or a step's ``code``: project files, each checked to exist inside it."""
+    """A lesson's or a step's ``code``: project files, each checked to exist inside it, or a
+    launch group's launch file (``launch/<group>.launch.py``)."""
     code = _require(raw, "code", list, where) if "code" in raw else []
     for i, source in enumerate(code):
         if not isinstance(source, str):
             raise LessonError(f"{where}: code[{i}] must be a string")
-        inside(PROJECT_ROOT, source, f"{where}: code[{i}]")
+        launch = LAUNCH_CODE.fullmatch(source)
+        if launch is None:
+            inside(PROJECT_ROOT, source, f"{where}: code[{i}]")
+        elif launch["group"] not in _GROUP_NAMES:
+            raise LessonError(f"{where}: code[{i}]: no launch group '{launch['group']}'")
     return tuple(code)
 
 

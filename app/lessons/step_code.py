@@ -13,8 +13,9 @@ from __future__ import annotations
 import html
 
 from app import PROJECT_ROOT
+from app.launch import PACKAGE, launch_file_text
 from app.learner_ws import folder
-from app.lessons.schema import Lesson, Step
+from app.lessons.schema import LAUNCH_CODE, Lesson, Step
 from app.ros.errors import Ros2Error
 from app.ui.code_view import python_listing
 
@@ -35,11 +36,16 @@ def listing(lesson: Lesson, step: Step) -> str:
     own = workspace_sources(step)
     if own:
         return "".join(_workspace_file(relative) for relative in own)
-    parts = [
-        python_listing(relative, (PROJECT_ROOT / relative).read_text(encoding="utf-8"), relative)
-        for relative in step.code or lesson.code
-    ]
+    parts = [_project_file(relative) for relative in step.code or lesson.code]
     return "".join(parts) or "<p><em>This lesson shows no code.</em></p>"
+
+
+def _project_file(relative: str) -> str:
+    launch = LAUNCH_CODE.fullmatch(relative)
+    if launch is not None:  # written for `ros2 launch`, from the catalog's group
+        name = f"{PACKAGE}/launch/{launch['group']}.launch.py"
+        return python_listing(name, launch_file_text(launch["group"]), name)
+    return python_listing(relative, (PROJECT_ROOT / relative).read_text(encoding="utf-8"), relative)
 
 
 def _workspace_file(relative: str) -> str:

@@ -26,6 +26,7 @@ import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import cv2
 import numpy as np
@@ -81,7 +82,14 @@ def turtle_outline(x: float, y: float, theta: float) -> tuple[np.ndarray, np.nda
 class TurtlesimView:
     """Owns the panel image; fed from any thread, drawn by its own thread."""
 
-    def __init__(self, gui: viser.GuiApi, request_snapshot: Callable[[], None]) -> None:
+    def __init__(
+        self,
+        gui: viser.GuiApi,
+        request_snapshot: Callable[[], None],
+        show: Callable[[np.ndarray], None] | None = None,
+    ) -> None:
+        """``show(frame)``: where a drawn frame goes (the drawing thread calls it); by
+        default an image of its own in ``gui``."""
         self._request_snapshot = request_snapshot
         self._lock = threading.Lock()
         self._wake = threading.Event()
@@ -106,7 +114,12 @@ class TurtlesimView:
         self._in_step = False
         self._frame_times: deque[float] = deque(maxlen=90)
         self._draw_costs: deque[float] = deque(maxlen=30)
-        self.handle = gui.add_image(self._compose(), label=WINDOW_TITLE, format="png")
+        if show is None:
+            handle = gui.add_image(self._compose(), label=WINDOW_TITLE, format="png")
+            show = partial(setattr, handle, "image")
+        else:
+            show(self._compose())
+        self._show = show
         self._thread = threading.Thread(target=self._run, name="turtlesim-view", daemon=True)
         self._thread.start()
 
@@ -157,6 +170,12 @@ class TurtlesimView:
             self._dirty = True
         self._wake.set()
 
+    def redraw(self) -> None:
+        """Draw the frame again (it is shown somewhere else now)."""
+        with self._lock:
+            self._dirty = True
+        self._wake.set()
+
     def stats(self) -> ViewStats:
         now = time.monotonic()
         with self._lock:
@@ -188,7 +207,7 @@ class TurtlesimView:
                     changed, self._dirty = changed or self._dirty, False
                 if changed:
                     started = time.monotonic()
-                    self.handle.image = self._compose()
+                    self._show(self._compose())
                     last_frame = time.monotonic()
                     with self._lock:
                         self._frames += 1
@@ -267,3 +286,32 @@ class TurtlesimView:
             )
             cv2.putText(frame, name, origin, cv2.FONT_HERSHEY_SIMPLEX, 0.45, LABEL, 1, cv2.LINE_AA)
         return frame
+
+
+class SideBySide:
+    """One image holding two turtlesim windows side by side (``multisim``'s two sims):
+    two stacked 500 px windows would not fit a laptop's screen. ``left``/``right`` are
+    ``show`` callbacks for two views; called from their drawing threads."""
+
+    GAP_PX = 12
+
+    def __init__(self, gui: viser.GuiApi, label: str = WINDOW_TITLE) -> None:
+        self._lock = threading.Lock()
+        blank = np.full((PIXELS, PIXELS, 3), 255, np.uint8)
+        self._frames = [blank, blank]
+        self.handle = gui.add_image(self._joined(), label=label, format="png")
+
+    def left(self, frame: np.ndarray) -> None:
+        self._put(0, frame)
+
+    def right(self, frame: np.ndarray) -> None:
+        self._put(1, frame)
+
+    def _put(self, side: int, frame: np.ndarray) -> None:
+        with self._lock:  # in order: an older picture never replaces a newer one
+            self._frames[side] = frame
+            self.handle.image = self._joined()
+
+    def _joined(self) -> np.ndarray:
+        gap = np.full((PIXELS, self.GAP_PX, 3), 255, np.uint8)
+        return np.hstack([self._frames[0], gap, self._frames[1]])

@@ -18,6 +18,7 @@ import math
 import time
 from collections.abc import Callable
 
+import numpy as np
 import viser
 from rclpy.node import Node
 from rclpy.publisher import Publisher
@@ -25,12 +26,13 @@ from std_msgs.msg import String
 
 from app.panels.turtlesim_feed import TurtlesimFeed, find_sims
 from app.panels.turtlesim_panel import KEY_TOPIC, KEYS, pose_topics
-from app.panels.turtlesim_view import TurtlesimView
+from app.panels.turtlesim_view import WINDOW_TITLE, SideBySide, TurtlesimView
 from app.ros.graph import GraphSnapshot
 from app.ui import MarkdownView
 from app.ui.loop import UiLoop
 from app.ui.page_links import PageLinks
 from app.ui.page_script import listen_on_page, page_script
+from nodes.common.turtlesim_world import PIXELS
 
 NO_SIM = (
     "_turtlesim_node is not running._ Start it from the lesson's button, "
@@ -38,6 +40,7 @@ NO_SIM = (
 )
 LOOK_EVERY = 1.0  # s between looks for a sim started since
 BURST_SEC = 1.5  # s: sims first seen this close together came from one launch
+PAIR_SEC = 5.0  # s: a sim first seen this close to the followed one is drawn beside it
 KEY_HINT = (
     "Arrow keys drive turtle1 while this window is shown (turtle_teleop_key must run: "
     "**Run › Turtlesim** starts it); G B V C D E R T turn it, F cancels the turn."
@@ -65,7 +68,10 @@ const onKey = (event) => {
 
 
 class TurtlesimStage:
-    """Built inside the stage window's tab; ``refresh`` and ``set_active`` on the UI thread."""
+    """Built inside the stage window's tab; ``refresh`` and ``set_active`` on the UI thread.
+
+    One sim is drawn at its own size. Two started by one launch (``multisim``, where
+    ``mimic`` makes the second turtle copy the first) are drawn side by side."""
 
     def __init__(self, gui: viser.GuiApi, ui: UiLoop, node: Node, links: PageLinks | None):
         self._ui = ui
@@ -73,14 +79,23 @@ class TurtlesimStage:
         self._active = False
         self._keys: Publisher | None = None
         self._sims: list[str] = []  # the sims running at the last look
-        self._seen: set[str] = set()  # every sim seen since the stage was built
+        self._seen: dict[str, float] = {}  # every sim seen since the stage was built: when
         self._next_look = 0.0
         self._adopted_at = -math.inf  # when a new sim last took the stage
+        self._paired = False  # read by the drawing thread: where the followed sim's frame goes
         self._box = gui.add_folder(None, visible=False)
         with self._box:
             self._status = MarkdownView(gui, NO_SIM)
-            self.view = TurtlesimView(gui, lambda: self._feed.ask_snapshot())
+            blank = np.zeros((PIXELS, PIXELS, 3), np.uint8)
+            self._single = gui.add_image(blank, label=WINDOW_TITLE, format="png")
+            self._pair = SideBySide(gui, f"{WINDOW_TITLE} × 2 (left, right)")
+            self._pair.handle.visible = False
+            self.view = TurtlesimView(gui, lambda: self._feed.ask_snapshot(), show=self._show)
             self._feed = TurtlesimFeed(node, ui, self.view)
+            partner_view = TurtlesimView(
+                gui, lambda: self._partner.ask_snapshot(), show=self._pair.right
+            )
+            self._partner = TurtlesimFeed(node, ui, partner_view)
             gui.add_markdown(KEY_HINT)
             if links is not None:
                 hrefs = {
@@ -89,6 +104,13 @@ class TurtlesimStage:
                 }
                 script = _KEYS_SCRIPT % (json.dumps(hrefs), json.dumps(KEYS))
                 gui.add_html(page_script(script, "turtlesim keys on stage"))
+
+    def _show(self, frame: np.ndarray) -> None:
+        """The followed sim's frame (its drawing thread): alone, or the left of a pair."""
+        if self._paired:
+            self._pair.left(frame)
+        else:
+            self._single.image = frame
 
     # -- keys (viser's asyncio thread posts; the UI thread publishes) -------------
 
@@ -110,6 +132,7 @@ class TurtlesimStage:
         self._next_look = 0.0
         if not active:
             self._feed.follow(None)
+            self._pair_with(None)
 
     def _choose_sim(self, graph: GraphSnapshot) -> None:
         """Follow the sim the learner started last; keep the followed one while it runs.
@@ -124,7 +147,7 @@ class TurtlesimStage:
         self._next_look = now + LOOK_EVERY  # asking DDS for every topic is not free
         self._sims = [s for s in find_sims(self._node) if graph.has_node(s)]
         new = [s for s in self._sims if s not in self._seen]
-        self._seen.update(self._sims)
+        self._seen.update({sim: now for sim in new})
         if new:
             # One launch starts several sims whose discovery order varies: within a burst
             # the first by name keeps the stage (multisim: turtlesim1, not turtlesim2).
@@ -135,23 +158,56 @@ class TurtlesimStage:
                 self._adopted_at = now
         elif followed is None or followed not in self._sims:
             self._feed.follow(self._sims[0] if self._sims else None)
+        self._pair_with(self._burst_partner())
+
+    def _burst_partner(self) -> str | None:
+        """A running sim first seen close after or before the followed one (multisim's second;
+        on a loaded machine one launch's sims are seen seconds apart)."""
+        followed = self._feed.sim
+        if followed is None:
+            return None
+        since = self._seen.get(followed, -math.inf)
+        near = [
+            (abs(self._seen[s] - since), s)
+            for s in self._sims
+            if s != followed and abs(self._seen[s] - since) < PAIR_SEC
+        ]
+        return min(near)[1] if near else None  # the one started closest to it
+
+    def _pair_with(self, partner: str | None) -> None:
+        if partner == self._partner.sim:
+            return
+        self._partner.follow(partner)
+        self._paired = partner is not None
+        self._pair.handle.visible = self._paired
+        self._single.visible = not self._paired
+        self.view.redraw()  # its frame goes to the other picture now
 
     def refresh(self, graph: GraphSnapshot) -> None:
         if not self._active:
             return
         self._choose_sim(graph)
-        sim = self._feed.sim
+        sim, partner = self._feed.sim, self._partner.sim
         self._feed.sync_turtles(pose_topics(graph, sim) if sim else {})
+        self._partner.sync_turtles(pose_topics(graph, partner) if partner else {})
         if sim is None:
             self._status.show(NO_SIM)
-        else:
-            turtles = ", ".join(self._feed.turtles) or "none yet"
-            others = [f"`{s}`" for s in self._sims if s != sim and graph.has_node(s)]
-            also = f" · also running: {', '.join(others)}" if others else ""
-            self._status.show(f"`{sim}` · turtles: {turtles}{also}")
+            return
+        shown = [(sim, self._feed)] + ([(partner, self._partner)] if partner else [])
+        sides = ("left", "right") if partner else ("",)
+        parts = [
+            f"`{name}`{f' ({side})' if side else ''} · turtles: "
+            + (", ".join(feed.turtles) or "none yet")
+            for (name, feed), side in zip(shown, sides, strict=True)
+        ]
+        others = [f"`{s}`" for s in self._sims if s not in (sim, partner) and graph.has_node(s)]
+        also = f" · also running: {', '.join(others)}" if others else ""
+        self._status.show(" · ".join(parts) + also)
 
     def close(self) -> None:
         self.view.close()
+        self._partner.view.close()
         self._feed.follow(None)
+        self._partner.follow(None)
         if self._keys is not None:
             self._node.destroy_publisher(self._keys)

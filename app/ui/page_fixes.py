@@ -41,6 +41,12 @@ _CSS = (
     # item it sits in and cutting that item's text off at the column's edge.
     # (Mantine's list item lays its label out in an inline flexbox: it may shrink too.)
     "pre{max-width:100%;overflow-x:auto}"
+    # A command or a program's output in a lesson's text wraps instead: a scroll bar that
+    # only shows on hover hid the end of a long `ros2 run ... --remap ...` line. Listings
+    # (Python, CMake, XML, the code window's numbered lines) keep their lines whole.
+    "pre:not(.highlight pre):not(:has(code[class*=language-python],"
+    "code[class*=language-cmake],code[class*=language-xml])){white-space:pre-wrap;"
+    "overflow-wrap:anywhere}"
     ".mantine-List-itemWrapper{max-width:100%}.mantine-List-itemLabel{min-width:0;max-width:100%}"
 )
 

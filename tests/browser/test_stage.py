@@ -472,7 +472,8 @@ def test_the_bag_stage_shows_a_recording_as_it_ends(browser, ros_env, tmp_path):
 
 
 def test_the_code_stage_shows_what_the_lessons_node_prints(page):
-    """Lesson 4: the node the step starts prints under its code, not 'Nothing has run yet'."""
+    """Lesson 4: the node the step starts prints under its code, not 'Nothing has run yet';
+    another lesson does not show it, and coming back to lesson 4 shows it again."""
     lesson = next(les for les in load_course().lessons if les.id == "04_first_node")
     open_lesson(page, lesson)
     _wait_stage(page, "code")
@@ -489,3 +490,9 @@ def test_the_code_stage_shows_what_the_lessons_node_prints(page):
     _wait_stage(page, "code")
     expect(page.get_by_text(re.compile("Nothing has run yet in this lesson"))).to_be_visible()
     expect(page.get_by_text(re.compile(r"^minimal_node · running"))).to_have_count(0)
+    # Back in lesson 4, its node still runs from before: that is this lesson's output again.
+    open_lesson(page, lesson)
+    _wait_stage(page, "code")
+    expect(page.get_by_text(re.compile(r"^minimal_node · running")).first).to_be_visible(
+        timeout=10_000
+    )

@@ -147,9 +147,14 @@ def test_the_stage_follows_the_sims_the_learner_starts_last(page):
     expect_status(page, r"^/turtlesim · turtles: turtle1$")
     start_group(page, "multisim")
     choose(page, "On stage", "Turtlesim")
-    # The two sims of one launch may be discovered a second apart: the first by name stays.
+    # The two sims of one launch may be discovered a second apart: the first by name stays
+    # on the left, the second is drawn beside it.
     expect_status(
         page,
-        r"^/turtlesim1/turtlesim · turtles: turtle1 · also running: "
-        r"/turtlesim, /turtlesim2/turtlesim$",
+        r"^/turtlesim1/turtlesim \(left\) · turtles: turtle1 · "
+        r"/turtlesim2/turtlesim \(right\) · turtles: turtle1 · also running: /turtlesim$",
     )
+    pair = page.get_by_role("img", name=re.compile("TurtleSim × 2"))
+    expect(pair).to_be_visible()
+    box = pair.bounding_box()
+    assert box is not None and box["width"] > 1.8 * box["height"]  # side by side

@@ -7,7 +7,7 @@ import pytest
 from app.learner_ws import folder
 from app.learner_ws.folder import LearnerWorkspace
 from app.lessons import step_code
-from app.lessons.schema import load_course
+from app.lessons.schema import LessonError, _code_list, load_course
 
 
 @pytest.fixture
@@ -72,3 +72,18 @@ def test_a_step_can_name_its_own_project_files():
     lesson, procedural = _step("04_first_node", "The same node without a class")
     shown = step_code.listing(lesson, procedural)
     assert "minimal_node_procedural.py" in shown and "nodes/minimal_node.py" not in shown
+
+
+def test_the_launch_lesson_reads_the_launch_file_that_ros2_launch_runs():
+    """Lesson 12's first step is about chatter_demo.launch.py, a file the classroom writes
+    for `ros2 launch` from the catalog's group: the window shows that very text."""
+    lesson, read = _step("12_launch", "Read the launch file")
+    assert read.stage == "code"
+    shown = step_code.listing(lesson, read)
+    assert "tutorial_nodes/launch/chatter_demo.launch.py" in shown
+    assert "generate_launch_description" in shown and "listener2" in shown
+
+
+def test_a_launch_code_entry_must_name_a_catalog_group(tmp_path):
+    with pytest.raises(LessonError, match="no launch group 'nonesuch'"):
+        _code_list({"code": ["launch/nonesuch.launch.py"]}, "here")
