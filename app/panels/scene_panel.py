@@ -97,9 +97,11 @@ PATHS = _Offer(
     latched=True,  # a plan comes once per goal: silence after it is normal
 )
 # Where new browsers start: close to the lesson-13 desk, or over the whole simulated world.
-DESK_VIEW = ((1.3, -1.4, 1.1), (0.25, 0.0, 0.25))
+DESK_VIEW = ((0.98, -0.98, 0.85), (0.25, 0.0, 0.25))  # the arm and camera fill the stage
 MIN_FRAMES_TO_FRAME = 3  # a robot's links with poses, before the cameras go to it
-REFRAME_ROOM_M = 1.0  # the room left round a moving robot's way when the cameras frame it
+REFRAME_ROOM_M = 1.0  # at most this much room round a robot's way when the cameras frame it
+REFRAME_ROOM_FRACTION = 0.5  # ...and at most this share of the robot's (or its way's) size
+REFRAME_ROOM_MIN_M = 0.15
 JOINTS = _Offer(
     picker.JOINT_TYPES,
     "sensor_msgs/msg/JointState topics",
@@ -420,8 +422,12 @@ class ScenePanel:
         self._robot_box = grown_box(self._robot_box, points)
         if not outgrown(self._framed_box, self._robot_box):
             return
-        # Framed with room round it: the next reframe waits until the robot drove a metre.
-        self._framed_box = low, high = padded(self._robot_box, REFRAME_ROOM_M)
+        # Framed with room round it, as much as half its size (up to a metre): an arm that
+        # moves its joints stays framed large, and a robot driving about is reframed less
+        # and less often as its way grows, not at each step.
+        extent = float(np.max(self._robot_box[1][:2] - self._robot_box[0][:2]))
+        room = min(max(REFRAME_ROOM_FRACTION * extent, REFRAME_ROOM_MIN_M), REFRAME_ROOM_M)
+        self._framed_box = low, high = padded(self._robot_box, room)
         position, look_at = overview(low, high)  # looks at the floor under the frames...
         lift = np.array([0.0, 0.0, (high[2] - low[2]) / 2.0])  # ...and here at their middle
         self.drive.move_cameras(position + lift, look_at + lift)

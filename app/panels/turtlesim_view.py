@@ -50,6 +50,7 @@ SNAPSHOT_RETRY_SEC = 1.0  # while out of step, ask the sim again this often
 TURTLE_BODY = (46, 139, 87)  # sea green, with a darker shell line
 TURTLE_EDGE = (20, 70, 40)
 LABEL = (255, 255, 255)
+MARK = (255, 140, 0)  # another TF frame in world (tf2 lesson's carrot): orange
 RGB = tuple[int, int, int]
 WINDOW_TITLE = "TurtleSim"  # upstream's window title
 
@@ -97,6 +98,7 @@ class TurtlesimView:
         # Handed in under the lock; read by the drawing thread.
         self._packets: deque[bytes] = deque(maxlen=2000)
         self._poses: dict[str, tuple[float, float, float]] = {}
+        self._marks: dict[str, tuple[float, float]] = {}  # other TF frames in world: (x, y)
         self._background: RGB = DEFAULT_BACKGROUND
         self._dirty = True
         self._restart = False
@@ -147,6 +149,16 @@ class TurtlesimView:
             self._dirty = self._dirty or bool(gone)
         self._wake.set()
 
+    def set_marks(self, marks: dict[str, tuple[float, float]]) -> None:
+        """TF frames other than the turtles' (a carrot), where they are in ``world``."""
+        rounded = {name: (round(x, 3), round(y, 3)) for name, (x, y) in marks.items()}
+        with self._lock:
+            if rounded == self._marks:
+                return
+            self._marks = rounded
+            self._dirty = True
+        self._wake.set()
+
     def set_background(self, rgb: RGB) -> None:
         with self._lock:
             if rgb != self._background:
@@ -164,6 +176,7 @@ class TurtlesimView:
         with self._lock:
             self._packets.clear()
             self._poses.clear()
+            self._marks = {}
             self._background = DEFAULT_BACKGROUND
             self._restart = True
             self._active = active
@@ -267,10 +280,18 @@ class TurtlesimView:
         with self._lock:
             background = self._background
             poses = sorted(self._poses.items())
+            marks = sorted(self._marks.items())
         if background != self._ground_background:  # repaint only what no pen covered
             self._ground[~self._painted] = background
             self._ground_background = background
         frame = self._ground.copy()
+        for name, (x, y) in marks:  # under the turtles: a carrot on a turtle hides under it
+            mx, my = (int(round(v)) for v in to_pixel(x, y))
+            cv2.circle(frame, (mx, my), 5, MARK, -1, cv2.LINE_AA)
+            cv2.circle(frame, (mx, my), 5, (0, 0, 0), 1, cv2.LINE_AA)
+            _label(
+                frame, name, (min(max(mx + 8, 2), PIXELS - 60), min(max(my + 4, 12), PIXELS - 4))
+            )
         for name, (x, y, theta) in poses:
             shell, head = turtle_outline(x, y, theta)
             hx, hy = (int(round(v)) for v in head)
@@ -280,12 +301,16 @@ class TurtlesimView:
             cv2.polylines(frame, [shell], True, TURTLE_EDGE, 2, cv2.LINE_AA)
             cx, cy = (int(round(v)) for v in to_pixel(x, y))
             (width, _height), _base = cv2.getTextSize(name, cv2.FONT_HERSHEY_SIMPLEX, 0.45, 1)
-            origin = (min(max(cx - width // 2, 2), PIXELS - width - 2), max(cy - 20, 12))
-            cv2.putText(
-                frame, name, origin, cv2.FONT_HERSHEY_SIMPLEX, 0.45, (0, 0, 0), 3, cv2.LINE_AA
+            _label(
+                frame, name, (min(max(cx - width // 2, 2), PIXELS - width - 2), max(cy - 20, 12))
             )
-            cv2.putText(frame, name, origin, cv2.FONT_HERSHEY_SIMPLEX, 0.45, LABEL, 1, cv2.LINE_AA)
         return frame
+
+
+def _label(frame: np.ndarray, text: str, origin: tuple[int, int]) -> None:
+    """White words with a black edge: readable on any background and trail."""
+    cv2.putText(frame, text, origin, cv2.FONT_HERSHEY_SIMPLEX, 0.45, (0, 0, 0), 3, cv2.LINE_AA)
+    cv2.putText(frame, text, origin, cv2.FONT_HERSHEY_SIMPLEX, 0.45, LABEL, 1, cv2.LINE_AA)
 
 
 class SideBySide:

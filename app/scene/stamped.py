@@ -20,6 +20,8 @@ from app.scene.latest import LatestWorker
 from app.scene.transforms import ros_to_wxyz
 
 MAX_TOPICS = 8
+LABEL_LIFT_M = 0.05  # a name above its point
+LABEL_ROW_M = 0.035  # and the next topic's name this much higher
 _COLOURS = ((230, 50, 50), (50, 120, 230), (40, 170, 60), (200, 120, 20), (150, 60, 200))
 
 
@@ -29,9 +31,15 @@ def _leaf(topic: str) -> str:
 
 class _StampedTopic:
     def __init__(
-        self, layer: StampedLayer, topic: str, is_pose: bool, colour: tuple[int, int, int]
+        self,
+        layer: StampedLayer,
+        topic: str,
+        is_pose: bool,
+        colour: tuple[int, int, int],
+        slot: int = 0,
     ) -> None:
         self.topic = topic
+        self.slot = slot  # which row its name takes
         self.is_pose = is_pose
         self.colour = colour
         self.handle: viser.FrameHandle | viser.IcosphereHandle | None = None
@@ -61,7 +69,10 @@ class _StampedTopic:
                 handle = scene.add_frame(path, axes_length=0.1, axes_radius=0.005)
             else:
                 handle = scene.add_icosphere(path, radius=0.025, color=self.colour)
-            scene.add_label(f"{path}/label", self.topic, position=(0.0, 0.0, 0.05))
+            # Each topic's name a row higher: the lesson's points coincide when they are
+            # right (the object seen from the camera, from the base, the gripper on it).
+            lift = LABEL_LIFT_M + LABEL_ROW_M * self.slot
+            scene.add_label(f"{path}/label", self.topic, position=(0.0, 0.0, lift))
             self.handle, self.path = handle, path
         handle.position = position
         handle.wxyz = wxyz
@@ -97,8 +108,9 @@ class StampedLayer:
                 continue
             if graph.publishers(topic) == 0:  # a subscriber alone lists it: nothing to draw
                 continue
-            colour = _COLOURS[len(self._followers) % len(_COLOURS)]
-            self._followers[topic] = _StampedTopic(self, topic, is_pose, colour)
+            slot = min(set(range(MAX_TOPICS)) - {f.slot for f in self._followers.values()})
+            colour = _COLOURS[slot % len(_COLOURS)]
+            self._followers[topic] = _StampedTopic(self, topic, is_pose, colour, slot)
 
     def forget_unpublished(self, graph: GraphSnapshot) -> None:
         """Stop drawing the points and poses nobody publishes now (UI thread)."""

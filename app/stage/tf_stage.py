@@ -111,16 +111,22 @@ class TfRecorder:
         return out
 
 
+MIN_TREE_SCALE = 0.75  # the frames' names stay readable at three quarters of their size
+
+
 def tf_tree_html(frames: dict[str, dict[str, object]], recorded_time: float) -> str:
-    """tf2_tools' picture at its natural size (never shrunk: its labels stay readable; a
-    big tree scrolls), on white paper in either colour scheme."""
+    """tf2_tools' picture, on white paper in either colour scheme: shrunk to the stage's
+    width down to MIN_TREE_SCALE of its size (a fifth frame cut the tree off at the edge,
+    and nobody scrolls a picture sideways), a bigger tree scrolls."""
     svg = render(frames, recorded_time)
     size = re.search(r'width="([\d.]+)" height="([\d.]+)"', svg)
     if size:
         width, height = size.groups()
+        least = float(width) * MIN_TREE_SCALE
         svg = svg.replace(
             size.group(0),
-            f'viewBox="0 0 {width} {height}" width="{width}" height="{height}" '
+            f'viewBox="0 0 {width} {height}" width="100%" '
+            f'style="max-width:{width}px;min-width:{least:.0f}px;height:auto" '
             f'role="img" aria-label="TF tree: {len(frames)} frames"',
             1,
         )

@@ -22,17 +22,20 @@ import numpy as np
 import viser
 from rclpy.node import Node
 from rclpy.publisher import Publisher
+from rclpy.time import Time
 from std_msgs.msg import String
+from tf2_ros import TransformException
 
 from app.panels.turtlesim_feed import TurtlesimFeed, find_sims
 from app.panels.turtlesim_panel import KEY_TOPIC, KEYS, pose_topics
 from app.panels.turtlesim_view import WINDOW_TITLE, SideBySide, TurtlesimView
+from app.ros import tf_sources
 from app.ros.graph import GraphSnapshot
 from app.ui import MarkdownView
 from app.ui.loop import UiLoop
 from app.ui.page_links import PageLinks
 from app.ui.page_script import listen_on_page, page_script
-from nodes.common.turtlesim_world import PIXELS
+from nodes.common.turtlesim_world import PIXELS, WORLD_SIZE
 
 NO_SIM = (
     "_turtlesim_node is not running._ Start it from the lesson's button, "
@@ -40,6 +43,7 @@ NO_SIM = (
 )
 LOOK_EVERY = 1.0  # s between looks for a sim started since
 BURST_SEC = 1.5  # s: sims first seen this close together came from one launch
+WORLD_FRAME = "world"  # the tf2 turtlesim demo's fixed frame: the window's corner
 PAIR_SEC = 5.0  # s: a sim first seen this close to the followed one is drawn beside it
 KEY_HINT = (
     "Arrow keys drive turtle1 while this window is shown (turtle_teleop_key must run: "
@@ -67,6 +71,10 @@ const onKey = (event) => {
 """ + listen_on_page("__stageKeysOff", "keydown", "onKey", capture=True).replace("%", "%%")
 
 
+def _inside(x: float, y: float) -> bool:
+    return 0.0 <= x <= WORLD_SIZE and 0.0 <= y <= WORLD_SIZE
+
+
 class TurtlesimStage:
     """Built inside the stage window's tab; ``refresh`` and ``set_active`` on the UI thread.
 
@@ -83,6 +91,7 @@ class TurtlesimStage:
         self._next_look = 0.0
         self._adopted_at = -math.inf  # when a new sim last took the stage
         self._paired = False  # read by the drawing thread: where the followed sim's frame goes
+        self._tf: tf_sources.TfSources | None = None  # the dashboard's TF reader, while shown
         self._box = gui.add_folder(None, visible=False)
         with self._box:
             self._status = MarkdownView(gui, NO_SIM)
@@ -130,9 +139,32 @@ class TurtlesimStage:
         self._active = active
         self._box.visible = active
         self._next_look = 0.0
+        if active and self._tf is None:
+            self._tf = tf_sources.shared(self._node)
         if not active:
             self._feed.follow(None)
             self._pair_with(None)
+            if self._tf is not None:
+                tf_sources.release(self._tf)
+                self._tf = None
+
+    def _frame_marks(self) -> dict[str, tuple[float, float]]:
+        """TF frames that are no turtle, where they are in turtlesim's ``world`` (the tf2
+        lesson's carrot beside turtle1); the view draws those inside the window."""
+        sources, turtles = self._tf, set(self._feed.turtles)
+        if sources is None:
+            return {}
+        marks = {}
+        for info in sources.frames():
+            name = info.frame
+            if not info.parent or info.stale or name in turtles or name == WORLD_FRAME:
+                continue
+            try:
+                t = sources.buffer.lookup_transform(WORLD_FRAME, name, Time()).transform
+            except TransformException:  # not joined to world (another tree)
+                continue
+            marks[name] = (t.translation.x, t.translation.y)
+        return marks
 
     def _choose_sim(self, graph: GraphSnapshot) -> None:
         """Follow the sim the learner started last; keep the followed one while it runs.
@@ -193,6 +225,8 @@ class TurtlesimStage:
         if sim is None:
             self._status.show(NO_SIM)
             return
+        marks = self._frame_marks()
+        self.view.set_marks(marks)
         shown = [(sim, self._feed)] + ([(partner, self._partner)] if partner else [])
         sides = ("left", "right") if partner else ("",)
         parts = [
@@ -202,9 +236,15 @@ class TurtlesimStage:
         ]
         others = [f"`{s}`" for s in self._sims if s not in (sim, partner) and graph.has_node(s)]
         also = f" · also running: {', '.join(others)}" if others else ""
-        self._status.show(" · ".join(parts) + also)
+        words = [
+            name if _inside(*marks[name]) else f"{name} (outside the window now)"
+            for name in sorted(marks)
+        ]
+        frames = f" · other frames (orange): {', '.join(words)}" if words else ""
+        self._status.show(" · ".join(parts) + frames + also)
 
     def close(self) -> None:
+        self.set_active(False)
         self.view.close()
         self._partner.view.close()
         self._feed.follow(None)
