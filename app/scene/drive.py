@@ -49,16 +49,13 @@ FOLLOW_HZ = 10.0
 FOLLOW_MIN_MOVE = 0.01  # m: smaller moves leave the cameras alone
 ROBOT_FRAME = "base_link"
 VIEW_FROM = np.array([-0.45, -0.7, 0.6])  # the overview looks at the room from here (a direction)
-# The control panel covers the canvas's right part: the cameras look this share of their
-# distance to the right of what they show, so it sits in the part of the canvas left visible.
-PANEL_SHIFT = 0.25
 OVERVIEW_DISTANCE = 0.85  # the overview's distance, in room sizes
 # A building (the 10 m x 8 m office) seen from the room's corner angle fills half the
 # stage's height and hides its rooms behind walls: it is looked at from higher up, as
 # rviz shows a map, so the map, the particles and the plan on its floor read at a glance.
 WIDE_WORLD = 6.0  # m: a world at least this long on the floor is seen from above
 VIEW_FROM_ABOVE = np.array([-0.12, -0.45, 1.0])
-ABOVE_DISTANCE = 0.8
+ABOVE_DISTANCE = 0.7
 
 HELP = (
     "**Drive the robot** with the buttons, or with the arrow keys while this tab is open "
@@ -107,9 +104,9 @@ def overview(low: np.ndarray, high: np.ndarray) -> tuple[np.ndarray, np.ndarray]
         (VIEW_FROM_ABOVE, ABOVE_DISTANCE) if wide else (VIEW_FROM, OVERVIEW_DISTANCE)
     )
     direction = view_from / np.linalg.norm(view_from)
-    position = centre + direction * max(size, 1.0) * distance
-    shift = panel_shift(position, centre)
-    return position + shift, centre + shift
+    # No turn aside for the control panel: on the 3D stage it docks, and viser insets the
+    # canvas to the room left of it (a shift there put the office off centre, to the left).
+    return centre + direction * max(size, 1.0) * distance, centre
 
 
 Box = tuple[np.ndarray, np.ndarray]  # (low corner, high corner)
@@ -134,31 +131,17 @@ def padded(box: Box, margin: float) -> Box:
     return box[0] - pad, box[1] + pad
 
 
-def panel_shift(position: np.ndarray, look_at: np.ndarray) -> np.ndarray:
-    """How far to move a camera right so that ``look_at`` shows left of the control panel."""
-    back = np.asarray(position, dtype=float) - np.asarray(look_at, dtype=float)
-    right = np.cross(-back, [0.0, 0.0, 1.0])  # the camera's right, level with the floor
-    norm = float(np.linalg.norm(right))
-    if norm < 1e-9:  # looking straight down: no level right to speak of
-        return np.zeros(3)
-    return right / norm * float(np.linalg.norm(back)) * PANEL_SHIFT
-
-
 def follow_step(
     cameras: list[tuple[np.ndarray, np.ndarray]], robot: np.ndarray, last: np.ndarray | None
 ) -> list[tuple[np.ndarray, np.ndarray]] | None:
     """New (position, look_at) per camera to keep ``robot`` in view, or None: leave them.
 
-    The first time (``last`` None) each camera moves to look at the robot (a
-    little left of the control panel) from its own angle and distance; after
+    The first time (``last`` None) each camera moves to look at the robot from its
+    own angle and distance; after
     that each moves along with the robot, keeping its angle.
     """
     if last is None:
-        moves = []
-        for position, look_at in cameras:
-            shift = panel_shift(position, look_at)
-            moves.append((position - look_at + robot + shift, robot + shift))
-        return moves
+        return [(position - look_at + robot, robot) for position, look_at in cameras]
     delta = robot - last
     if float(np.linalg.norm(delta)) < FOLLOW_MIN_MOVE:
         return None

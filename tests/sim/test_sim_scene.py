@@ -13,7 +13,7 @@ from visualization_msgs.msg import Marker
 
 from app.ros.graph import GraphSnapshot, TopicInfo
 from app.scene import marker_plan as mp
-from app.scene.drive import BUTTONS, KEYS, follow_step, key_listener, overview, panel_shift
+from app.scene.drive import BUTTONS, KEYS, follow_step, key_listener, overview
 from app.scene.laser_scan import range_colours, scan_points
 from app.scene.namespaced_robots import namespaced_descriptions, tag_of
 from app.scene.sim_world import marker_bounds, tf_frame_path
@@ -45,19 +45,17 @@ def test_following_keeps_each_cameras_angle_and_moves_it_with_the_robot():
     camera = (np.array([-2.0, -3.0, 2.0]), np.array([0.0, 0.0, 0.0]))
     robot = np.array([0.5, 0.0, 0.0])
     (first,) = follow_step([camera], robot, None) or []
-    shift = panel_shift(*camera)
-    assert first[1] == pytest.approx(robot + shift)  # looks at the robot, left of the panel
+    assert first[1] == pytest.approx(robot)  # looks at the robot
     assert first[0] - first[1] == pytest.approx(camera[0] - camera[1])  # same angle, distance
     assert follow_step([first], robot + 0.005, robot) is None  # a twitch: leave it be
     (moved,) = follow_step([first], robot + [0.3, 0.1, 0.0], robot) or []
     assert moved[0] - first[0] == pytest.approx([0.3, 0.1, 0.0])
     assert moved[1] - first[1] == pytest.approx([0.3, 0.1, 0.0])
-    assert panel_shift(np.array([0.0, 0.0, 5.0]), np.zeros(3)).tolist() == [0.0, 0.0, 0.0]
 
 
 def test_the_overview_looks_down_on_the_whole_room_from_a_corner():
     position, look_at = overview(np.array([-2.5, -2.5, -0.01]), np.array([2.5, 2.5, 0.5]))
-    assert look_at[2] == pytest.approx(-0.01)  # the floor's middle, moved aside for the panel
+    assert look_at[2] == pytest.approx(-0.01)  # the floor's middle
     assert np.linalg.norm(look_at[:2]) < 2.0
     back = position - look_at
     assert back[2] > 2.0 and back[0] < 0 and back[1] < 0  # above, from the south-west
