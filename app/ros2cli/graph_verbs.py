@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import math
 import threading
 import time
@@ -31,8 +32,10 @@ from app.ros.errors import Cancelled
 from app.ros.graph import all_nodes, wait_for_graph
 from app.ros.names import split_node_name
 from app.ros2cli.common import (
+    Commands,
     Ros2cliMessage,
     SilentFailure,
+    Verb,
     ros2_type,
     visible,
     write_names,
@@ -40,6 +43,7 @@ from app.ros2cli.common import (
     write_text,
 )
 from app.ros2cli.msg_yaml import message_to_yaml
+from app.ros2cli.options import node_listing_options, not_here, strategy
 
 # ------------------------------------------------------------------- node
 
@@ -275,3 +279,174 @@ def action_send_goal(
     write_message_block(ctx, "Result", run.result, 4)
     ctx.write(f"Goal finished with status: {run.status}")
     return 0
+
+
+# --- arguments: `ros2 node/service/action ...` as ros2cli takes them
+
+
+def add_node_verbs(v: Commands, verb: Verb) -> None:
+    p = verb(
+        v,
+        "list",
+        "Output a list of available nodes",
+        lambda c, a: node_list(c, a.all, a.count_nodes),
+    )
+    node_listing_options(p)
+    p = verb(
+        v,
+        "info",
+        "Output information about a node",
+        lambda c, a: node_info(c, a.node_name, a.include_hidden),
+    )
+    strategy(p)
+    p.add_argument("node_name", help="Node name to request information")
+    p.add_argument(
+        "--include-hidden",
+        action="store_true",
+        help="Display hidden topics, services, and actions as well",
+    )
+
+
+def _count_services(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "-c",
+        "--count-services",
+        action="store_true",
+        help="Only display the number of services discovered",
+    )
+    p.add_argument(
+        "--include-hidden-services", action="store_true", help="Consider hidden services as well"
+    )
+
+
+def add_service_verbs(v: Commands, verb: Verb) -> None:
+    p = verb(
+        v,
+        "list",
+        "Output a list of available services",
+        lambda c, a: service_list(c, a.show_types, a.count_services, a.include_hidden_services),
+    )
+    strategy(p)
+    p.add_argument(
+        "-t", "--show-types", action="store_true", help="Additionally show the service type"
+    )
+    _count_services(p)
+
+    p = verb(
+        v,
+        "type",
+        "Output a service's type",
+        lambda c, a: service_type(c, a.service_name, a.include_hidden_services),
+    )
+    p.add_argument(
+        "service_name",
+        help="Name of the ROS service to get type (e.g. '/talker/list_parameters')",
+    )
+
+    p = verb(
+        v,
+        "find",
+        "Output a list of available services of a given type",
+        lambda c, a: service_find(c, a.service_type, a.count_services, a.include_hidden_services),
+    )
+    p.add_argument(
+        "service_type",
+        help="Name of the ROS service type to filter for "
+        "(e.g. 'rcl_interfaces/srv/ListParameters')",
+    )
+    _count_services(p)
+
+    p = verb(
+        v,
+        "info",
+        "Print information about a service",
+        lambda c, a: service_info(c, a.service_name, a.include_hidden_services),
+    )
+    strategy(p)
+    p.add_argument(
+        "service_name", help="Name of the ROS service to get info (e.g. '/add_two_ints')"
+    )
+
+    p = verb(
+        v,
+        "call",
+        "Call a service",
+        lambda c, a: service_call(c, a.service_name, a.service_type, a.values, rate=a.rate),
+    )
+    p.add_argument("service_name", help="Name of the ROS service to call to (e.g. '/add_two_ints')")
+    p.add_argument("service_type", help="Type of the ROS service (e.g. 'std_srvs/srv/Empty')")
+    values_or_stdin = p.add_mutually_exclusive_group()
+    values_or_stdin.add_argument(
+        "values",
+        nargs="?",
+        default="{}",
+        help="Values to fill the service request with in YAML format (e.g. '{a: 1, b: 2}'), "
+        "otherwise the service request will be published with default values",
+    )
+    not_here(p, "--stdin", flag=True, group=values_or_stdin, help="Read values from standard input")
+    p.add_argument(
+        "-r",
+        "--rate",
+        metavar="N",
+        type=float,
+        default=None,
+        help="Repeat the call at a specific rate in Hz",
+    )
+
+
+def add_action_verbs(v: Commands, verb: Verb) -> None:
+    p = verb(
+        v,
+        "list",
+        "Output a list of action names",
+        lambda c, a: action_list(c, a.show_types, a.count_actions),
+    )
+    p.add_argument(
+        "-t", "--show-types", action="store_true", help="Additionally show the action type"
+    )
+    p.add_argument(
+        "-c",
+        "--count-actions",
+        action="store_true",
+        help="Only display the number of actions discovered",
+    )
+    # (sic: "a action's", and the example of `action type` says "get info")
+    p = verb(v, "type", "Print a action's type", lambda c, a: action_type(c, a.action_name))
+    p.add_argument("action_name", help="Name of the ROS action to get info (e.g. '/fibonacci')")
+    p = verb(
+        v,
+        "info",
+        "Print information about an action",
+        lambda c, a: action_info(c, a.action_name, a.show_types, a.count),
+    )
+    p.add_argument("action_name", help="Name of the ROS action to get info (e.g. '/fibonacci')")
+    p.add_argument(
+        "-t", "--show-types", action="store_true", help="Additionally show the action type"
+    )
+    p.add_argument(
+        "-c",
+        "--count",
+        action="store_true",
+        help="Only display the number of action clients and action servers",
+    )
+    p = verb(
+        v,
+        "send_goal",
+        "Send an action goal",
+        lambda c, a: action_send_goal(c, a.action_name, a.action_type, a.goal, a.feedback),
+    )
+    p.add_argument("action_name", help="Name of the ROS action (e.g. '/fibonacci')")
+    p.add_argument(
+        "action_type", help="Type of the ROS action (e.g. 'example_interfaces/action/Fibonacci')"
+    )
+    goal_or_stdin = p.add_mutually_exclusive_group()
+    goal_or_stdin.add_argument(
+        "goal",
+        nargs="?",
+        default="{}",
+        help="Goal request values in YAML format (e.g. '{order: 10}')",
+    )
+    not_here(p, "--stdin", flag=True, group=goal_or_stdin, help="Read goal from standard input")
+    p.add_argument(
+        "-f", "--feedback", action="store_true", help="Echo feedback messages for the goal"
+    )

@@ -8,14 +8,17 @@ search path when ``AMENT_PREFIX_PATH`` is not set.
 
 from __future__ import annotations
 
+import argparse
 import os
 import re
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 
+from app.ros.context import CallContext
 from app.ros.convert import import_type
 from app.ros.errors import Ros2Error
-from app.ros2cli.common import Ros2cliMessage
+from app.ros2cli.common import Commands, Ros2cliMessage, Verb
 from app.ros2cli.msg_yaml import message_to_yaml
 
 _EXT = {"msg": ".msg", "srv": ".srv", "action": ".action"}
@@ -188,3 +191,137 @@ def prototype(type_text: str, quotes: bool = True) -> str:
         cls = cls.Request
     text = message_to_yaml(cls())
     return f'"{text}"' if quotes else text
+
+
+# --- `ros2 interface ...`: arguments as ros2cli takes them, and what each verb does
+
+
+def add_verbs(v: Commands, verb: Verb) -> None:
+    """`ros2 interface list/packages/package/show/proto`, with ros2cli's arguments."""
+    p = verb(v, "list", "List all interface types available", _interface_list)
+    only_kinds(p)
+    packages_help = "Output a list of packages that provide interfaces"
+    p = verb(v, "packages", packages_help, _interface_packages)
+    only_kinds(
+        p,
+        (
+            "Only list packages that generate messages",
+            "Only list packages that generate services",
+            "Only list packages that generate actions",
+        ),
+    )
+    p = verb(
+        v,
+        "package",
+        "Output a list of available interface types within one package",
+        _interface_package,
+    )
+    only_kinds(p)
+    p.add_argument("package_name", help="Name of the ROS package (e.g. 'example_interfaces')")
+    p = verb(v, "show", "Output the interface definition", _interface_show)
+    comment_options(p)
+    p.add_argument(
+        "type",
+        help="Show an interface definition (e.g. 'example_interfaces/msg/String'). Passing '-' "
+        "reads the argument from stdin (e.g. 'ros2 topic type /chatter | ros2 interface show -').",
+    )
+    p.epilog = "Not supported here: '-' (reading the type from standard input)."
+    p = verb(v, "proto", "Output an interface prototype", _interface_proto)
+    p.add_argument(
+        "type", help="Show an interface definition (e.g. 'example_interfaces/msg/String')"
+    )
+    p.add_argument("--no-quotes", action="store_true", help="if true output has no outer quotes.")
+
+
+def only_kinds(p: argparse.ArgumentParser, what: Sequence[str] | None = None) -> None:
+    """`ros2 interface list/package(s)`: -m, -s, -a, with each verb's own help texts."""
+    texts = what or (
+        "Print out only the message types",
+        "Print out only the service types",
+        "Print out only the action types",
+    )
+    for short, long, text in zip(
+        ("-m", "-s", "-a"), ("--only-msgs", "--only-srvs", "--only-actions"), texts, strict=True
+    ):
+        p.add_argument(short, long, action="store_true", help=text)
+
+
+def comment_options(p: argparse.ArgumentParser) -> None:
+    """`ros2 interface show`: --all-comments or --no-comments."""
+    group = p.add_mutually_exclusive_group()
+    group.add_argument(
+        "--all-comments",
+        action="store_true",
+        help="Show all comments, including for nested interface definitions",
+    )
+    group.add_argument("--no-comments", action="store_true", help="Show no comments or whitespace")
+
+
+def _interface_list(ctx: CallContext, args: argparse.Namespace) -> int:
+    found = all_interfaces()
+    chosen = [
+        k
+        for k, flag in (
+            ("msg", args.only_msgs),
+            ("srv", args.only_srvs),
+            ("action", args.only_actions),
+        )
+        if flag
+    ] or ["msg", "srv", "action"]
+    titles = {"msg": "Messages", "srv": "Services", "action": "Actions"}
+    for kind in chosen:
+        ctx.write(f"{titles[kind]}:")
+        for name in found[kind]:
+            ctx.write(f"    {name}")
+    return 0
+
+
+def _kinds(args: argparse.Namespace) -> set[str]:
+    """-m/-s/-a: which kinds to list (none given: all)."""
+    chosen = {
+        k
+        for k, on in (
+            ("msg", args.only_msgs),
+            ("srv", args.only_srvs),
+            ("action", args.only_actions),
+        )
+        if on
+    }
+    return chosen or {"msg", "srv", "action"}
+
+
+def _interface_packages(ctx: CallContext, args: argparse.Namespace) -> int:
+    kinds = _kinds(args)
+    for package, names in interface_packages().items():
+        if any(name.split("/", 1)[0] in kinds for name in names):
+            ctx.write(package)
+    return 0
+
+
+def _interface_package(ctx: CallContext, args: argparse.Namespace) -> int:
+    packages = interface_packages()
+    if args.package_name not in packages:
+        raise Ros2cliMessage(f"Unknown package '{args.package_name}'")
+    kinds = _kinds(args)
+    for name in packages[args.package_name]:
+        if name.split("/", 1)[0] in kinds:
+            ctx.write(f"{args.package_name}/{name}")
+    return 0
+
+
+def _interface_proto(ctx: CallContext, args: argparse.Namespace) -> int:
+    for line in prototype(args.type, quotes=not args.no_quotes).split("\n"):
+        ctx.write(line)
+    return 0
+
+
+def _interface_show(ctx: CallContext, args: argparse.Namespace) -> int:
+    text = show(
+        args.type,
+        expand=True,
+        comments=not args.no_comments,
+        nested_comments=args.all_comments,
+    )
+    for line in text.split("\n"):
+        ctx.write(line)
+    return 0

@@ -16,8 +16,14 @@ from app.ros.lifecycle import (
     lifecycle_nodes,
     lifecycle_target,
 )
-from app.ros2cli.common import Ros2cliMessage, write_names, write_outcome
+from app.ros2cli.common import Commands, Ros2cliMessage, Verb, write_names, write_outcome
 from app.ros2cli.graph_verbs import find_node
+from app.ros2cli.options import (
+    hidden_nodes_option,
+    node_listing_options,
+    node_name_argument,
+    strategy,
+)
 
 
 def _managed(ctx: CallContext, include_hidden: bool) -> list[str]:
@@ -84,3 +90,52 @@ def verb_set(ctx: CallContext, fqn: str, transition: str, include_hidden: bool =
     ok, _chosen = change_state(ctx, target, transition)
     write_outcome(ctx, ok, "Transitioning successful" if ok else "Transitioning failed")
     return 0
+
+
+# --- arguments: `ros2 lifecycle ...` as ros2cli takes them
+
+
+def add_verbs(v: Commands, verb: Verb) -> None:
+    p = verb(
+        v,
+        "get",
+        "Get lifecycle state for one or more nodes",
+        lambda c, a: verb_get(c, a.node_name, a.include_hidden_nodes),
+    )
+    strategy(p)
+    node_name_argument(
+        p,
+        optional=True,
+        help_text="Name of the ROS node. If no name is provided, then get the state for all nodes.",
+    )
+    hidden_nodes_option(p)
+
+    p = verb(
+        v,
+        "list",
+        "Output a list of available transitions",
+        lambda c, a: verb_list(c, a.node_name, a.include_hidden_nodes, a.all),
+    )
+    strategy(p)
+    node_name_argument(p)
+    hidden_nodes_option(p)
+    p.add_argument("-a", "--all", action="store_true", help="Display all existing transitions")
+
+    p = verb(
+        v,
+        "nodes",
+        "Output a list of nodes with lifecycle",
+        lambda c, a: verb_nodes(c, a.count_nodes, a.all),
+    )
+    node_listing_options(p)
+
+    p = verb(
+        v,
+        "set",
+        "Trigger lifecycle state transition",
+        lambda c, a: verb_set(c, a.node_name, a.transition, a.include_hidden_nodes),
+    )
+    strategy(p)
+    node_name_argument(p)
+    hidden_nodes_option(p)
+    p.add_argument("transition", help="The lifecycle transition")

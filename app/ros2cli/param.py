@@ -24,8 +24,14 @@ from app.ros.params import (
     python_value,
     set_value,
 )
-from app.ros2cli.common import Ros2cliMessage, write_outcome, write_text
+from app.ros2cli.common import Commands, Ros2cliMessage, Verb, write_outcome, write_text
 from app.ros2cli.graph_verbs import find_node
+from app.ros2cli.options import (
+    hidden_nodes_option,
+    node_name_argument,
+    strategy,
+    timeout_option,
+)
 from app.ros2cli.run import params_file
 
 # `ros2 param list --param-type` and `ros2 param describe` name the types so.
@@ -213,3 +219,122 @@ def param_load(
                 ctx, ok, f"Set parameter {name} {outcome}" + (f": {reason}" if reason else "")
             )
     return 0  # ros2cli exits with 0 even when a parameter was refused
+
+
+# --- arguments: `ros2 param ...` as ros2cli takes them
+
+
+def add_verbs(v: Commands, verb: Verb) -> None:
+    p = verb(
+        v,
+        "list",
+        "Output a list of available parameters",
+        lambda c, a: param_list(
+            c,
+            a.node_name,
+            a.param_type,
+            a.include_hidden_nodes,
+            a.param_prefixes,
+            a.filter[0] if a.filter else None,
+        ),
+    )
+    strategy(p)
+    node_name_argument(p, optional=True)
+    p.add_argument(
+        "--filter",
+        nargs=1,
+        help="Only parameters matching the regex expression will be showed. "
+        "Supports `re` regex syntax.",
+    )
+    hidden_nodes_option(p)
+    p.add_argument(
+        "--param-prefixes",
+        nargs="+",
+        default=[],
+        help="Only list parameters with the provided prefixes",
+    )
+    p.add_argument(
+        "--param-type", action="store_true", help="Print parameter types with parameter names"
+    )
+
+    p = verb(
+        v,
+        "get",
+        "Get parameter",
+        lambda c, a: param_get(
+            c, a.node_name, a.parameter_name, a.include_hidden_nodes, a.hide_type
+        ),
+    )
+    strategy(p)
+    node_name_argument(p)
+    hidden_nodes_option(p)
+    p.add_argument("parameter_name", help="Name of the parameter")
+    p.add_argument("--hide-type", action="store_true", help="Hide the type information")
+    timeout_option(p)
+
+    p = verb(
+        v,
+        "set",
+        "Set parameter",
+        lambda c, a: param_set(c, a.node_name, a.parameter_name, a.value, a.include_hidden_nodes),
+    )
+    strategy(p)
+    node_name_argument(p)
+    hidden_nodes_option(p)
+    p.add_argument("parameter_name", help="Name of the parameter")
+    p.add_argument("value", help="Value of the parameter")
+    timeout_option(p)
+
+    p = verb(
+        v,
+        "describe",
+        "Show descriptive information about declared parameters",
+        lambda c, a: param_describe(c, a.node_name, a.parameter_names, a.include_hidden_nodes),
+    )
+    strategy(p)
+    node_name_argument(p)
+    hidden_nodes_option(p)
+    p.add_argument("parameter_names", nargs="+", help="Names of the parameters")
+    timeout_option(p)
+
+    p = verb(
+        v,
+        "dump",
+        "Show all of the parameters of a node in a YAML file format",
+        lambda c, a: param_dump(c, a.node_name, a.include_hidden_nodes),
+    )
+    strategy(p)
+    node_name_argument(p)
+    hidden_nodes_option(p)
+    timeout_option(p)
+
+    p = verb(
+        v,
+        "load",
+        "Load parameter file for a node",
+        lambda c, a: param_load(
+            c, a.node_name, a.parameter_file, a.include_hidden_nodes, not a.no_use_wildcard
+        ),
+    )
+    strategy(p)
+    node_name_argument(p)
+    hidden_nodes_option(p)
+    p.add_argument("parameter_file", help="Parameter file")
+    p.add_argument(
+        "--no-use-wildcard",
+        action="store_true",
+        help="Do not load parameters in the '/**' namespace into the node",
+    )
+    timeout_option(p)
+
+    p = verb(
+        v,
+        "delete",
+        "Delete parameter",
+        lambda c, a: param_delete(c, a.node_name, a.parameter_name, a.include_hidden_nodes),
+    )
+    strategy(p)
+    node_name_argument(p)
+    hidden_nodes_option(p)
+    p.add_argument("parameter_name", help="Name of the parameter")
+    timeout_option(p)

@@ -17,8 +17,7 @@ from rclpy.exceptions import NameValidationException
 
 from app.ros.context import CallContext, Write
 from app.ros.errors import Cancelled, Ros2Error
-from app.ros2cli import bag, interfaces, launch_verb, pkg, run
-from app.ros2cli import verbs as verb_args
+from app.ros2cli import bag, graph_verbs, interfaces, launch_verb, lifecycle, param, pkg, run, topic
 from app.ros2cli.common import (
     Commands,
     Handler,
@@ -28,7 +27,7 @@ from app.ros2cli.common import (
     settle_discovery,
 )
 from app.ros2cli.groups import GROUPS
-from app.ros2cli.verbs import NOT_HERE
+from app.ros2cli.options import NOT_HERE, command_options
 
 log = logging.getLogger(__name__)
 
@@ -154,7 +153,7 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
 
     def group(name: str, description: str) -> _Commands:
         g = groups.add_parser(name, description=description, formatter_class=RAW, write=write)
-        verb_args.command_options(name, g)  # `ros2 topic --include-hidden-topics ...`
+        command_options(name, g)  # `ros2 topic --include-hidden-topics ...`
         g.set_defaults(handler=lambda ctx, _args: _print_help(ctx, g))
         verbs = commands(g, "verb")
         groups_done.append((g, verbs, name))
@@ -168,47 +167,14 @@ def build_parser(write: Write, prog: str = "ros2") -> argparse.ArgumentParser:
         return p
 
     # node, topic, service, action, param, lifecycle: arguments as Jazzy's ros2cli has them
-    verb_args.add_node(group("node", "Various node related sub-commands"), verb)
-    verb_args.add_topic(group("topic", "Various topic related sub-commands"), verb)
-    verb_args.add_service(group("service", "Various service related sub-commands"), verb)
-    verb_args.add_action(group("action", "Various action related sub-commands"), verb)
-    verb_args.add_param(group("param", "Various param related sub-commands"), verb)
-    verb_args.add_lifecycle(group("lifecycle", "Various lifecycle related sub-commands"), verb)
+    graph_verbs.add_node_verbs(group("node", "Various node related sub-commands"), verb)
+    topic.add_verbs(group("topic", "Various topic related sub-commands"), verb)
+    graph_verbs.add_service_verbs(group("service", "Various service related sub-commands"), verb)
+    graph_verbs.add_action_verbs(group("action", "Various action related sub-commands"), verb)
+    param.add_verbs(group("param", "Various param related sub-commands"), verb)
+    lifecycle.add_verbs(group("lifecycle", "Various lifecycle related sub-commands"), verb)
 
-    v = group("interface", "Show information about ROS interfaces")
-    p = verb(v, "list", "List all interface types available", _interface_list)
-    verb_args.only_kinds(p)
-    packages_help = "Output a list of packages that provide interfaces"
-    p = verb(v, "packages", packages_help, _interface_packages)
-    verb_args.only_kinds(
-        p,
-        (
-            "Only list packages that generate messages",
-            "Only list packages that generate services",
-            "Only list packages that generate actions",
-        ),
-    )
-    p = verb(
-        v,
-        "package",
-        "Output a list of available interface types within one package",
-        _interface_package,
-    )
-    verb_args.only_kinds(p)
-    p.add_argument("package_name", help="Name of the ROS package (e.g. 'example_interfaces')")
-    p = verb(v, "show", "Output the interface definition", _interface_show)
-    verb_args.comment_options(p)
-    p.add_argument(
-        "type",
-        help="Show an interface definition (e.g. 'example_interfaces/msg/String'). Passing '-' "
-        "reads the argument from stdin (e.g. 'ros2 topic type /chatter | ros2 interface show -').",
-    )
-    p.epilog = "Not supported here: '-' (reading the type from standard input)."
-    p = verb(v, "proto", "Output an interface prototype", _interface_proto)
-    p.add_argument(
-        "type", help="Show an interface definition (e.g. 'example_interfaces/msg/String')"
-    )
-    p.add_argument("--no-quotes", action="store_true", help="if true output has no outer quotes.")
+    interfaces.add_verbs(group("interface", "Show information about ROS interfaces"), verb)
 
     bag.add_verbs(group("bag", "Various rosbag related sub-commands"), verb)
     pkg.add_verbs(group("pkg", "Various package related sub-commands"), verb)  # issue 22
@@ -272,80 +238,6 @@ def needs_ros(argv: list[str]) -> bool:
 _FRESH_CLIENT = {("service", "call")}
 
 _HELP_WITHOUT_DDS = {"node", "topic", "service", "action", "param", "lifecycle", "interface"}
-
-
-def _pkg_executables(ctx: CallContext, args: argparse.Namespace) -> int:
-    return run.pkg_executables(ctx, args.package_name)
-
-
-def _interface_list(ctx: CallContext, args: argparse.Namespace) -> int:
-    found = interfaces.all_interfaces()
-    chosen = [
-        k
-        for k, flag in (
-            ("msg", args.only_msgs),
-            ("srv", args.only_srvs),
-            ("action", args.only_actions),
-        )
-        if flag
-    ] or ["msg", "srv", "action"]
-    titles = {"msg": "Messages", "srv": "Services", "action": "Actions"}
-    for kind in chosen:
-        ctx.write(f"{titles[kind]}:")
-        for name in found[kind]:
-            ctx.write(f"    {name}")
-    return 0
-
-
-def _kinds(args: argparse.Namespace) -> set[str]:
-    """-m/-s/-a: which kinds to list (none given: all)."""
-    chosen = {
-        k
-        for k, on in (
-            ("msg", args.only_msgs),
-            ("srv", args.only_srvs),
-            ("action", args.only_actions),
-        )
-        if on
-    }
-    return chosen or {"msg", "srv", "action"}
-
-
-def _interface_packages(ctx: CallContext, args: argparse.Namespace) -> int:
-    kinds = _kinds(args)
-    for package, names in interfaces.interface_packages().items():
-        if any(name.split("/", 1)[0] in kinds for name in names):
-            ctx.write(package)
-    return 0
-
-
-def _interface_package(ctx: CallContext, args: argparse.Namespace) -> int:
-    packages = interfaces.interface_packages()
-    if args.package_name not in packages:
-        raise Ros2cliMessage(f"Unknown package '{args.package_name}'")
-    kinds = _kinds(args)
-    for name in packages[args.package_name]:
-        if name.split("/", 1)[0] in kinds:
-            ctx.write(f"{args.package_name}/{name}")
-    return 0
-
-
-def _interface_proto(ctx: CallContext, args: argparse.Namespace) -> int:
-    for line in interfaces.prototype(args.type, quotes=not args.no_quotes).split("\n"):
-        ctx.write(line)
-    return 0
-
-
-def _interface_show(ctx: CallContext, args: argparse.Namespace) -> int:
-    text = interfaces.show(
-        args.type,
-        expand=True,
-        comments=not args.no_comments,
-        nested_comments=args.all_comments,
-    )
-    for line in text.split("\n"):
-        ctx.write(line)
-    return 0
 
 
 def parse(argv: list[str], write: Write, prog: str = "ros2") -> argparse.Namespace | None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import math
 import time
 from collections.abc import Mapping
@@ -41,14 +42,25 @@ from app.ros.graph import topic_types
 from app.ros.monitor import TopicMonitor
 from app.ros.qos import MEASURE_QOS, suit_publishers
 from app.ros2cli.common import (
+    Commands,
     Ros2cliMessage,
     SilentFailure,
+    Verb,
     ros2_type,
     visible,
     write_names,
     write_text,
 )
 from app.ros2cli.msg_yaml import ECHO_TRUNCATE_LENGTH, message_to_csv, message_to_yaml
+from app.ros2cli.options import (
+    nonnegative_int,
+    not_here,
+    positive_float,
+    positive_int,
+    spin_time,
+    strategy,
+    unsigned_int,
+)
 
 M = TypeVar("M")  # a message (its generated class is untyped)
 
@@ -522,3 +534,365 @@ def pub(
     finally:
         ctx.node.destroy_publisher(publisher)
     return 0
+
+
+# --- arguments: `ros2 topic ...` as ros2cli takes them
+
+
+def qos_options(p: argparse.ArgumentParser, verb: str, default_profile: str) -> None:
+    """`topic echo` and `topic pub`'s QoS options (read back by ``qos_of``)."""
+    history = QoSPresetProfiles.get_from_short_key(default_profile).history.short_key
+    compatible = "default: Compatible profile with running endpoints )"
+    p.add_argument(
+        "--qos-profile",
+        choices=QoSPresetProfiles.short_keys(),
+        default=default_profile,
+        help=f"Quality of service preset profile to {verb} with (default: {default_profile})",
+    )
+    p.add_argument(
+        "--qos-depth",
+        metavar="N",
+        type=int,
+        help=f"Queue size setting to {verb} with (overrides depth value of --qos-profile option)",
+    )
+    p.add_argument(
+        "--qos-history",
+        choices=QoSHistoryPolicy.short_keys(),
+        help=f"History of samples setting to {verb} with (overrides history value of "
+        f"--qos-profile option, default: {history})",
+    )
+    p.add_argument(
+        "--qos-reliability",
+        choices=QoSReliabilityPolicy.short_keys(),
+        help=f"Quality of service reliability setting to {verb} with (overrides "
+        f"reliability value of --qos-profile option, {compatible}",
+    )
+    p.add_argument(
+        "--qos-durability",
+        choices=QoSDurabilityPolicy.short_keys(),
+        help=f"Quality of service durability setting to {verb} with (overrides "
+        f"durability value of --qos-profile option, {compatible}",
+    )
+    p.add_argument(
+        "--qos-liveliness",
+        choices=QoSLivelinessPolicy.short_keys(),
+        help=f"Quality of service liveliness setting to {verb} with (overrides "
+        "liveliness value of --qos-profile option",
+    )
+    p.add_argument(
+        "--qos-liveliness-lease-duration-seconds",
+        type=float,
+        help=f"Quality of service liveliness lease duration setting to {verb} with "
+        "(overrides liveliness lease duration value of --qos-profile option",
+    )
+
+
+def qos_of(a: argparse.Namespace) -> QosOptions:
+    return QosOptions(
+        a.qos_profile,
+        reliability=a.qos_reliability,
+        durability=a.qos_durability,
+        depth=a.qos_depth,
+        history=a.qos_history,
+        liveliness=a.qos_liveliness,
+        lease_seconds=a.qos_liveliness_lease_duration_seconds,
+    )
+
+
+HIDDEN_TOPICS_HELP = "Consider hidden topics as well"
+
+
+def add_verbs(v: Commands, verb: Verb) -> None:
+    p = verb(
+        v,
+        "list",
+        "Output a list of available topics",
+        lambda c, a: list_topics(
+            c, a.show_types, a.verbose, a.count_topics, a.include_hidden_topics
+        ),
+    )
+    strategy(p)
+    p.add_argument(
+        "-t", "--show-types", action="store_true", help="Additionally show the topic type"
+    )
+    p.add_argument(
+        "-c",
+        "--count-topics",
+        action="store_true",
+        help="Only display the number of topics discovered",
+    )
+    p.add_argument("--include-hidden-topics", action="store_true", help=HIDDEN_TOPICS_HELP)
+    p.add_argument(
+        "-v", "--verbose", action="store_true", help="List full details about each topic"
+    )
+
+    p = verb(
+        v,
+        "info",
+        "Print information about a topic",
+        lambda c, a: topic_info(c, a.topic_name, a.verbose),
+    )
+    strategy(p)
+    p.add_argument("topic_name", help="Name of the ROS topic to get info (e.g. '/chatter')")
+    p.add_argument(
+        "--verbose",
+        "-v",
+        action="store_true",
+        help="Prints detailed information like the node name, node namespace, topic type, "
+        "topic type hash, GUID, and QoS Profile of the publishers and subscribers to this topic",
+    )
+
+    p = verb(
+        v,
+        "type",
+        "Print a topic's type",
+        lambda c, a: topic_type(c, a.topic_name, a.include_hidden_topics),
+    )
+    strategy(p)
+    p.add_argument("topic_name", help="Name of the ROS topic to get type (e.g. '/chatter')")
+
+    p = verb(
+        v,
+        "find",
+        "Output a list of available topics of a given type",
+        lambda c, a: find(c, a.topic_type, a.count_topics, a.include_hidden_topics),
+    )
+    strategy(p)
+    # (sic: ros2cli's example says std_msg)
+    p.add_argument(
+        "topic_type", help="Name of the ROS topic type to filter for (e.g. 'std_msg/msg/String')"
+    )
+    p.add_argument(
+        "-c",
+        "--count-topics",
+        action="store_true",
+        help="Only display the number of topics discovered",
+    )
+    p.add_argument("--include-hidden-topics", action="store_true", help=HIDDEN_TOPICS_HELP)
+
+    _add_echo(v, verb)
+
+    p = verb(
+        v,
+        "hz",
+        "Print the average publishing rate to screen",
+        lambda c, a: hz(c, a.topic_name, None, a.window_size),
+    )
+    p.add_argument("topic_name", help="Name of the ROS topic to listen to (e.g. '/chatter')")
+    p.add_argument(
+        "--window",
+        "-w",
+        dest="window_size",
+        type=positive_int,
+        default=10_000,
+        metavar="WINDOW",
+        help="window size, in # of messages, for calculating rate (default: 10000)",
+    )
+    not_here(
+        p, "--filter", metavar="EXPR", help="only measure messages matching the specified "
+        "Python expression",
+    )  # fmt: skip
+    not_here(
+        p,
+        "--wall-time",
+        flag=True,
+        help="calculates rate using wall time which can be helpful when clock is not "
+        "published during simulation",
+    )
+    spin_time(p)
+
+    p = verb(
+        v,
+        "bw",
+        "Display bandwidth used by topic",
+        lambda c, a: bw(c, a.topic, None, a.window),
+    )
+    p.add_argument("topic", help="Topic name to monitor for bandwidth utilization")
+    p.add_argument(
+        "--window",
+        "-w",
+        type=positive_int,
+        default=100,
+        metavar="WINDOW",
+        help="maximum window size, in # of messages, for calculating rate (default: 100)",
+    )
+    spin_time(p)
+
+    _add_pub(v, verb)
+
+
+def _add_echo(v: Commands, verb: Verb) -> None:
+    p = verb(
+        v,
+        "echo",
+        "Output messages from a topic",
+        lambda c, a: echo(
+            c,
+            a.topic_name,
+            a.message_type,
+            once=a.once,
+            field=a.field,
+            style=EchoStyle(
+                truncate_length=None if a.full_length else a.truncate_length,
+                no_arr=a.no_arr,
+                no_str=a.no_str,
+                flow_style=a.flow_style,
+                csv=a.csv,
+            ),
+            timeout=a.timeout,
+            qos=qos_of(a),
+        ),
+    )
+    strategy(p)
+    p.add_argument("topic_name", help="Name of the ROS topic to listen to (e.g. '/chatter')")
+    p.add_argument(
+        "message_type", nargs="?", help="Type of the ROS message (e.g. 'std_msgs/msg/String')"
+    )
+    qos_options(p, "subscribe", "sensor_data")
+    p.add_argument(
+        "--csv",
+        action="store_true",
+        help="Output all recursive fields separated by commas (e.g. for plotting). If "
+        "--include-message-info is also passed, the following fields are prepended: "
+        "source_timestamp, received_timestamp, publication_sequence_number, "
+        "reception_sequence_number.",
+    )
+    p.add_argument(
+        "--field",
+        type=str,
+        default=None,
+        help="Echo a selected field of a message. Use '.' to select sub-fields. For example, "
+        "to echo the position field of a nav_msgs/msg/Odometry message: "
+        "'ros2 topic echo /odom --field pose.pose.position'",
+    )
+    p.add_argument(
+        "--full-length",
+        "-f",
+        action="store_true",
+        help="Output all elements for arrays, bytes, and string with a length > "
+        "'--truncate-length', by default they are truncated after '--truncate-length' "
+        "elements with '...''",
+    )
+    p.add_argument(
+        "--truncate-length",
+        "-l",
+        type=unsigned_int,
+        default=128,
+        help="The length to truncate arrays, bytes, and string to (default: 128)",
+    )
+    p.add_argument("--no-arr", action="store_true", help="Don't print array fields of messages")
+    p.add_argument("--no-str", action="store_true", help="Don't print string fields of messages")
+    # (sic: ros2cli's help says block style for the option that asks for the flow style)
+    p.add_argument(
+        "--flow-style",
+        action="store_true",
+        help="Print collections in the block style (not available with csv format)",
+    )
+    not_here(p, "--no-lost-messages", flag=True, help="Don't report when a message is lost")
+    not_here(p, "--raw", flag=True, help="Echo the raw binary representation")
+    not_here(
+        p,
+        "--filter",
+        dest="filter_expr",
+        help="Python expression to filter messages that are printed. Expression can use "
+        "Python builtins as well as m (the message).",
+    )
+    p.add_argument(
+        "--once", action="store_true", help="Print the first message received and then exit."
+    )
+    p.add_argument(
+        "--timeout",
+        metavar="N",
+        type=positive_float,
+        default=None,
+        help="Set a timeout in seconds for waiting",
+    )
+    not_here(
+        p, "--include-message-info", "-i", flag=True, help="Shows the associated message info."
+    )
+
+
+def _add_pub(v: Commands, verb: Verb) -> None:
+    p = verb(
+        v,
+        "pub",
+        "Publish a message to a topic",
+        lambda c, a: pub(
+            c,
+            a.topic_name,
+            a.message_type,
+            a.values,
+            once=a.once,
+            rate=a.rate,
+            times=a.times,
+            wait_matching=a.wait_matching_subscriptions,
+            print_nth=a.print,
+            max_wait_time=a.max_wait_time_secs,
+            keep_alive=a.keep_alive,
+            qos=qos_of(a),
+        ),
+    )
+    p.add_argument("topic_name", help="Name of the ROS topic to publish to (e.g. '/chatter')")
+    p.add_argument("message_type", help="Type of the ROS message (e.g. 'std_msgs/String')")
+    values_or_stdin = p.add_mutually_exclusive_group()
+    values_or_stdin.add_argument(
+        "values",
+        nargs="?",
+        default="{}",
+        help="Values to fill the message with in YAML format (e.g. 'data: Hello World'), "
+        "otherwise the message will be published with default values",
+    )
+    not_here(p, "--stdin", flag=True, group=values_or_stdin, help="Read values from standard input")
+    p.add_argument(
+        "-r",
+        "--rate",
+        metavar="N",
+        type=positive_float,
+        default=1.0,
+        help="Publishing rate in Hz (default: 1)",
+    )
+    p.add_argument(
+        "-p",
+        "--print",
+        metavar="N",
+        type=int,
+        default=1,
+        help="Only print every N-th published message (default: 1)",
+    )
+    once_or_times = p.add_mutually_exclusive_group()
+    once_or_times.add_argument(
+        "-1", "--once", action="store_true", help="Publish one message and exit"
+    )
+    once_or_times.add_argument(
+        "-t",
+        "--times",
+        type=nonnegative_int,
+        default=0,
+        help="Publish this number of times and then exit",
+    )
+    p.add_argument(
+        "-w",
+        "--wait-matching-subscriptions",
+        type=nonnegative_int,
+        default=None,
+        help="Wait until finding the specified number of matching subscriptions. "
+        'Defaults to 1 when using "-1"/"--once"/"--times", otherwise defaults to 0.',
+    )
+    p.add_argument(
+        "--max-wait-time-secs",
+        type=positive_float,
+        default=None,
+        help="This sets the maximum wait time in seconds if "
+        "--wait-until-matching-subscriptions is set. By default, this flag is not set "
+        "meaning the subscriber will wait endlessly.",
+    )
+    p.add_argument(
+        "--keep-alive",
+        metavar="N",
+        type=positive_float,
+        default=0.1,
+        help="Keep publishing node alive for N seconds after the last msg (default: 0.1)",
+    )
+    not_here(p, "-n", "--node-name", help="Name of the created publishing node")
+    qos_options(p, "publish", "default")
+    spin_time(p)
