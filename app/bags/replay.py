@@ -1,13 +1,15 @@
-"""What a recording shows when it is watched: the robot's way, its scans, the room, and each
-topic's messages over time.
+"""What a recording shows when it is watched: the robot's way, its scans, the room, the
+turtles of turtlesim, and each topic's messages over time.
 
 A graded attempt (app/exercises/attempts.py) or any bag of the simulated world
 holds ``/ground_truth/odom`` (where the robot really was), ``/scan`` and the
-world's latched ``/sim_world/static_markers`` (floor, walls, furniture). This
-reads them once into plain numbers a player can step through by time: poses
-and scans as seen from above, the room as boxes, and every other message as
-a line of text at its moment (what the grader sent, what the node answered).
-Times are seconds since the bag's first message, by when each was recorded.
+world's latched ``/sim_world/static_markers`` (floor, walls, furniture). A
+turtlesim exercise's attempt holds each turtle's ``/<turtle>/pose``
+(``turtlesim/msg/Pose``). This reads them once into plain numbers a player can
+step through by time: poses and scans as seen from above, the room as boxes,
+each turtle's poses, and every other message as a line of text at its moment
+(what the grader sent, what the node answered). Times are seconds since the
+bag's first message, by when each was recorded.
 """
 
 from __future__ import annotations
@@ -35,11 +37,13 @@ if TYPE_CHECKING:
     from nav_msgs.msg import Odometry
     from rcl_interfaces.msg import Log
     from sensor_msgs.msg import LaserScan
+    from turtlesim.msg import Pose as TurtlePose
     from visualization_msgs.msg import MarkerArray
 
 POSE_TOPICS = ("/ground_truth/odom", "/odom")  # the first one a bag holds is the robot's way
 SCAN_TOPIC = "/scan"
 ROOM_TOPIC = "/sim_world/static_markers"
+TURTLE_POSE = "turtlesim/msg/Pose"  # on /<turtle>/pose: a turtle of turtlesim
 MOST_MOMENTS = 3000  # lines of other messages kept (a long bag keeps its first ones)
 MOMENT_TEXT = 160  # characters of one message's text
 FLOOR_HEIGHT = 0.05  # m: a marker no taller than this is floor, not an obstacle
@@ -55,6 +59,7 @@ DRAWN_TYPES = (
     "rosgraph_msgs/msg/Clock",
     "sensor_msgs/msg/Imu",
     "sensor_msgs/msg/JointState",
+    TURTLE_POSE,
 )
 
 
@@ -87,14 +92,34 @@ class Track:
     scans: list[Scan] = field(default_factory=list)
     room: list[Box] = field(default_factory=list)
     floor: Box | None = None
+    turtles: dict[str, list[Pose]] = field(default_factory=dict)  # by name, e.g. "turtle1"
     moments: list[Moment] = field(default_factory=list)
     stamps: dict[str, list[float]] = field(default_factory=dict)  # topic -> message times
     problems: list[str] = field(default_factory=list)  # messages that could not be read
 
     @property
+    def world(self) -> str:
+        """What plays seen from above: "robot" (the simulated world), "turtlesim" (its
+        window), or "" (nothing moves: the messages' timeline). A robot wins over turtles."""
+        if self.poses:
+            return "robot"
+        return "turtlesim" if self.turtles else ""
+
+    @property
     def drives(self) -> bool:
-        """Whether there is a robot to watch (else: the messages' timeline)."""
-        return bool(self.poses)
+        """Whether something moves to watch from above (else: the messages' timeline)."""
+        return bool(self.world)
+
+    def turtles_at(self, t: float) -> dict[str, Pose]:
+        """Each turtle's newest pose at ``t``, by name (a turtle not spawned yet is left out)."""
+        now = {name: _newest(poses, t) for name, poses in self.turtles.items()}
+        return {name: pose for name, pose in now.items() if pose is not None}
+
+    def trail_until(self, name: str, t: float) -> list[Pose]:
+        """Turtle ``name``'s poses up to ``t``: its trail, as turtlesim's pen draws it (a
+        teleport included: the pen draws that line too)."""
+        poses = self.turtles.get(name, [])
+        return poses[: bisect.bisect_right([p.t for p in poses], t)]
 
     def pose_at(self, t: float) -> Pose | None:
         """The newest pose at ``t`` (None before the first)."""
@@ -198,7 +223,8 @@ def _wanted_messages(
         topic, kind = connection.topic, connection.msgtype
         t = max(0.0, (stamp - start) / 1e9)
         track.stamps.setdefault(topic, []).append(t)
-        if topic in (track.pose_topic, SCAN_TOPIC, ROOM_TOPIC) or kind not in DRAWN_TYPES:
+        drawn = topic in (track.pose_topic, SCAN_TOPIC, ROOM_TOPIC) or kind == TURTLE_POSE
+        if drawn or kind not in DRAWN_TYPES:
             kept.append((t, topic, kind, bytes(raw)))
     return kept
 
@@ -217,6 +243,10 @@ def _take(track: Track, topic: str, kind: str, t: float, msg: object) -> None:
             track.scans.append(Scan(t, _scan_points(cast("LaserScan", msg), pose)))
     elif topic == ROOM_TOPIC and kind == "visualization_msgs/msg/MarkerArray":
         _room(track, cast("MarkerArray", msg))
+    elif kind == TURTLE_POSE:
+        turtle = cast("TurtlePose", msg)
+        name = turtle_name(topic)
+        track.turtles.setdefault(name, []).append(Pose(t, turtle.x, turtle.y, turtle.theta))
     elif kind == "rcl_interfaces/msg/Log":  # as ros2 run prints a node's log line
         log = cast("Log", msg)
         level = LOG_LEVELS.get(log.level, str(log.level))
@@ -224,6 +254,11 @@ def _take(track: Track, topic: str, kind: str, t: float, msg: object) -> None:
     else:
         text = json.dumps(to_plain(msg, max_items=8), separators=(", ", ": "))
         track.moments.append(Moment(t, topic, _cut(text)))
+
+
+def turtle_name(topic: str) -> str:
+    """``/turtle1/pose`` -> ``turtle1``; ``/sim2/turtle1/pose`` -> ``sim2/turtle1``."""
+    return topic.removesuffix("/pose").strip("/") or topic
 
 
 def _cut(text: str) -> str:

@@ -1,12 +1,17 @@
-"""A recording played on stage: the robot's way seen from above, or each topic's messages.
+"""A recording played on stage: the robot's way or turtlesim's window seen from above, or
+each topic's messages.
 
 "Watch this attempt" beside a grading's result opens its bag here (any bag
 can be opened: a graded attempt is one). A bag of the simulated world plays
 as a top view: the room, the way the robot really went so far (one line per
 trial: the grader resets the world between them), the robot now and what its
-scan saw now. Any other bag plays as its messages' timeline, with the
-newest messages at the cursor as text: what the grader sent and what the
-node answered, and when. Play/pause, a speed and a time slider drive it.
+scan saw now. A bag of turtlesim's poses plays as its window: the 11.09 m
+square on turtlesim's blue, each turtle where its pose put it, with its trail
+so far. Any other bag plays as its messages' timeline, with the newest
+messages at the cursor as text: what the grader sent and what the node
+answered, and when. The same play/pause, speed and time slider drive all
+three (one ``ReplayStage``; the teacher page plays a learner's attempt with it
+too).
 
 Threads: reading the bag is a worker job (``app.bags.replay.read_track``);
 everything else runs on the UI thread, one frame per refresh while playing.
@@ -16,6 +21,7 @@ from __future__ import annotations
 
 import html
 import math
+import textwrap
 import time
 from pathlib import Path
 
@@ -27,6 +33,7 @@ from app.ros.planar import Box
 from app.stage.bag_stage import BagPicture, timeline_svg
 from app.ui import MarkdownView, assign, code_block
 from app.ui.loop import UiLoop
+from nodes.common.turtlesim_world import DEFAULT_BACKGROUND, METER, WORLD_SIZE
 
 WIDTH, HEIGHT = 760, 560  # px of the top view
 MARGIN_M = 0.3  # m around what is drawn
@@ -34,7 +41,14 @@ SPEEDS = {"¼×": 0.25, "½×": 0.5, "1×": 1.0, "2×": 2.0, "4×": 4.0}
 LINES_AT_CURSOR = 8  # messages listed under the picture
 WAY_STEP_PX = 2.0  # a drawn way's points at least this far apart (a long run stays small)
 ROBOT_RADIUS_M = 0.17
+CAPTION_CHAR_PX = 6.6  # a 12 px sans-serif character, about: the caption wraps to the picture
+CAPTION_LINE_PX = 16
 TRIAL_COLOURS = ("#1c7ed6", "#e8590c", "#2f9e44", "#ae3ec9")
+# A turtle's trail: turtlesim's own pen colour first, then colours that stand out on its blue
+# (set_pen is a service call and the sim's trails topic is hidden: no bag holds the pens).
+TURTLE_PENS = ("#b3b8ff", "#ffd43b", "#ff8787", "#8ce99a", "#ffffff", "#ffa94d")
+TURTLE_BODY = (46, 139, 87)  # as the Turtlesim tool draws a turtle
+TURTLE_EDGE = (20, 70, 40)
 NOTHING = (
     "_Nothing to watch yet._ After **Check my node**, click **Watch this attempt** under "
     "the results: the grading plays here."
@@ -44,9 +58,11 @@ NOTHING = (
 class TopView:
     """World metres -> pixels of the top view (y up, as a map is read)."""
 
-    def __init__(self, low: tuple[float, float], high: tuple[float, float]) -> None:
+    def __init__(
+        self, low: tuple[float, float], high: tuple[float, float], scale: float | None = None
+    ) -> None:
         span_x, span_y = max(high[0] - low[0], 0.5), max(high[1] - low[1], 0.5)
-        self.scale = min((WIDTH - 20) / span_x, (HEIGHT - 40) / span_y)
+        self.scale = scale or min((WIDTH - 20) / span_x, (HEIGHT - 40) / span_y)
         self.low = low
         self.height = span_y * self.scale + 20
         self.width = span_x * self.scale + 20
@@ -58,7 +74,10 @@ class TopView:
 
     @classmethod
     def around(cls, track: Track) -> TopView:
-        """The floor, or else everything the robot went past and saw."""
+        """Turtlesim's window at its own size; else the floor, or everything the robot went
+        past and saw."""
+        if track.world == "turtlesim":
+            return cls((0.0, 0.0), (WORLD_SIZE, WORLD_SIZE), scale=METER)
         if track.floor is not None:
             corners = [c for box in (track.floor, *track.room) for c in box.corners()]
         else:
@@ -78,24 +97,38 @@ def _xy(x: float, y: float) -> str:
     return f"{x:.1f},{y:.1f}"
 
 
+def _rgb(colour: tuple[int, int, int]) -> str:
+    return "#{:02x}{:02x}{:02x}".format(*colour)
+
+
 def _polygon(view: TopView, box: Box, style: str) -> str:
     points = " ".join(_xy(*view.px(x, y)) for x, y in box.corners())
     return f'<polygon points="{points}" {style}><title>{html.escape(box.name)}</title></polygon>'
 
 
-def _way(view: TopView, piece: list[Pose], colour: str) -> str:
+def _way(view: TopView, piece: list[Pose], colour: str, width: float = 2) -> str:
     points: list[tuple[float, float]] = []
     for pose in piece:
         here = view.px(pose.x, pose.y)
         if not points or math.dist(here, points[-1]) >= WAY_STEP_PX or pose is piece[-1]:
             points.append(here)
     text = " ".join(f"{x:.1f},{y:.1f}" for x, y in points)
-    return f'<polyline points="{text}" fill="none" stroke="{colour}" stroke-width="2"/>'
+    return (
+        f'<polyline points="{text}" fill="none" stroke="{colour}" stroke-width="{width:g}" '
+        'stroke-linejoin="round" stroke-linecap="round"/>'
+    )
 
 
-def top_view_svg(track: Track, t: float, view: TopView | None = None) -> str:
-    """The room, the way so far, the scan and the robot at ``t`` seconds into the bag."""
-    view = view or TopView.around(track)
+def _pose_data(pose: Pose) -> str:
+    """The pose drawn, as attributes: a test (or a curious learner's devtools) reads it."""
+    return (
+        f'data-x="{pose.x:.3f}" data-y="{pose.y:.3f}" data-yaw="{pose.yaw:.3f}" '
+        f'data-t="{pose.t:.6f}"'  # to the microsecond: two poses can be 1 ms apart
+    )
+
+
+def _robot_world(track: Track, t: float, view: TopView) -> tuple[list[str], str]:
+    """The room, the way so far (a line per trial), the scan and the robot at ``t``."""
     parts = []
     if track.floor is not None:
         parts.append(_polygon(view, track.floor, 'fill="#f8f9fa" stroke="#ced4da"'))
@@ -118,10 +151,8 @@ def top_view_svg(track: Track, t: float, view: TopView | None = None) -> str:
             pose.x + ROBOT_RADIUS_M * math.cos(pose.yaw),
             pose.y + ROBOT_RADIUS_M * math.sin(pose.yaw),
         )
-        # The robot carries its pose, so a test (or a curious learner's devtools) reads it.
         parts.append(
-            f'<g id="replay-robot" data-x="{pose.x:.3f}" data-y="{pose.y:.3f}" '
-            f'data-yaw="{pose.yaw:.3f}" data-t="{pose.t:.3f}">'
+            f'<g id="replay-robot" {_pose_data(pose)}>'
             f'<circle cx="{cx:.1f}" cy="{cy:.1f}" r="{r:.1f}" fill="#ffd43b" stroke="#212529" '
             f'stroke-width="1.5"/><line x1="{cx:.1f}" y1="{cy:.1f}" x2="{nose[0]:.1f}" '
             f'y2="{nose[1]:.1f}" stroke="#212529" stroke-width="2.5"/></g>'
@@ -133,13 +164,72 @@ def top_view_svg(track: Track, t: float, view: TopView | None = None) -> str:
         f"{t:.1f} s of {track.duration:.1f} s{simulated}{trials} · seen from above: the line "
         f"is where the robot really went ({track.pose_topic}), red dots what its /scan saw"
     )
-    height = view.height + 24
+    return parts, caption
+
+
+def _turtle(view: TopView, name: str, pose: Pose, colour: str) -> str:
+    """A turtle as turtlesim's window draws one (the Turtlesim tool's shape), named."""
+    cx, cy = view.px(pose.x, pose.y)
+    k = view.scale / METER  # the shape is in the window's pixels
+    fx, fy = math.cos(pose.yaw) * k, -math.sin(pose.yaw) * k  # window y grows downwards
+    sx, sy = -fy, fx
+    shell = [(13, 0), (8, 11), (-10, 11), (-15, 0), (-10, -11), (8, -11)]
+    points = " ".join(_xy(cx + a * fx + b * sx, cy + a * fy + b * sy) for a, b in shell)
+    hx, hy = cx + 18 * fx, cy + 18 * fy
     return (
-        f'<svg class="stage-replay" width="{view.width:.0f}" height="{height:.0f}" '
-        f'viewBox="0 0 {view.width:.0f} {height:.0f}" font-family="sans-serif" font-size="12" '
-        f'role="img" aria-label="The recorded run seen from above at {t:.1f} s">'
-        f"{''.join(parts)}"
-        f'<text x="10" y="{height - 6:.0f}" fill="#495057">{html.escape(caption)}</text></svg>'
+        f'<g class="replay-turtle" data-name="{html.escape(name)}" {_pose_data(pose)}>'
+        f'<circle cx="{hx:.1f}" cy="{hy:.1f}" r="{5 * k:.1f}" fill="{_rgb(TURTLE_BODY)}" '
+        f'stroke="{_rgb(TURTLE_EDGE)}"/><polygon points="{points}" fill="{_rgb(TURTLE_BODY)}" '
+        f'stroke="{_rgb(TURTLE_EDGE)}" stroke-width="1.5"/>'
+        f'<text x="{cx:.1f}" y="{cy - 20 * k:.1f}" text-anchor="middle" fill="{colour}" '
+        'stroke="#1c2159" stroke-width="3" paint-order="stroke" '
+        f'font-weight="bold">{html.escape(name)}</text></g>'
+    )
+
+
+def _turtlesim_world(track: Track, t: float, view: TopView) -> tuple[list[str], str]:
+    """Turtlesim's window at ``t``: its blue ground, each turtle's trail so far and the turtles."""
+    (x0, y1), (x1, y0) = view.px(0.0, 0.0), view.px(WORLD_SIZE, WORLD_SIZE)
+    parts = [
+        f'<rect x="{x0:.1f}" y="{y0:.1f}" width="{x1 - x0:.1f}" height="{y1 - y0:.1f}" '
+        f'fill="{_rgb(DEFAULT_BACKGROUND)}"/>'
+    ]
+    colours = {name: TURTLE_PENS[n % len(TURTLE_PENS)] for n, name in enumerate(track.turtles)}
+    for name in track.turtles:
+        trail = track.trail_until(name, t)
+        if len(trail) > 1:
+            parts.append(_way(view, trail, colours[name], width=3 * view.scale / METER))
+    now = track.turtles_at(t)
+    parts += [_turtle(view, name, pose, colours[name]) for name, pose in now.items()]
+    named = ", ".join(f"/{name}/pose" for name in track.turtles)
+    caption = (
+        f"{t:.1f} s of {track.duration:.1f} s · turtlesim's window: each turtle where its pose "
+        f"put it ({named}), its trail so far in a colour of its own (pens are not recorded)"
+    )
+    return parts, caption
+
+
+def top_view_svg(track: Track, t: float, view: TopView | None = None) -> str:
+    """What moves, seen from above at ``t`` seconds into the bag: the simulated world's
+    robot or turtlesim's window. The svg says its cursor (``data-cursor``)."""
+    view = view or TopView.around(track)
+    if track.world == "turtlesim":
+        parts, caption = _turtlesim_world(track, t, view)
+    else:
+        parts, caption = _robot_world(track, t, view)
+    lines = textwrap.wrap(caption, max(20, int((view.width - 20) / CAPTION_CHAR_PX)))
+    height = view.height + 8 + CAPTION_LINE_PX * len(lines)
+    text = "".join(
+        f'<text x="10" y="{view.height + 2 + CAPTION_LINE_PX * (n + 1):.0f}" fill="#495057">'
+        f"{html.escape(line)}</text>"
+        for n, line in enumerate(lines)
+    )
+    return (
+        f'<svg class="stage-replay" data-cursor="{t:.3f}" width="{view.width:.0f}" '
+        f'height="{height:.0f}" viewBox="0 0 {view.width:.0f} {height:.0f}" '
+        f'font-family="sans-serif" font-size="12" role="img" '
+        f'aria-label="The recorded run seen from above at {t:.1f} s">'
+        f"{''.join(parts)}{text}</svg>"
     )
 
 
@@ -171,7 +261,7 @@ class ReplayStage:
             self._picture = gui.add_html("")
             self._messages = MarkdownView(gui, "")
         self._play.on_click(ui.callback(self._toggle))
-        self._slider.on_update(ui.callback(self._on_slider))
+        self._slider.on_update(self._slider_moved)
 
     # -- opening ------------------------------------------------------------------
 
@@ -179,6 +269,7 @@ class ReplayStage:
         """Read ``bag`` (a worker job) and show it from its start, paused."""
         self._playing = False
         self._track = None
+        self._slider.disabled = self._play.disabled = True  # until it is read (if ever)
         self._heading.show(f"{heading}\n\n_Reading `{bag.name}`…_".strip())
         self._set_picture("")
         self._messages.show("")
@@ -188,11 +279,12 @@ class ReplayStage:
             self._slider.max = max(track.duration, 0.1)
             self._slider.disabled = self._play.disabled = False
             self._t = 0.0
-            what = (
-                "It plays from the start: **Pause** stops it, the time slider goes to any moment."
-                if track.drives
-                else "No robot in this recording: its messages, topic by topic."
-            )
+            what = {
+                "robot": "It plays from the start: **Pause** stops it, the time slider goes to "
+                "any moment.",
+                "turtlesim": "It plays from the start in turtlesim's window: **Pause** stops "
+                "it, the time slider goes to any moment.",
+            }.get(track.world, "No robot in this recording: its messages, topic by topic.")
             damaged = (
                 f"\n\n⚠ Some messages could not be read: {'; '.join(track.problems)}"
                 if track.problems
@@ -222,9 +314,22 @@ class ReplayStage:
         self._last_frame = time.monotonic()
         self._draw()
 
-    def _on_slider(self) -> None:
-        if self._track is not None and abs(float(self._slider.value) - self._t) > 0.05:
-            self._t = float(self._slider.value)  # a learner's drag (our own steps match)
+    def _slider_moved(self, event: object) -> None:
+        """viser's thread: a time the browser set (a drag, or a time typed in the box).
+
+        The value travels with the intent: read later on the UI thread, the handle could
+        already hold a playing frame's own time (each frame sets the slider), and the
+        learner's time would be lost. The server's own settings (no client) are ignored.
+        """
+        if getattr(event, "client", True) is None:
+            return
+        value = float(self._slider.value)
+        self._ui.post(lambda: self._go_to(value))
+
+    def _go_to(self, t: float) -> None:
+        if self._track is not None:
+            self._t = min(max(t, 0.0), self._track.duration)
+            self._last_frame = time.monotonic()  # playing goes on from there
             self._draw()
 
     def set_active(self, active: bool) -> None:
@@ -233,7 +338,13 @@ class ReplayStage:
         if not active:
             self._playing = False
 
-    def refresh(self, graph: GraphSnapshot) -> None:
+    @property
+    def playing(self) -> bool:
+        """Whether a frame is due at each refresh (the teacher page refreshes faster then)."""
+        return self._active and self._playing and self._track is not None
+
+    def refresh(self, graph: GraphSnapshot | None = None) -> None:
+        """One frame while playing (the graph is not used: the stage's parts all take it)."""
         track = self._track
         if not self._active or track is None or not self._playing:
             return

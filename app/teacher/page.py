@@ -7,10 +7,15 @@ the same look, widgets and token gate as the learners' dashboards; two plain
 HTTP routes on the same server serve the CSV export and the JSON table that
 ``classroom status`` prints.
 
+On the machine that keeps the learners' attempts (``classroom``), the
+"Learner's attempts" tab lists the chosen learner's kept attempts of their
+current exercise, shows one's result lines and plots, and plays it with the
+learner's own player (``app.stage.replay_stage.ReplayStage``).
+
 Threads, as in the dashboard (app.ui): one UI thread owns every widget and
 the teacher's choices; viser callbacks post intents; the routes run on
 viser's asyncio thread and read only the roster's copies and the current
-(immutable) stuck rule.
+(immutable) stuck rule. Reading a recording to play it is a worker job.
 """
 
 from __future__ import annotations
@@ -27,13 +32,27 @@ from dataclasses import dataclass
 from pathlib import Path
 from urllib.parse import urlsplit
 
+import cv2
+import numpy as np
 import viser
 from websockets.asyncio.server import ServerConnection
 from websockets.datastructures import Headers
 from websockets.http11 import Request, Response
 
 from app.access import Handler, ProcessRequest, make_server
-from app.exercises.attempt_folders import ATTEMPTS_FOLDER, age_order, attempt_label, replay_of
+from app.exercises.attempt_folders import (
+    ATTEMPTS_FOLDER,
+    attempt_heading,
+    attempt_label,
+    replay_of,
+)
+from app.stage.replay_stage import ReplayStage
+from app.teacher.attempt_files import (
+    MOST_PLOTS,
+    attempt_markdown,
+    kept_attempts,
+    plot_files,
+)
 from app.teacher.record import (
     COLUMNS,
     MAX_NOTICE,
@@ -53,11 +72,17 @@ from app.ui.loop import UiLoop
 log = logging.getLogger(__name__)
 
 REFRESH_SEC = 0.5
+FRAME_SEC = 0.1  # while an attempt plays: its frames come this often
 ROUTES = "/classroom/teacher/"
 CSV_PATH = ROUTES + "progress.csv"
 JSON_PATH = ROUTES + "progress.json"
 EVERYONE = "everyone"
 NOBODY = "(choose a learner)"
+NO_ATTEMPT = "(no attempt kept)"
+NO_ATTEMPTS_HERE = (
+    "_Choose a learner on the right: their kept attempts of the exercise they are on show "
+    "here, with what each judged, its plots, and **Watch this attempt**._"
+)
 
 
 def _cell(value: str) -> str:
@@ -97,20 +122,18 @@ class LocalAttempts:
     bags_root: Path
     site: str
 
-    def newest(self, record: LearnerRecord) -> Path | None:
-        """The newest kept attempt of the learner's current exercise (None: none here)."""
+    def kept(self, record: LearnerRecord) -> list[Path]:
+        """The kept attempts of the learner's current exercise, newest first ([]: none here)."""
         if record.site != self.site or not (
             _NAME.fullmatch(record.learner) and _SLUG.fullmatch(record.exercise)
         ):
-            return None
-        folder = self.bags_root / record.learner / ATTEMPTS_FOLDER / record.exercise
-        try:
-            kept = sorted(
-                (p for p in folder.iterdir() if p.is_dir()), key=lambda p: age_order(p.name)
-            )
-        except OSError:  # none yet, or not readable
-            return None
-        return kept[-1] if kept else None
+            return []
+        return kept_attempts(self.bags_root / record.learner / ATTEMPTS_FOLDER / record.exercise)
+
+    def newest(self, record: LearnerRecord) -> Path | None:
+        """The newest kept attempt of the learner's current exercise (None: none here)."""
+        kept = self.kept(record)
+        return kept[0] if kept else None
 
 
 def attempt_text(path: Path) -> str:
@@ -119,8 +142,9 @@ def attempt_text(path: Path) -> str:
     opened = _code(str(mcap[0])) if mcap else "the .mcap file in it"
     text = (
         f"**Newest attempt** ({plain_markdown(attempt_label(path))}): {_code(str(path))}\n\n"
-        f"Open {opened} in Foxglove or Lichtblick (Open local file), or ask the learner to "
-        "pick it under **Attempt** in their Exercise tab and press **Watch this attempt**."
+        f"Open {opened} in Foxglove or Lichtblick (Open local file), or pick it under "
+        "**Attempt** in the **Learner's attempts** tab and press **Watch this attempt**: "
+        "its result lines, its plots and its run, played as the learner sees it."
     )
     command = replay_of(path)  # '' : no seed, or its code was not kept
     if command:
@@ -170,6 +194,19 @@ def learner_detail(record: LearnerRecord, newest_attempt: Path | None = None) ->
     else:
         parts.append("_No exercise in this unit._")
     return "\n\n".join(p for p in parts if p)
+
+
+def _plot_images(attempt: Path) -> list[np.ndarray]:
+    """The attempt's plots as RGB pixels; one that cannot be read is left out (never raises)."""
+    images = []
+    for path in plot_files(attempt):
+        try:
+            pixels = cv2.imread(str(path), cv2.IMREAD_COLOR)
+        except Exception:  # cv2 raises its own error for some damaged files
+            pixels = None
+        if pixels is not None:
+            images.append(np.ascontiguousarray(pixels[:, :, ::-1]))
+    return images
 
 
 class TeacherRoutes:
@@ -252,6 +289,21 @@ class TeacherPage:
             self._exercises = MarkdownView(gui)
         with window.add_tab("Learner's code", viser.Icon.CODE):
             self._detail = MarkdownView(gui, "_Choose a learner on the right._")
+        with window.add_tab("Learner's attempts", viser.Icon.PLAYER_PLAY):
+            self._attempts_note = MarkdownView(gui, NO_ATTEMPTS_HERE)
+            self._attempt_pick = gui.add_dropdown("Attempt", [NO_ATTEMPT], visible=False)
+            self._attempt_text = MarkdownView(gui, "", visible=False)
+            self._watch = gui.add_button(
+                "Watch this attempt", icon=viser.Icon.PLAYER_PLAY, visible=False
+            )
+            # The learner's own player: the same picture, slider and speeds they see.
+            self.replay = ReplayStage(gui, ui)
+            blank = np.full((8, 8, 3), 255, np.uint8)
+            self._plots = [
+                gui.add_image(blank, format="png", visible=False) for _ in range(MOST_PLOTS)
+            ]
+        self._attempt_paths: dict[str, Path] = {}  # the Attempt dropdown's labels
+        self._attempt_shown: tuple[str, Path | None] = ("", None)  # (learner, attempt) drawn
 
         self._learner = gui.add_dropdown("Learner", [NOBODY])
         with gui.add_folder("Message to learners"):
@@ -281,6 +333,8 @@ class TeacherPage:
             )
             self._applied = MarkdownView(gui)
         self._learner.on_update(ui.callback(self._show_detail))
+        self._attempt_pick.on_update(ui.callback(self._show_attempt))
+        self._watch.on_click(ui.callback(self._on_watch))
         self._send.on_click(ui.callback(self._on_send))
         self._apply.on_click(ui.callback(self._on_apply))
         self._stuck_min.on_update(ui.callback(self._on_rule))
@@ -292,11 +346,15 @@ class TeacherPage:
         self._thread.start()
 
     def _loop(self) -> None:
+        next_refresh = 0.0
         while not self._stop.is_set():
-            self.ui.wait(REFRESH_SEC)
+            self.ui.wait(FRAME_SEC if self.replay.playing else REFRESH_SEC)
             self.ui.apply_pending()
             try:
-                self._refresh()
+                if time.monotonic() >= next_refresh:
+                    next_refresh = time.monotonic() + REFRESH_SEC
+                    self._refresh()
+                self.replay.refresh()
             except Exception:  # keep the page going; the traceback goes to the log
                 log.exception("teacher page refresh failed")
             self.server.flush()
@@ -323,14 +381,85 @@ class TeacherPage:
         chosen = self._learner.value
         if chosen == NOBODY:
             self._detail.show("_Choose a learner on the right._")
+            self._list_attempts(None)
             return
         by_key = {r.key: r for r in (records or self.roster.records())}
         record = by_key.get(chosen)
         if record is None:
             self._detail.show(f"_{chosen}: no news yet._")
+            self._list_attempts(None)
             return
-        newest = self.attempts.newest(record) if self.attempts and record.exercise else None
-        self._detail.show(learner_detail(record, newest))
+        kept = self.attempts.kept(record) if self.attempts and record.exercise else []
+        self._detail.show(learner_detail(record, kept[0] if kept else None))
+        self._list_attempts(record, kept)
+
+    # -- the learner's attempts (UI thread) -------------------------------------------
+
+    def _list_attempts(self, record: LearnerRecord | None, kept: list[Path] | None = None) -> None:
+        """The Attempt dropdown: the learner's kept attempts of their exercise, newest first,
+        labelled as in their own Exercise tab; the teacher's pick stays while it is kept."""
+        if record is None:
+            note = NO_ATTEMPTS_HERE
+        elif self.attempts is None or record.site != self.attempts.site:
+            note = (
+                f"_{plain_markdown(record.learner)}'s attempts are kept on their own machine "
+                f"({plain_markdown(record.site)}): the learner's **Watch this attempt** plays "
+                "them there._"
+            )
+        elif not record.exercise:
+            note = f"_{plain_markdown(record.learner)} is on no exercise in this unit._"
+        elif not kept:
+            note = (
+                f"_{plain_markdown(record.learner)} has no graded attempt of "
+                f"`{record.exercise}` yet: each **Check my node** keeps one._"
+            )
+        else:
+            note = (
+                f"**{plain_markdown(record.learner)}'s attempts at `{record.exercise}`** "
+                f"({len(kept)} kept, newest first)"
+            )
+        self._attempts_note.show(note)
+        paths = {attempt_label(path): path for path in (kept or [])}
+        if paths != self._attempt_paths:
+            self._attempt_paths = paths
+            previous = self._attempt_pick.value
+            if paths:
+                self._attempt_pick.options = list(paths)
+                if previous not in paths:  # a new learner, or theirs was pruned: the newest
+                    assign(self._attempt_pick, next(iter(paths)))
+        self._attempt_pick.visible = self._watch.visible = bool(paths)
+        self._attempt_text.handle.visible = bool(paths)
+        learner = record.key if record is not None else ""
+        if learner != self._attempt_shown[0]:
+            self.replay.set_active(False)  # another learner's run is not this one's
+        self._show_attempt(learner)
+
+    def _show_attempt(self, learner: str | None = None) -> None:
+        """The picked attempt's result lines and plots, read again only when the pick changed."""
+        learner = self._attempt_shown[0] if learner is None else learner
+        path = self._attempt_paths.get(str(self._attempt_pick.value))
+        if (learner, path) == self._attempt_shown:
+            return
+        self._attempt_shown = (learner, path)
+        self._attempt_text.show(attempt_markdown(path) if path is not None else "")
+        images = _plot_images(path) if path is not None else []
+        for index, handle in enumerate(self._plots):
+            if index < len(images):
+                handle.image = images[index]
+            handle.visible = index < len(images)
+
+    def _on_watch(self) -> None:
+        path = self._attempt_paths.get(str(self._attempt_pick.value))
+        if path is None:
+            return
+        learner = plain_markdown(self._attempt_shown[0].rsplit("/", 1)[-1] or "the learner")
+        told = attempt_heading(path) or "_Its verdict could not be read: the file is damaged._"
+        heading = (
+            f"### {learner}'s attempt at {path.parent.name}\n\n"
+            f"{plain_markdown(attempt_label(path))}\n\n{told}"
+        )
+        self.replay.open(path, heading)
+        self.replay.set_active(True)
 
     def _on_send(self) -> None:
         text = self._text.value.strip()
@@ -362,5 +491,6 @@ class TeacherPage:
         self._stop.set()
         self.ui.post(lambda: None)
         self._thread.join(timeout=2.0)
+        self.replay.close()
         self.ui.close()
         self.server.stop()

@@ -16,6 +16,7 @@ from playwright.sync_api import Page, expect
 from app.exercises.model import load_exercises
 from tests.bags.readers import mcap_messages
 from tests.browser.helpers import choose, click, expect_text, open_tab
+from tests.browser.replay_helpers import go_to_moments, newest_at
 from tests.browser.test_exercise import _type_code
 from tests.conftest import ARTIFACTS, DashboardProcess, free_port
 
@@ -81,33 +82,13 @@ def test_a_failed_simulation_attempt_is_plotted_and_replayed(browser, ros_env, t
         assert len(truth) > 20, len(truth)
         robot = page.locator("#replay-robot")
         expect(robot).to_be_visible(timeout=20_000)
-        # It plays from the start; pause it (or let it end) and go to three moments by the
-        # slider's number box, as a learner types a time (a loaded machine plays on too fast
-        # for sampling to catch three moments).
-        play = page.get_by_role("button", name=re.compile(r"^(Play|Pause)$"))
-        if play.inner_text().strip() == "Pause":
-            play.click()
-        expect(play).to_have_text(re.compile("Play"), timeout=20_000)
-        time_box = (
-            page.get_by_text("Time (s)", exact=True)
-            .locator("visible=true")
-            .first.locator("xpath=ancestor::div[contains(@class,'mantine-Flex-root')][1]//input")
-            .last
-        )
-        for share in (0.25, 0.5, 0.75):
-            wanted = round(truth[int(len(truth) * share)][0], 1)
-            time_box.fill(str(wanted))
-            time_box.press("Enter")
-            page.wait_for_function(
-                "(t) => { const r = document.querySelector('#replay-robot');"
-                " return r && Math.abs(parseFloat(r.dataset.t) - t) < 0.3; }",
-                arg=wanted,
-                timeout=20_000,
-            )
+        # It plays from the start; once it ended, go to three moments by the slider's number
+        # box, as a learner types a time (a loaded machine plays on too fast for sampling to
+        # catch three moments).
+        for wanted in go_to_moments(page, [p[0] for p in truth]):
             drawn = _robot(page)
-            # The newest ground truth at the drawn moment (the two clocks are the same
-            # bag's receive times; a millisecond of rounding either way).
-            newest = max((p for p in truth if p[0] <= drawn["t"] + 0.002), key=lambda p: p[0])
+            newest = newest_at(truth, wanted)
+            assert abs(drawn["t"] - newest[0]) < 1e-5, (drawn, newest, wanted)
             assert math.dist((drawn["x"], drawn["y"]), newest[1:]) < 0.002, (drawn, newest)
     finally:
         page.screenshot(path=str(ARTIFACTS / "attempt-replay.png"))

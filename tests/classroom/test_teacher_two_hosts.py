@@ -313,6 +313,19 @@ def test_teacher_follows_three_learners_on_two_hosts(ros_env, two_hosts, tmp_pat
         assert seen["ok"], seen["markdown"]
         assert "### Exercises across the class" in seen["markdown"]
         assert "1 failed; last failure: too fast" in seen["markdown"]
+        # The Learner's attempts tab lists it with its failed line, and plays it in the page
+        # (a topic-only exercise: the messages' timeline).
+        seen = a("wait_text", page="teacher", text="learner1's attempts at `heartbeat_logger`")
+        assert seen["ok"], seen["markdown"]
+        assert re.search(r"UTC · fail · seed \d+\*\*", seen["markdown"]), seen["markdown"]
+        assert "- ✗ **" in seen["markdown"]
+        a("click", page="teacher", label="Watch this attempt")
+        seen = a(
+            "wait_regex",
+            page="teacher",
+            regex=r"learner1's attempt at heartbeat_logger[\s\S]*\d+ messages in \d+\.\d s",
+        )
+        assert seen["ok"], seen["markdown"][-3000:]
 
         code.write_text((exercise_dir / "reference.py").read_text())
         a("click", page="a1", label="Run my node")
