@@ -1,6 +1,8 @@
 """``FoxgloveBridge``: the live ROS graph served over the Foxglove WebSocket protocol.
 
 The server is foxglove-sdk's (``foxglove.start_server``); this class feeds it.
+Clients reach it through ``ProtocolRelay`` (app/foxglove/relay.py), which also
+accepts the protocol's older name that Lichtblick offers.
 Each topic someone publishes becomes a channel: encoding ``cdr`` (the bytes a
 ROS 2 subscriber receives, passed through unparsed) and schema encoding
 ``ros2msg`` (the full definition, nested types after ``====`` lines, as a
@@ -93,6 +95,7 @@ from rclpy.validate_full_topic_name import validate_full_topic_name
 from app.bags.definitions import definition, service_definitions
 from app.bags.errors import BagError
 from app.foxglove.limits import BridgeLimits, NoteThrottle, RateLimit, ros_message_type
+from app.foxglove.relay import ProtocolRelay
 from app.ros.convert import ConversionError, import_type
 from app.ros.names import ACTION_MARKER, QUIET_TOPICS, is_hidden_node, is_internal_topic, node_fqn
 from app.ros.params import parameter_value, python_value
@@ -241,6 +244,8 @@ class FoxgloveBridge:
         # server that uses the SDK's global one).
         self._context = foxglove.Context()
         self._server: WebSocketServer | None = None
+        self._relay: ProtocolRelay | None = None  # the public port, in front of the server
+        self._sdk_port = 0
         self._stopping = threading.Event()
         self._wake = threading.Event()
         self._thread = threading.Thread(target=self._run, name="foxglove-bridge", daemon=True)
@@ -281,17 +286,28 @@ class FoxgloveBridge:
 
     def start(self) -> None:
         """Listen (FoxgloveError, a RuntimeError, when the port is taken) and serve."""
+        # The SDK's server on a loopback port of its own; clients come through the relay
+        # on the address asked for, which also takes Lichtblick's name of the protocol.
         self._server = foxglove.start_server(
             name=SERVER_NAME,
-            host=self.host,
-            port=self._asked_port,
+            host="127.0.0.1",
+            port=0,
             capabilities=[Capability.ClientPublish, Capability.Services, Capability.Parameters],
             supported_encodings=[ENCODING],
             server_listener=_Listener(self),
             context=self._context,
             message_backlog_size=self.limits.client_backlog,
         )
-        self._port = self._server.port  # the one it got (``port`` 0: a free one)
+        self._sdk_port = self._server.port
+        relay = ProtocolRelay(self.host, self._asked_port, self._sdk_port)
+        try:
+            relay.start()
+        except BaseException:
+            self._server.stop()
+            self._server = None
+            raise
+        self._relay = relay
+        self._port = relay.port  # the one it got (``port`` 0: a free one)
         self._thread.start()
 
     @property
@@ -310,6 +326,8 @@ class FoxgloveBridge:
         self._stopping.set()
         self._wake.set()
         self._fail_all_calls("the bridge is closing")  # their handlers return now
+        if self._relay is not None:
+            self._relay.stop()
         self._server.stop()
         if self._thread.is_alive():
             self._thread.join(JOIN_SEC)
@@ -535,7 +553,7 @@ class FoxgloveBridge:
             clients = {c for watching in self._watchers.values() for c in watching}
             clients |= {client for client, _channel in self._adverts}
         if clients - self._clients:
-            no_delay(self.port)
+            no_delay(self._sdk_port)
         self._clients = clients
 
     def _read_graph(self) -> None:

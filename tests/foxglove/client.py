@@ -70,10 +70,12 @@ class FoxgloveClient:
         *,
         on_message: Callable[[Received], None] | None = None,
         timeout: float = 10.0,
+        subprotocols: list[Subprotocol] | None = None,
     ) -> None:
+        """``subprotocols``: what the client offers (Foxglove's app: both names)."""
         self.url = url
         self.ws: ClientConnection = connect(
-            url, subprotocols=SUBPROTOCOLS, max_size=None, open_timeout=timeout
+            url, subprotocols=subprotocols or SUBPROTOCOLS, max_size=None, open_timeout=timeout
         )
         self.subprotocol = self.ws.subprotocol
         self._lock = threading.Lock()

@@ -326,3 +326,45 @@ def test_subscribing_to_everything_and_publishing_floods_are_bounded(probe):
             fox.close()
         tight.close()
     _wait(lambda: node.count_publishers(topic) == 0, 10, "the closed bridge's publisher to go")
+
+
+@pytest.mark.parametrize("name", ["foxglove.websocket.v1", "foxglove.sdk.v1"])
+def test_a_client_offering_either_name_of_the_protocol_is_served(probe, bridge, name):
+    """Lichtblick and @foxglove/ws-protocol clients offer only "foxglove.websocket.v1",
+    which the SDK's own server refuses: the bridge's relay takes both, and what flows is
+    the same (serverInfo, a channel, its CDR messages, and a client's publish)."""
+    from std_msgs.msg import String
+    from websockets.typing import Subprotocol
+
+    timer = _beat(probe.node, "/relay_beat", 20.0)
+    heard: list[str] = []
+    probe.node.create_subscription(String, "/from_fox", lambda m: heard.append(m.data), 10)
+    fox = FoxgloveClient(bridge.url, subprotocols=[Subprotocol(name)])
+    try:
+        assert fox.subprotocol == name
+        fox.wait_for(lambda: fox.server_info, 10, "serverInfo")
+        assert fox.server_info is not None and "clientPublish" in fox.server_info["capabilities"]
+        subscription = fox.subscribe_topic("/relay_beat")
+        fox.wait_for(lambda: fox.count(subscription) >= 5, 20, "five /relay_beat messages")
+        channel = fox.channel("/relay_beat")
+        assert channel is not None
+        ours, theirs = _decode_both(channel, fox.messages(subscription)[-1].payload)
+        assert ours.data == theirs.data == "beat"
+        from rclpy.serialization import serialize_message
+
+        advertised = fox.advertise("/from_fox", "std_msgs/msg/String")
+        _wait(lambda: probe.node.count_publishers("/from_fox"), DISCOVERY_SEC, "bridge publishes")
+        sent = serialize_message(String(data=f"over {name}"))
+        _wait(lambda: fox.publish(advertised, sent) or heard, 15, "a client's message on ROS")
+        assert heard[-1] == f"over {name}"
+    finally:
+        fox.close()
+        probe.node.destroy_timer(timer)
+
+
+def test_a_client_offering_another_protocol_is_refused(bridge):
+    from websockets.exceptions import InvalidStatus
+    from websockets.typing import Subprotocol
+
+    with pytest.raises(InvalidStatus):
+        FoxgloveClient(bridge.url, subprotocols=[Subprotocol("not.foxglove")])
