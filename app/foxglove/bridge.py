@@ -94,6 +94,7 @@ from rclpy.validate_full_topic_name import validate_full_topic_name
 
 from app.bags.definitions import definition, service_definitions
 from app.bags.errors import BagError
+from app.foxglove.assets import fetch_asset
 from app.foxglove.limits import BridgeLimits, NoteThrottle, RateLimit, ros_message_type
 from app.foxglove.relay import ProtocolRelay
 from app.ros.convert import ConversionError, import_type
@@ -293,6 +294,7 @@ class FoxgloveBridge:
             host="127.0.0.1",
             port=0,
             capabilities=[Capability.ClientPublish, Capability.Services, Capability.Parameters],
+            asset_handler=fetch_asset,  # a URDF's package:// meshes for the 3D panel ("assets")
             supported_encodings=[ENCODING],
             server_listener=_Listener(self),
             context=self._context,

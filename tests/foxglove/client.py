@@ -39,6 +39,7 @@ SUBPROTOCOLS = [Subprotocol("foxglove.sdk.v1"), Subprotocol("foxglove.websocket.
 MESSAGE_DATA = 0x01
 SERVICE_CALL_REQUEST = 0x02  # client to server
 SERVICE_CALL_RESPONSE = 0x03  # server to client
+FETCH_ASSET_RESPONSE = 0x04  # server to client: request id, status (0 ok), error, data
 KEEP = 2000  # messages kept per subscription (the count goes on)
 
 
@@ -81,6 +82,7 @@ class FoxgloveClient:
         self._lock = threading.Lock()
         self._on_message = on_message
         self.server_info: dict[str, Any] | None = None
+        self.assets: dict[int, tuple[int, str, bytes]] = {}  # request -> (status, error, data)
         self.channels: dict[int, dict[str, Any]] = {}
         self.statuses: list[dict[str, Any]] = []
         self.received: dict[int, deque[Received]] = {}
@@ -110,6 +112,11 @@ class FoxgloveClient:
                         self.counts[sub] = self.counts.get(sub, 0) + 1
                     if self._on_message is not None:
                         self._on_message(got)
+                elif frame and frame[0] == FETCH_ASSET_RESPONSE and len(frame) >= 10:
+                    request, status, length = struct.unpack_from("<IBI", frame, 1)
+                    error = bytes(frame[10 : 10 + length]).decode()
+                    with self._lock:
+                        self.assets[request] = (status, error, bytes(frame[10 + length :]))
                 elif frame and frame[0] == SERVICE_CALL_RESPONSE and len(frame) >= 13:
                     service, call, length = struct.unpack_from("<III", frame, 1)
                     encoding = bytes(frame[13 : 13 + length]).decode()
@@ -258,6 +265,12 @@ class FoxgloveClient:
     def _parameters_answer(self, request: str) -> dict[str, Any] | None:
         with self._lock:
             return next((m for m in self.parameter_values if m.get("id") == request), None)
+
+    def fetch_asset(self, uri: str, timeout: float = 10.0) -> tuple[int, str, bytes]:
+        """(status, error, data) of a fetchAsset: status 0 is found."""
+        request = next(self._channel_ids)
+        self.send_json({"op": "fetchAsset", "uri": uri, "requestId": request})
+        return self.wait_for(lambda: self.assets.get(request), timeout, f"asset {uri}")
 
     def close(self) -> None:
         self.ws.close()
