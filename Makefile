@@ -19,11 +19,13 @@ HUB_PROXY := app/hub/proxy
 HUB_PROXY_STAMP := $(HUB_PROXY)/node_modules/.classroom-setup
 AXE := tests/browser/axe
 AXE_STAMP := $(AXE)/node_modules/.classroom-setup
+FOXGLOVE_CLIENT := tests/foxglove/wsclient
+FOXGLOVE_CLIENT_STAMP := $(FOXGLOVE_CLIENT)/node_modules/.classroom-setup
 ARGS ?=
 
 .PHONY: setup run test check browser sandbox lint docs bench screenshots clean render
 
-setup: $(STAMP) $(EDITOR_STAMP) $(HUB_PROXY_STAMP) $(AXE_STAMP) render
+setup: $(STAMP) $(EDITOR_STAMP) $(HUB_PROXY_STAMP) $(AXE_STAMP) $(FOXGLOVE_CLIENT_STAMP) render
 
 # The exercise code editor (Ace), from the npm registry at the version the lock file pins.
 $(EDITOR_STAMP): $(EDITOR)/package.json $(EDITOR)/package-lock.json
@@ -46,6 +48,12 @@ $(AXE_STAMP): $(AXE)/package.json $(AXE)/package-lock.json $(EDITOR_STAMP)
 	@echo "== installing axe-core for the accessibility tests (npm)"
 	npm ci --prefix $(AXE) --no-audit --no-fund --loglevel=error
 	@touch $(AXE_STAMP)
+
+# @foxglove/ws-protocol, the client Lichtblick is built on, for tests/foxglove (npm, like the editor).
+$(FOXGLOVE_CLIENT_STAMP): $(FOXGLOVE_CLIENT)/package.json $(FOXGLOVE_CLIENT)/package-lock.json $(EDITOR_STAMP)
+	@echo "== installing @foxglove/ws-protocol for the Foxglove bridge's tests (npm)"
+	npm ci --prefix $(FOXGLOVE_CLIENT) --no-audit --no-fund --loglevel=error
+	@touch $(FOXGLOVE_CLIENT_STAMP)
 
 $(STAMP): pyproject.toml ros_python/pyproject.toml $(INTERFACE_FILES)
 	@test -n "$(PYTHON)" || { echo "error: ROS 2 Jazzy wheels need CPython 3.10, 3.11 or 3.12; none found" >&2; exit 1; }
