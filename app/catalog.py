@@ -10,6 +10,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+# nav2_bringup's parameters file (issue 40), relative as the office map's path is: the
+# catalog's programs run from the project's folder.
+NAV2_PARAMS = "ros_python/src/nav2_bringup/params/nav2_params.yaml"
+
 
 @dataclass(frozen=True)
 class CatalogEntry:
@@ -642,8 +646,9 @@ ENTRIES: tuple[CatalogEntry, ...] = (
         "amcl_office",
         "amcl",
         "/amcl",
-        "Nav2's amcl told where the office robot starts (set_initial_pose at 0, 0, facing east).",
-        ros_args=("-p", "set_initial_pose:=true"),
+        "Nav2's amcl with nav2_bringup's params file: told where the office robot starts "
+        "(set_initial_pose at 0, 0, facing east).",
+        ros_args=("--params-file", NAV2_PARAMS),
         package="nav2_amcl",
     ),
     CatalogEntry(
@@ -679,6 +684,14 @@ ENTRIES: tuple[CatalogEntry, ...] = (
     ),
     CatalogEntry(
         "lifecycle_manager",
+        "lifecycle_manager",
+        "/lifecycle_manager",
+        "Nav2's lifecycle manager as `ros2 run` starts it: give it node_names (and autostart) "
+        "to configure and activate those servers in order.",
+        package="nav2_lifecycle_manager",
+    ),
+    CatalogEntry(
+        "lifecycle_manager_navigation",
         "lifecycle_manager",
         "/lifecycle_manager_navigation",
         "Nav2's lifecycle manager: configures and activates the map server, amcl and the "
@@ -850,7 +863,7 @@ GROUPS: tuple[LaunchGroup, ...] = (
             "controller_server",
             "bt_navigator",
             "waypoint_follower",
-            "lifecycle_manager",
+            "lifecycle_manager_navigation",
         ),
     ),
 )

@@ -29,6 +29,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 import ros2launch
+from nav2_bringup import share_files as nav2_bringup_files
 
 from app.ament_prefix import write_prefix
 from app.catalog import ENTRIES, GROUPS, CatalogEntry
@@ -111,6 +112,7 @@ def _files() -> dict[str, str]:
         files[f"share/{PACKAGE}/launch/{group.name}.launch.py"] = launch_file_text(group)
     files["share/turtlesim/launch/multisim.launch.py"] = MULTISIM
     files.update(TF2_LAUNCH_FILES)  # issue 23: turtle_tf2_py's demo launch files
+    files.update(nav2_bringup_files())  # issue 40: nav2_bringup's launch files and params
     packages = {path.split("/")[1] for path in files}
     for package in packages:
         files[f"share/ament_index/resource_index/packages/{package}"] = ""

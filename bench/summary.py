@@ -53,7 +53,7 @@ RUNS: tuple[tuple[str, list[str]], ...] = (
     ("classroom_footprint", ["--counts", "20", "--seconds", "10"]),  # issue 43's class of 20
     ("nav_mapping", []),  # the office tour mapped (issue 40): about 2 minutes
     ("nav_localization", []),  # amcl along the same tour (issue 40): about 2 minutes
-    ("nav_navigation", ["--goals", "10"]),  # Nav2 to random office goals: 2-3 minutes
+    ("nav_navigation", ["--goals", "20"]),  # Nav2 to random office goals: 4-6 minutes
     ("colcon_build", ["--python-rounds", "4", "--interface-rounds", "2", "--run-rounds", "6"]),
     ("soak", ["--minutes", "3"]),  # the real soak: --bench soak --minutes 30
 )

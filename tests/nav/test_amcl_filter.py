@@ -185,6 +185,35 @@ def test_kidnapped_recovery_injects_random_particles():
     assert max(shares) > 0.0, shares  # one injection, then both averages start again (Nav2)
 
 
+def test_with_the_product_model_recovery_waits_for_a_clear_drop_then_finds_the_robot():
+    # The course's laser model with recovery alphas 0.01 / 0.2: scans that fit as well as
+    # ever inject nothing (their noise is no kidnapping), a kidnapping keeps injecting until
+    # the robot is found again.
+    rng = np.random.default_rng(5)
+    grid = room()
+    params = FilterParameters(
+        laser_model_type="likelihood_field_prob",
+        do_beamskip=True,
+        beam_skip_distance=0.2,
+        recovery_alpha_slow=0.01,
+        recovery_alpha_fast=0.2,
+    )
+    pf = ParticleFilter(params, make_map(grid), seed=3)
+    pf.init_gaussian((1.0, 1.0, 0.0), np.diag([0.01, 0.01, 0.005]))
+    for _ in range(30):
+        pf.update(beams(cast(grid, (1.0, 1.0, 0.0), rng)[0], params))
+        assert np.hypot(pf.poses[:, 0] - 1.0, pf.poses[:, 1] - 1.0).max() < 0.5
+    found = None
+    for k in range(60):
+        pf.update(beams(cast(grid, (4.0, 3.0, 2.5), rng)[0], params))
+        e = pf.estimate()
+        if math.hypot(e.x - 4.0, e.y - 3.0) < 0.25:
+            found = k + 1
+            break
+    print(f"\nkidnapped in the room: found again after {found} updates")
+    assert found is not None
+
+
 def test_one_update_keeps_up_with_10_hz_scans_with_2000_particles_and_60_beams():
     rng = np.random.default_rng(4)
     grid = room()

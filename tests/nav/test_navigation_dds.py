@@ -113,7 +113,7 @@ def test_navigate_to_pose_through_a_door_a_wall_goal_and_a_cancel(probe, supervi
     supervisor.start_program(lookup("bt_navigator"))
     # The catalog's manager also brings up amcl; this test has no amcl (a static map -> world).
     supervisor.start_program(
-        lookup("lifecycle_manager"),
+        lookup("lifecycle_manager_navigation"),
         ("-p", f"node_names:=[{','.join(MANAGED)}]"),
     )
     truth.get()
@@ -181,7 +181,12 @@ def test_navigate_to_pose_through_a_door_a_wall_goal_and_a_cancel(probe, supervi
     assert cancelled.status == GoalStatus.STATUS_CANCELED
     wait_until(lambda: truth.speed < 0.02, timeout=5, what=lambda: f"speed {truth.speed}")
     stopped = time.monotonic() - cancel_at
-    for name in ("planner_server", "controller_server", "bt_navigator", "lifecycle_manager"):
+    for name in (
+        "planner_server",
+        "controller_server",
+        "bt_navigator",
+        "lifecycle_manager_navigation",
+    ):
         assert supervisor.status(name).active, name
         assert "Traceback" not in "\n".join(supervisor.output(name)), _logs(supervisor)
     print(
@@ -193,5 +198,5 @@ def test_navigate_to_pose_through_a_door_a_wall_goal_and_a_cancel(probe, supervi
 
 def _logs(supervisor: Any) -> str:
     names = ("sim_office", "map_server", "planner_server", "controller_server", "bt_navigator",
-             "lifecycle_manager")  # fmt: skip
+             "lifecycle_manager_navigation")  # fmt: skip
     return "\n".join(f"--- {n}\n" + "\n".join(supervisor.output(n, last=30)) for n in names)

@@ -144,12 +144,12 @@ def test_boxes_not_on_the_map_are_driven_round_or_reported_and_a_cancel_stops_at
         supervisor.start(name)
     for name in ("planner_server", "controller_server", "bt_navigator"):
         supervisor.start(name)
-    supervisor.start("lifecycle_manager", ("-p", f"node_names:=[{','.join(MANAGED)}]"))
+    supervisor.start("lifecycle_manager_navigation", ("-p", f"node_names:=[{','.join(MANAGED)}]"))
     truth.get()
 
     def logs() -> str:
         names = ("sim_office", "planner_server", "controller_server", "bt_navigator",
-                 "lifecycle_manager")  # fmt: skip
+                 "lifecycle_manager_navigation")  # fmt: skip
         return "\n".join(f"--- {n}\n" + "\n".join(supervisor.output(n, last=25)) for n in names)
 
     is_active = node.create_client(Trigger, "/lifecycle_manager_navigation/is_active")
@@ -214,7 +214,12 @@ def test_boxes_not_on_the_map_are_driven_round_or_reported_and_a_cancel_stops_at
     cancelled = wait_future(handle.get_result_async(), 30, "the cancelled goal did not end")
     assert cancelled.status == GoalStatus.STATUS_CANCELED
     assert stopped < 0.5, f"the robot stopped {stopped:.2f} s after the cancel"
-    for name in ("planner_server", "controller_server", "bt_navigator", "lifecycle_manager"):
+    for name in (
+        "planner_server",
+        "controller_server",
+        "bt_navigator",
+        "lifecycle_manager_navigation",
+    ):
         assert supervisor.status(name).active, name
         assert "Traceback" not in "\n".join(supervisor.output(name)), logs()
     print(

@@ -11,7 +11,13 @@
   (``recovery_alpha_slow`` / ``recovery_alpha_fast``). When the short-term
   average falls below the long-term one the scans fit worse than they used
   to (the robot was kidnapped): resampling then puts a fraction ``1 -
-  w_fast / w_slow`` of the new particles at random free poses.
+  w_fast / w_slow`` of the new particles at random free poses. With
+  ``likelihood_field_prob`` (ours) the fit is the particles' mean per-beam
+  likelihood over all beams, the averages go on through the spread and
+  through injections (Nav2 starts them again), and only a drop of
+  ``RECOVERY_MIN_DROP`` or more injects: replayed office tours with 0.01 / 0.2,
+  the robot carried 3 m, found it again in 13 of 15 cases within 60 s (without
+  recovery 3 of 15), and tracked as closely as without recovery.
 - ``resample``: low-variance (systematic) resampling, the draws taken in a
   random order, stopping once there are enough particles for the number of
   distinct (0.5 m, 0.5 m, 10 degree) bins they fill (KLD-sampling, Fox 2003:
@@ -39,6 +45,10 @@ OMNI = ("nav2_amcl::OmniMotionModel", "omnidirectional", "omni")
 LASER_MODELS = ("likelihood_field", "likelihood_field_prob")
 CONVERGED_SPREAD = 0.5  # m: every particle this close to the mean in x and y (Nav2's pf)
 GATHERED_SPREAD = 0.5  # m: the particles' spread (x and y std combined) of a filter that tracks
+# Ours, likelihood_field_prob: random particles only once the short-term fit fell this far (a
+# share) below the long-term one. Smaller drops are the scans' own noise: injecting on them
+# scattered a tracking filter (replayed office tours: mean error 0.4 m instead of 0.012 m).
+RECOVERY_MIN_DROP = 0.15
 
 
 @dataclass
@@ -294,8 +304,9 @@ class ParticleFilter:
         if isinstance(self.sensor, LikelihoodFieldProbModel) and self.gathered:
             # A product of many beams' pz is tiny: weigh in logs, so that the relative
             # weights survive where the absolute ones would underflow to 0.
+            prior = self.weights
             with np.errstate(divide="ignore"):
-                log_w = np.log(self.weights)
+                log_w = np.log(prior)
             log_w = log_w + self.sensor.log_weights(self.poses, scan, self.converged)
             top = float(log_w.max())
             if not math.isfinite(top):
@@ -304,9 +315,14 @@ class ParticleFilter:
             scaled = np.exp(log_w - top)
             kept = float(scaled.sum())
             self.weights = scaled / kept
-            total = math.exp(top) * kept  # 0.0 when it underflows: no average from this scan
+            total = math.exp(top) * kept  # 0.0 when it underflows
+            fit = self.sensor.fit_log
+            if fit is not None:
+                self.update_recovery_averages(float(np.dot(prior, np.exp(fit))))
+            return total
         else:
             # LikelihoodFieldModel's own weights: the sum of cubes, whichever model was chosen
+            prior = self.weights
             cubes = LikelihoodFieldModel.weights(self.sensor, self.poses, scan)
             self.weights = self.weights * cubes
             total = float(self.weights.sum())
@@ -314,21 +330,42 @@ class ParticleFilter:
                 self.weights = np.full(self.count, 1.0 / self.count)
                 return total
             self.weights /= total
+            if isinstance(self.sensor, LikelihoodFieldProbModel):
+                # The recovery's fit as a gathered filter measures it (comparable across both).
+                if self.params.recovery_alpha_slow > 0.0:
+                    self.sensor.log_weights(self.poses, scan, False)
+                    fit = self.sensor.fit_log
+                    if fit is not None:
+                        self.update_recovery_averages(float(np.dot(prior, np.exp(fit))))
+                return total
         if total > 0.0 and math.isfinite(total):
             # The average likelihood of the scan (the weights summed to 1 before). Nav2 divides
             # this by the particle count too, which makes KLD's changing count look like a
             # change of fit; the textbook's average does not.
-            w_avg = total
-            p = self.params
-            if self.w_slow == 0.0:
-                self.w_slow = w_avg
-            else:
-                self.w_slow += p.recovery_alpha_slow * (w_avg - self.w_slow)
-            if self.w_fast == 0.0:
-                self.w_fast = w_avg
-            else:
-                self.w_fast += p.recovery_alpha_fast * (w_avg - self.w_fast)
+            self.update_recovery_averages(total)
         return total
+
+    def update_recovery_averages(self, w_avg: float) -> None:
+        """``w_slow`` and ``w_fast``, the long- and short-term averages of how well scans fit.
+
+        Ours, for the product of the beams (a gathered filter): the fit is each particle's
+        geometric mean pz over all the scan's beams, averaged with the particles' weights,
+        not the product itself. The product grows when beam skipping leaves out the beams
+        that do not fit, which is just what a kidnapped filter's scans do, and it changes
+        by orders of magnitude with the number of beams: as the recovery's measure it never
+        fell after a kidnap (replayed office tours).
+        """
+        if not (w_avg > 0.0 and math.isfinite(w_avg)):
+            return
+        p = self.params
+        if self.w_slow == 0.0:
+            self.w_slow = w_avg
+        else:
+            self.w_slow += p.recovery_alpha_slow * (w_avg - self.w_slow)
+        if self.w_fast == 0.0:
+            self.w_fast = w_avg
+        else:
+            self.w_fast += p.recovery_alpha_fast * (w_avg - self.w_fast)
 
     def update(self, scan: ScanBeams) -> bool:
         """The sensor update, then resampling every ``resample_interval`` updates; resampled?"""
@@ -342,8 +379,11 @@ class ParticleFilter:
     def resample(self) -> None:
         p = self.params
         w_diff = 0.0
+        prob = isinstance(self.sensor, LikelihoodFieldProbModel)
         if self.w_slow > 0.0:
             w_diff = max(0.0, 1.0 - self.w_fast / self.w_slow)
+            if prob and w_diff < RECOVERY_MIN_DROP:
+                w_diff = 0.0
         m = p.max_particles
         cumulative = np.cumsum(self.weights)
         cumulative /= cumulative[-1]
@@ -364,7 +404,7 @@ class ParticleFilter:
         count = int(n[over[0]]) if len(over) else m
         self.poses = candidates[:count].copy()
         self.weights = np.full(count, 1.0 / count)
-        if w_diff > 0.0:
+        if w_diff > 0.0 and not prob:  # Nav2's: both averages start again
             self.w_slow = self.w_fast = 0.0
         self.update_converged()
         self.update_gathered()
@@ -380,8 +420,8 @@ class ParticleFilter:
         """
         spread = math.hypot(float(self.poses[:, 0].std()), float(self.poses[:, 1].std()))
         gathered = spread < GATHERED_SPREAD
-        if gathered != self.gathered:  # the two models' likelihoods are not comparable
-            self.w_slow = self.w_fast = 0.0
+        if gathered != self.gathered and not isinstance(self.sensor, LikelihoodFieldProbModel):
+            self.w_slow = self.w_fast = 0.0  # the two models' likelihoods are not comparable
         self.gathered = gathered
         return gathered
 

@@ -147,6 +147,9 @@ class LikelihoodFieldProbModel(LikelihoodFieldModel):
         self.beam_skip_error_threshold = beam_skip_error_threshold
         self.skipped = 0  # beams left out by the last update (for the log)
         self.all_beams_forced = False  # the last update found too few beams on the map
+        # Each particle's mean log pz over every beam of the last scan, the skipped ones too:
+        # how well the scan fits there, comparable from scan to scan (recovery's averages).
+        self.fit_log: np.ndarray | None = None
         self._log_field: np.ndarray | None = None  # log pz per cell (_field keeps pz)
         self._log_field_range = math.nan
 
@@ -166,13 +169,14 @@ class LikelihoodFieldProbModel(LikelihoodFieldModel):
 
     def log_weights(self, poses: np.ndarray, scan: ScanBeams, converged: bool) -> np.ndarray:
         """Each particle's ``sum(log pz)`` over the beams used (N,)."""
-        self.skipped, self.all_beams_forced = 0, False
+        self.skipped, self.all_beams_forced, self.fit_log = 0, False, None
         found = self.end_points(poses, scan)
         if found is None:
             return np.zeros(len(poses))
         flat, inside, _keep = found
         log_field, log_off_map = self._log_pz_field(scan.range_max)
         log_pz = np.where(inside, log_field[flat], log_off_map)
+        self.fit_log = log_pz.mean(axis=1)
         if self.do_beamskip and converged:
             distances = self.map.distances
             assert distances is not None

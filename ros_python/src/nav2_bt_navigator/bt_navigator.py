@@ -51,7 +51,7 @@ from typing import Any
 
 from geometry_msgs.msg import PoseStamped, Twist
 from lifecycle_msgs.msg import State
-from nav2_costmap_2d.costmap_2d_ros import LATCHED, stop_listener, yaw_of
+from nav2_costmap_2d.costmap_2d_ros import LATCHED, own_listener, stop_listener, yaw_of
 from nav2_msgs.action import ComputePathToPose, FollowPath, NavigateThroughPoses, NavigateToPose
 from nav2_msgs.srv import ClearEntireCostmap
 from nav2_util.action_client import SerializedActionClient
@@ -66,7 +66,6 @@ from rclpy.lifecycle import LifecycleState, TransitionCallbackReturn
 from rclpy.task import Future
 from rclpy.time import Time
 from tf2_ros.buffer import Buffer
-from tf2_ros.transform_listener import TransformListener
 
 SUCCEEDED, CANCELED, ABORTED = 4, 5, 6  # action_msgs/GoalStatus
 RECOVERIES = ("wait", "back up", "clear costmaps")  # in turn, as the tree's RoundRobin
@@ -151,7 +150,7 @@ class BtNavigator(LifecycleNode):
         # /tf comes at 60-80 messages a wall second with the world at twice real time; each
         # one through this node's multi-threaded executor cost a wake-up of its whole wait
         # set (about a third of the process's CPU), through a one-node executor very little.
-        self.tf_listener = TransformListener(self.tf_buffer)
+        self.tf_listener = own_listener(self.tf_buffer)
 
     # --- transitions ---
     def on_configure(self, state: LifecycleState) -> TransitionCallbackReturn:

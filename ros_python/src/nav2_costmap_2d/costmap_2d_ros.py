@@ -29,6 +29,7 @@ Parameters (Nav2's names): ``global_frame`` (map), ``robot_base_frame``
 configured values: global 1 and 1 Hz, local 5 and 2 Hz), ``plugins``
 (``[static_layer, obstacle_layer, inflation_layer]``; leave
 ``obstacle_layer`` out for a map-only costmap), ``static_layer.map_topic``,
+``<layer>.plugin`` (Nav2's class of each layer, logged at configure),
 ``obstacle_layer.enabled``, ``obstacle_layer.observation_sources`` (``scan``),
 ``obstacle_layer.footprint_clearing_enabled`` (true), and per source
 ``obstacle_layer.<source>.topic`` (``/<source>``), ``.marking``,
@@ -39,7 +40,7 @@ configured values: global 1 and 1 Hz, local 5 and 2 Hz), ``plugins``
 ``inflation_layer.cost_scaling_factor`` (3.0), ``inflation_layer.inflate_unknown``.
 Where Nav2's code defaults would leave a layer idle (no observation source,
 ``clearing`` false) these are the values of Nav2's shipped
-``nav2_params.yaml``, since nothing here loads a params file.
+``nav2_params.yaml``; nav2_bringup's ``params/nav2_params.yaml`` holds them all.
 Not here: voxel layers, point clouds, rolling windows (the local costmap
 covers the whole map), footprint polygons, layer plugins of one's own.
 """
@@ -50,6 +51,7 @@ import array
 import functools
 import math
 import threading
+import uuid
 from typing import Any
 
 import numpy as np
@@ -79,7 +81,29 @@ from nav2_costmap_2d.obstacle_layer import (
 LATCHED = QoSProfile(
     depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
 )
+# The layers here, with the class Nav2's params files name for each (``<layer>.plugin``).
+LAYER_PLUGINS = {
+    "static_layer": "nav2_costmap_2d::StaticLayer",
+    "obstacle_layer": "nav2_costmap_2d::ObstacleLayer",
+    "inflation_layer": "nav2_costmap_2d::InflationLayer",
+}
 SCAN_MAX_AGE = 1.0  # s: a scan whose transform is still missing after this is dropped
+
+
+def own_listener(buffer: Buffer) -> TransformListener:
+    """A TransformListener on a node and thread of its own, as Nav2's C++ servers make one.
+
+    Its node ignores the process's command line (as rclcpp's does,
+    ``use_global_arguments(false)``): a launch file's ``-r __node:=bt_navigator``
+    would otherwise rename it too, and two nodes of one name answer each other's
+    parameter services.
+    """
+    node = Node(
+        f"transform_listener_impl_{uuid.uuid4().hex[:12]}",
+        use_global_arguments=False,
+        start_parameter_services=False,
+    )
+    return TransformListener(buffer, node, spin_thread=True)
 
 
 def stop_listener(listener: TransformListener) -> None:
@@ -108,6 +132,11 @@ class Costmap2DROS(Node):
         **kwargs: Any,
     ) -> None:
         namespace = (parent_namespace.rstrip("/") + "/" + name) if parent_namespace else name
+        # As Nav2's: its own name and namespace before the process's remaps (a launch file's
+        # `-r __node:=planner_server` is for the server), the params file's values still apply.
+        absolute = namespace if namespace.startswith("/") else "/" + namespace
+        own = ["--ros-args", "-r", f"__node:={name}", "-r", f"__ns:={absolute}"]
+        kwargs["cli_args"] = [*own, *(kwargs.get("cli_args") or [])]
         super().__init__(name, namespace=namespace, **kwargs)
         self.name = name
         given = {"update_frequency": 5.0, "publish_frequency": 1.0, **(defaults or {})}
@@ -120,6 +149,8 @@ class Costmap2DROS(Node):
         p("update_frequency", float(given["update_frequency"]))
         p("publish_frequency", float(given["publish_frequency"]))
         p("plugins", ["static_layer", "obstacle_layer", "inflation_layer"])
+        for layer, plugin in LAYER_PLUGINS.items():
+            p(f"{layer}.plugin", plugin)
         p("static_layer.map_topic", "/map")
         p("obstacle_layer.enabled", True)
         p("obstacle_layer.observation_sources", "scan")
@@ -142,7 +173,7 @@ class Costmap2DROS(Node):
         # /tf comes at 60-80 messages a wall second with the world at twice real time; each
         # one through this node's multi-threaded executor cost a wake-up of its whole wait
         # set (about a third of the process's CPU), through a one-node executor very little.
-        self.tf_listener = TransformListener(self.tf_buffer)
+        self.tf_listener = own_listener(self.tf_buffer)
         self.fixed_frame: str | None = None  # odom: see lookup_now
         self.own_executor: SingleThreadedExecutor | None = None
         self.own_thread: threading.Thread | None = None
@@ -169,6 +200,11 @@ class Costmap2DROS(Node):
             self.create_service(GetCostmap, "get_costmap", self.on_get_costmap),
         ]
         self.get_logger().info(f"Subscribing to the map topic ({topic}) with transient local")
+        for layer in [str(v) for v in g("plugins").value or []]:
+            if layer not in LAYER_PLUGINS:
+                self.get_logger().warning(f'No layer "{layer}" here: it is left out')
+                continue
+            self.get_logger().info(f'Using plugin "{layer}" ({g(f"{layer}.plugin").value})')
         self.sources = self.configure_sources()
 
     def configure_sources(self) -> list[ObservationSource]:
