@@ -63,6 +63,27 @@ const fix = () => {
     const name = nameOf(button);
     if (name) button.setAttribute('aria-label', name);
   }
+  // Back and Next on one row (the step card's last), Back left: viser stacks every widget.
+  // Their boxes are the nearest siblings holding each; half the row each.
+  for (const icon of doc.querySelectorAll('button svg.icon-tabler-arrow-left')) {
+    const back = icon.closest('button');
+    if (!back || back.__classroomRow) continue;
+    let box = back;
+    for (let up = 0; box && up < 6; up++, box = box.parentElement) {
+      const next = box.nextElementSibling;
+      if (next && next.querySelector('button svg.icon-tabler-arrow-right')) {
+        for (const half of [box, next]) {
+          const css = parent.getComputedStyle(half);
+          const margins = parseFloat(css.marginLeft) + parseFloat(css.marginRight) || 0;
+          half.style.display = 'inline-block';
+          half.style.width = `calc(50% - ${margins}px)`;
+          half.style.verticalAlign = 'top';
+        }
+        back.__classroomRow = true;
+        break;
+      }
+    }
+  }
   // viser's image widget (turtlesim's window, camera images) has a label but no alt text.
   for (const img of doc.querySelectorAll('img:not([alt])')) {
     const box = img.parentElement && img.parentElement.parentElement;
