@@ -8,6 +8,10 @@ from collections.abc import Iterator
 
 from playwright.sync_api import Page, expect
 
+from app.exercises.model import Exercise
+from tests.browser.helpers import choose, click, expect_text, open_tab
+from tests.browser.test_exercise import _type_code
+
 
 def newest_at(samples: list[tuple[float, float, float]], t: float) -> tuple[float, float, float]:
     """The newest sample at or before ``t``, as the player picks it. Exactly: both clocks are
@@ -53,3 +57,16 @@ def go_to_moments(page: Page, times: list[float]) -> Iterator[float]:
             timeout=20_000,
         )
         yield wanted
+
+
+def grade_in_browser(page: Page, exercise: Exercise, code: str) -> None:
+    """As a learner: open ``exercise``, type ``code`` in its editor, run it, Check my node."""
+    open_tab(page, "Exercise")
+    choose(page, "Exercise", f"{exercise.unit:02d} · {exercise.title}")
+    page.get_by_role("tab", name="Your code").click()
+    editor = page.frame_locator(f"iframe[src*='slug={exercise.slug}']")
+    expect(editor.locator("#status")).to_have_text(re.compile("saved|connected"))
+    _type_code(page, editor, code)
+    click(page, "Run my node")
+    expect_text(page, re.compile(r"running \(pid \d+\) · on the graph"), 60_000)
+    click(page, "Check my node")

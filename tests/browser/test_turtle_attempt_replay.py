@@ -13,9 +13,8 @@ from playwright.sync_api import Page, expect
 
 from app.exercises.model import load_exercises
 from tests.bags.readers import mcap_messages
-from tests.browser.helpers import choose, click, expect_text, open_tab
-from tests.browser.replay_helpers import go_to_moments, newest_at
-from tests.browser.test_exercise import _type_code
+from tests.browser.helpers import click, expect_text
+from tests.browser.replay_helpers import go_to_moments, grade_in_browser, newest_at
 from tests.conftest import ARTIFACTS, DashboardProcess, free_port
 
 EXERCISE = load_exercises().get("turtle_follower")
@@ -49,15 +48,7 @@ def test_a_failed_turtlesim_attempt_plays_in_turtlesims_window(browser, ros_env,
     page = browser.new_page(viewport={"width": 1400, "height": 900})
     try:
         page.goto(dashboard.url)
-        open_tab(page, "Exercise")
-        choose(page, "Exercise", f"{EXERCISE.unit:02d} · {EXERCISE.title}")
-        page.get_by_role("tab", name="Your code").click()
-        editor = page.frame_locator(f"iframe[src*='slug={EXERCISE.slug}']")
-        expect(editor.locator("#status")).to_have_text(re.compile("saved|connected"))
-        _type_code(page, editor, MISTAKE.path.read_text(encoding="utf-8"))
-        click(page, "Run my node")
-        expect_text(page, re.compile(r"running \(pid \d+\) · on the graph"), 60_000)
-        click(page, "Check my node")
+        grade_in_browser(page, EXERCISE, MISTAKE.path.read_text(encoding="utf-8"))
         expect_text(page, re.compile(r"needed below 1 m"), 150_000)
         told = page.get_by_text(re.compile(r"ros2 bag info attempts/")).first
         expect(told).to_be_visible(timeout=20_000)
