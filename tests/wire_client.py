@@ -13,6 +13,7 @@ import re
 import threading
 import time
 from collections import Counter
+from collections.abc import Iterator
 from typing import Any
 
 import msgspec
@@ -41,6 +42,35 @@ CAMERA_REPORT = {
 }
 
 
+# How often a reader looks up from its socket to see whether it should close it.
+READ_POLL_SEC = 0.05
+
+
+def connect_quietly(url: str, **options: Any) -> ClientConnection:
+    """A websockets sync client without its keepalive thread (see frames_until_closed)."""
+    return connect(url, ping_interval=None, **options)
+
+
+def frames_until_closed(ws: ClientConnection, closing: threading.Event) -> Iterator[str | bytes]:
+    """Each frame ``ws`` receives until ``closing`` is set; then this thread closes ``ws``.
+
+    Only one thread may ever join websockets' event thread. On CPython 3.11 two
+    threads joining one thread as it ends can race (``Thread._stop`` asserts the
+    state lock is free while the other joiner holds it, then releases the
+    other's lock): ``RuntimeError: release unlocked lock``, which once killed a
+    churner in CI's viser stress test. websockets joins that thread in
+    ``recv()`` and ``close()`` when the connection ends, and its keepalive
+    thread sleeps in such a join; so test clients run without keepalive (they
+    live seconds) and the thread that reads is the one that closes.
+    """
+    while not closing.is_set():
+        try:
+            yield ws.recv(timeout=READ_POLL_SEC)
+        except TimeoutError:
+            continue
+    ws.close()
+
+
 def decode_frame(frame: bytes) -> list[dict[str, Any]]:
     """One server->client frame: [raw size][compressed size][zstd msgpack][binary tail]."""
     raw_size = int.from_bytes(frame[:8], "little")
@@ -56,7 +86,7 @@ class WireClient:
 
     def __init__(self, url: str, *, headers: dict[str, str] | None = None) -> None:
         self.url = url.replace("http://", "ws://", 1)
-        self.ws: ClientConnection = connect(
+        self.ws: ClientConnection = connect_quietly(
             self.url,
             subprotocols=[f"viser-v{viser.__version__}"],  # type: ignore[list-item]
             additional_headers=headers or {},
@@ -70,6 +100,7 @@ class WireClient:
         self.bytes = 0
         self.last_frame_at = 0.0
         self.closed_reason: str | None = None
+        self._closing = threading.Event()
         self._reader = threading.Thread(target=self._read, name="wire-reader", daemon=True)
         self._reader.start()
         # viser counts a client as connected (and runs its clicks) only after
@@ -78,7 +109,7 @@ class WireClient:
 
     def _read(self) -> None:
         try:
-            for frame in self.ws:
+            for frame in frames_until_closed(self.ws, self._closing):
                 assert isinstance(frame, bytes)
                 messages = decode_frame(frame)
                 with self.lock:
@@ -156,5 +187,5 @@ class WireClient:
         self.set_value(uuid, True)
 
     def close(self) -> None:
-        self.ws.close()
+        self._closing.set()
         self._reader.join(timeout=5)

@@ -46,7 +46,6 @@ from typing import Any
 import psutil
 import pytest
 from websockets.exceptions import ConnectionClosed
-from websockets.sync.client import connect
 
 from app import PROJECT_ROOT
 from app.bags.errors import BagError
@@ -57,7 +56,7 @@ from app.lessons.panel import NEXT_LABEL
 from app.lessons.schema import load_course
 from tests.conftest import ARTIFACTS, DashboardProcess, free_port, wait_until
 from tests.faults.helpers import choose, live_children, record
-from tests.wire_client import WireClient
+from tests.wire_client import WireClient, connect_quietly, frames_until_closed
 
 pytestmark = [pytest.mark.ros, pytest.mark.browser, pytest.mark.timeout(900)]
 
@@ -145,19 +144,20 @@ class EditorClient:
 
     def __init__(self, url: str, killed: threading.Event) -> None:
         base = url.replace("http://", "ws://", 1)
-        self.ws = connect(f"{base}/classroom/editor/ws?slug={SLUG}", open_timeout=10)
+        self.ws = connect_quietly(f"{base}/classroom/editor/ws?slug={SLUG}", open_timeout=10)
         self.killed = killed
         self.lock = threading.Lock()
         self.loads: dict[str, str] = {}  # file -> the code the hub last sent
         self.acked: dict[str, int] = {}  # file -> highest revision acknowledged
         self.errors: list[str] = []
         self.rev = 0
+        self._closing = threading.Event()
         self._reader = threading.Thread(target=self._read, daemon=True)
         self._reader.start()
 
     def _read(self) -> None:
         try:
-            for raw in self.ws:
+            for raw in frames_until_closed(self.ws, self._closing):
                 message = json.loads(raw)
                 file = message.get("file") or ""
                 with self.lock:
@@ -202,7 +202,7 @@ class EditorClient:
         return self.wait(lambda: self.loads.get(file))
 
     def close(self) -> None:
-        self.ws.close()
+        self._closing.set()
         self._reader.join(timeout=5)
 
 
@@ -503,7 +503,7 @@ def marked(mark: str) -> list[tuple[int, str]]:
             cmd = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
         except (OSError, IndexError):
             continue
-        found.append((int(entry.name), cmd.strip()[:120]))
+        found.append((int(entry.name), cmd.strip()[-200:]))  # the end names the program
     return found
 
 

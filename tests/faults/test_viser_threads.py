@@ -16,6 +16,7 @@ import sys
 import threading
 import time
 import traceback
+from collections import Counter
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -202,3 +203,37 @@ def test_handles_set_from_many_threads_while_clients_come_and_go(server: viser.V
         frames_per_client=min(c.frames for c in steady),
         last_update_ms=round(latency * 1000, 1),
     )
+
+
+def test_a_test_client_closes_with_one_thread_joining_its_reader(
+    server: viser.ViserServer, monkeypatch: pytest.MonkeyPatch
+):
+    """CI once lost a churner to CPython 3.11's race between two joiners of one thread.
+
+    websockets joins its event thread in ``recv()``, in ``close()`` and in its
+    keepalive thread's sleep (see tests/wire_client.frames_until_closed). Count
+    the threads inside ``join`` of one thread at once: when one thread read and
+    another closed, every close made it 2.
+    """
+    joining: Counter[int] = Counter()
+    most = [0]
+    lock = threading.Lock()
+    real_join = threading.Thread.join
+
+    def counted_join(thread: threading.Thread, timeout: float | None = None) -> None:
+        with lock:
+            joining[id(thread)] += 1
+            most[0] = max(most[0], joining[id(thread)])
+        try:
+            real_join(thread, timeout)
+        finally:
+            with lock:
+                joining[id(thread)] -= 1
+
+    monkeypatch.setattr(threading.Thread, "join", counted_join)
+    url = f"ws://127.0.0.1:{server.get_port()}"
+    for _ in range(5):
+        client = WireClient(url)
+        wait_until(lambda c=client: c.frames > 0, timeout=10, what="the client's first frame")
+        client.close()
+    assert most[0] == 1, f"{most[0]} threads joined one thread at once"

@@ -32,8 +32,10 @@ from dataclasses import dataclass
 from typing import Any
 
 from websockets.exceptions import ConnectionClosed
-from websockets.sync.client import ClientConnection, connect
+from websockets.sync.client import ClientConnection
 from websockets.typing import Subprotocol
+
+from tests.wire_client import connect_quietly, frames_until_closed
 
 SUBPROTOCOLS = [Subprotocol("foxglove.sdk.v1"), Subprotocol("foxglove.websocket.v1")]
 MESSAGE_DATA = 0x01
@@ -75,7 +77,7 @@ class FoxgloveClient:
     ) -> None:
         """``subprotocols``: what the client offers (Foxglove's app: both names)."""
         self.url = url
-        self.ws: ClientConnection = connect(
+        self.ws: ClientConnection = connect_quietly(
             url, subprotocols=subprotocols or SUBPROTOCOLS, max_size=None, open_timeout=timeout
         )
         self.subprotocol = self.ws.subprotocol
@@ -94,6 +96,7 @@ class FoxgloveClient:
         self._channel_ids = itertools.count(1)
         self._call_ids = itertools.count(1)
         self.closed = threading.Event()
+        self._closing = threading.Event()
         self._reader = threading.Thread(target=self._read, name="foxglove-client", daemon=True)
         self._reader.start()
 
@@ -101,7 +104,7 @@ class FoxgloveClient:
 
     def _read(self) -> None:
         try:
-            for frame in self.ws:
+            for frame in frames_until_closed(self.ws, self._closing):
                 if isinstance(frame, str):
                     self._on_json(json.loads(frame))
                 elif frame and frame[0] == MESSAGE_DATA and len(frame) >= 13:
@@ -273,5 +276,5 @@ class FoxgloveClient:
         return self.wait_for(lambda: self.assets.get(request), timeout, f"asset {uri}")
 
     def close(self) -> None:
-        self.ws.close()
+        self._closing.set()
         self._reader.join(5.0)
