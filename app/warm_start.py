@@ -42,10 +42,12 @@ carries an earlier learner's token.
 What differs from a cold start, knowingly: the secret of ``str`` hash
 randomization is the warm parent's (every fork shares it; numpy's global
 generator is seeded again, ``random`` is by Python itself);
-``/proc/PID/environ`` shows the environment the warm parent started with
-(the learner's own is what ``os.environ`` and ``getenv`` see); what the
-imports made is frozen for the garbage collector (``gc.freeze``), so the
-learners' collections leave the shared pages shared. A learner's startup
+``/proc/PID/environ`` shows the learner's environment written over room the
+warm parent was started with (``_set_environ``: a learner's bigger than
+ENVIRON_ROOM leaves the warm parent's there, while ``os.environ`` and
+``getenv`` see the learner's own either way); what the imports made is
+frozen for the garbage collector (``gc.freeze``), so the learners'
+collections leave the shared pages shared. A learner's startup
 variables (``STARTUP_VARS``) must equal the warm parent's, else it starts cold.
 
 Protocol, over a ``SOCK_SEQPACKET`` socket pair the classroom makes (nothing
@@ -137,9 +139,11 @@ WARM_IMPORTS = REQUIRED_IMPORTS + (
 
 # Read when a process starts or a library loads, so a learner's must equal the warm
 # parent's (else that learner starts cold): the interpreter's, the loader's, the
-# locale, and what the libraries loaded at import read.
+# locale, and what the libraries loaded at import read. Not HOME: each hub learner
+# has their own, and nothing the warm parent imports keeps it (only site's unused
+# USER_SITE; tests/classroom/test_warm_start.py looks through every module).
 STARTUP_VARS = re.compile(
-    r"^(PYTHON|LD_|LC_|LANG|TZ$|HOME$|GLIBC_TUNABLES$|MALLOC_|OPENBLAS_|OMP_|LTTNG_)"
+    r"^(PYTHON|LD_|LC_|LANG|TZ$|GLIBC_TUNABLES$|MALLOC_|OPENBLAS_|OMP_|LTTNG_)"
 )
 
 IMPORT_TIMEOUT_SEC = 120.0  # a warm parent's imports on a busy 2-core machine
@@ -151,6 +155,10 @@ MAX_RESTARTS = 3  # within RESTART_WINDOW_SEC, then warm start is off for this c
 RESTART_WINDOW_SEC = 600.0
 MAX_REQUEST = 256 * 1024  # one learner's argv, folder and environment
 TITLE_ROOM = 1536  # bytes of command line a fork can show in `ps` (see _set_title)
+# Bytes of environment a fork can show in /proc/PID/environ (see _set_environ): a
+# hub learner's is ~4 KB (its hub's URLs and tokens).
+ENVIRON_ROOM = 64 * 1024
+ENVIRON_ROOM_VAR = "CLASSROOM_ENVIRON_ROOM"
 
 _PR_SET_PDEATHSIG = 1
 _PR_SET_CHILD_SUBREAPER = 36
@@ -261,6 +269,28 @@ def _set_title(argv: list[str]) -> None:
     ctypes.memmove(start, title.ljust(room, b" "), room)
 
 
+def _set_environ(environ: bytes) -> bool:
+    """Show ``environ`` (``KEY=VALUE\\0``...) as this process's /proc/PID/environ.
+
+    A fork keeps its parent's: tools and tests that read a learner's environment
+    there (``ps e``, psutil) would see the warm parent's. The warm parent is
+    started with ENVIRON_ROOM spare bytes in its environment; once the learner's
+    own environment is in place (``os.environ`` no longer points into that
+    area), it is written over it, NUL-padded. False (left as it is) when it
+    does not fit.
+    """
+    try:
+        fields = Path("/proc/self/stat").read_text().rsplit(")", 1)[1].split()
+        start, end = int(fields[47]), int(fields[48])  # env_start, env_end (proc(5))
+    except (OSError, IndexError, ValueError):
+        return False
+    room = end - start
+    if len(environ) > room:
+        return False
+    ctypes.memmove(start, environ.ljust(room, b"\0"), room)
+    return True
+
+
 def _wait_adopted(before: int, classroom: int) -> bool:
     """Once the middle process has ended, die with the classroom; False if it is not our parent.
 
@@ -317,6 +347,7 @@ class _Learner:
             if sep:
                 os.environb[key] = value
         _set_title(argv)
+        _set_environ(self.environ)
         if "numpy.random" in sys.modules:  # its global generator was seeded in the warm parent
             sys.modules["numpy.random"].seed()
         if sys.path and sys.path[0] == str(PROJECT_ROOT):  # `-m` puts the working folder first
@@ -582,6 +613,15 @@ class WarmChild:
             time.sleep(0.02)
         return code
 
+    def __enter__(self) -> WarmChild:
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        """As Popen's: its output closed, it is reaped (JupyterHub's poll does ``with proc``)."""
+        if self.stdout is not None:
+            self.stdout.close()
+        self.wait()
+
     def send_signal(self, sig: int) -> None:
         with self._lock:  # never a signal to a pid reaped (and maybe reused) meanwhile
             if self._poll_locked() is None:
@@ -676,7 +716,7 @@ class WarmStarter:
                 [sys.executable, "-m", module, "--fd", str(theirs.fileno()),
                  "--room", " " * TITLE_ROOM],
                 cwd=PROJECT_ROOT,
-                env=self.env,
+                env={**self.env, ENVIRON_ROOM_VAR: " " * ENVIRON_ROOM},
                 pass_fds=(theirs.fileno(),),
                 stdin=subprocess.DEVNULL,
                 stdout=subprocess.PIPE,

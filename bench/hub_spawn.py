@@ -8,7 +8,9 @@ per single-user mode:
 - lean (``CLASSROOM_SINGLEUSER=dashboard``, the README's recommendation): the
   dashboard is the learner's server and does the hub's OAuth itself;
 - lab: a Jupyter server (JupyterLab) whose jupyter-server-proxy starts the
-  dashboard on the first request to ``/user/<name>/ros2-classroom/``.
+  dashboard on the first request to ``/user/<name>/ros2-classroom/``;
+- lean_cold: lean with the spawner's warm start off, so each dashboard pays
+  its own imports: ``hub_warm_spawn_speedup`` is its p50 over lean's.
 
 Per learner, spawn -> dashboard ready is the time from the spawn request to
 the moment a websocket client, through the hub's proxy, is sent the
@@ -49,8 +51,10 @@ SETTLE_SEC = 4.0
 POLL_SEC = 1.0  # how often the hub is asked whether a server is ready
 # The sides run one after another: the largest (a lab learner, ~300 MB) with headroom.
 MB_PER_LEARNER = 450
-MODES = ("lean", "lab")  # the first is the README's recommendation
-SINGLEUSER = {"lean": "dashboard", "lab": "lab"}
+# The first is the README's recommendation; lean_cold is lean with warm start off
+# (CLASSROOM_COLD_START=1: every dashboard imports everything itself), its baseline.
+MODES = ("lean", "lab", "lean_cold")
+SINGLEUSER = {"lean": "dashboard", "lab": "lab", "lean_cold": "dashboard"}
 
 
 def _ready_one(hub: Any, user: str, started: float, out: dict[str, Any]) -> None:
@@ -96,9 +100,12 @@ def hub_class(learners: int, seconds: float, mode: str) -> dict[str, Any]:
     state = LOGS / f"bench-hub-{mode}-{learners}"
     shutil.rmtree(state, ignore_errors=True)
     users = [f"learner{i + 1}" for i in range(learners)]
+    env = dict(os.environ)
+    if mode == "lean_cold":
+        env["CLASSROOM_COLD_START"] = "1"
     hub = LocalHub(
         state,
-        dict(os.environ),
+        env,
         learners=users,
         teachers=[],
         first_domain_id=1,
@@ -260,7 +267,7 @@ def main(argv: list[str] | None = None) -> int:
     result: dict[str, Any] = {"seconds": args.seconds, "rows": [_deep_round(r) for r in rows]}
     if good:
         largest = max(good, key=lambda r: r["learners"])
-        lean, lab = largest["lean"], largest["lab"]
+        lean, lab, cold = largest["lean"], largest["lab"], largest["lean_cold"]
         result.update(
             hub_mode="lean",
             hub_spawn_p50_s=lean["spawn_p50_s"],
@@ -272,6 +279,9 @@ def main(argv: list[str] | None = None) -> int:
             hub_lab_memory_overhead_percent=lab["memory_overhead_percent"],
             hub_lab_cpu_overhead_core_percent=lab["cpu_overhead_core_percent"],
             hub_learners_measured=largest["learners"],
+            hub_cold_spawn_p50_s=cold["spawn_p50_s"],
+            hub_cold_spawn_p95_s=cold["spawn_p95_s"],
+            hub_warm_spawn_speedup=cold["spawn_p50_s"] / lean["spawn_p50_s"],
         )
     else:
         result["error"] = "no class size could be measured: " + "; ".join(

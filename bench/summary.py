@@ -492,6 +492,22 @@ ROWS += (
         "≤ 1",
         lambda v: v <= 1,
     ),
+    (
+        "JupyterHub spawn → ready p50 / p95 with warm start off (baseline, same run)",
+        "hub_spawn",
+        "hub_cold_spawn_p50_s|hub_cold_spawn_p95_s",
+        "s",
+        "",
+        None,
+    ),
+    (
+        "JupyterHub warm start: cold spawn p50 over warm (same class, same run)",
+        "hub_spawn",
+        "hub_warm_spawn_speedup",
+        "x",
+        "> 1",
+        lambda v: v > 1,
+    ),
 )
 
 ROWS += (
@@ -561,6 +577,7 @@ HEADLINE = {
     "tf2_ingest_cpu_percent": ("tf2_lookup", "tf2_ingest_cpu_percent"),
     "hub_spawn_p50_s": ("hub_spawn", "hub_spawn_p50_s"),
     "hub_memory_overhead_percent": ("hub_spawn", "hub_memory_overhead_percent"),
+    "hub_warm_spawn_speedup": ("hub_spawn", "hub_warm_spawn_speedup"),
     "colcon_build_ratio": ("colcon_build", "colcon_build_ratio"),
     "own_node_run_ratio": ("colcon_build", "own_node_run_ratio"),
     "soak_rss_growth_percent": ("soak", "soak_rss_growth_percent"),

@@ -130,6 +130,43 @@ def test_warm_parent_imports_everything_and_starts_nothing(starter, ros_env):
     assert _show(starter, dict(starter.env))["threads"] == int(cold.stdout)
 
 
+def test_no_warm_import_keeps_what_differs_between_hub_learners(ros_env, tmp_path):
+    """HOME is not a start-up variable (each hub learner has their own): nothing keeps it.
+
+    Imported once with every per-learner variable set to a marked value, no module
+    keeps one; the one known keeper, ``site.USER_SITE`` (from HOME), shows the look
+    finds what it is after, and a venv never reads it.
+    """
+    per_learner = {
+        "HOME": str(tmp_path / "home-sentinel"),
+        "USER": "user-sentinel",
+        "ROS_DOMAIN_ID": "93",
+        "CLASSROOM_TOKEN": "classroom-token-sentinel",
+        "CLASSROOM_TEACHER_URL": "http://teacher-sentinel/",
+        "JUPYTERHUB_API_TOKEN": "hub-token-sentinel",
+        "JUPYTERHUB_USER": "hub-user-sentinel",
+        "JUPYTERHUB_SERVICE_PREFIX": "/user/prefix-sentinel/",
+        "JUPYTERHUB_API_URL": "http://hub-sentinel/hub/api",
+        "JUPYTERHUB_CLIENT_ID": "client-sentinel",
+        "JUPYTERHUB_OAUTH_CALLBACK_URL": "/user/callback-sentinel/oauth_callback",
+    }
+    done = subprocess.run(
+        [*PROBE, "kept"],
+        env={**ros_env, **per_learner},
+        cwd=PROJECT_ROOT,
+        capture_output=True,
+        text=True,
+        timeout=180,
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    hits = json.loads(done.stdout.strip().splitlines()[-1])
+    assert sorted(hits) == ["HOME site.USER_BASE", "HOME site.USER_SITE"], hits
+    assert not warm_start.STARTUP_VARS.match("HOME")
+    import site
+
+    assert not site.ENABLE_USER_SITE  # the project's venv: user site-packages are never read
+
+
 def test_each_fork_is_its_own_process(starter):
     env_a = {**starter.env, "CLASSROOM_TOKEN": "token-of-alpha"}
     env_b = {**starter.env, "CLASSROOM_TOKEN": "token-of-beta"}
@@ -139,6 +176,7 @@ def test_each_fork_is_its_own_process(starter):
         assert shown["ppid"] == os.getpid()  # the classroom waits for it, as for a cold start
         assert shown["sid"] == shown["pid"]  # own session and process group
         assert shown["token"] == token  # its own environment, never another learner's
+        assert shown["proc_token"] == token  # also where `ps e` and psutil read it
         assert shown["cwd"] == str(PROJECT_ROOT)
         assert shown["argv"] == ["show"]
         assert shown["cmdline"] == " ".join([*PROBE, "show"])  # what `ps` shows

@@ -5,6 +5,9 @@ threads, working folder, its token, its argv, command line and open files. ``wri
 writes WORD into memory the warm parent made (a module's dictionary, a list,
 and the bytes of a string in place), says ``written``, then waits to be
 ended. ``read`` prints what those places hold. ``sleep`` waits to be ended.
+``kept`` (run cold) imports what the warm parent imports and prints, as JSON,
+every place in a module's globals (three levels into containers and objects)
+that holds the value of an environment variable whose value has ``-sentinel``.
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ import json
 import os
 import sys
 import time
+import types
 
 import app.dds  # imported by the warm parent: its objects live in the shared pages
 
@@ -35,6 +39,13 @@ def _files() -> list[str]:
     return found
 
 
+def _proc_environ() -> dict[str, str]:
+    """What /proc/self/environ (ps e, psutil) says this process's environment is."""
+    with open("/proc/self/environ", "rb") as f:
+        entries = f.read().split(b"\0")
+    return dict(e.decode(errors="replace").split("=", 1) for e in entries if b"=" in e)
+
+
 def places() -> dict[str, object]:
     doc = app.dds.__doc__ or ""
     return {
@@ -42,6 +53,49 @@ def places() -> dict[str, object]:
         "path_entry": [p for p in sys.path if p.startswith("warm-probe:")],
         "string_start": doc[:12],
     }
+
+
+def kept() -> list[str]:
+    """Where the warm imports keep a sentinel variable's value: 'NAME module.attr[...]'."""
+    import importlib
+
+    from app.warm_start import WARM_IMPORTS
+
+    for module in WARM_IMPORTS:
+        importlib.import_module(module)
+    sentinels = {k: v for k, v in os.environ.items() if "-sentinel" in v}
+    seen: set[int] = set()
+    hits: list[str] = []
+    # The environment itself: a fork's is the learner's (app/warm_start._Learner.run).
+    import posix
+
+    environs = (os.environ, os.environ._data, posix.environ)  # type: ignore[attr-defined]
+
+    def look(value: object, where: str, depth: int) -> None:
+        if id(value) in seen or depth > 3 or any(value is e for e in environs):
+            return
+        if isinstance(value, types.ModuleType):  # looked at under its own name
+            return
+        seen.add(id(value))
+        if isinstance(value, (str, bytes, os.PathLike)):
+            text = os.fsdecode(value)
+            hits.extend(f"{k} {where}" for k, v in sentinels.items() if v in text)
+        elif isinstance(value, (list, tuple, set, frozenset)):
+            for i, item in enumerate(list(value)[:500]):
+                look(item, f"{where}[{i}]", depth + 1)
+        elif isinstance(value, dict):
+            for key, item in list(value.items())[:1000]:
+                look(item, f"{where}[{key!r}]", depth + 1)
+        elif not isinstance(value, type) and isinstance(getattr(value, "__dict__", None), dict):
+            look(vars(value), f"{where}.__dict__", depth + 1)
+
+    for name, module in list(sys.modules.items()):
+        if name == "__main__" or module is None:
+            continue
+        for attr, value in list(vars(module).items()):
+            if not attr.startswith("__"):
+                look(value, f"{name}.{attr}", 0)
+    return hits
 
 
 def main(argv: list[str]) -> int:
@@ -58,6 +112,7 @@ def main(argv: list[str]) -> int:
                     "threads": len(os.listdir("/proc/self/task")),
                     "cwd": os.getcwd(),
                     "token": os.environ.get("CLASSROOM_TOKEN"),
+                    "proc_token": _proc_environ().get("CLASSROOM_TOKEN"),
                     "argv": sys.argv[1:],
                     "cmdline": cmdline,
                     "files": sorted(_files()),
@@ -74,6 +129,9 @@ def main(argv: list[str]) -> int:
         print("written", json.dumps(places()), flush=True)
         while True:
             time.sleep(1)
+    if verb == "kept":
+        print(json.dumps(kept()), flush=True)
+        return 0
     if verb == "read":
         print(json.dumps(places()), flush=True)
         return 0

@@ -127,6 +127,10 @@ def test_each_learner_lands_in_their_own_dashboard_through_the_hubs_oauth(hub, r
         # The dashboard is the learner's server itself: no Jupyter server in between.
         server = hub.single_user_servers()[user]
         assert "--jupyterhub" in server.cmdline() and hub.dashboards()[user].pid == server.pid
+        # A fork of the hub's one warm parent (app/hub/spawner.py), yet the hub's own child.
+        log = hub.log_tail(10**7)
+        assert f"warm start: this dashboard (pid {server.pid}) is a fork" in log, log[-3000:]
+        assert server.ppid() == hub.proc.pid
 
     # Each learner's nodes on their own graph only, both ways (the websocket works both ways).
     dora, erik = room.pages["dora"], room.pages["erik"]
