@@ -57,7 +57,8 @@ else can connect), one JSON object a message unless said otherwise:
 2. classroom -> warm parent: ``{"adopt": true}``, while it is a subreaper
 3. warm parent (the thread-free copy) -> classroom: ``{"ready": ..., "pid": ...}``
 4. per learner, classroom -> warm parent: a 4-byte header length, the header
-   ``{"id", "argv", "cwd"}``, the environment as ``KEY=VALUE\\0`` bytes, and
+   ``{"id", "argv", "cwd", "user"}`` (user: null, or the uid, gid and groups
+   the fork becomes), the environment as ``KEY=VALUE\\0`` bytes, and
    two descriptors (the learner's output pipe, its go pipe); answered with
    ``{"id", "pid"}`` or ``{"id", "error"}``.
 """
@@ -83,7 +84,7 @@ import warnings
 from collections import deque
 from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager, suppress
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import IO, Any
 
@@ -161,6 +162,7 @@ ENVIRON_ROOM = 64 * 1024
 ENVIRON_ROOM_VAR = "CLASSROOM_ENVIRON_ROOM"
 
 _PR_SET_PDEATHSIG = 1
+_PR_SET_DUMPABLE = 4
 _PR_SET_CHILD_SUBREAPER = 36
 _PR_GET_CHILD_SUBREAPER = 37
 _libc = ctypes.CDLL(None, use_errno=True)
@@ -169,6 +171,37 @@ _ANNOUNCE = re.compile(rb"warm start: this dashboard \(pid (\d+)\)")
 
 class WarmStartError(RuntimeError):
     """The warm parent could not start a learner (or could not start itself): start cold."""
+
+
+@dataclass(frozen=True)
+class Credentials:
+    """The account a fork becomes before it runs the learner's command (a hub run as root)."""
+
+    uid: int
+    gid: int
+    groups: tuple[int, ...]
+
+
+def _become(user: dict[str, Any], classroom: int) -> None:
+    """Switch to the learner's account for good; any step that fails ends the process.
+
+    Changing credentials clears the parent-death signal and makes the process
+    non-dumpable (its /proc files the old owner's), which an exec would undo:
+    both are set back, and the parent checked again.
+    """
+    try:
+        os.setgroups([int(g) for g in user["groups"]])
+        os.setgid(int(user["gid"]))
+        os.setuid(int(user["uid"]))
+        if os.getuid() != int(user["uid"]) or os.geteuid() != int(user["uid"]):
+            raise PermissionError("the uid did not change")
+    except (OSError, KeyError, TypeError, ValueError) as exc:
+        os.write(2, f"warm start: could not become uid {user.get('uid')}: {exc}\n".encode())
+        os._exit(72)  # never run a learner's server as the warm parent's account
+    _libc.prctl(_PR_SET_DUMPABLE, 1, 0, 0, 0)
+    _libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
+    if os.getppid() != classroom:
+        os._exit(0)  # the classroom died meanwhile: nobody waits for us
 
 
 # --------------------------------------------------------------------- the warm parent
@@ -340,6 +373,8 @@ class _Learner:
         if go != b"g":  # the classroom did not take us (its request failed): end unseen
             os._exit(0)
         argv: list[str] = self.header["argv"]
+        if self.header.get("user") is not None:
+            _become(self.header["user"], self.classroom)
         os.chdir(self.header["cwd"])
         os.environ.clear()
         for entry in self.environ.split(b"\0"):
@@ -880,28 +915,45 @@ class WarmStarter:
             return f"its environment differs from the warm parent's in {', '.join(differ)}"
         return ""
 
-    def spawn(self, argv: list[str], env: Mapping[str, str], cwd: Path | str) -> WarmChild:
+    def spawn(
+        self,
+        argv: list[str],
+        env: Mapping[str, str],
+        cwd: Path | str,
+        user: Credentials | None = None,
+    ) -> WarmChild:
         """Start ``argv`` (``python -m MODULE ...``) as a fork of the warm parent.
 
         The result is this process's child, in a session of its own, dying with
-        this process, its output (stdout and stderr) on ``.stdout``.
+        this process, its output (stdout and stderr) on ``.stdout``. ``user``:
+        the account it becomes first (this process must be root).
         """
         why = self.refusal(argv, env)
+        if user is not None and os.geteuid() != 0:
+            why = why or "becoming another account needs a classroom (or hub) run as root"
         if why:
             raise WarmStartError(why)
         with self._lock:
             try:
-                return self._spawn(self._ensure(), argv, env, cwd)
+                return self._spawn(self._ensure(), argv, env, cwd, user)
             except _ParentGone:
                 # Said and restarted by _ensure; the learner is never another's process.
-                return self._spawn(self._ensure(), argv, env, cwd)
+                return self._spawn(self._ensure(), argv, env, cwd, user)
 
     def _spawn(
-        self, parent: _Generation, argv: list[str], env: Mapping[str, str], cwd: Path | str
+        self,
+        parent: _Generation,
+        argv: list[str],
+        env: Mapping[str, str],
+        cwd: Path | str,
+        user: Credentials | None,
     ) -> WarmChild:
         self._next_id += 1
         request = self._next_id
-        header = json.dumps({"id": request, "argv": list(argv), "cwd": str(cwd)}).encode()
+        account = None if user is None else {**asdict(user), "groups": list(user.groups)}
+        header = json.dumps(
+            {"id": request, "argv": list(argv), "cwd": str(cwd), "user": account}
+        ).encode()
         environ = b"".join(os.fsencode(f"{k}={v}") + b"\0" for k, v in env.items())
         out_r, out_w = os.pipe()
         go_r, go_w = os.pipe()

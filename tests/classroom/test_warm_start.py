@@ -16,12 +16,15 @@ import array
 import errno
 import json
 import os
+import pwd
 import re
+import shutil
 import signal
 import socket
 import struct
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 import urllib.request
@@ -34,7 +37,7 @@ import app.dds
 import app.warm_start as warm_start
 from app import PROJECT_ROOT
 from app.classroom import Classroom, plan
-from app.warm_start import WarmParent, WarmStarter, WarmStartError
+from app.warm_start import Credentials, WarmParent, WarmStarter, WarmStartError
 from tests.conftest import free_port, wait_until
 from tests.wire_client import WireClient
 
@@ -184,6 +187,32 @@ def test_each_fork_is_its_own_process(starter):
         assert not [f for f in shown["files"] if f.startswith("socket:")], shown["files"]
         assert len({f for f in shown["files"] if f.startswith("pipe:")}) == 1, shown["files"]
     assert a["pid"] != b["pid"]
+
+
+def test_a_fork_becomes_the_learners_account_before_it_runs_their_command(starter):
+    """As the hub's system-user spawner asks: uid, gid and groups switched, and what the
+    switch undoes set back (its own /proc readable by itself, the parent-death signal)."""
+    nobody = pwd.getpwnam("nobody")
+    user = Credentials(nobody.pw_uid, nobody.pw_gid, (nobody.pw_gid,))
+    # The probe where any account can read it (pytest's folders are the test's own).
+    shared = Path(tempfile.mkdtemp(prefix="warm-probe-", dir="/var/tmp"))
+    try:
+        shared.chmod(0o755)
+        shutil.copy(Path(__file__).with_name("warm_probe.py"), shared / "warm_probe.py")
+        (shared / "warm_probe.py").chmod(0o644)
+        env = {**starter.env, "CLASSROOM_TOKEN": "token-of-nobody"}
+        child = starter.spawn([sys.executable, "-m", "warm_probe", "show"], env, shared, user)
+        assert child.stdout is not None
+        out = child.stdout.read().decode()
+        assert child.wait(10) == 0, out
+    finally:
+        shutil.rmtree(shared)
+    shown = json.loads(out.strip().splitlines()[-1])
+    assert (shown["uid"], shown["euid"], shown["gid"]) == (nobody.pw_uid,) * 2 + (nobody.pw_gid,)
+    assert shown["groups"] == [nobody.pw_gid]  # none of the warm parent's (root's) groups
+    assert shown["proc_token"] == "token-of-nobody"  # dumpable again: /proc/self is its own
+    assert shown["pdeathsig"] == signal.SIGTERM  # the switch cleared it; set again
+    assert shown["ppid"] == os.getpid() and shown["cwd"] == str(shared)
 
 
 def test_memory_written_by_one_fork_is_not_seen_by_another(starter):

@@ -39,6 +39,13 @@ def _files() -> list[str]:
     return found
 
 
+def _death_signal() -> int:
+    """This process's parent-death signal (prctl PR_GET_PDEATHSIG)."""
+    found = ctypes.c_int(0)
+    ctypes.CDLL(None).prctl(2, ctypes.byref(found), 0, 0, 0)
+    return found.value
+
+
 def _proc_environ() -> dict[str, str]:
     """What /proc/self/environ (ps e, psutil) says this process's environment is."""
     with open("/proc/self/environ", "rb") as f:
@@ -113,6 +120,11 @@ def main(argv: list[str]) -> int:
                     "cwd": os.getcwd(),
                     "token": os.environ.get("CLASSROOM_TOKEN"),
                     "proc_token": _proc_environ().get("CLASSROOM_TOKEN"),
+                    "uid": os.getuid(),
+                    "euid": os.geteuid(),
+                    "gid": os.getgid(),
+                    "groups": sorted(os.getgroups()),
+                    "pdeathsig": _death_signal(),
                     "argv": sys.argv[1:],
                     "cmdline": cmdline,
                     "files": sorted(_files()),
