@@ -34,7 +34,7 @@ import websockets.asyncio.server as ws_server
 from websockets.asyncio.server import ServerConnection
 from websockets.http11 import Request, Response
 
-from app import viser_threads
+from app import viser_icons, viser_threads
 
 TOKEN_ENV = "CLASSROOM_TOKEN"
 TOKEN_HEADER = "X-Classroom-Token"
@@ -182,6 +182,7 @@ def make_server(
         raise ValueError("one gate: an access token or another gate, not both")
     # Before the server exists: it makes its broadcast buffer as it starts.
     viser_threads.install()
+    viser_icons.install()
     if token is None and extension is None and gate is None:
         return viser.ViserServer(host=host, port=port, verbose=False), None
     if token is not None:
