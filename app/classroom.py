@@ -30,7 +30,6 @@ teacher's gradebook behind the teacher's token.
 
 from __future__ import annotations
 
-import ctypes
 import os
 import signal
 import socket
@@ -46,6 +45,7 @@ from urllib.parse import urlsplit
 
 from app import PROJECT_ROOT
 from app.dds import MAX_DOMAIN_ID
+from app.stop_signals import die_with
 from app.warm_start import COLD_START_VAR, WarmChild, WarmStarter, WarmStartError, cold_start_asked
 
 if TYPE_CHECKING:
@@ -54,8 +54,6 @@ if TYPE_CHECKING:
     from app.teacher.record import LearnerRecord
     from app.teacher.roster import Roster
 
-_PR_SET_PDEATHSIG = 1
-_libc = ctypes.CDLL(None, use_errno=True)
 READY_TIMEOUT_SEC = 90.0
 MAX_LEARNERS = 40
 LTI_URL_ENV = "CLASSROOM_LTI_URL"  # as the hub's teacher service reads it
@@ -232,11 +230,6 @@ def _lti_lines(lti: ClassroomLtiServer, host: str) -> list[str]:
     return lines
 
 
-def _die_with_parent() -> None:
-    """Runs in each child between fork and exec: end when the classroom command ends."""
-    _libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
-
-
 Process = subprocess.Popen[bytes] | WarmChild  # a dashboard started cold, or a warm fork
 
 
@@ -296,7 +289,7 @@ class Classroom:
                 stdout=subprocess.PIPE,
                 stderr=subprocess.STDOUT,
                 start_new_session=True,  # Ctrl+C reaches us; we stop them in order
-                preexec_fn=_die_with_parent,
+                preexec_fn=die_with(os.getpid()),
             )
             self._procs[learner.name] = proc
             self._ready[learner.name] = threading.Event()

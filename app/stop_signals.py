@@ -11,12 +11,37 @@ Python lock, and a small thread of ours reads it and sets the event.
 
 from __future__ import annotations
 
+import ctypes
 import os
 import signal
 import threading
 from collections.abc import Callable, Iterable
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+_PR_SET_PDEATHSIG = 1
+_libc = ctypes.CDLL(None, use_errno=True)
+
+
+def die_with(parent: int) -> Callable[[], None]:
+    """What a child runs between fork and exec (``preexec_fn``): die with ``parent``.
+
+    A fork keeps its parent's signal handlers until it execs, and ours (above)
+    turn SIGTERM into a byte on a pipe: a parent that died in that moment sent
+    its parent-death SIGTERM to a handler that did nothing, and the child ran
+    on for ever (CI: a learner's program outlived a SIGKILLed dashboard). So
+    the stop signals go back to their default first. The parent-death signal
+    only comes for a death after it is set: a parent that died between the fork
+    and here left this child to another, so it ends at once.
+    """
+
+    def set_parent_death_signal() -> None:
+        for number in STOP_SIGNALS:
+            signal.signal(number, signal.SIG_DFL)
+        _libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
+        if os.getppid() != parent:
+            os._exit(1)
+
+    return set_parent_death_signal
 
 
 def set_on_signals(

@@ -16,7 +16,6 @@ node make one process, never two with the first one lost.
 
 from __future__ import annotations
 
-import ctypes
 import logging
 import os
 import signal
@@ -35,9 +34,7 @@ from pathlib import Path
 from app import PROJECT_ROOT
 from app.catalog import CatalogEntry, lookup
 from app.containment.policy import RunPolicy
-
-_PR_SET_PDEATHSIG = 1
-_libc = ctypes.CDLL(None, use_errno=True)
+from app.stop_signals import die_with
 
 
 class NodeState(str, Enum):
@@ -164,21 +161,6 @@ def ended_state(code: int, stop_requested: bool, output: Iterable[str]) -> NodeS
     last = next((line.strip() for line in reversed(list(output)) if line.strip()), "")
     error = last.split(":", 1)[0].rsplit(".", 1)[-1]
     return NodeState.STOPPED if code > 0 and error in _INTERRUPTS else NodeState.CRASHED
-
-
-def die_with(parent: int) -> Callable[[], None]:
-    """What the child runs between fork and exec: die with the dashboard ``parent``.
-
-    The signal only comes for a death after it is set: a dashboard that died between
-    the fork and here left this child to another parent, so it ends at once.
-    """
-
-    def set_parent_death_signal() -> None:
-        _libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
-        if os.getppid() != parent:
-            os._exit(1)
-
-    return set_parent_death_signal
 
 
 class Supervisor:

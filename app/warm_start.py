@@ -89,6 +89,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from app import PROJECT_ROOT
+from app.stop_signals import die_with
 
 PARENT_MODULE = "app.warm_start"
 COLD_START_VAR = "CLASSROOM_COLD_START"  # "1": every dashboard starts cold (a cold process each)
@@ -610,11 +611,6 @@ def _parent_of(pid: int) -> int | None:
         return None
 
 
-def _die_with_parent() -> None:
-    """Runs in the warm parent between fork and exec: end when the classroom ends."""
-    _libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
-
-
 class WarmChild:
     """A process the classroom adopted from the warm parent, handled like ``subprocess.Popen``."""
 
@@ -757,7 +753,7 @@ class WarmStarter:
                 stdout=subprocess.PIPE,
                 stderr=subprocess.STDOUT,
                 start_new_session=True,
-                preexec_fn=_die_with_parent,
+                preexec_fn=die_with(os.getpid()),  # dies with the classroom
             )  # fmt: skip
         except OSError as exc:
             ours.close()

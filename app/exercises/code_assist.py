@@ -31,7 +31,7 @@ from typing import IO, Any
 from app.containment import sandbox
 from app.containment.policy import RunPolicy
 from app.exercises.lint import Problem, lint
-from app.supervisor import die_with
+from app.stop_signals import die_with
 
 log = logging.getLogger(__name__)
 

@@ -7,7 +7,10 @@ import subprocess
 import sys
 import time
 
-from app.supervisor import die_with
+import psutil
+
+from app import PROJECT_ROOT
+from app.stop_signals import die_with
 
 
 def test_a_child_of_a_living_parent_runs():
@@ -23,3 +26,48 @@ def test_a_child_whose_parent_is_already_gone_ends_before_it_runs():
                           capture_output=True, text=True, timeout=30)  # fmt: skip
     assert done.returncode != 0 and "ran" not in done.stdout
     assert time.monotonic() - started < 10
+
+
+# A dashboard-like parent: stop signals handled (app.stop_signals), a child whose
+# moment between fork and exec lasts a second, and the parent killed in that second.
+PARENT = """
+import os, subprocess, sys, threading, time
+from app.stop_signals import die_with, set_on_signals
+
+set_on_signals(threading.Event())
+die = die_with(os.getpid())
+
+def slow_preexec():
+    die()
+    time.sleep(1.0)  # the moment before exec, made long
+
+print("forking", flush=True)
+subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"], preexec_fn=slow_preexec)
+time.sleep(60)
+"""
+
+
+def test_a_parent_killed_just_before_its_child_execs_still_takes_the_child():
+    """The fork has the parent's SIGTERM handler until it execs: the death signal must not
+    land there (CI: a learner's program outlived a SIGKILLed dashboard)."""
+    parent = subprocess.Popen(
+        [sys.executable, "-c", PARENT], stdout=subprocess.PIPE, cwd=PROJECT_ROOT, text=True
+    )
+    child = None
+    try:
+        assert parent.stdout is not None and parent.stdout.readline().strip() == "forking"
+        deadline = time.monotonic() + 10
+        while not (children := psutil.Process(parent.pid).children()):
+            assert time.monotonic() < deadline, "the child was never forked"
+            time.sleep(0.01)
+        child = children[0]
+        time.sleep(0.3)  # inside its slow moment, its death signal set
+        parent.kill()
+        parent.wait(10)
+        gone, _alive = psutil.wait_procs([child], timeout=8)
+        assert gone, f"the child (pid {child.pid}) outlived its parent"
+    finally:
+        parent.kill()
+        parent.wait(10)
+        if child is not None and child.is_running():
+            child.kill()
