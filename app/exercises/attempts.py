@@ -96,12 +96,7 @@ class AttemptStore:
 
     def start(self, node: Node, slug: str) -> AttemptRecording:
         """Begin recording one grading of ``slug`` (never raises: see ``AttemptRecording``)."""
-        folder = self.root / slug
-        for name in unfinished_names():  # two gradings within one second get -2, -3 ...
-            path = folder / name
-            if not path.exists():
-                break
-        return AttemptRecording(self, node, path)
+        return AttemptRecording(self, node, next_attempt_path(self.root / slug))
 
     def attempts(self, slug: str) -> list[Path]:
         """The kept attempts of ``slug``, oldest first (unfinished ones included)."""
@@ -254,6 +249,17 @@ def _custom_data(report: Report) -> dict[str, str]:
     lines = (ResultLine(r.name, r.passed, r.detail) for r in report.results)
     verdict = verdict_of(report.passed, report.problem)
     return custom_data(report.slug, report.seed, verdict, report.summary(), lines)
+
+
+def next_attempt_path(folder: Path, when: float | None = None) -> Path:
+    """Where a grading starting at ``when`` (now) records: a stamp no attempt has yet.
+
+    A stamp is taken by a recording or a finished attempt of that second alike
+    (the finished name would collide): two gradings within one second get -2, -3 ...
+    """
+    taken = {age_order(p.name)[:2] for p in _dirs(folder)}
+    names = list(unfinished_names(when))
+    return folder / next((n for n in names if age_order(n)[:2] not in taken), names[-1])
 
 
 def _dirs(folder: Path) -> list[Path]:

@@ -454,5 +454,10 @@ class TopicMonitor(Generic[M]):
             sum(values[1:]) / span, len(values), sum(values) / len(values), min(values), max(values)
         )
 
+    def matched_publishers(self) -> int:
+        """Writers this subscription is matched with (DDS endpoint matching, which the
+        ROS graph can show well before: a message sent before it is not received)."""
+        return int(self._sub.get_publisher_count())
+
     def close(self) -> None:
         self._node.destroy_subscription(self._sub)

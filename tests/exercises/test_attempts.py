@@ -9,6 +9,7 @@ written leaves the grading as it was, with the reason the attempt was not kept.
 
 from __future__ import annotations
 
+import calendar
 import json
 from pathlib import Path
 
@@ -19,10 +20,11 @@ from app.exercises import runner
 from app.exercises.attempt_folders import (
     attempt_heading,
     attempt_label,
+    finished_name,
     graded_code,
     replay_of,
 )
-from app.exercises.attempts import AttemptStore, keep_graded_code
+from app.exercises.attempts import AttemptStore, keep_graded_code, next_attempt_path
 from app.exercises.grader import Grader
 from app.exercises.model import load_exercises
 from app.exercises.report import Report
@@ -53,6 +55,21 @@ def test_the_newest_attempts_of_an_exercise_stay(tmp_path):
     store.prune(SLUG, made[-1])
     assert [p.name for p in store.attempts(SLUG)] == names[1:]
     assert other.exists()  # another exercise's attempts are counted apart
+
+
+def test_two_gradings_within_one_second_get_two_folders(tmp_path):
+    """CI: a quick exercise graded twice in one second lost the second attempt, whose
+    final name was the first's (the first no longer had its .recording name)."""
+    when = calendar.timegm((2026, 11, 30, 10, 7, 2, 0, 0, 0))
+    folder = tmp_path / SLUG
+    first = next_attempt_path(folder, when)
+    assert first.name == "20261130-100702.recording"
+    _attempt(tmp_path, SLUG, finished_name(first.name, 7, "fail"))
+    second = next_attempt_path(folder, when)
+    assert second.name == "20261130-100702-2.recording"
+    _attempt(tmp_path, SLUG, second.name)  # still recording
+    assert next_attempt_path(folder, when).name == "20261130-100702-3.recording"
+    assert next_attempt_path(folder, when + 1).name == "20261130-100703.recording"
 
 
 def test_the_oldest_attempts_of_all_exercises_go_first_over_the_size_cap(tmp_path):

@@ -7,7 +7,7 @@ import time
 from rclpy.qos import QoSProfile
 
 from app.exercises.probes.base import ProbeContext, draw, expected_value, register_probe, same
-from app.exercises.probes.topics import others_subscribed
+from app.exercises.probes.topics import others_subscribed, wait_answering
 from app.exercises.report import Result
 from app.lessons.schema import Spec
 from app.ros.convert import fill, import_type, to_plain
@@ -42,13 +42,7 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
             if time.monotonic() > deadline:
                 return Result(name, False, f"nothing subscribes to {in_topic}")
             ctx.call.sleep(0.05)
-        # Its answers reach us only once its writer and our reader know each other: seen
-        # late on a loaded machine (the first answers were lost). Wait for our side to see
-        # its publisher (it may have none: the grading then says so), then a little more.
-        deadline = time.monotonic() + 3.0
-        while not node.count_publishers(out_topic) and time.monotonic() < deadline:
-            ctx.call.sleep(0.05)
-        ctx.call.sleep(0.5)
+        wait_answering(ctx, monitor)  # else its first answers can be lost
         before = monitor.count
         for value in inputs:
             publisher.publish(fill(in_type, {p["input_field"]: value}))

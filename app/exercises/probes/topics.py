@@ -19,6 +19,7 @@ from app.ros.qos import matching_qos
 # Reaches reliable and best-effort subscribers alike.
 SEND_QOS = QoSProfile(depth=10)
 MATCH_WAIT_SEC = 5.0  # for the learner's subscription to appear
+ANSWER_MATCH_SEC = 0.5  # once our reader matched its writer, for its writer to match ours
 ANSWER_WAIT_SEC = 2.0  # for one answer to one input
 RESENDS = 3  # an input is sent again when no answer came (discovery may lag)
 
@@ -74,6 +75,17 @@ def wait_matched(ctx: ProbeContext, ours: Sequence[tuple[Any, str]], theirs: str
         ctx.call.sleep(0.05)
     ctx.call.sleep(0.1)
     return ""
+
+
+def wait_answering(ctx: ProbeContext, monitor: TopicMonitor, timeout: float = 3.0) -> None:
+    """Wait until the node's publisher on ``monitor``'s topic is matched with our reader (it
+    may have none: the grading then says so), then a little for its writer to match us in
+    turn. The ROS graph shows a publisher well before that on a loaded machine, and what
+    it sends before is lost (CI: the first three of seven answers)."""
+    deadline = time.monotonic() + timeout
+    while not monitor.matched_publishers() and time.monotonic() < deadline:
+        ctx.call.sleep(0.05)
+    ctx.call.sleep(ANSWER_MATCH_SEC)
 
 
 def exchange(
