@@ -283,6 +283,17 @@ class _LttngUst:
         self._call("after_fork_child")
 
 
+def _own_area(which: str) -> tuple[int, int]:
+    """Where this process's argv (``"arg"``) or environment (``"env"``) strings lie in its
+    memory, as /proc/self/stat says (arg_start..env_end, proc(5)); (0, 0) if it cannot."""
+    first = {"arg": 45, "env": 47}[which]  # counted after the command name's ")"
+    try:
+        fields = Path("/proc/self/stat").read_text().rsplit(")", 1)[1].split()
+        return int(fields[first]), int(fields[first + 1])
+    except (OSError, IndexError, ValueError):
+        return 0, 0
+
+
 def _set_title(argv: list[str]) -> None:
     """Show ``argv`` as this process's command line (ps, top, /proc/PID/cmdline).
 
@@ -291,11 +302,7 @@ def _set_title(argv: list[str]) -> None:
     argv (TITLE_ROOM bytes); the learner writes its own command there, as the
     setproctitle package does: one string, the area's last byte not NUL.
     """
-    try:
-        fields = Path("/proc/self/stat").read_text().rsplit(")", 1)[1].split()
-        start, end = int(fields[45]), int(fields[46])  # arg_start, arg_end (proc(5))
-    except (OSError, IndexError, ValueError):
-        return
+    start, end = _own_area("arg")
     room = end - start
     if room < 2:
         return
@@ -313,13 +320,9 @@ def _set_environ(environ: bytes) -> bool:
     area), it is written over it, NUL-padded. False (left as it is) when it
     does not fit.
     """
-    try:
-        fields = Path("/proc/self/stat").read_text().rsplit(")", 1)[1].split()
-        start, end = int(fields[47]), int(fields[48])  # env_start, env_end (proc(5))
-    except (OSError, IndexError, ValueError):
-        return False
+    start, end = _own_area("env")
     room = end - start
-    if len(environ) > room:
+    if room <= 0 or len(environ) > room:
         return False
     ctypes.memmove(start, environ.ljust(room, b"\0"), room)
     return True

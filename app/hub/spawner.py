@@ -210,7 +210,7 @@ class ClassroomSystemUserSpawner(LocalProcessSpawner):
     async def start(self) -> tuple[str, int]:
         if not self.warm_start or not is_lean(self.cmd) or self.shell_cmd:
             return await super().start()
-        if cold_start_asked(os.environ):
+        if cold_start_asked(os.environ):  # the switch for every server of this hub
             return await super().start()
         if self.port == 0:  # type: ignore[has-type]  # as LocalProcessSpawner.start
             self.port = random_port()
