@@ -61,14 +61,6 @@ log = logging.getLogger(__name__)
 
 UI_PERIOD_SEC = 0.2  # panels refresh at 5 Hz
 GRAPH_CHECK_SEC = 0.02  # ...and within 20 ms of a node joining/leaving or an intent
-# A learner reading, not clicking: QUIET_AFTER_SEC after the last intent or node change the
-# node list is looked at every QUIET_CHECK_SEC (a node started from outside the dashboard
-# shows within a tenth of a second; one started by a click, at once), and the whole graph
-# (every topic's endpoints) is read every QUIET_SNAPSHOT_SEC unless the node list changes.
-# A class's dashboards spend most of their time so: about 1 % of a core each (issue 43).
-QUIET_AFTER_SEC = 5.0
-QUIET_CHECK_SEC = 0.1
-QUIET_SNAPSHOT_SEC = 1.0
 # With no browser connected nobody sees a frame: checks and progress still move on, once
 # a second, at a tenth of the idle cost (a class's dashboards idle while learners are away).
 UNWATCHED_PERIOD_SEC = 1.0
@@ -319,35 +311,25 @@ class Dashboard:
         # intent, refresh at once; otherwise panels refresh at UI_PERIOD_SEC.
         # A node shows up within a frame, a click's effect within one pass.
         last_nodes: list[tuple[str, str]] | None = None
-        due = snapshot_due = last_activity = 0.0
+        due = 0.0
         while not self._stop.is_set():
             watched = bool(self.server.get_clients())
-            quiet = time.monotonic() - last_activity > QUIET_AFTER_SEC
-            if not watched:
-                check = UNWATCHED_CHECK_SEC
-            else:
-                check = QUIET_CHECK_SEC if quiet else GRAPH_CHECK_SEC
-            woken = self.ui.wait(check)
+            woken = self.ui.wait(GRAPH_CHECK_SEC if watched else UNWATCHED_CHECK_SEC)
             applied = self.ui.apply_pending()
             try:
                 nodes = self.runtime.node.get_node_names_and_namespaces()
             except Exception:  # the graph may be unreadable for a moment
                 nodes = last_nodes or []
             now = time.monotonic()
-            changed = nodes != last_nodes or bool(woken or applied)
-            if changed:
-                last_activity = now
-            elif now < due:
+            if nodes == last_nodes and now < due and not (woken or applied):
                 continue
             last_nodes, due = nodes, now + (UI_PERIOD_SEC if watched else UNWATCHED_PERIOD_SEC)
-            if changed or not quiet or now >= snapshot_due:
-                snapshot_due = now + QUIET_SNAPSHOT_SEC
-                try:
-                    self.graph = snapshot(self.runtime.node)
-                    self.supervisor.note_visible_nodes(self.graph.nodes)
-                    self.lessons.graph = self.graph
-                except Exception:  # the graph may be unreadable for a moment: keep panels going
-                    log.exception("graph snapshot failed")
+            try:
+                self.graph = snapshot(self.runtime.node)
+                self.supervisor.note_visible_nodes(self.graph.nodes)
+                self.lessons.graph = self.graph
+            except Exception:  # the graph may be unreadable for a moment: keep the panels going
+                log.exception("graph snapshot failed")
             for panel in self._panels:
                 try:
                     panel.refresh(self.graph)
