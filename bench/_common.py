@@ -126,15 +126,25 @@ def spawn(argv: list[str], log_name: str, **kwargs: Any) -> tuple[subprocess.Pop
     return proc, log
 
 
+def dashboard_argv(port: int) -> list[str]:
+    """``ros2-classroom serve`` on ``port``, its progress in the benchmarks' own folder."""
+    progress = LOGS / "bench-progress"
+    return [
+        sys.executable,
+        "-m",
+        "app",
+        "serve",
+        "--port",
+        str(port),
+        "--progress-dir",
+        str(progress),
+    ]
+
+
 def start_dashboard(log_name: str = "bench-dashboard.log") -> tuple[subprocess.Popen, str]:
     """``ros2-classroom serve`` as a child; returns it and its URL once it says it is ready."""
     port = free_port()
-    progress = LOGS / "bench-progress"
-    proc, log = spawn(
-        [sys.executable, "-m", "app", "serve", "--port", str(port)]
-        + ["--progress-dir", str(progress)],
-        log_name,
-    )
+    proc, log = spawn(dashboard_argv(port), log_name)
     wait_for_text(proc, log, "is ready", 60.0)
     return proc, f"http://127.0.0.1:{port}"
 

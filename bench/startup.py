@@ -33,6 +33,7 @@ from bench._common import (
     LOGS,
     ROOT,
     configure_dds,
+    dashboard_argv,
     free_port,
     launch_browser,
     ratio,
@@ -66,13 +67,6 @@ finally:
 KINDS = ("baseline", "dashboard", "warm")
 
 
-def _dashboard_argv(port: int) -> list[str]:
-    return [sys.executable, "-m", "app", "serve", "--port", str(port)] + [
-        "--progress-dir",
-        str(LOGS / "bench-progress"),
-    ]
-
-
 def _fork_warm(starter: Any, argv: list[str], log: Path) -> Any:
     """``argv`` as a fork of the warm parent, its output copied to ``log`` by a thread."""
     out = log.open("wb")  # emptied before the fork: never the last round's ready line
@@ -101,9 +95,9 @@ def one_start(browser: Any, kind: str, starter: Any) -> tuple[float, float]:
     if kind == "baseline":
         proc, log = spawn([sys.executable, "-c", BARE_APP, str(port)], log.name)
     elif kind == "dashboard":
-        proc, log = spawn(_dashboard_argv(port), log.name)
+        proc, log = spawn(dashboard_argv(port), log.name)
     else:
-        proc = _fork_warm(starter, _dashboard_argv(port), log)
+        proc = _fork_warm(starter, dashboard_argv(port), log)
     try:
         ready = wait_for_text(proc, log, "is ready", 60) - t0
         context = browser.new_context(viewport={"width": 1400, "height": 900})
