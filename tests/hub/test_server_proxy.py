@@ -89,7 +89,9 @@ class JupyterServer:
             children = psutil.Process(self.proc.pid).children(recursive=True)
         except psutil.NoSuchProcess:
             return []
-        return [p for p in children if _is_dashboard(p)]
+        # A dashboard's child between fork and exec still shows the dashboard's command
+        # line (seen: two "dashboards" while it started a node): count the top one only.
+        return [p for p in children if _is_dashboard(p) and not _is_dashboard(_parent(p))]
 
     def stop(self) -> None:
         """End the server and everything it started; the dashboard stops its nodes.
@@ -112,7 +114,16 @@ class JupyterServer:
         assert not alive, f"the dashboard outlived its Jupyter server: {alive}"
 
 
-def _is_dashboard(proc: psutil.Process) -> bool:
+def _parent(proc: psutil.Process) -> psutil.Process | None:
+    try:
+        return proc.parent()
+    except psutil.Error:
+        return None
+
+
+def _is_dashboard(proc: psutil.Process | None) -> bool:
+    if proc is None:
+        return False
     try:
         cmdline = proc.cmdline()
     except psutil.Error:
