@@ -46,6 +46,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # run as a script from anywhere
 from bench._reaper import end_found  # the run's reaper; it needs only the stdlib
+from tests.worker_plan import GENERAL_WORKERS, WAITING_WORKERS  # stdlib only, too
 
 _SIOCGIFFLAGS = 0x8913
 _SIOCSIFFLAGS = 0x8914
@@ -56,8 +57,9 @@ WORKER = "CLASSROOM_WORKER_NETNS"  # set only for the worker that unshare starts
 NAMESPACES = "CLASSROOM_RUN_NAMESPACES"  # the file where workers note their namespaces
 # Three workers on two cores, measured: the whole suite in 16-17 min instead of
 # 47, a core still idle a third of the time. Four took 15 min but saturated the
-# cores: eight tests that wait on real time failed (a MuJoCo run, turtlesim).
-DEFAULT_WORKERS = 3
+# cores: eight tests that wait on real time failed (a MuJoCo run, turtlesim). So
+# three take any test, and two more only tests that wait (tests/worker_plan.py).
+DEFAULT_WORKERS = GENERAL_WORKERS + WAITING_WORKERS
 FORWARDED = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 LOADED = "loaded"  # the mark of tests that take the cores on purpose (tests/conftest.py)
 ALONE = "alone"  # ...and of tests that need the machine's real time to themselves

@@ -15,12 +15,26 @@ Two rules, both for a worker pool on two cores:
   mostly wait, hardly use. Measured on 2 cores, whole suite: 16.2 min spread
   (a third of the time a core idle); 20.9 min in folder order, though five of
   that run's tests also waited out their time limits.
+
+And a third: the cores go to the tests that use them. Most of a grading, a
+lesson walk or a ros2 verb's test is spent waiting on the clock (a check's
+time limit, a rate measured over seconds, discovery): three workers of
+``test_grading`` alone kept two cores 15-40 % busy. So the first
+GENERAL_WORKERS workers take every unit, in the spread order, and the
+WAITING_WORKERS more take only such waiting units (the next one in that
+order), never a browser, a simulated world or a build: those run at most
+GENERAL_WORKERS at a time, as before.
 """
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any, TypeVar
+
+GENERAL_WORKERS = 3  # take any unit: the whole suite's share of the cores, measured
+WAITING_WORKERS = 2  # take only waiting units (below)
 
 ONE_WORKER = frozenset(
     {
@@ -89,13 +103,79 @@ def spread(items: Sequence[Item], nodeid_of: Any = lambda item: item.nodeid) -> 
     return [item for unit in sorted(units, key=place.__getitem__) for item in units[unit]]
 
 
+# Modules whose tests mostly wait on the clock, and start no browser, build or world.
+WAITING_MODULES = frozenset(
+    {
+        "tests/exercises/test_grading.py",
+        "tests/integration/test_lessons_walk.py",
+        "tests/integration/test_core_nodes.py",
+        "tests/integration/test_ros2cli_types_and_errors.py",
+        "tests/integration/test_ros2cli_fidelity.py",
+        "tests/integration/test_ros2cli_params_lifecycle.py",
+        "tests/integration/test_supervisor.py",
+        "tests/tf2/test_tf2_tutorial_commands.py",
+        "tests/tf2/test_tf_checks.py",
+        "tests/turtlesim/test_cli_tutorial_commands.py",
+        "tests/turtlesim/test_ros2_run.py",
+    }
+)
+_LESSONS = Path(__file__).resolve().parent.parent / "lessons"
+# What takes a core: a simulated world (MuJoCo, the office with Nav2), the SLAM capstone,
+# or a colcon build (a lesson's command, an exercise that is a package).
+_BUSY = re.compile(r'"(sim_\w+|office_\w+|slam_node)"|colcon build|^package = "\w', re.M)
+
+
+def busy_cases() -> set[str]:
+    """Exercise slugs and lesson ids whose grading or walk takes a core (``_BUSY``)."""
+    found = {
+        p.parent.name
+        for p in _LESSONS.glob("*/exercises/*/exercise.toml")
+        if _BUSY.search(p.read_text(encoding="utf-8"))
+    }
+    found |= {
+        p.parent.name
+        for p in _LESSONS.glob("*/lesson.toml")
+        if _BUSY.search(p.read_text(encoding="utf-8"))
+    }
+    return found
+
+
+def waits(unit: str, busy: frozenset[str] | set[str]) -> bool:
+    """Whether ``unit`` mostly waits: a test of WAITING_MODULES whose parameter (an
+    exercise slug or a lesson id) is not ``busy``."""
+    module, _, name = unit.partition("::")
+    case = name.partition("[")[2].rstrip("]")
+    return module in WAITING_MODULES and not any(
+        case == item or case.startswith(f"{item}-") for item in busy
+    )
+
+
+def _worker_number(node: Any) -> int:
+    return int(str(node.workerinput["workerid"]).removeprefix("gw"))
+
+
 def make_scheduler(config: Any, log: Any) -> Any:
-    """xdist's scope scheduler with our units, handed out in the spread order."""
+    """xdist's scope scheduler with our units, handed out in the spread order, the
+    workers after GENERAL_WORKERS given only units that wait."""
     from xdist.scheduler import LoadScopeScheduling
+
+    busy = frozenset(busy_cases())
 
     class Units(LoadScopeScheduling):
         def _split_scope(self, nodeid: str) -> str:
             return unit_of(nodeid)
+
+        def _assign_work_unit(self, node: Any) -> None:
+            if _worker_number(node) < GENERAL_WORKERS:
+                super()._assign_work_unit(node)
+                return
+            unit = next((u for u in self.workqueue if waits(u, busy)), None)
+            if unit is None:  # nothing left that waits: the rest is the general workers'
+                if not node.shutting_down:
+                    node.shutdown()
+                return
+            self.workqueue.move_to_end(unit, last=False)
+            super()._assign_work_unit(node)
 
     # Its reorder puts the largest units first: all the one-worker modules at
     # once at the start, which undoes the spreading.

@@ -5,7 +5,16 @@ from __future__ import annotations
 import re
 
 from app import PROJECT_ROOT
-from tests.worker_plan import ONE_WORKER, SAME_UNIT, SHARED_MODULE_FIXTURES, spread, unit_of
+from tests.worker_plan import (
+    ONE_WORKER,
+    SAME_UNIT,
+    SHARED_MODULE_FIXTURES,
+    WAITING_MODULES,
+    busy_cases,
+    spread,
+    unit_of,
+    waits,
+)
 
 HUB = "tests/hub/test_jupyterhub.py"
 MODULE_FIXTURE = re.compile(r"^@pytest\.fixture\(.*scope=.module", re.M)
@@ -61,3 +70,24 @@ def test_each_folders_tests_are_spread_over_the_whole_run():
         assert positions == sorted(positions)  # the collection order within a folder
         first_half = sum(p < len(order) / 2 for p in positions)
         assert abs(first_half - len(folder) / 2) <= 1, (folder[0], positions)
+
+
+def test_every_waiting_module_exists_and_starts_no_browser():
+    # A waiting worker beside three general ones must never start a Chromium.
+    for path in WAITING_MODULES:
+        source = (PROJECT_ROOT / path).read_text(encoding="utf-8")
+        assert "browser" not in source, f"{path} uses a browser: it does not only wait"
+
+
+def test_only_gradings_and_walks_that_start_nothing_busy_wait():
+    busy = busy_cases()
+    assert {"patrol", "wall_follower", "24_navigation", "package_adder"} <= busy
+    grading = "tests/exercises/test_grading.py::test_grading"
+    walk = (
+        "tests/integration/test_lessons_walk.py::test_every_step_of_the_lesson_passes_on_real_nodes"
+    )
+    assert waits(f"{grading}[counter_publisher-starter]", busy)
+    assert waits(f"{walk}[05_topics]", busy)
+    assert not waits(f"{grading}[patrol-reference]", busy)  # the office world with Nav2
+    assert not waits(f"{walk}[20_workspaces_packages]", busy)  # colcon builds
+    assert not waits("tests/browser/test_stage.py::test_every_step", busy)
