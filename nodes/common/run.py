@@ -85,8 +85,9 @@ def stopped_quietly() -> Iterator[None]:
     rclpy's signal thread shuts the context down while the main thread may be
     inside any ROS call: spinning (ExternalShutdownException), publishing or
     waiting for a server (RCLError: "context is invalid"), creating an entity
-    (ValueError), or using one already destroyed (InvalidHandle). With ROS
-    still up, those are real errors and go on.
+    (ValueError), using one already destroyed (InvalidHandle), or starting to
+    spin (AttributeError: the global executor is gone). With ROS still up,
+    those are real errors and go on.
     """
     global _ending
     try:
@@ -99,6 +100,13 @@ def stopped_quietly() -> Iterator[None]:
         # this clause (seen: view_frames stopped while creating its node).
         _ending = True
         if rclpy.ok():
+            raise
+    except AttributeError as exc:
+        # rclpy.spin(node) just after the signal shut the context down: rclpy's global
+        # executor is then None, and spin() fails on None.add_node (seen: amcl, SIGTERM
+        # between making its node and spinning it).
+        _ending = True
+        if rclpy.ok() or "'NoneType'" not in str(exc):
             raise
     finally:
         _ending = True  # first, in one store: a late signal in what follows raises nothing
