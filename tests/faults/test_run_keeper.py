@@ -19,7 +19,7 @@ import pytest
 
 from app import PROJECT_ROOT
 from tests.conftest import wait_until
-from tests.worker_plan import ONE_WORKER
+from tests.worker_plan import GENERAL_WORKERS, ONE_WORKER, WAITING_MODULES, WAITING_WORKERS
 
 # Starts a program in a session of its own (as the dashboard fixture does),
 # says its pid, then either waits to be killed or exits at once.
@@ -137,13 +137,11 @@ def test_workers_have_namespaces_of_their_own_and_the_keeper_ends_what_they_leav
     wait_until(lambda: _gone(left), timeout=10, what=f"pid {left} to be gone")
 
 
-def test_a_one_worker_module_runs_whole_on_one_worker_and_the_rest_is_shared():
-    """tests/worker_plan.py's units, as the real run hands them out (not just as planned)."""
-    module = "tests/sim/test_sim_physics.py"
-    assert module in ONE_WORKER
+def _workers_of(workers: int, *paths: str) -> dict[str, set[str]]:
+    """Which workers ran each module's tests when the real run is given ``paths``."""
     env = {k: v for k, v in os.environ.items() if k != "CLASSROOM_PRIVATE_NETNS"}
     run = subprocess.run(
-        [sys.executable, "tests/run.py", "--workers", "3", module, "tests/unit/test_cli.py", "-v"],
+        [sys.executable, "tests/run.py", "--workers", str(workers), *paths, "-v"],
         cwd=PROJECT_ROOT,
         env=env,
         capture_output=True,
@@ -153,6 +151,22 @@ def test_a_one_worker_module_runs_whole_on_one_worker_and_the_rest_is_shared():
     out = run.stdout + run.stderr
     assert run.returncode == 0, out
     ran = re.findall(r"^\[(gw\d)\] .*PASSED (\S+)::", out, re.M)
-    workers_of = {path: {gw for gw, p in ran if p == path} for _, path in ran}
+    return {path: {gw for gw, p in ran if p == path} for _, path in ran}
+
+
+def test_a_one_worker_module_runs_whole_on_one_worker_and_the_rest_is_shared():
+    """tests/worker_plan.py's units, as the real run hands them out (not just as planned)."""
+    module = "tests/sim/test_sim_physics.py"
+    assert module in ONE_WORKER
+    workers_of = _workers_of(3, module, "tests/unit/test_cli.py")
     assert len(workers_of[module]) == 1, workers_of
     assert len(workers_of["tests/unit/test_cli.py"]) > 1, workers_of
+
+
+def test_the_workers_after_the_general_ones_take_only_tests_that_wait():
+    waiting, general = "tests/turtlesim/test_ros2_run.py", "tests/unit/test_cli.py"
+    assert waiting in WAITING_MODULES and general not in WAITING_MODULES
+    workers_of = _workers_of(GENERAL_WORKERS + WAITING_WORKERS, waiting, general)
+    extra = {f"gw{n}" for n in range(GENERAL_WORKERS, GENERAL_WORKERS + WAITING_WORKERS)}
+    assert workers_of[waiting] & extra, workers_of  # the extra workers did take some
+    assert not workers_of[general] & extra, workers_of
