@@ -55,7 +55,7 @@ from app.exercises.model import load_exercises
 from app.lessons.panel import NEXT_LABEL
 from app.lessons.schema import load_course
 from tests.conftest import ARTIFACTS, DashboardProcess, free_port, wait_until
-from tests.faults.helpers import choose, live_children, record
+from tests.faults.helpers import live_children, record
 from tests.wire_client import WireClient, connect_quietly, frames_until_closed
 
 pytestmark = [pytest.mark.ros, pytest.mark.browser, pytest.mark.timeout(900)]
@@ -277,6 +277,22 @@ class Round:
 
     # -- through viser's websocket (the intents the page posts) --------------------
 
+    def widget(self, label: str, kind: str) -> str:
+        """A widget's id once the page state has it: the tools' widgets arrive after the
+        lessons' (seen on a busy CI run: no 'Start' yet when the round began)."""
+        client = self.client
+        assert client is not None
+        found: str = self.wait(lambda: client.find(label, kind), what=f"the widget {label!r}")
+        return found
+
+    def click(self, label: str) -> None:
+        assert self.client is not None
+        self.client.set_value(self.widget(label, "GuiButtonMessage"), True)
+
+    def choose(self, label: str, value: str) -> None:
+        assert self.client is not None
+        self.client.set_value(self.widget(label, "GuiDropdownMessage"), value)
+
     def next_step(self) -> None:
         assert self.client is not None
         target = self.learner.shown + 1
@@ -326,7 +342,7 @@ class Round:
             self.page_tool("Nodes")
             self.page_click("Start")
         else:
-            self.client.click("Start")
+            self.click("Start")
         self.wait(lambda: live_children(self.dash.proc.pid), what="the talker's process")
         self.did.append("node")
 
@@ -339,9 +355,9 @@ class Round:
                 self.page_choose("Exercise", self.exercise_label)
             self.page_click("Run my node")
         else:
-            choose(self.client, "Exercise", self.exercise_label)
+            self.choose("Exercise", self.exercise_label)
             time.sleep(0.2)
-            self.client.click("Run my node")
+            self.click("Run my node")
 
         def learner_process() -> bool:
             for child in psutil.Process(self.dash.proc.pid).children(recursive=True):
@@ -361,7 +377,7 @@ class Round:
             self.page_tool("Bags")
             self.page_click("Record")
         else:
-            self.client.click("Record")
+            self.click("Record")
         client = self.client
         self.wait(lambda: "**Recording**" in client.markdown(), what="the recording")
         self.learner.recording_shown = True
@@ -371,7 +387,7 @@ class Round:
             if self.page is not None:
                 self.page_click("Stop recording")
             else:
-                self.client.click("Stop recording")
+                self.click("Stop recording")
             client = self.client
             self.wait(lambda: "Saved `rosbag2_" in client.markdown(), what="the bag closed")
         self.did.append("bag")
