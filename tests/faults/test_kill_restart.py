@@ -475,7 +475,15 @@ class Round:
             "code => document.getElementById('status').textContent === 'saved ✓' && "
             "window.classroomEditor.getValue() === code"
         )
-        self.wait(lambda: self.frame.evaluate(js, code), what="the editor's save")  # type: ignore[union-attr]
+        try:
+            self.wait(lambda: self.frame.evaluate(js, code), what="the editor's save")  # type: ignore[union-attr]
+        except AssertionError as exc:  # what the learner saw instead, for the report
+            shown = self.frame.evaluate(
+                "code => [document.getElementById('status').textContent, "
+                "window.classroomEditor.getValue() === code]",
+                code,
+            )
+            raise AssertionError(f"{exc}: status {shown[0]!r}, code as sent: {shown[1]}") from None
 
     frame: Any = None
     reference = ""
