@@ -127,17 +127,8 @@ _BUSY = re.compile(r'"(sim_\w+|office_\w+|slam_node)"|colcon build|^package = "\
 
 def busy_cases() -> set[str]:
     """Exercise slugs and lesson ids whose grading or walk takes a core (``_BUSY``)."""
-    found = {
-        p.parent.name
-        for p in _LESSONS.glob("*/exercises/*/exercise.toml")
-        if _BUSY.search(p.read_text(encoding="utf-8"))
-    }
-    found |= {
-        p.parent.name
-        for p in _LESSONS.glob("*/lesson.toml")
-        if _BUSY.search(p.read_text(encoding="utf-8"))
-    }
-    return found
+    data = [*_LESSONS.glob("*/exercises/*/exercise.toml"), *_LESSONS.glob("*/lesson.toml")]
+    return {p.parent.name for p in data if _BUSY.search(p.read_text(encoding="utf-8"))}
 
 
 def waits(unit: str, busy: frozenset[str] | set[str]) -> bool:
