@@ -17,6 +17,7 @@ import os
 import signal
 import sys
 import threading
+import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from types import FrameType
@@ -69,9 +70,11 @@ def spin_node(
                 raise SystemExit(EXIT_BAD_PARAMETER) from None
             ros_started()
             if executor is None:
+                _stop_watch.spinning = rclpy.get_global_executor()  # what rclpy.spin uses
                 rclpy.spin(node)
             else:
                 spinner = _make_executor(executor, node)
+                _stop_watch.spinning = spinner
                 spinner.add_node(node)
                 spinner.spin()
     finally:
@@ -139,6 +142,7 @@ def ros_started() -> None:
     done, so a signal in between is held, not lost.
     """
     install_signal_handlers(SignalHandlerOptions.ALL)
+    _stop_watch.start()
     _start.end()
     if _start.requested:
         raise KeyboardInterrupt
@@ -158,6 +162,58 @@ class _StartUp:
 
 
 _start = _StartUp()
+
+
+class _StopWatch:
+    """Makes sure a stop signal ends the spin, whatever the order rclpy's thread works in.
+
+    On Ctrl+C or SIGTERM rclpy's signal thread first wakes the executors, *then* shuts
+    the context down. An executor that wakes in between finds ROS still up and waits
+    again, with nothing left to wake it: the node ignores the signal for good (seen on a
+    loaded machine: turtle_tf2_broadcaster, sim_arm_state_publisher and
+    turtle_mimic_multisim still in rclpy.spin 20 s after SIGTERM). So a stop signal
+    also wakes this thread, which waits for the context to go down (taking it down
+    itself after ``GRACE_SEC``) and then wakes the spinning executor once more. The
+    signal handler only writes a byte to a pipe: no lock a signal could interrupt.
+    """
+
+    GRACE_SEC = 1.0
+
+    def __init__(self) -> None:
+        self.spinning: Executor | None = None
+        self._pipe: tuple[int, int] | None = None
+
+    def start(self) -> None:
+        if self._pipe is not None:
+            return
+        self._pipe = os.pipe()
+        os.set_blocking(self._pipe[1], False)
+        threading.Thread(target=self._watch, name="stop-watch", daemon=True).start()
+
+    def stop_requested(self) -> None:
+        """From the signal handler: a write, nothing that takes a lock."""
+        if self._pipe is not None:
+            try:
+                os.write(self._pipe[1], b"x")
+            except OSError:  # full (signals already told) or closed: nothing to add
+                pass
+
+    def _watch(self) -> None:
+        assert self._pipe is not None
+        os.read(self._pipe[0], 1)
+        context = rclpy.get_default_context()
+        deadline = time.monotonic() + self.GRACE_SEC
+        while context.ok() and time.monotonic() < deadline:
+            time.sleep(0.02)
+        try:
+            context.try_shutdown()  # already down (rclpy's thread did it): nothing happens
+            if self.spinning is not None:
+                self.spinning.wake()
+        except Exception:  # the main thread tore it all down meanwhile: it has ended
+            pass
+
+
+_stop_watch = _StopWatch()
 
 
 # A node ends at most this long after Ctrl+C or SIGTERM, whatever hangs in its teardown.
@@ -217,6 +273,7 @@ def _stop_signals_held_until_started() -> None:
 
     def on_stop(signum: int, frame: object) -> None:
         if _start.done:
+            _stop_watch.stop_requested()
             return
         _start.requested += 1
         if _start.requested > 1:

@@ -97,7 +97,9 @@ def _stop_one(entry: catalog.CatalogEntry, env: dict[str, str], probe) -> Ending
         what="the graph to clear",
     )
     proc = subprocess.Popen(
-        [sys.executable, "-m", f"nodes.{entry.module}", *entry.argv_tail()],
+        # faulthandler: a node that does not end prints every thread's stack when told to
+        # (SIGABRT, below), so the report says where it hung.
+        [sys.executable, "-X", "faulthandler", "-m", f"nodes.{entry.module}", *entry.argv_tail()],
         cwd=PROJECT_ROOT,
         env=env,
         stdin=subprocess.DEVNULL,
@@ -133,6 +135,11 @@ def _stop_one(entry: catalog.CatalogEntry, env: dict[str, str], probe) -> Ending
             code = proc.wait(STOP_TIMEOUT)
         except subprocess.TimeoutExpired:
             code = None
+            proc.send_signal(signal.SIGABRT)  # its stacks to stderr, then it ends
+            try:
+                proc.wait(5)
+            except subprocess.TimeoutExpired:
+                pass
         seconds = time.monotonic() - sent
     finally:
         if proc.poll() is None:
@@ -192,7 +199,9 @@ def endings(request) -> dict[str, Ending]:
 
 
 def _clean(what: str, code: int | None, expected: tuple[int, ...], output: str) -> None:
-    assert code is not None, f"{what} did not end within {STOP_TIMEOUT:.0f} s of SIGTERM"
+    assert code is not None, (
+        f"{what} did not end within {STOP_TIMEOUT:.0f} s of SIGTERM; its threads then:\n{output}"
+    )
     assert ABORT not in output, f"{what} aborted on SIGTERM:\n{output}"
     assert "Traceback" not in output, f"{what} printed a traceback on SIGTERM:\n{output}"
     assert code in expected, f"{what} ended with {code} on SIGTERM, not {expected}:\n{output}"
