@@ -55,6 +55,7 @@ class LifecyclePanel:
         self._available: set[str] = set()
         self._message = ""
         self._polling = False  # a get_state job is out: never two at once
+        self._stale = False  # the state changed while that job was out: ask again
         self._changing = False  # a transition job is out: buttons stay disabled
         self._last_poll = 0.0
         self._event_sub: Subscription | None = None
@@ -110,9 +111,14 @@ class LifecyclePanel:
 
     def _poll(self) -> None:
         target = self._target
-        if target is None or self._polling:
+        if target is None:
             return
-        self._polling = True
+        if self._polling:
+            # The job out may have read the state before this change: its answer would show
+            # the old state's transitions (clickable, wrong) until the next poll, 2 s on.
+            self._stale = True
+            return
+        self._polling, self._stale = True, False
         self._last_poll = time.monotonic()
         ctx = panel_context(self._node)
 
@@ -122,12 +128,16 @@ class LifecyclePanel:
 
         def done(answer: tuple[str, set[str]]) -> None:
             self._polling = False
-            if self._target == target:
+            if self._stale:
+                self._poll()
+            elif self._target == target:
                 self._state, self._available = answer
 
         def failed(text: str) -> None:
             self._polling = False
             self._message = f"⚠️ {text}"
+            if self._stale:
+                self._poll()
 
         self._ui.run_job(work, done, failed)
 

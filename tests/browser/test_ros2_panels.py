@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import time
 
 import pytest
 from playwright.sync_api import expect
@@ -53,6 +54,26 @@ def test_console_ros2_run_starts_turtlesim_as_the_tutorial_types_it(page):
     expect_shown(page, "/turtlesim")
 
 
+# Each primary state's transitions, as the lifecycle design lists them.
+_WAYS_OUT = {
+    "unconfigured": {"configure", "shutdown"},
+    "inactive": {"activate", "cleanup", "shutdown"},
+    "active": {"deactivate", "shutdown"},
+}
+
+
+def _wait_live_edges(page, wanted: set[str], timeout: float = 20.0) -> None:
+    """The drawing's live edges are exactly ``wanted`` (the panel's last answer is in)."""
+    read = (
+        "() => [...document.querySelectorAll('g.live-edge a')]"
+        ".map(a => a.getAttribute('aria-label').split(':')[0])"
+    )
+    deadline = time.monotonic() + timeout
+    while (shown := set(page.evaluate(read))) != wanted:
+        assert time.monotonic() < deadline, f"live edges {sorted(shown)}, not {sorted(wanted)}"
+        page.wait_for_timeout(100)
+
+
 def test_lifecycle_walk_changes_state_and_rate(page):
     start_node(page, "lifecycle_talker")
     open_tab(page, "Lifecycle")
@@ -66,9 +87,14 @@ def test_lifecycle_walk_changes_state_and_rate(page):
         ("cleanup", "unconfigured"),
         ("shutdown", "finalized"),
     ]
+    now = "unconfigured"
     for transition, state in steps:
         # The drawing's blue edges are the controls here (the buttons are used by
         # the lifecycle lesson's test); a live edge is a link labelled by its transition.
+        # Clicked once the drawing shows this state's own ways out: a click while the
+        # drawing is redrawn is lost, as a learner's would be (a CI run: the last poll's
+        # answer redrew it under the click on "shutdown").
+        _wait_live_edges(page, _WAYS_OUT[now])
         edge = page.locator(f'g.live-edge a[aria-label^="{transition}:"]')
         expect(edge).to_have_count(1, timeout=20_000)
         expect(page.get_by_role("button", name=transition, exact=True)).to_be_enabled()
@@ -80,6 +106,7 @@ def test_lifecycle_walk_changes_state_and_rate(page):
             expect_regex(page, r"on_activate")  # the node's own log line
         if transition == "deactivate":
             expect_regex(page, r"/lifecycle_chatter: silent", timeout=20_000)
+        now = state
     for transition in ("configure", "activate", "cleanup"):
         expect(page.get_by_role("button", name=transition, exact=True)).to_be_disabled()
     expect(page.locator("g.live-edge")).to_have_count(0)  # finalized: no way out
