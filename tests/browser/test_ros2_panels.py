@@ -92,8 +92,8 @@ def test_lifecycle_walk_changes_state_and_rate(page):
         # The drawing's blue edges are the controls here (the buttons are used by
         # the lifecycle lesson's test); a live edge is a link labelled by its transition.
         # Clicked once the drawing shows this state's own ways out: a click while the
-        # drawing is redrawn is lost, as a learner's would be (a CI run: the last poll's
-        # answer redrew it under the click on "shutdown").
+        # drawing is redrawn is lost, as a learner's would be (likely what lost a CI run's
+        # click on "shutdown": no request left the browser, and the drawing was settling).
         _wait_live_edges(page, _WAYS_OUT[now])
         edge = page.locator(f'g.live-edge a[aria-label^="{transition}:"]')
         expect(edge).to_have_count(1, timeout=20_000)
