@@ -52,7 +52,7 @@ from app.supervisor import NodeState, Supervisor
 from app.ui import GROUP_OF, TAB_NAMES, TOOL_GROUPS, TOOLS, Inspector, MarkdownView, Panel
 from app.ui.loop import UiLoop
 from app.ui.page_fixes import page_fixes_html
-from app.ui.page_links import PageLinks
+from app.ui.page_links import PageLinks, link_sender_html
 from app.ui.page_script import page_script
 from app.ui.starting import StartRequests
 from app.ui.tab_opener import TabOpener
@@ -120,6 +120,7 @@ class Dashboard:
             titlebar_content=None, control_width="large", show_share_button=False, show_logo=False
         )
         gui.add_html(page_fixes_html())  # contrast and button names viser leaves out
+        gui.add_html(link_sender_html())  # clicks on links in drawings (graph, lifecycle)
         # Both cost a lot where WebGL runs in software (no GPU: headless
         # browsers, many classroom VMs). The shadow pass of the arm on the grid
         # alone stalled the page ~100 ms on every redraw (measured; findings.md).

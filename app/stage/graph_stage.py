@@ -5,6 +5,7 @@ it offers and uses, with buttons to the tools already set to it.
 
 from __future__ import annotations
 
+import hashlib
 import html
 import time
 from collections.abc import Callable
@@ -72,12 +73,15 @@ class GraphStage:
         self._open_tool = open_tool
         self._width = width
         self._active = False
-        self._picked: list[Vertex] = []  # the boxes in the picture, in link order
+        # The boxes a click may name: this picture's and the one before (the learner may
+        # click the picture on screen just as a newer one is drawn), by their link's id.
+        self._pickable: dict[str, Vertex] = {}
+        self._drawn_picks: dict[str, Vertex] = {}
+        self._placed: list[Vertex] = []  # the boxes in the picture, in link order
         self._inspected = ""  # Vertex.key the learner clicked
         self._endpoints: list[NodeEndpoints] = []
-        if links is not None:  # a click on a box runs stage.pick.<its index>
-            for i in range(MAX_PICKS):
-                links.register(f"stage.pick.{i}", self._picker(i))
+        if links is not None:  # a click on a box runs stage.pick/<its id>
+            links.register_value("stage.pick", self._picker)
         self._rates: RateBoard | SharedRatesClient = rates or RateBoard(node)
         self._places = StablePlaces()
         # Calls and goals as pulses: an event wakes the UI loop, which draws it at once.
@@ -170,7 +174,10 @@ class GraphStage:
             self._places.forget(key)
         self._alone = {f"node:{v.name}" for v in vertices if v.kind == "node"} - linked
         placed = self._places.place(vertices, edges)
-        self._picked = [p.vertex for p in placed]
+        self._placed = [p.vertex for p in placed]
+        picture = {_pick_id(v.key): v for v in self._placed[:MAX_PICKS]}
+        self._pickable = {**self._drawn_picks, **picture}
+        self._drawn_picks = picture
         self._endpoints = endpoints
         self._calls.watch(*_calls_to_watch(vertices, endpoints))
         self._drawn_pulses = {(p.kind, p.name, p.shown_at) for p in pulses}
@@ -230,22 +237,23 @@ class GraphStage:
             return ""
         return next(iter(users)).partition(":")[2]
 
-    def _picker(self, index: int) -> Callable[[], None]:
+    def _picker(self, pick_id: str) -> None:
         """The link's action: runs in viser's asyncio thread, so it only posts."""
-        return lambda: self._ui.post(lambda: self._pick(index))
+        self._ui.post(lambda: self._pick(pick_id))
 
     def _link(self, index: int, content: str, title: str) -> str:
         if self._links is None or index >= MAX_PICKS:
             return content
         # Named by its <title> and text, not aria-label: tests and screen readers find the
         # control panel's fields by label ("Topic", "Node"), which box names often contain.
-        href = html.escape(self._links.href(f"stage.pick.{index}"))
+        pick_id = _pick_id(self._placed[index].key)
+        href = html.escape(f"{self._links.href('stage.pick')}/{pick_id}")
         return f'<a href="{href}" target="{SINK}"><title>{html.escape(title)}</title>{content}</a>'
 
-    def _pick(self, index: int) -> None:
-        if not 0 <= index < len(self._picked):
+    def _pick(self, pick_id: str) -> None:
+        vertex = self._pickable.get(pick_id)
+        if vertex is None:  # a box from a picture two redraws ago: gone or moved on
             return
-        vertex = self._picked[index]
         self._inspected = vertex.key
         self._last_picture = 0.0  # answer at once
         self._inspect(vertex.kind, vertex.name, self._full_type(vertex))
@@ -325,6 +333,12 @@ class GraphStage:
     def close(self) -> None:
         self._rates.close()
         self._calls.close()
+
+
+def _pick_id(key: str) -> str:
+    """A box's id in its link: the same box keeps it in every picture (an index did not:
+    a redraw between a click and its arrival could turn it into another box's)."""
+    return hashlib.blake2s(key.encode(), digest_size=8).hexdigest()
 
 
 def _calls_to_watch(

@@ -28,12 +28,31 @@ from websockets.asyncio.server import ServerConnection
 from websockets.http11 import Request, Response
 
 from app.access import Handler, ProcessRequest, ServerExtension
+from app.ui.page_script import listen_on_page, page_script
 
 PREFIX = "/classroom/act/"
 SINK = "classroom-link-sink"
 # Put once into any HTML that holds action links: where their empty answers land.
 SINK_FRAME = f'<iframe name="{SINK}" title="link answers" hidden></iframe>'
 _NAME = re.compile(r"^[a-z0-9_.-]{1,64}$")
+
+# The page sends a click on such a link itself, with fetch: a panel redrawn just after the
+# click (the graph once a second) replaced its hidden frame while the frame's request was
+# starting, and the click never arrived. The frame stays as the way before this script runs.
+_SEND_CLICKS = f"""
+const sendLink = (event) => {{
+  const link = event.target.closest ? event.target.closest('a[target="{SINK}"]') : null;
+  if (!link || event.button !== 0) return;
+  event.preventDefault();
+  const url = new URL(link.getAttribute('href'), parent.document.baseURI);
+  parent.fetch(url, {{credentials: 'same-origin', cache: 'no-store'}}).catch(() => {{}});
+}};
+""" + listen_on_page("__classroomLinks", "click", "sendLink", capture=True)
+
+
+def link_sender_html() -> str:
+    """Sent once with the page: the script that delivers every link click (see above)."""
+    return page_script(_SEND_CLICKS, "link clicks")
 
 
 class PageLinks:
