@@ -91,9 +91,10 @@ def test_lifecycle_walk_changes_state_and_rate(page):
     for transition, state in steps:
         # The drawing's blue edges are the controls here (the buttons are used by
         # the lifecycle lesson's test); a live edge is a link labelled by its transition.
-        # Clicked once the drawing shows this state's own ways out: a click while the
-        # drawing is redrawn is lost, as a learner's would be (likely what lost a CI run's
-        # click on "shutdown": no request left the browser, and the drawing was settling).
+        # Clicked once the drawing shows this state's own ways out, so the click is on the
+        # state it is meant for. (A CI run lost a click on "shutdown" as the drawing was
+        # redrawn: the redraw replaced the hidden frame the link's request went through.
+        # The page now sends link clicks itself: app/ui/page_links.py.)
         _wait_live_edges(page, _WAYS_OUT[now])
         edge = page.locator(f'g.live-edge a[aria-label^="{transition}:"]')
         expect(edge).to_have_count(1, timeout=20_000)
