@@ -113,16 +113,37 @@ class ProbeGoal:
         return response.status, list(response.result.sequence)
 
 
+def _wait_feedback_flows(client: ThreadSafeActionClient) -> None:
+    """Feedback is a topic: until the server's side has discovered this client's feedback
+    subscription (ready says only that the client sees the server), feedback goes nowhere,
+    as for any ROS client (CI: a loaded machine's first goal succeeded, none of its
+    feedback arrived). Short goals until one's feedback does."""
+    deadline = time.monotonic() + DISCOVERY_TIMEOUT
+    while True:
+        goal = ProbeGoal(client, 1)
+        assert goal.result()[0] == GoalStatus.STATUS_SUCCEEDED
+        settle = time.monotonic() + 1.0  # feedback may trail the result (another channel)
+        while not goal.feedback and time.monotonic() < settle:
+            time.sleep(0.05)
+        if goal.feedback:
+            return
+        assert time.monotonic() < deadline, "no feedback from any /fibonacci goal"
+
+
 def test_fibonacci_feedback_result_rejection_cancel_and_preemption(supervisor, probe):
     supervisor.start("fibonacci_action_server", ["-p", "step_period:=0.1"])
     client = ThreadSafeActionClient(probe.node, Fibonacci, "/fibonacci")
     wait_until(client.server_is_ready, timeout=DISCOVERY_TIMEOUT, what="the /fibonacci server")
+    _wait_feedback_flows(client)
 
     # Feedback grows one number per step; the result has order + 1 numbers.
     goal = ProbeGoal(client, 6)
     assert goal.handle.accepted
     assert goal.result() == (GoalStatus.STATUS_SUCCEEDED, [0, 1, 1, 2, 3, 5, 8])
-    wait_until(lambda: goal.feedback and goal.feedback[-1] == fib(6), what="the last feedback")
+    wait_until(
+        lambda: goal.feedback and goal.feedback[-1] == fib(6),
+        what=lambda: f"the last feedback (got {goal.feedback})",
+    )
     assert len(goal.feedback) >= 3
     assert all(fb == fib(len(fb) - 1) for fb in goal.feedback)
     lengths = [len(fb) for fb in goal.feedback]
