@@ -368,7 +368,17 @@ class Round:
                     continue
             return False
 
-        self.wait(learner_process, what="the learner's program")
+        try:
+            self.wait(learner_process, what="the learner's program")
+        except AssertionError as exc:  # what the Exercise tool said, for the report
+            said = [
+                line.strip()
+                for line in self.client.markdown().splitlines()
+                if any(w in line for w in ("Saving and", "Started your", "Not started", "⚠"))
+            ]
+            picked = self.client.find("Exercise", "GuiDropdownMessage")
+            value = self.client.value(picked) if picked else None
+            raise AssertionError(f"{exc}; Exercise {value!r} says {said or 'nothing'}") from None
         self.did.append("run")
 
     def record_bag(self) -> None:
