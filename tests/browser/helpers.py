@@ -77,6 +77,18 @@ def open_lesson(page: Page, lesson) -> None:
     choose(page, "Lesson", label)
 
 
+def go_to_step(page: Page, lesson, index: int) -> None:
+    """Open ``lesson`` and press Next until step ``index`` (from 0) is on screen."""
+    open_lesson(page, lesson)
+    for at in range(index):
+        expect_text(page, f"Step {at + 1} of {len(lesson.steps)}")
+        # Next once the card has settled: a step that changes the stage re-mounts the
+        # column, which slides into place, and a click on the sliding card was lost (CI).
+        step_head_in_view(page, lesson, at)
+        click_next(page)
+    expect_text(page, f"Step {index + 1} of {len(lesson.steps)}")
+
+
 def click(page: Page, button: str) -> None:
     page.get_by_role("button", name=button, exact=True).click()
 

@@ -21,9 +21,8 @@ from app.supervisor import Supervisor
 from tests.browser.helpers import (
     NEXT_OR_SKIP,
     click,
-    click_next,
     expect_text,
-    open_lesson,
+    go_to_step,
     open_tab,
     step_reads_top_down,
 )
@@ -109,13 +108,6 @@ def test_axe_finds_nothing_serious_in_the_lesson_exercise_and_graph_views(
         assert not problems, f"{scheme} mode: {problems}"
 
 
-def _go_to_step(page: Page, lesson, index: int) -> None:
-    open_lesson(page, lesson)
-    for at in range(index):
-        expect_text(page, f"Step {at + 1} of {len(lesson.steps)}")
-        click_next(page)
-
-
 def test_at_125_percent_zoom_each_step_reads_top_down_and_every_control_is_reachable(
     browser, dashboard_with_chatter
 ):
@@ -125,7 +117,7 @@ def test_at_125_percent_zoom_each_step_reads_top_down_and_every_control_is_reach
         places += [(COURSE.lesson(lesson_id), index) for lesson_id, index in CROWDED]
         hidden = []
         for lesson, index in places:
-            _go_to_step(page, lesson, index)
+            go_to_step(page, lesson, index)
             hidden += [
                 f"{lesson.id} step {index + 1}: {why}"
                 for why in step_reads_top_down(page, lesson, index)
@@ -156,7 +148,7 @@ def test_the_keyboard_alone_moves_through_a_lesson(browser, dashboard_with_chatt
     page = _page(browser, dashboard_with_chatter.url)
     try:
         lesson = COURSE.lesson("01_ros2_and_dds")
-        _go_to_step(page, lesson, 0)  # (the mouse only picks the lesson to start from)
+        go_to_step(page, lesson, 0)  # (the mouse only picks the lesson to start from)
         page.locator("body").click(position={"x": 5, "y": 700})  # focus on the page itself
         total = len(lesson.steps)
         _tab_to(page, NEXT_OR_SKIP)

@@ -6,7 +6,7 @@ import pytest
 from playwright.sync_api import expect
 
 from app.lessons.schema import load_course
-from tests.browser.helpers import click_next, expect_text, open_lesson, open_tab
+from tests.browser.helpers import click_next, expect_text, go_to_step, open_tab
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 COURSE = load_course()
@@ -35,9 +35,7 @@ def _picture_steps():
 def test_a_step_shows_its_picture_and_the_next_step_does_not(page, lesson, index):
     step = lesson.steps[index]
     open_tab(page, "Lessons")
-    open_lesson(page, lesson)
-    for _ in range(index):
-        click_next(page)
+    go_to_step(page, lesson, index)
     expect_text(page, f"Step {index + 1} of {len(lesson.steps)}: {step.title}")
 
     picture = page.get_by_role("img", name=step.image_alt, exact=True)
