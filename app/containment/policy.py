@@ -5,9 +5,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from app.ros.errors import Ros2Error
 
-class RunRefused(RuntimeError):
-    """Learner code may not run here (remote dashboard without the teacher's consent)."""
+
+class RunRefused(Ros2Error, RuntimeError):
+    """Learner code may not run here (remote dashboard without the teacher's consent).
+
+    A ``Ros2Error``: the refusal is the teacher's setting working as meant, so the page
+    shows its one line and the log no traceback (as for a build refused the same way).
+    """
 
 
 @dataclass(frozen=True)

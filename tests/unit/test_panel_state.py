@@ -221,6 +221,25 @@ def test_a_job_that_fails_because_the_dashboard_stops_logs_no_error(caplog):
     assert [r.levelname for r in caplog.records] == ["DEBUG"], caplog.text
 
 
+def test_learner_code_refused_by_the_teachers_setting_is_one_line_not_a_fault(caplog):
+    """A remote dashboard without --allow-learner-code refuses a run: the learner reads
+    why, and the log has no 'job failed' traceback for what is the setting working."""
+    from app.containment.policy import RunPolicy, RunRefused
+
+    ui = UiLoop()
+    shown: list[str] = []
+    refusal = RunPolicy(allowed=False).refusal()
+
+    def refused() -> None:
+        raise RunRefused(refusal)
+
+    with caplog.at_level("INFO", logger="app.ui.loop"):
+        ui.run_job(refused, None, shown.append)
+        drain(ui, until=lambda: len(shown) == 1)
+    assert shown == [refusal]
+    assert not [r for r in caplog.records if r.levelname == "ERROR"], caplog.text
+
+
 def test_jobs_of_one_lane_run_in_the_order_posted():
     ui, order = UiLoop(), []
     for i in range(20):
