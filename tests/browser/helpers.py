@@ -146,7 +146,7 @@ def cut_off_at_panel_edge(page: Page, selector: str, text: str) -> list[str]:
 
 # Why an element is not fully in view: outside the window, clipped by a scrolling box
 # (the control panel scrolled), or covered by something else; '' when the learner sees it.
-_OUT_OF_VIEW_JS = """([elements, scroll]) => elements.map((el) => {
+_WHY_UNSEEN_FN = """function whyUnseen(el, scroll) {
   if (scroll) el.scrollIntoView({block: 'nearest'});
   const r = el.getBoundingClientRect();
   const at = (b) => `${Math.round(b.top)}..${Math.round(b.bottom)} x ${Math.round(b.left)}..`
@@ -166,7 +166,13 @@ _OUT_OF_VIEW_JS = """([elements, scroll]) => elements.map((el) => {
   if (!hit || !(hit === el || el.contains(hit) || hit.contains(el)))
     return `covered by ${hit ? hit.tagName + ' ' + (hit.innerText || '').slice(0, 30) : 'nothing'}`;
   return '';
-})"""
+}"""
+
+_OUT_OF_VIEW_JS = (
+    "([elements, scroll]) => { "
+    + _WHY_UNSEEN_FN
+    + " return elements.map((el) => whyUnseen(el, scroll)); }"
+)
 
 
 def out_of_view(page: Page, controls: dict[str, Locator], scroll: bool = False) -> list[str]:
@@ -180,37 +186,126 @@ def out_of_view(page: Page, controls: dict[str, Locator], scroll: bool = False) 
     return [f"{name}: {why}" for name, why in zip(controls, reasons, strict=True) if why]
 
 
+# A step card's controls found as the Playwright locators of ``step_controls`` find them,
+# in one pass over the page (those locators cost about 0.4 s a step on a loaded machine,
+# 171 steps a walk): text as get_by_text (spaces folded; the innermost element holding
+# it; exact, or any case), buttons as get_by_role("button", name=..., exact) (the name
+# is aria-label or the text; hidden ones left out), check lines as li elements whose text
+# matches CHECK_LINE. Answers a list of what is missing, or the named elements.
+_STEP_CARD_FN = """function stepCard(spec) {
+  const fold = (s) => (s || '').replace(/\\s+/g, ' ').trim();
+  const visible = (e) => { const r = e.getBoundingClientRect();
+    return r.width > 0 && r.height > 0 && getComputedStyle(e).visibility !== 'hidden'; };
+  const inTree = (e) => e.getClientRects().length > 0 && !e.closest('[aria-hidden=true]')
+    && getComputedStyle(e).visibility !== 'hidden';
+  const everything = [...document.body.querySelectorAll('*')]
+    .filter((e) => !['SCRIPT', 'STYLE'].includes(e.tagName));
+  const innermost = (test) => {
+    const hits = new Set(everything.filter((e) => test(fold(e.textContent))));
+    return [...hits].filter((e) => ![...e.children].some((c) => hits.has(c)));
+  };
+  const buttons = [...document.body.querySelectorAll(
+    'button, [role=button], input[type=button], input[type=submit]')].filter(inTree);
+  const nameOf = (b) => fold(b.getAttribute('aria-label') || b.innerText || b.value || '');
+  const button = (test) => buttons.find((b) => test(nameOf(b)));
+  const found = {}, missing = [];
+  const want = (name, el) => { if (el) found[name] = el; else missing.push(name); };
+  want('title', innermost((t) => t === spec.title)[0]);
+  const words = spec.words.toLowerCase();
+  want('text', innermost((t) => t.toLowerCase().includes(words)).find(visible));
+  if (spec.head) return {missing, names: Object.keys(found), elements: Object.values(found)};
+  for (const [name, label] of spec.buttons) want(name, button((n) => n === label));
+  const line = new RegExp(spec.check_line);
+  const checks = [...document.body.querySelectorAll('li')]
+    .filter((e) => line.test(fold(e.textContent)) && visible(e));
+  if (checks.length !== spec.checks.length)
+    missing.push(`${spec.checks.length} check lines (${checks.length} shown)`);
+  spec.checks.forEach(([name, answers], i) => {
+    for (const [answer, labels] of answers) want(answer, button((n) => labels.includes(n)));
+    want(name, checks[i]);
+  });
+  want('Back', button((n) => n === 'Back'));
+  const next = new RegExp(spec.next);
+  want('Next', button((n) => next.test(n) || n === spec.end));
+  return {missing, names: Object.keys(found), elements: Object.values(found)};
+}"""
+
+_STEP_CARD_JS = (
+    "(spec) => { "
+    + _STEP_CARD_FN
+    + " "
+    + _WHY_UNSEEN_FN
+    + """
+  const card = stepCard(spec);
+  if (card.missing.length) return {missing: card.missing};
+  const top = (name) => card.elements[card.names.indexOf(name)].getBoundingClientRect().y;
+  const before = card.names.find((n) => n.startsWith('button') || n.startsWith('answer'));
+  const order = before && top(before) < top('text')
+    ? [`${before} comes before the step's text`] : [];
+  const why = card.elements.map((el) => whyUnseen(el, !spec.head));
+  return {missing: [], wrong: order.concat(
+    card.names.map((name, i) => why[i] ? `${name}: ${why[i]}` : '').filter(Boolean))};
+}"""
+)
+
+
+def _card_spec(lesson, index: int, head: bool) -> dict:
+    """What step ``index``'s card must show, for ``_STEP_CARD_JS``."""
+    step = lesson.steps[index]
+    buttons = []
+    for action in step.actions:
+        label = action.get("label") or action.kind.replace("_", " ")
+        buttons.append([f"button {label!r}", label])
+    checks = []
+    for i, check in enumerate(step.checks):
+        answers = []
+        if check.kind == "quiz":
+            for option in check["options"]:
+                labels = [answer_button_label(option, chosen) for chosen in (False, True)]
+                answers.append([f"answer {option[:30]!r}", labels])
+        checks.append([f"check {i + 1}", answers])
+    return {
+        "head": head,
+        "title": f"Step {index + 1} of {len(lesson.steps)}: {step.title}",
+        "words": first_words(step.text),
+        "buttons": buttons,
+        "checks": checks,
+        "check_line": CHECK_LINE.pattern,
+        "next": NEXT_OR_SKIP.pattern,
+        "end": COURSE_END,
+    }
+
+
+def _read_card(page: Page, lesson, index: int, head: bool, timeout: float = 10.0) -> list[str]:
+    """Problems of step ``index``'s card (see ``_STEP_CARD_JS``), once all of it is on the
+    page (up to ``timeout`` s, as ``step_controls``' waits); what is missing after that."""
+    spec = _card_spec(lesson, index, head)
+    deadline = time.monotonic() + timeout
+    while True:
+        seen = page.evaluate(_STEP_CARD_JS, spec)
+        if not seen["missing"]:
+            return list(seen["wrong"])
+        if time.monotonic() > deadline:
+            return [f"not on the page after {timeout:.0f} s: {', '.join(seen['missing'])}"]
+        page.wait_for_timeout(100)
+
+
 def step_reads_top_down(page: Page, lesson, index: int) -> list[str]:
     """What is wrong with step ``index``'s card as a learner reads it (none: []): its title
     and text in view as the step opens, the text above its first button and answer, and
     every control whole, uncovered and inside the window once scrolled to."""
     wrong = step_head_in_view(page, lesson, index)
-    controls = step_controls(page, lesson, index)
-    text_box = controls["text"].first.bounding_box()
-    for name, locator in controls.items():
-        if name.startswith(("button", "answer")):
-            box = locator.first.bounding_box()
-            if text_box and box and box["y"] < text_box["y"]:
-                wrong.append(f"{name} comes before the step's text")
-            break
-    wrong += out_of_view(page, controls, scroll=True)
-    return wrong
+    return wrong + _read_card(page, lesson, index, head=False)
 
 
 def step_head_in_view(page: Page, lesson, index: int) -> list[str]:
     """What keeps a learner from reading step ``index``'s title and the start of its text
     as the step opens (none: [])."""
-    step = lesson.steps[index]
-    title = f"Step {index + 1} of {len(lesson.steps)}: {step.title}"
-    head = {
-        "title": page.get_by_text(title, exact=True),
-        "text": page.get_by_text(first_words(step.text)).filter(visible=True),
-    }
     # A stage change re-mounts the column (3D scene: docked right) and its panel slides
     # into place (seen: the title 20 px wide at x -287 mid-slide): a learner reads the
     # card once it has settled, so the head is judged after up to 5 s of settling.
     for _ in range(10):
-        wrong = out_of_view(page, head)
+        wrong = _read_card(page, lesson, index, head=True)
         if not wrong:
             break
         page.wait_for_timeout(500)

@@ -57,25 +57,59 @@ _IMAGE_NOTE = re.compile(r"^(What the camera sends, and what a node|No camera im
 _LIFECYCLE_NOTE = re.compile(r"^(Current state of /|Start lifecycle_talker in the Nodes tab)")
 
 
+# What each stage shows when it is on, read in one pass over the page (one round trip:
+# a Playwright locator a stage cost 360 ms a look on a loaded machine, 10 a look).
+# Each is (kind, what): "css" an element matching a selector; "text" an element whose
+# text, spaces folded, matches the regex (Playwright's get_by_text(re)); "exact" whose
+# text is exactly that; "contains" holds it, any case (get_by_text(str)); "tabs" a tab
+# of each name (get_by_role("tab", name=...)). Shown as Playwright's visible: a box,
+# not visibility:hidden.
+_STAGE_SIGNS: dict[str, tuple[str, object]] = {
+    "graph": ("css", "svg.stage-graph"),
+    "plot": ("text", _PLOT_NOTE.pattern),
+    "image": ("text", _IMAGE_NOTE.pattern),
+    "lifecycle": ("text", _LIFECYCLE_NOTE.pattern),
+    "bag": ("exact", "Newest bag"),  # its folder's title
+    "replay": ("exact", "Watch a recording"),  # its folder's
+    "code": ("tabs", ["Code of this lesson", "Program output"]),
+    "turtlesim": ("contains", "Arrow keys drive turtle1 while this window"),
+    "tf": ("css", "div.stage-tf"),
+}
+
+_ON_STAGE_JS = """(signs) => {
+  const shown = (e) => { const r = e.getBoundingClientRect();
+    return r.width > 0 && r.height > 0 && getComputedStyle(e).visibility !== 'hidden'; };
+  const fold = (s) => s.replace(/\\s+/g, ' ').trim();
+  // Elements that hold text, and the few above each (a line's first words may be bold).
+  const holders = new Set();
+  const walk = document.createTreeWalker(document.body, NodeFilter.SHOW_TEXT);
+  for (let n = walk.nextNode(); n; n = walk.nextNode()) {
+    if (!n.nodeValue.trim()) continue;
+    let e = n.parentElement;
+    for (let up = 0; e && e !== document.body && up < 4; up++, e = e.parentElement) holders.add(e);
+  }
+  const texts = [...holders].map((e) => [e, fold(e.textContent)]);
+  const anyText = (test) => texts.some(([e, t]) => test(t) && shown(e));
+  const tabs = [...document.querySelectorAll('[role=tab]')].filter(shown)
+    .map((t) => fold(t.textContent));
+  const on = [];
+  for (const [name, [kind, what]] of signs) {
+    let seen;
+    if (kind === 'css') seen = [...document.querySelectorAll(what)].some(shown);
+    else if (kind === 'text') { const re = new RegExp(what); seen = anyText((t) => re.test(t)); }
+    else if (kind === 'exact') seen = anyText((t) => t === what);
+    else if (kind === 'contains')
+      seen = anyText((t) => t.toLowerCase().includes(what.toLowerCase()));
+    else seen = what.every((name) => tabs.includes(name));
+    if (seen) on.push(name);
+  }
+  return on;
+}"""
+
+
 def _on_stage(page: Page) -> list[str]:
     """Which stages the page shows, read from what is visible ([] is the 3D scene)."""
-
-    def shown(locator) -> bool:
-        return locator.filter(visible=True).count() > 0
-
-    seen = {
-        "graph": shown(page.locator("svg.stage-graph")),
-        "plot": shown(page.get_by_text(_PLOT_NOTE)),
-        "image": shown(page.get_by_text(_IMAGE_NOTE)),
-        "lifecycle": shown(page.get_by_text(_LIFECYCLE_NOTE)),
-        "bag": shown(page.get_by_text("Newest bag", exact=True)),  # its folder's title
-        "replay": shown(page.get_by_text("Watch a recording", exact=True)),  # its folder's
-        "code": shown(page.get_by_role("tab", name="Code of this lesson"))
-        and shown(page.get_by_role("tab", name="Program output")),
-        "turtlesim": shown(page.get_by_text("Arrow keys drive turtle1 while this window")),
-        "tf": shown(page.locator("div.stage-tf")),
-    }
-    return [name for name, on in seen.items() if on]
+    return page.evaluate(_ON_STAGE_JS, [[name, list(sign)] for name, sign in _STAGE_SIGNS.items()])
 
 
 def _wait_stage(page: Page, wanted: str, timeout: float = 5.0) -> None:

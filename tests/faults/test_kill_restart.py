@@ -757,8 +757,10 @@ def test_twenty_sigkills_lose_nothing_and_leave_no_orphans(ros_env, probe, brows
 
             def kill(pid: int = dash.proc.pid, seen: list[int] = seen, work: Round = work) -> None:
                 seen.extend(_descendants(pid))
-                os.kill(pid, signal.SIGKILL)
+                # Said before it is done: a step that sees the connection drop must know it
+                # was the kill (ci10, loaded: the step's error came before this thread set it).
                 work.killed.set()
+                os.kill(pid, signal.SIGKILL)
 
             timer = threading.Timer(delay, kill)
             try:

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import threading
+from dataclasses import replace
+
 import pytest
 
 from app.ros.context import CONSOLE_LIMITS, CallContext
@@ -16,9 +19,14 @@ pytestmark = pytest.mark.ros
 def console(probe, supervisor):
     """Runs console text like the Console tab, with the supervisor as ``ctx.programs``."""
 
-    def run(text: str) -> tuple[int, list[str]]:
+    def run(text: str, until: threading.Event | None = None) -> tuple[int, list[str]]:
+        """``until``: the command runs until it is set (a terminal's Ctrl+C), not the
+        Console's 5 s, and ends as a stopped Console command does."""
         lines: list[str] = []
-        ctx = CallContext(probe.node, lines.append, CONSOLE_LIMITS, programs=supervisor)
+        limits = CONSOLE_LIMITS if until is None else replace(CONSOLE_LIMITS, max_seconds=None)
+        ctx = CallContext(probe.node, lines.append, limits, programs=supervisor)
+        if until is not None:
+            ctx.cancel = until
         code = run_text(ctx, text)
         return code, "\n".join(lines).splitlines()
 

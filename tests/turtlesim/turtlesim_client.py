@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import math
+import statistics
 import sys
 import threading
 import time
@@ -385,6 +386,14 @@ class Goal:
             "feedback": len(self.feedback),
             "seconds": time.monotonic() - self.sent,
             "first_remaining": self.feedback[0] if self.feedback else None,
+            # How far the turtle turned between two feedbacks that came in, middle value:
+            # one 16 ms step when the server sends feedback at each step (a client that
+            # falls behind on a loaded machine drops some, which this does not hide).
+            "gap_p50": statistics.median(
+                abs(b - a) for a, b in zip(self.feedback, self.feedback[1:], strict=False)
+            )
+            if len(self.feedback) > 1
+            else None,
         }
 
 
