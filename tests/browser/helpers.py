@@ -276,9 +276,13 @@ def _card_spec(lesson, index: int, head: bool) -> dict:
     }
 
 
+class CardMissing(AssertionError):
+    """Part of a step card never came on the page (as a locator's wait timing out)."""
+
+
 def _read_card(page: Page, lesson, index: int, head: bool, timeout: float = 10.0) -> list[str]:
     """Problems of step ``index``'s card (see ``_STEP_CARD_JS``), once all of it is on the
-    page (up to ``timeout`` s, as ``step_controls``' waits); what is missing after that."""
+    page (up to ``timeout`` s, as ``step_controls``' waits); raises CardMissing after that."""
     spec = _card_spec(lesson, index, head)
     deadline = time.monotonic() + timeout
     while True:
@@ -286,7 +290,10 @@ def _read_card(page: Page, lesson, index: int, head: bool, timeout: float = 10.0
         if not seen["missing"]:
             return list(seen["wrong"])
         if time.monotonic() > deadline:
-            return [f"not on the page after {timeout:.0f} s: {', '.join(seen['missing'])}"]
+            raise CardMissing(
+                f"{lesson.id} step {index + 1}: not on the page after {timeout:.0f} s: "
+                + ", ".join(seen["missing"])
+            )
         page.wait_for_timeout(100)
 
 
