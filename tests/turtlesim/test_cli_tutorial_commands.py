@@ -177,7 +177,7 @@ def test_nodes_and_topics_tutorials(console, probe, supervisor):  # noqa: F811
     for thread, result in pubs:
         thread.join(timeout=15)
         assert result, "a publisher did not stop"
-        code, out = result[0]
+        _code, out = result[0]
         assert out[0] == "publisher: beginning loop" and out[-1] == "(stopped)", out
         assert out[1].startswith("publishing #1: "), out
 

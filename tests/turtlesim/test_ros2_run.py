@@ -24,9 +24,9 @@ def console(probe, supervisor):
         Console's 5 s, and ends as a stopped Console command does."""
         lines: list[str] = []
         limits = CONSOLE_LIMITS if until is None else replace(CONSOLE_LIMITS, max_seconds=None)
-        ctx = CallContext(probe.node, lines.append, limits, programs=supervisor)
-        if until is not None:
-            ctx.cancel = until
+        ctx = CallContext(
+            probe.node, lines.append, limits, until or threading.Event(), programs=supervisor
+        )
         code = run_text(ctx, text)
         return code, "\n".join(lines).splitlines()
 
