@@ -27,6 +27,8 @@ from std_srvs.srv import Empty, Trigger
 
 from app import PROJECT_ROOT
 from app.launch_prefix import PREFIX_ENV, ROS2LAUNCH_MAIN, launch_env
+from app.ros.calls import call_service
+from app.ros.context import CallContext, Limits
 from app.supervisor import LearnerProgram
 from tests.conftest import wait_until
 from tests.nav.bringup_helpers import bringup_prefix, load, node_sections
@@ -60,16 +62,12 @@ def changed_copy(folder: Path) -> Path:
 
 
 def call(node: Any, srv_type: Any, name: str, request: Any, timeout: float = 20.0) -> Any:
-    client = node.create_client(srv_type, name)
-    try:
-        assert client.wait_for_service(timeout_sec=timeout), f"no service {name}"
-        done = threading.Event()
-        future = client.call_async(request)
-        future.add_done_callback(lambda _f: done.set())
-        assert done.wait(timeout), f"{name} did not answer"
-        return future.result()
-    finally:
-        node.destroy_client(client)
+    """One answer, as the dashboard asks: these requests are safe to repeat, so one that
+    got no answer goes out once more (``call_service``'s ``resend_unanswered``: Fast DDS
+    drops a reply when the server has not yet matched a new client's reader, which a
+    loaded machine's discovery can take longer than its 100 ms wait for)."""
+    ctx = CallContext(node, limits=Limits(service_timeout=timeout))
+    return call_service(ctx, name, srv_type, request, resend_unanswered=True)
 
 
 def test_bringup_launch_brings_the_stack_up_with_the_params_file(probe, supervisor, tmp_path):

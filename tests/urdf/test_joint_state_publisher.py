@@ -108,4 +108,5 @@ def test_publishes_every_movable_joint_and_takes_source_values(probe) -> None:
         except subprocess.TimeoutExpired:
             os.killpg(proc.pid, signal.SIGKILL)
             proc.wait(timeout=5)
-    assert proc.returncode == 0
+    output = proc.stdout.read() if proc.stdout else ""
+    assert proc.returncode == 0, output
