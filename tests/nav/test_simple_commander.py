@@ -122,6 +122,36 @@ def test_cancel_task(navigator, nav2, capfd):
     assert "Canceling current task." in capfd.readouterr().err
 
 
+def test_polling_a_long_task_leaves_no_work_behind(navigator, nav2):
+    """Polled for seconds, a task must not leave wake-ups behind that later turn the
+    executor round and round without waiting. rclpy 7.1's spin_until_future_complete
+    adds a done callback at every turn, and each becomes a task when the future ends
+    (ros2/rclpy#1374): a navigator that polls and plans again and again spun a core."""
+    nav2.mode["navigate_to_pose"] = UNTIL_CANCELED
+    assert navigator.goToPose(pose(3.0, 1.0))
+    deadline = time.monotonic() + 3.0
+    while time.monotonic() < deadline:  # feedback flows at 10 Hz meanwhile
+        assert not navigator.isTaskComplete()
+    navigator.cancelTask()
+    until_complete(navigator)
+    executor = rclpy.get_global_executor()
+    turns = 0
+    turn = executor._spin_once_impl
+
+    def counted(*args, **kwargs):
+        nonlocal turns
+        turns += 1
+        return turn(*args, **kwargs)
+
+    executor._spin_once_impl = counted
+    try:
+        assert isinstance(navigator.getPath(pose(0.0, 0.0), pose(2.0, 1.0)), NavPath)
+    finally:
+        del executor._spin_once_impl
+    # A plan is a goal answer, a status or two and a result: a handful of turns.
+    assert turns <= 15, f"{turns} turns of the executor for one plan"
+
+
 def test_waypoints_paths_and_behaviours(navigator, nav2, capfd):
     """followWaypoints, followPath, spin, backup and driveOnHeading send Nav2's goals."""
     assert navigator.followWaypoints([pose(1.0, 1.0), pose(2.0, 2.0), pose(3.0, 1.0)])

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import math
 import time
+import weakref
 from enum import Enum
 from typing import Any
 
@@ -73,6 +74,40 @@ ClearCostmapAroundRobot: Any = getattr(nav2_msgs.srv, "ClearCostmapAroundRobot",
 ClearCostmapAroundPose: Any = getattr(nav2_msgs.srv, "ClearCostmapAroundPose", None)
 
 MANAGE_NODES_TYPE = "nav2_msgs/srv/ManageLifecycleNodes"
+
+
+_WAKING: weakref.WeakSet[Future] = weakref.WeakSet()  # futures that already wake the executor
+
+
+def _spin_until_done(node: Node, future: Future, timeout_sec: float | None = None) -> None:
+    """``rclpy.spin_until_future_complete(node, future, timeout_sec=...)``, without its pile-up.
+
+    rclpy 7.1 (Jazzy's, the wheel on PyPI) adds a done callback to the future on every
+    turn of its loop and again on every call; each becomes a task when the future ends,
+    and leftover tasks make the next wait turn without waiting (ros2/rclpy#1374, #1702).
+    A navigator polls ``isTaskComplete`` and plans again and again, so that grew into a
+    loop taking a core while it waited (measured: about 760 turns and 0.35 s of CPU for a
+    90 ms plan). Here: one wake callback per future, and plain ``spin_once`` turns on the
+    same global executor, added and removed as rclpy does.
+    """
+    executor = rclpy.get_global_executor()
+    if future not in _WAKING:
+        _WAKING.add(future)
+        future.add_done_callback(lambda _f: executor.wake())
+    deadline = None if timeout_sec is None or timeout_sec < 0 else time.monotonic() + timeout_sec
+    added = executor.add_node(node)
+    try:
+        while executor.context.ok() and not future.done():
+            if deadline is None:
+                executor.spin_once()
+                continue
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return
+            executor.spin_once(timeout_sec=left)
+    finally:
+        if added:
+            executor.remove_node(node)
 
 
 class TaskResult(Enum):
@@ -227,7 +262,7 @@ class BasicNavigator(Node):
         send_goal_future = client.send_goal_async(
             goal_msg, self._feedbackCallback if feedback else None
         )
-        rclpy.spin_until_future_complete(self, send_goal_future)
+        _spin_until_done(self, send_goal_future)
         self.goal_handle = send_goal_future.result()
         if self.goal_handle is None or not self.goal_handle.accepted:
             self.error(rejected)
@@ -405,14 +440,14 @@ class BasicNavigator(Node):
         self.info("Canceling current task.")
         if self.result_future and self.goal_handle is not None:
             future = self.goal_handle.cancel_goal_async()
-            rclpy.spin_until_future_complete(self, future)
+            _spin_until_done(self, future)
 
     def isTaskComplete(self) -> bool:
         """Check if the task request of any type is complete yet."""
         if not self.result_future:
             # no task sent yet: nothing is pending
             return True
-        rclpy.spin_until_future_complete(self, self.result_future, timeout_sec=0.10)
+        _spin_until_done(self, self.result_future, timeout_sec=0.10)
         response = self.result_future.result()
         if not response:
             # still running
@@ -458,13 +493,13 @@ class BasicNavigator(Node):
             self.info(f"'{server}' action server not available, waiting...")
         self.info(doing)
         send_goal_future = client.send_goal_async(goal_msg)
-        rclpy.spin_until_future_complete(self, send_goal_future)
+        _spin_until_done(self, send_goal_future)
         self.goal_handle = send_goal_future.result()
         if self.goal_handle is None or not self.goal_handle.accepted:
             self.error(rejected)
             return None
         self.result_future = self.goal_handle.get_result_async()
-        rclpy.spin_until_future_complete(self, self.result_future)
+        _spin_until_done(self, self.result_future)
         response = self.result_future.result()
         self.status = response.status
         return response.result
@@ -578,7 +613,7 @@ class BasicNavigator(Node):
         while not client.wait_for_service(timeout_sec=1.0):
             self.info(not_available)
         future = client.call_async(request)
-        rclpy.spin_until_future_complete(self, future)
+        _spin_until_done(self, future)
         return future.result()
 
     def changeMap(self, map_filepath: str) -> None:
@@ -687,7 +722,7 @@ class BasicNavigator(Node):
             # gives once it has a pose: keep offering it the initial pose until it answers.
             offered = -math.inf
             while not future.done():
-                rclpy.spin_until_future_complete(self, future, timeout_sec=0.10)
+                _spin_until_done(self, future, timeout_sec=0.10)
                 now = time.monotonic()
                 if not future.done() and not self.initial_pose_received and now - offered > 1.0:
                     self._setInitialPose()
@@ -722,7 +757,7 @@ class BasicNavigator(Node):
         while True:
             self.debug(f"Getting {node_name} state...")
             future = state_client.call_async(GetState.Request())
-            rclpy.spin_until_future_complete(self, future)
+            _spin_until_done(self, future)
             response = future.result()
             if response is not None:
                 state = response.current_state.label
