@@ -6,11 +6,13 @@ import re
 
 from app import PROJECT_ROOT
 from tests.worker_plan import (
+    LONG_UNITS,
     ONE_WORKER,
     SAME_UNIT,
     SHARED_MODULE_FIXTURES,
     WAITING_MODULES,
     busy_cases,
+    is_long,
     spread,
     unit_of,
     waits,
@@ -99,3 +101,20 @@ def test_only_gradings_and_walks_that_start_nothing_busy_wait():
     assert not waits(f"{grading}[patrol-reference]", busy)  # the office world with Nav2
     assert not waits(f"{walk}[20_workspaces_packages]", busy)  # colcon builds
     assert not waits("tests/browser/test_stage.py::test_every_step", busy)
+
+
+def test_long_units_start_in_the_first_half_and_each_names_real_tests():
+    faults = _ids("faults", 20)
+    long_one = "tests/faults/test_kill_restart.py::test_twenty_sigkills_lose_nothing"
+    assert is_long(long_one) and not is_long(faults[0])
+    order = spread([*_ids("unit", 40), *faults, long_one], nodeid_of=str)
+    assert order.index(long_one) < len(order) / 2  # collected last of its folder
+    # Each entry still names tests: a renamed one would silently start late again.
+    hub_units = set(SAME_UNIT.values())
+    for prefix in LONG_UNITS:
+        if prefix in hub_units:
+            continue
+        module, _, name = prefix.partition("::")
+        source = (PROJECT_ROOT / module).read_text(encoding="utf-8")
+        if name:
+            assert f"def {name.split('[')[0]}" in source, prefix
