@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 import time
+from typing import Any
 
 import pytest
 from playwright.sync_api import Locator, Page, expect
@@ -112,6 +113,19 @@ def start_group(page: Page, group: str) -> None:
     choose(page, "Launch group", group)
     click(page, "Start group")
     expect_text(page, "Started group")
+
+
+# The code editor (app/exercises/editor) is read-only until the learner's saved code has
+# arrived; its status says "connected" before that. Text put in earlier is replaced by the
+# saved code when it arrives (ci17: the kill/restart test's round 4 set its code in that
+# moment, and the saved code won).
+EDITOR_TAKES_TYPING = "textarea.ace_text-input:not([readonly])"
+
+
+def expect_editor_loaded(editor: Any, timeout: float = 30_000) -> None:
+    """``editor`` (the editor's frame locator) shows the saved code and takes typing."""
+    expect(editor.locator("#status")).to_have_text(re.compile("saved|connected"), timeout=timeout)
+    expect(editor.locator(EDITOR_TAKES_TYPING)).to_be_attached(timeout=timeout)
 
 
 def expect_text(page: Page, text: str | re.Pattern[str], timeout: float = 20_000) -> None:

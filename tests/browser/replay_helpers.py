@@ -9,7 +9,7 @@ from collections.abc import Iterator
 from playwright.sync_api import Page, expect
 
 from app.exercises.model import Exercise
-from tests.browser.helpers import choose, click, expect_text, open_tab
+from tests.browser.helpers import choose, click, expect_editor_loaded, expect_text, open_tab
 from tests.browser.test_exercise import _type_code
 
 
@@ -65,7 +65,7 @@ def grade_in_browser(page: Page, exercise: Exercise, code: str) -> None:
     choose(page, "Exercise", f"{exercise.unit:02d} · {exercise.title}")
     page.get_by_role("tab", name="Your code").click()
     editor = page.frame_locator(f"iframe[src*='slug={exercise.slug}']")
-    expect(editor.locator("#status")).to_have_text(re.compile("saved|connected"))
+    expect_editor_loaded(editor)
     _type_code(page, editor, code)
     click(page, "Run my node")
     expect_text(page, re.compile(r"running \(pid \d+\) · on the graph"), 60_000)

@@ -9,7 +9,7 @@ import signal
 from playwright.sync_api import Page, expect
 
 from app.exercises.model import load_exercises
-from tests.browser.helpers import choose, click, expect_text, open_tab
+from tests.browser.helpers import choose, click, expect_editor_loaded, expect_text, open_tab
 from tests.browser.test_ros2_panels import expect_regex, field
 from tests.conftest import DashboardProcess, free_port
 
@@ -29,7 +29,7 @@ def _open_editor(page: Page):
 def _frame(page: Page):
     """The editor's frame once it shows this exercise's saved code."""
     locator = page.frame_locator(f"iframe[src*='slug={EXERCISE.slug}']")
-    expect(locator.locator("#status")).to_have_text(re.compile("saved|connected"))
+    expect_editor_loaded(locator)
     frame = page.frame(url=re.compile(rf"editor\.html\?slug={EXERCISE.slug}"))
     assert frame is not None
     return frame
@@ -137,7 +137,7 @@ def test_workspace_files_in_the_editor_complete_lint_and_format(page, progress_d
     choose(page, "On stage", "Code")
     page.get_by_role("tab", name="Your code").click()
     editor = page.frame_locator("iframe[src*='editor.html']")
-    expect(editor.locator("#status")).to_have_text(re.compile("saved|connected"))
+    expect_editor_loaded(editor)
     for path in ("src/my_package/my_package/my_node.py", "src/my_package/setup.py"):
         _open_from_tree(editor, path)
     expect(editor.get_by_role("tab", name="setup.py")).to_have_attribute("aria-selected", "true")

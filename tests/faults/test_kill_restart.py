@@ -54,6 +54,7 @@ from app.bags.repair import reindex
 from app.exercises.model import load_exercises
 from app.lessons.panel import NEXT_LABEL
 from app.lessons.schema import load_course
+from tests.browser.helpers import EDITOR_TAKES_TYPING
 from tests.conftest import ARTIFACTS, DashboardProcess, free_port, wait_until
 from tests.faults.helpers import live_children, record
 from tests.wire_client import WireClient, connect_quietly, frames_until_closed
@@ -404,13 +405,13 @@ class Round:
 
     # -- through the page ----------------------------------------------------------
 
-    def page_wait(self, locator: Any, timeout: float = 20.0) -> None:
+    def page_wait(self, locator: Any, timeout: float = 20.0, state: str = "visible") -> None:
         from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
         deadline = time.monotonic() + timeout
         while True:
             try:
-                locator.wait_for(state="visible", timeout=400)
+                locator.wait_for(state=state, timeout=400)
                 return
             except PlaywrightTimeout:
                 self.alive()
@@ -477,6 +478,9 @@ class Round:
             self.page.get_by_role("tab", name="Your code").click(timeout=30_000)
             editor = self.page.frame_locator(f"iframe[src*='slug={SLUG}']")
             self.page_wait(editor.locator("#status").filter(has_text=re.compile("saved|connected")))
+            # The saved code has arrived (the editor takes typing): code set before then is
+            # replaced by it (ci17, round 4: 'saved ✓', and the code was the old one).
+            self.page_wait(editor.locator(EDITOR_TAKES_TYPING), state="attached")
             self.frame = self.page.frame(url=re.compile(rf"editor\.html\?slug={SLUG}"))
             assert self.frame is not None
         self.alive()

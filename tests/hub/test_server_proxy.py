@@ -26,7 +26,7 @@ from playwright.sync_api import expect
 
 from app import PROJECT_ROOT
 from app.exercises.model import load_exercises
-from tests.browser.helpers import choose, expect_text, open_tab, start_node
+from tests.browser.helpers import choose, expect_editor_loaded, expect_text, open_tab, start_node
 from tests.conftest import ARTIFACTS, free_port, wait_until
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -183,7 +183,7 @@ def test_the_dashboard_works_under_the_proxy_and_only_through_it(jupyter, browse
         page.get_by_role("button", name="Open my code").click()  # the editor goes on stage
         page.get_by_role("tab", name="Your code").click()
         frame = page.frame_locator("iframe[src*='editor.html']")
-        expect(frame.locator("#status")).to_have_text(re.compile("saved|connected"), timeout=30_000)
+        expect_editor_loaded(frame)
         editor_frame = page.frame(url=re.compile(r"/ros2-classroom/classroom/editor/editor\.html"))
         assert editor_frame is not None, [f.url for f in page.frames]
 
