@@ -477,7 +477,6 @@ class Round:
             self.page.get_by_role("button", name="Open my code").click(timeout=15_000)
             self.page.get_by_role("tab", name="Your code").click(timeout=30_000)
             editor = self.page.frame_locator(f"iframe[src*='slug={SLUG}']")
-            self.page_wait(editor.locator("#status").filter(has_text=re.compile("saved|connected")))
             # The saved code has arrived (the editor takes typing): code set before then is
             # replaced by it (ci17, round 4: 'saved ✓', and the code was the old one).
             self.page_wait(editor.locator(EDITOR_TAKES_TYPING), state="attached")
