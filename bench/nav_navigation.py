@@ -32,6 +32,11 @@ each a process of its own. This process uses Nav2's Python API
   controller_server and bt_navigator together while the goals are driven
   (per cent of one core, aim <= 100), and each of them in ``cpu_by_node``.
 
+Beside them, ``nav_localization_error_max_m``: how far amcl's ``/amcl_pose`` was from
+the ground truth at its stamp, at worst while driving (each goal's worst is printed
+with it): a goal missed with a large one was lost by localization, not by planning
+or control.
+
 The stack's logs are kept in ``test-artifacts/bench-nav_navigation.log``.
 Also ``rtf_kept`` (simulated over wall seconds while driving) and the load
 average at the start: others on the cores stretch every wall time.
@@ -46,6 +51,7 @@ The last line printed is one JSON object.
 from __future__ import annotations
 
 import argparse
+import collections
 import json
 import math
 import os
@@ -160,11 +166,12 @@ def draw_goals(
 def run(goals_n: int, seed: int, rtf: float) -> dict[str, Any]:
     import psutil
     import rclpy
-    from geometry_msgs.msg import PoseStamped
+    from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
     from nav2_planner.navfn_planner import PlannerOptions, create_plan
     from nav2_simple_commander.robot_navigator import BasicNavigator, TaskResult
     from nav_msgs.msg import Odometry
     from rclpy.executors import SingleThreadedExecutor
+    from rclpy.qos import DurabilityPolicy, QoSProfile
 
     from app.catalog import lookup_group
     from app.lessons.checks._world_map import load_world_map
@@ -184,6 +191,8 @@ def run(goals_n: int, seed: int, rtf: float) -> dict[str, Any]:
     spinner = threading.Thread(target=executor.spin, daemon=True)
     lock = threading.Lock()
     truth: dict[str, Any] = {"pose": None, "t": 0.0, "path": 0.0, "record": False}
+    recent: collections.deque[tuple[float, float, float]] = collections.deque(maxlen=300)
+    localization = {"worst": 0.0, "samples": 0}  # amcl against the truth, while recording
     clearance: dict[str, Any] = {"min": math.inf, "collisions": 0, "inside": False, "at": []}
 
     def on_truth(msg: Any) -> None:
@@ -197,13 +206,26 @@ def run(goals_n: int, seed: int, rtf: float) -> dict[str, Any]:
             if truth["record"] and last is not None:
                 truth["path"] += math.hypot(p.x - last[0], p.y - last[1])
             truth["pose"], truth["t"] = (p.x, p.y), t
+            recent.append((t, p.x, p.y))
             clearance["min"] = min(clearance["min"], d)
             if d < ROBOT_RADIUS and not clearance["inside"]:
                 clearance["collisions"] += 1
                 clearance["at"].append((round(p.x, 2), round(p.y, 2)))
             clearance["inside"] = d < ROBOT_RADIUS
 
+    def on_amcl(msg: Any) -> None:
+        t = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        p = msg.pose.pose.position
+        with lock:
+            if not truth["record"] or not recent:
+                return
+            _t, x, y = min(recent, key=lambda r: abs(r[0] - t))  # the truth at its stamp
+            localization["worst"] = max(localization["worst"], math.hypot(p.x - x, p.y - y))
+            localization["samples"] += 1
+
     observer.create_subscription(Odometry, "/ground_truth/odom", on_truth, 50)
+    latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    observer.create_subscription(PoseWithCovarianceStamped, "/amcl_pose", on_amcl, latched)
     spinner.start()
     nav: Any = None
 
@@ -290,6 +312,7 @@ def run(goals_n: int, seed: int, rtf: float) -> dict[str, Any]:
         with lock:
             sim0 = truth["t"]
         reached, driven, optimal, outcomes = 0, 0.0, 0.0, []
+        worst_localization = 0.0
         for k, goal in enumerate(goals):
             here2 = robot()
             best, _w = grid_lengths(costmap, here2)
@@ -297,6 +320,7 @@ def run(goals_n: int, seed: int, rtf: float) -> dict[str, Any]:
             shortest = best.get(cell[1] * costmap.size_x + cell[0], math.nan) * costmap.resolution
             with lock:
                 truth["path"], truth["record"] = 0.0, True
+                localization["worst"] = 0.0
             t0 = time.monotonic()
             if not nav.goToPose(stamped(*goal)):
                 outcomes.append("rejected")
@@ -316,6 +340,8 @@ def run(goals_n: int, seed: int, rtf: float) -> dict[str, Any]:
             with lock:
                 truth["record"] = False
                 length = truth["path"]
+                lost = localization["worst"]
+                worst_localization = max(worst_localization, lost)
             x, y = robot()
             error = math.hypot(x - goal[0], y - goal[1])
             ok = result == TaskResult.SUCCEEDED and error < REACHED
@@ -327,7 +353,8 @@ def run(goals_n: int, seed: int, rtf: float) -> dict[str, Any]:
             print(
                 f"  goal {k + 1}/{len(goals)} ({goal[0]:.2f}, {goal[1]:.2f}): {result.name}, "
                 f"ended {error:.2f} m away, drove {length:.2f} m (grid optimum "
-                f"{shortest:.2f} m) in {time.monotonic() - t0:.1f} s",
+                f"{shortest:.2f} m) in {time.monotonic() - t0:.1f} s; amcl off by {lost:.2f} m "
+                "at worst",
                 flush=True,
             )
         wall = time.monotonic() - wall0
@@ -343,6 +370,12 @@ def run(goals_n: int, seed: int, rtf: float) -> dict[str, Any]:
         figures["nav_success_percent"] = 100.0 * reached / len(goals)
         figures["nav_path_ratio"] = driven / optimal if optimal > 0 else math.nan
         figures["outcomes"] = outcomes
+        with lock:
+            compared = localization["samples"]
+        if compared:
+            figures["nav_localization_error_max_m"] = worst_localization
+        else:
+            figures["errors"].append("no /amcl_pose came while the goals were driven")
         with lock:
             figures["nav_collisions"] = clearance["collisions"]
             figures["nav_min_clearance_m"] = clearance["min"]
@@ -376,6 +409,7 @@ def run(goals_n: int, seed: int, rtf: float) -> dict[str, Any]:
         "nav_plan_inprocess_p50_ms",
         "nav_plan_ratio",
         "nav_stack_cpu_percent",
+        "nav_localization_error_max_m",
     ):
         figures.setdefault(key, math.nan)
     return figures

@@ -10,6 +10,7 @@ from typing import Any
 from geometry_msgs.msg import PoseStamped
 from rcl_interfaces.srv import GetParameters
 from rclpy.node import Node
+from rclpy.parameter import parameter_value_to_python
 
 
 def pose_stamped(x: float, y: float, yaw: float) -> PoseStamped:
@@ -29,14 +30,18 @@ def wait_future(future: Any, timeout: float, what: str | Callable[[], str]) -> A
     return future.result()
 
 
-def string_parameter(node: Node, fqn: str, name: str, timeout: float = 10.0) -> str:
-    """A running node's string parameter, asked over its parameter service (not its log,
-    which a busy node's warnings can push out of the supervisor's ring of lines)."""
+def parameter(node: Node, fqn: str, name: str, timeout: float = 10.0) -> Any:
+    """A running node's parameter as a Python value, asked over its parameter service (not
+    its log, which a busy node's warnings can push out of the supervisor's ring of lines)."""
     client = node.create_client(GetParameters, f"{fqn}/get_parameters")
     try:
         assert client.wait_for_service(timeout_sec=timeout), f"{fqn} offers no parameters"
         future = client.call_async(GetParameters.Request(names=[name]))
         (value,) = wait_future(future, timeout, f"{fqn} did not answer for {name!r}").values
-        return str(value.string_value)
+        return parameter_value_to_python(value)
     finally:
         node.destroy_client(client)
+
+
+def string_parameter(node: Node, fqn: str, name: str, timeout: float = 10.0) -> str:
+    return str(parameter(node, fqn, name, timeout))

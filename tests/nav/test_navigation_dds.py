@@ -11,7 +11,9 @@ shows; a result answer lost to it once left "the wall goal did not end"):
 from the corridor into the meeting room through its door (reached, feedback
 with a shrinking distance_remaining, never near a wall by ground truth),
 into a wall (an error code, the servers live on), and one that is cancelled
-(the robot stops).
+(the robot stops). The planner keeps a finished goal on its action server for
+``action_server_result_timeout`` seconds, as Nav2's does (rclpy's own
+default would keep it 15 minutes, and every status message would list it).
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from action_msgs.msg import GoalStatus
+from action_msgs.msg import GoalStatus, GoalStatusArray
 from geometry_msgs.msg import TransformStamped
 from nav2_msgs.action import ComputePathToPose, NavigateToPose
 from nav_msgs.msg import Odometry, Path
@@ -38,7 +40,7 @@ from app.lessons.checks._world_map import load_world_map
 from app.ros.action_client import ThreadSafeActionClient
 from nodes.common.occupancy_grid import plan_distance
 from tests.conftest import wait_until
-from tests.nav.goal_helpers import pose_stamped, wait_future
+from tests.nav.goal_helpers import parameter, pose_stamped, wait_future
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(240)]
 
@@ -51,6 +53,7 @@ MANAGED = ["map_server", "planner_server", "controller_server", "bt_navigator"]
 DOOR_GOAL = (4.0, 1.7, math.pi / 2)  # the meeting room, through its door at x = 3.7..4.6
 WALL_GOAL = (0.6, 0.8, 0.0)  # on the corridor's north wall
 FAR_GOAL = (-3.0, 2.0, 0.0)  # the office, west: long enough to cancel on the way
+RESULT_KEPT = 2.0  # s: the planner's action_server_result_timeout here (Nav2's default: 10)
 
 
 class Truth:
@@ -108,7 +111,10 @@ def test_navigate_to_pose_through_a_door_a_wall_goal_and_a_cancel(probe, supervi
     node.create_subscription(Path, "/plan", plans.append, 10)
     supervisor.start_program(lookup("sim_office"), SIM_ARGS)
     supervisor.start_program(lookup("map_server"), ("-p", f"yaml_filename:={MAP_YAML}"))
-    supervisor.start_program(lookup("planner_server"), ("-p", "GridBased.tolerance:=0.0"))
+    supervisor.start_program(
+        lookup("planner_server"),
+        ("-p", "GridBased.tolerance:=0.0", "-p", f"action_server_result_timeout:={RESULT_KEPT}"),
+    )
     supervisor.start_program(lookup("controller_server"))
     supervisor.start_program(lookup("bt_navigator"))
     # The catalog's manager also brings up amcl; this test has no amcl (a static map -> world).
@@ -140,6 +146,29 @@ def test_navigate_to_pose_through_a_door_a_wall_goal_and_a_cancel(probe, supervi
         planned.result.planning_time.nanosec / 1e6 + planned.result.planning_time.sec * 1e3
     )
     wait_until(lambda: plans, timeout=20, what="/plan")
+
+    # Once its result timeout has passed, a finished plan is gone from the action's status
+    # list: the next plan's status lists that one alone. Nav2's controller keeps results 10 s.
+    statuses: list[GoalStatusArray] = []
+    node.create_subscription(
+        GoalStatusArray, "/compute_path_to_pose/_action/status", statuses.append, LATCHED
+    )
+    time.sleep(RESULT_KEPT + 1.0)
+    second = send(planner, plan_goal, [])
+    assert wait_future(second.get_result_async(), 30, "no second plan").status == (
+        GoalStatus.STATUS_SUCCEEDED
+    )
+
+    def listed() -> list[bytes]:
+        return [bytes(s.goal_info.goal_id.uuid) for s in statuses[-1].status_list]
+
+    wait_until(
+        lambda: statuses and bytes(second.goal_id.uuid) in listed(),
+        timeout=10,
+        what="the second plan in the status list",
+    )
+    assert bytes(plan_handle.goal_id.uuid) not in listed(), "an expired plan is still listed"
+    assert parameter(node, "/controller_server", "action_server_result_timeout") == 10.0
 
     # Navigate into the meeting room.
     navigator = ThreadSafeActionClient(node, NavigateToPose, "/navigate_to_pose")

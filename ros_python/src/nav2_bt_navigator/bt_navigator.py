@@ -134,6 +134,7 @@ class BtNavigator(LifecycleNode):
         p("backup_speed", 0.15)
         p("robot_radius", 0.15)  # the costmaps' robot_radius: the room backing up needs
         p("local_costmap_topic", "local_costmap/costmap")
+        p("action_server_result_timeout", 900.0)  # Nav2's bt_action_server default
         self.group = ReentrantCallbackGroup()
         self.lock = threading.Lock()
         self.current: Any = None
@@ -191,6 +192,7 @@ class BtNavigator(LifecycleNode):
                     handle_accepted_callback=self.on_accepted,
                     cancel_callback=self.on_cancel,
                     callback_group=self.group,
+                    result_timeout=float(self.get_parameter("action_server_result_timeout").value),
                 )
             )
         return TransitionCallbackReturn.SUCCESS

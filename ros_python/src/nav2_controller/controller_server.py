@@ -81,6 +81,7 @@ class ControllerServer(LifecycleNode):
         self.get_logger().info("Creating controller server")
         p = self.declare_parameter
         p("controller_frequency", 20.0)
+        p("action_server_result_timeout", 10.0)  # Nav2's; rclpy's default is 900 s
         p("controller_plugins", ["FollowPath"])
         p("goal_checker_plugins", ["goal_checker"])
         p("progress_checker_plugins", ["progress_checker"])
@@ -139,6 +140,7 @@ class ControllerServer(LifecycleNode):
             handle_accepted_callback=self.on_accepted,
             cancel_callback=self.on_cancel,
             callback_group=self.group,
+            result_timeout=float(g("action_server_result_timeout").value),
         )
         return TransitionCallbackReturn.SUCCESS
 

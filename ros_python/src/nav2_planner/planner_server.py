@@ -80,6 +80,9 @@ class PlannerServer(LifecycleNode):
         self.get_logger().info("Creating")
         self.declare_parameter("planner_plugins", ["GridBased"])
         self.declare_parameter("expected_planner_frequency", 1.0)
+        # How long a finished goal's result stays on the action server (and in its status
+        # list): Nav2's planner server keeps it 10 s; rclpy's own default would be 900 s.
+        self.declare_parameter("action_server_result_timeout", 10.0)
         self.declare_parameter("GridBased.plugin", "nav2_navfn_planner::NavfnPlanner")
         self.declare_parameter("GridBased.tolerance", 0.5)
         self.declare_parameter("GridBased.use_astar", False)
@@ -137,6 +140,7 @@ class PlannerServer(LifecycleNode):
             handle_accepted_callback=self.on_accepted,
             cancel_callback=lambda _goal: CancelResponse.ACCEPT,
             callback_group=self.group,
+            result_timeout=float(self.get_parameter("action_server_result_timeout").value),
         )
         return TransitionCallbackReturn.SUCCESS
 

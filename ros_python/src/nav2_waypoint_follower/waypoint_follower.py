@@ -174,7 +174,7 @@ class WaypointFollower(LifecycleNode):
             handle_accepted_callback=self.on_accepted,
             cancel_callback=lambda _goal: CancelResponse.ACCEPT,
             callback_group=self.group,
-            result_timeout=max(int(g("action_server_result_timeout").value), 1),
+            result_timeout=float(g("action_server_result_timeout").value),
         )
         return TransitionCallbackReturn.SUCCESS
 
