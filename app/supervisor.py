@@ -189,9 +189,22 @@ class Supervisor:
         self._ended: deque[NodeStatus] = deque(maxlen=500)  # who ended, newest last
         self._spawner = ThreadPoolExecutor(max_workers=1, thread_name_prefix="supervisor-spawn")
         self._closed = False
+        self._listeners: list[Callable[[NodeStatus], None]] = []
         # How learner code may run (app.containment.policy), set by whoever serves the
         # page; None refuses it. `ros2 launch` of a learner's launch file reads it.
         self.learner_policy: RunPolicy | None = None
+
+    def on_change(self, listener: Callable[[NodeStatus], None]) -> None:
+        """Call ``listener`` with a program's status when it was started, asked to stop and
+        reaped (on the thread that did it): the moments its node joins or leaves the graph."""
+        self._listeners.append(listener)
+
+    def _tell(self, status: NodeStatus) -> None:
+        for listener in list(self._listeners):
+            try:
+                listener(status)
+            except Exception:  # a listener's bug must not stop a start, a stop or a reap
+                logging.getLogger(__name__).exception("supervisor listener failed")
 
     # -- queries -----------------------------------------------------------
 
@@ -284,9 +297,11 @@ class Supervisor:
                 return future
             proc.stop_requested = True
             proc.state = NodeState.STOPPING
+            stopping = proc.status()
         threading.Thread(
             target=self._escalate_stop, args=(proc, future), name=f"stop-{name}", daemon=True
         ).start()
+        self._tell(stopping)
         return future
 
     def restart(self, name: str) -> NodeStatus:
@@ -351,7 +366,9 @@ class Supervisor:
         threading.Thread(
             target=self._read_and_reap, args=(proc,), name=f"output-{entry.name}", daemon=True
         ).start()
-        return proc.status()
+        status = proc.status()
+        self._tell(status)
+        return status
 
     def _read_and_reap(self, proc: _Process) -> None:
         """Read the output; reap on another thread, so a process that escaped the group
@@ -392,7 +409,9 @@ class Supervisor:
             proc.ended_at = time.time()
             proc.state = ended_state(code, proc.stop_requested, list(proc.output)[-5:])
             self._ended.append(proc.status())
+            ended = self._ended[-1]
         proc.done.set()
+        self._tell(ended)
 
     def _escalate_stop(self, proc: _Process, future: Future[NodeStatus]) -> None:
         # SIGINT is Ctrl+C: rclpy nodes leave spin and shut down cleanly, so

@@ -48,6 +48,10 @@ class UiLoop:
         if refresh:
             self._wake.set()
 
+    def wake(self) -> None:
+        """Wake the UI thread now: it looks at the graph and refreshes the panels."""
+        self._wake.set()
+
     def callback(self, intent: Callable[..., None], *args: object) -> Callable[[object], None]:
         """A viser callback that posts ``intent(*args)`` when a browser changed the widget.
 

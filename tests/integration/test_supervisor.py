@@ -211,3 +211,34 @@ def test_start_right_after_stop_starts_a_new_process(supervisor):
     assert second.state is NodeState.STARTING
     assert [p.pid for p in _node_children("talker")] == [second.pid]
     supervisor.stop("talker").result(timeout=10)
+
+
+def test_listeners_hear_each_start_stop_and_end(supervisor):
+    """The moments a node joins or leaves the graph, told as they happen (the dashboard then
+    looks at the graph often for a while, instead of fifty times a second all day)."""
+    import threading
+
+    heard: list[tuple[str, NodeState]] = []
+    ended = threading.Event()
+
+    def broken(_status: object) -> None:
+        raise RuntimeError("a listener's bug")
+
+    def listen(status: object) -> None:
+        heard.append((status.name, status.state))  # type: ignore[attr-defined]
+        if status.state is NodeState.STOPPED:  # type: ignore[attr-defined]
+            ended.set()
+
+    supervisor.on_change(broken)  # logged; the others are still told, the work goes on
+    supervisor.on_change(listen)
+    started = supervisor.start("talker")
+    assert heard == [("talker", NodeState.STARTING)]
+    assert supervisor.start("talker").pid == started.pid  # running already: nothing new
+    assert len(heard) == 1
+    supervisor.stop("talker").result(timeout=10)
+    assert ended.wait(5), heard
+    assert heard == [
+        ("talker", NodeState.STARTING),
+        ("talker", NodeState.STOPPING),
+        ("talker", NodeState.STOPPED),
+    ]
