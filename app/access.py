@@ -43,6 +43,10 @@ _PATCH_LOCK = threading.Lock()
 
 ProcessRequest = Callable[[ServerConnection, Request], Response | None]
 Handler = Callable[[ServerConnection], Awaitable[None]]
+# What websockets' ``serve`` takes as ``process_request``: a function or a coroutine function.
+GateProcessRequest = Callable[
+    [ServerConnection, Request], Awaitable[Response | None] | Response | None
+]
 
 
 class AccessError(ValueError):
@@ -131,7 +135,7 @@ class Gate(Protocol):
 
     installed: bool
 
-    def wrap(self, inner: ProcessRequest | None) -> Callable[..., Any]: ...
+    def wrap(self, inner: ProcessRequest | None) -> GateProcessRequest: ...
 
 
 class ServerExtension(Protocol):
@@ -147,7 +151,7 @@ def _extended_serve(gate: Gate | None, extension: ServerExtension | None) -> Ite
     """While viser builds its server: our routes behind the gate, the gate in front of all."""
     original = ws_server.serve
 
-    def serve(handler: Handler, *args: Any, **kwargs: Any) -> Any:
+    def serve(handler: Handler, *args: Any, **kwargs: Any) -> ws_server.serve:
         process_request = kwargs.get("process_request")
         if extension is not None:
             process_request = extension.wrap_http(process_request)

@@ -14,13 +14,20 @@ import sys
 import threading
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from app import catalog
 from app.dds import configure_this_process, validate_domain_id
 from app.hosts import is_loopback
 from app.ros2cli.groups import GROUPS
 from app.stop_signals import set_on_signals
+
+if TYPE_CHECKING:
+    from app.containment.policy import RunPolicy
+    from app.dashboard import Dashboard
+    from app.exercises.workspace import Workspace
+    from app.hub.singleuser_auth import HubLogin
+    from app.teacher.beacon import ProgressBeacon
 
 EXIT_USAGE = 2
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell tool killed by it reports
@@ -77,7 +84,7 @@ def _access_token(args: argparse.Namespace) -> str | None:
         raise CliError(str(exc)) from None
 
 
-def _run_policy(args: argparse.Namespace, progress_dir: Path, workspace: Any) -> Any:
+def _run_policy(args: argparse.Namespace, progress_dir: Path, workspace: Workspace) -> RunPolicy:
     """Learner code: as the user on loopback; served to others, only contained and allowed."""
     from app.containment.policy import RunPolicy
 
@@ -211,7 +218,7 @@ def _containment_line(allowed: bool) -> str:
     return f"Learner code: off; containment is not available here either ({missing})."
 
 
-def _hub_singleuser(args: argparse.Namespace) -> Any:
+def _hub_singleuser(args: argparse.Namespace) -> HubLogin | None:
     """``serve --jupyterhub``: this dashboard is a learner's JupyterHub server (the lean mode).
 
     The hub's spawner says where to listen, under which base path and for
@@ -238,7 +245,7 @@ def _hub_singleuser(args: argparse.Namespace) -> Any:
     return HubLogin(settings)
 
 
-def _hub_run_policy() -> Any:
+def _hub_run_policy() -> RunPolicy:
     """Behind the hub's login only the learner (or an admin the hub lets in) reaches the
     dashboard, which runs as the learner, in their own container under a container
     spawner: their code runs as in their own terminal, as in the Jupyter mode."""
@@ -247,11 +254,11 @@ def _hub_run_policy() -> Any:
     return LOOPBACK_POLICY
 
 
-def _hub_path(hub_login: Any) -> str:
+def _hub_path(hub_login: HubLogin | None) -> str:
     return hub_login.settings.prefix if hub_login is not None else ""
 
 
-def _progress_beacon(args: argparse.Namespace, dashboard: Any) -> Any:
+def _progress_beacon(args: argparse.Namespace, dashboard: Dashboard) -> ProgressBeacon | None:
     """In a classroom: report this learner's progress to the teacher (app/teacher/beacon.py)."""
     from app.teacher.hub_link import HubTarget
 

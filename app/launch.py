@@ -16,7 +16,7 @@ import sys
 import threading
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, TextIO
+from typing import TextIO
 
 import yaml
 
@@ -38,7 +38,7 @@ class NodeSpec:
     name: str
     namespace: str | None = None
     arguments: list[str] = field(default_factory=list)
-    parameters: dict[str, Any] = field(default_factory=dict)
+    parameters: dict[str, object] = field(default_factory=dict)
     remappings: list[tuple[str, str]] = field(default_factory=list)
     ros_arguments: list[str] = field(default_factory=list)
 
@@ -73,7 +73,7 @@ def node_spec(entry: CatalogEntry) -> NodeSpec:
     return spec
 
 
-def _py(value: Any) -> str:
+def _py(value: object) -> str:
     """A Python literal in the double-quoted style of our code."""
     if isinstance(value, str):
         return json.dumps(value)

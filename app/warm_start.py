@@ -86,10 +86,41 @@ from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager, suppress
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, TYPE_CHECKING, Any
 
 from app import PROJECT_ROOT
 from app.stop_signals import die_with
+
+if TYPE_CHECKING:
+    from typing import TypedDict
+
+    class _Account(TypedDict):
+        """A request's ``user``: the account its fork becomes."""
+
+        uid: int
+        gid: int
+        groups: list[int]
+
+    class _Said(TypedDict, total=False):
+        """What the warm parent says to the classroom (protocol steps 1 and 3)."""
+
+        imported: bool
+        seconds: float
+        missing: list[str]  # the optional modules that failed to import
+        error: str
+        ready: bool
+        pid: int
+        threads: int
+        open_files: list[str]
+        python_threads: list[str]
+
+    class _Answer(TypedDict, total=False):
+        """The warm parent's answer to one request (protocol step 4)."""
+
+        id: int | None
+        pid: int
+        error: str
+
 
 PARENT_MODULE = "app.warm_start"
 COLD_START_VAR = "CLASSROOM_COLD_START"  # "1": every dashboard starts cold (a cold process each)
@@ -183,7 +214,7 @@ class Credentials:
     groups: tuple[int, ...]
 
 
-def _become(user: dict[str, Any], classroom: int) -> None:
+def _become(user: _Account, classroom: int) -> None:
     """Switch to the learner's account for good; any step that fails ends the process.
 
     Changing credentials clears the parent-death signal and makes the process
@@ -208,7 +239,7 @@ def _become(user: dict[str, Any], classroom: int) -> None:
 # --------------------------------------------------------------------- the warm parent
 
 
-def _send(sock: socket.socket, message: Mapping[str, Any]) -> None:
+def _send(sock: socket.socket, message: Mapping[str, object]) -> None:
     sock.sendall(json.dumps(message).encode())
 
 
@@ -253,7 +284,7 @@ def _end_openblas_threads() -> None:
 class _LttngUst:
     """LTTng-UST's fork protocol (what its liblttng-ust-fork.so wraps ``fork`` with)."""
 
-    def __init__(self, libraries: list[Any]) -> None:
+    def __init__(self, libraries: list[ctypes.CDLL]) -> None:
         self._libraries = libraries
         self._sigsets = [ctypes.create_string_buffer(128) for _ in libraries]  # sigset_t
 
@@ -426,7 +457,7 @@ class WarmParent:
                 return learner
 
     def _start(self, size: int, fds: list[int], flags: int) -> _Learner | None:
-        request: Any = None
+        request: object = None
         try:
             if flags & (socket.MSG_TRUNC | socket.MSG_CTRUNC) or len(fds) != 2:
                 raise ValueError("a request too large, or without its two descriptors")
@@ -493,7 +524,7 @@ class WarmParent:
         self._reply({"id": header.get("id"), "pid": int(said)})
         return None
 
-    def _reply(self, message: Mapping[str, Any]) -> None:
+    def _reply(self, message: Mapping[str, object]) -> None:
         _send(self.sock, message)
 
 
@@ -686,7 +717,7 @@ class _Generation:
     sock: socket.socket
     process: WarmChild
     import_sec: float
-    ready: dict[str, Any]
+    ready: _Said
     tail: deque[str] = field(default_factory=lambda: deque(maxlen=20))
 
 
@@ -724,7 +755,7 @@ class WarmStarter:
         return self._current.process.pid if self._current is not None else None
 
     @property
-    def ready(self) -> dict[str, Any]:
+    def ready(self) -> dict[str, object]:
         """What the running warm parent said when ready (threads, open files)."""
         return dict(self._current.ready) if self._current is not None else {}
 
@@ -768,7 +799,7 @@ class WarmStarter:
             target=self._pump, args=(importer.stdout, tail), name="warm-parent-log", daemon=True
         )
         pump.start()
-        ready: dict[str, Any] = {}
+        ready: _Said = {}
         try:
             said = self._receive(ours, IMPORT_TIMEOUT_SEC, importer)
             if "imported" not in said:
@@ -801,7 +832,7 @@ class WarmStarter:
 
     def _receive(
         self, sock: socket.socket, timeout: float, importer: subprocess.Popen[bytes]
-    ) -> dict[str, Any]:
+    ) -> _Said:
         deadline = time.monotonic() + timeout
         while True:
             left = deadline - time.monotonic()
@@ -816,7 +847,7 @@ class WarmStarter:
                     except subprocess.TimeoutExpired:
                         code = None
                     raise WarmStartError(f"it ended ({describe_exit(code)})")
-                result: dict[str, Any] = json.loads(data)
+                result: _Said = json.loads(data)
                 return result
 
     def _pump(self, stream: IO[bytes], tail: deque[str]) -> None:
@@ -980,7 +1011,7 @@ class WarmStarter:
         os.close(go_w)
         return WarmChild(pid, list(argv), os.fdopen(out_r, "rb"))
 
-    def _reply(self, parent: _Generation, request: int) -> dict[str, Any]:
+    def _reply(self, parent: _Generation, request: int) -> _Answer:
         deadline = time.monotonic() + REPLY_TIMEOUT_SEC
         while True:
             left = deadline - time.monotonic()
@@ -1000,7 +1031,7 @@ class WarmStarter:
                     parent.process.kill()
                     parent.process.wait()
                 raise _ParentGone()
-            reply: dict[str, Any] = json.loads(data)
+            reply: _Answer = json.loads(data)
             if reply.get("id") == request:
                 return reply
 

@@ -20,7 +20,11 @@ from __future__ import annotations
 import json
 import os
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, TypedDict
+
+if TYPE_CHECKING:
+    from jedi import Project, Script
+    from jedi.api.classes import Completion
 
 if sys.path and os.path.realpath(sys.path[0]) == os.path.dirname(os.path.realpath(__file__)):
     del sys.path[0]  # app/exercises: its modules must not shadow anything the learner imports
@@ -30,15 +34,60 @@ DOC_CHARS = 1200
 PRELOAD = ("rclpy", "rclpy.node", "std_msgs.msg", "geometry_msgs.msg")
 
 
+class Request(TypedDict, total=False):
+    """One request line (``code_assist`` sends every field; ``id`` is read by ``main``)."""
+
+    id: int
+    op: str
+    code: str
+    path: str
+    line: int
+    column: int
+    sys_path: list[str]
+    project: str
+    name: str
+
+
+class CompletionItem(TypedDict):
+    name: str
+    type: str
+    module: str
+
+
+class SignatureItem(TypedDict):
+    label: str
+    params: list[str]
+    index: int | None
+    name: str
+
+
+class Doc(TypedDict, total=False):
+    """What ``doc`` answers; empty when no completion has that name."""
+
+    name: str
+    type: str
+    signatures: list[str]
+    doc: str
+
+
+class Reply(TypedDict, total=False):
+    """One answer line: ``items`` or ``error`` (the first line says ``ready`` instead)."""
+
+    id: int
+    items: list[CompletionItem | SignatureItem] | Doc
+    error: str
+    ready: bool
+
+
 class Assistant:
     def __init__(self) -> None:
         import jedi
 
         self._jedi = jedi
         self._environment = jedi.InterpreterEnvironment()
-        self._projects: dict[tuple[str, tuple[str, ...]], Any] = {}
+        self._projects: dict[tuple[str, tuple[str, ...]], Project] = {}
 
-    def _script(self, request: dict[str, Any]) -> Any:
+    def _script(self, request: Request) -> Script:
         extra = tuple(str(p) for p in request.get("sys_path") or ())
         root = str(request.get("project") or os.path.dirname(str(request["path"])))
         key = (root, extra)
@@ -54,7 +103,7 @@ class Assistant:
             environment=self._environment,
         )
 
-    def answer(self, request: dict[str, Any]) -> list[dict[str, Any]] | dict[str, Any]:
+    def answer(self, request: Request) -> list[CompletionItem | SignatureItem] | Doc:
         op = request.get("op")
         script = self._script(request)
         line, column = int(request["line"]), int(request["column"])
@@ -87,7 +136,7 @@ class Assistant:
             pass
 
 
-def _doc(completion: Any) -> dict[str, Any]:
+def _doc(completion: Completion) -> Doc:
     signatures = [s.to_string() for s in completion.get_signatures()]
     try:
         text = completion.docstring(raw=True)
@@ -117,7 +166,7 @@ def main() -> int:
         except (ValueError, KeyError, TypeError):
             continue
         try:
-            reply: dict[str, Any] = {"id": ident, "items": assistant.answer(request)}
+            reply: Reply = {"id": ident, "items": assistant.answer(request)}
         except Exception as exc:  # Jedi on half-typed code: an empty answer, not a dead worker
             reply = {"id": ident, "error": f"{type(exc).__name__}: {exc}"[:300]}
         out.write(json.dumps(reply) + "\n")

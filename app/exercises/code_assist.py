@@ -26,12 +26,17 @@ import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, TYPE_CHECKING, TypedDict
 
 from app.containment import sandbox
 from app.containment.policy import RunPolicy
 from app.exercises.lint import Problem, lint
 from app.stop_signals import die_with
+
+if TYPE_CHECKING:
+    from typing import Literal
+
+    from app.exercises.assist_worker import Reply, Request
 
 log = logging.getLogger(__name__)
 
@@ -47,7 +52,16 @@ class FormatError(ValueError):
     """ruff could not format the text (a syntax error, say); one line for the learner."""
 
 
-def marks(problems: Sequence[Problem]) -> list[dict[str, Any]]:
+class Mark(TypedDict):
+    """An Ace gutter annotation (``row`` is 0-based)."""
+
+    row: int
+    column: int
+    text: str
+    type: Literal["error", "warning"]
+
+
+def marks(problems: Sequence[Problem]) -> list[Mark]:
     """pyflakes problems as Ace gutter annotations (rows are 0-based)."""
     return [
         {
@@ -60,7 +74,7 @@ def marks(problems: Sequence[Problem]) -> list[dict[str, Any]]:
     ]
 
 
-def lint_marks(code: str, filename: str) -> list[dict[str, Any]]:
+def lint_marks(code: str, filename: str) -> list[Mark]:
     return marks(lint(code, filename))
 
 
@@ -129,7 +143,7 @@ class AssistProcess:
         self._argv, self._cwd, self._restart_pause = argv, cwd, restart_pause
         self._lock = threading.Lock()
         self._proc: subprocess.Popen[str] | None = None
-        self._pending: dict[int, tuple[subprocess.Popen[str], Future[Any]]] = {}
+        self._pending: dict[int, tuple[subprocess.Popen[str], Future[Reply]]] = {}
         self._next = 1
         self._last_start = 0.0
         self.problem = ""  # why the worker cannot run, for the editor's status line
@@ -189,9 +203,9 @@ class AssistProcess:
             if not future.done():
                 future.set_exception(RuntimeError("the completion worker ended"))
 
-    def request(self, payload: dict[str, Any]) -> Future[Any]:
+    def request(self, payload: Request) -> Future[Reply]:
         """Send one request; the future holds the worker's answer (a dict)."""
-        future: Future[Any] = Future()
+        future: Future[Reply] = Future()
         with self._lock:
             proc = self._start()
             if proc is None or proc.stdin is None:

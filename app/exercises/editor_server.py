@@ -39,7 +39,7 @@ import logging
 import threading
 from collections.abc import Awaitable, Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, TypedDict, TypeVar
 from urllib.parse import parse_qs, urlsplit
 
 from websockets.asyncio.server import ServerConnection
@@ -52,6 +52,12 @@ from app.exercises import code_assist
 from app.exercises.code_assist import AssistProcess, FormatError
 from app.learner_ws import files, folder, overlay
 from app.ros.errors import Ros2Error
+
+if TYPE_CHECKING:
+    from collections.abc import Coroutine, Mapping
+
+    from app.exercises import assist_worker
+    from app.exercises.code_assist import Mark
 
 log = logging.getLogger(__name__)
 
@@ -69,6 +75,14 @@ _TYPES = {".html": "text/html; charset=utf-8", ".js": "application/javascript; c
 
 Handler = Callable[[ServerConnection], Awaitable[None]]
 ProcessRequest = Callable[[ServerConnection, Request], Response | None]
+T = TypeVar("T")
+
+
+class AssistState(TypedDict):
+    """Whether completion works here, and if not, why (the editor's status line)."""
+
+    completion: bool
+    note: str
 
 
 def editor_url(slug: str) -> str:
@@ -129,11 +143,11 @@ class EditorHub:
         self._open: list[str] = []
         self._known: dict[str, tuple[int, int] | None] = {}
         self._watcher: asyncio.Task[None] | None = None
-        self._tasks: set[asyncio.Task[Any]] = set()
+        self._tasks: set[asyncio.Task[None]] = set()
         self._policy: RunPolicy | None = None
         self._scratch: Path | None = None
         self._assist: AssistProcess | None = None
-        self._newest: dict[tuple[ServerConnection, str], Any] = {}  # the latest question asked
+        self._newest: dict[tuple[ServerConnection, str], object] = {}  # the latest question asked
         self._asking: dict[tuple[ServerConnection, str], asyncio.Lock] = {}
 
     def attach(
@@ -212,7 +226,7 @@ class EditorHub:
             if event is not None:
                 event.set()
 
-    async def _on_message(self, connection: ServerConnection, slug: str, raw: Any) -> None:
+    async def _on_message(self, connection: ServerConnection, slug: str, raw: str | bytes) -> None:
         if not isinstance(raw, str) or len(raw) > MAX_MESSAGE_BYTES:
             await connection.send(json.dumps({"type": "error", "text": "message too large"}))
             return
@@ -243,7 +257,7 @@ class EditorHub:
             self._tasks.add(task)
             task.add_done_callback(self._tasks.discard)
 
-    async def _send(self, connection: ServerConnection, message: dict[str, Any]) -> None:
+    async def _send(self, connection: ServerConnection, message: Mapping[str, object]) -> None:
         try:
             await connection.send(json.dumps(message))
         except ConnectionClosed:
@@ -255,7 +269,7 @@ class EditorHub:
     # -- files -------------------------------------------------------------------
 
     async def _on_save(
-        self, connection: ServerConnection, slug: str, file: str, code: str, rev: Any
+        self, connection: ServerConnection, slug: str, file: str, code: str, rev: object
     ) -> None:
         if file == EXERCISE:
             try:
@@ -374,13 +388,13 @@ class EditorHub:
                     }
                 )
 
-    async def _broadcast_all(self, message: dict[str, Any]) -> None:
+    async def _broadcast_all(self, message: Mapping[str, object]) -> None:
         for connection in list(self._editors):
             await self._send(connection, message)
 
     # -- completion, signatures, format ---------------------------------------------
 
-    def _assist_state(self) -> dict[str, Any]:
+    def _assist_state(self) -> AssistState:
         try:
             code_assist.worker_argv(self._policy, self._scratch)
         except ValueError as exc:
@@ -411,7 +425,12 @@ class EditorHub:
         if kind == "format":
             await self._format(connection, file, code, message.get("rev", 0))
             return
-        reply: dict[str, Any] = {"type": kind, "id": message.get("id"), "file": file, "items": []}
+        reply: dict[str, object] = {
+            "type": kind,
+            "id": message.get("id"),
+            "file": file,
+            "items": [],
+        }
         # Typing fast asks on every key: only the newest question of a kind waits for Jedi,
         # the ones it overtook are answered empty at once.
         key = (connection, kind)
@@ -429,13 +448,13 @@ class EditorHub:
         await self._send(connection, reply)
 
     async def _ask_worker(
-        self, slug: str, kind: str, file: str, message: dict, reply: dict[str, Any]
+        self, slug: str, kind: str, file: str, message: dict, reply: dict[str, object]
     ) -> None:
         code = message["code"]
         try:
             row, column = int(message["row"]), int(message["column"])
             path, root = self._where(slug, file)
-            request = {
+            request: assist_worker.Request = {
                 "op": kind,
                 "code": code,
                 "path": str(path),
@@ -455,7 +474,9 @@ class EditorHub:
         except asyncio.TimeoutError:  # not the builtin TimeoutError on Python 3.10
             reply["note"] = f"no answer within {ASSIST_SECONDS:g} s"
 
-    async def _format(self, connection: ServerConnection, file: str, code: str, rev: Any) -> None:
+    async def _format(
+        self, connection: ServerConnection, file: str, code: str, rev: object
+    ) -> None:
         name = Path(file).name if file != EXERCISE else "exercise.py"
         try:
             formatted = await asyncio.to_thread(code_assist.format_code, code, name)
@@ -470,7 +491,7 @@ class EditorHub:
 
     # -- from other threads ----------------------------------------------------
 
-    def _run(self, coroutine: Any, timeout: float) -> Any:
+    def _run(self, coroutine: Coroutine[object, None, T], timeout: float) -> T | None:
         loop = self._loop
         if loop is None or loop.is_closed():
             coroutine.close()
@@ -481,7 +502,7 @@ class EditorHub:
             log.debug("editor call failed", exc_info=True)
             return None
 
-    async def _broadcast(self, slug: str, message: dict[str, Any]) -> int:
+    async def _broadcast(self, slug: str, message: Mapping[str, object]) -> int:
         text = json.dumps(message)
         sent = 0
         for connection, editing in list(self._editors.items()):
@@ -497,7 +518,7 @@ class EditorHub:
         """Show ``code`` in every editor of ``slug`` (after "Reset to starter")."""
         self._run(self._broadcast(slug, {"type": "load", "code": code, "note": note}), 2.0)
 
-    def show_problems(self, slug: str, items: list[dict[str, Any]]) -> None:
+    def show_problems(self, slug: str, items: list[Mark]) -> None:
         """Lint results as gutter marks: ``{"row": 0-based, "column", "text", "type"}``."""
         message = {"type": "problems", "file": EXERCISE, "items": items}
         self._run(self._broadcast(slug, message), 2.0)

@@ -9,8 +9,6 @@ here.
 
 from __future__ import annotations
 
-from typing import Any
-
 from app.exercises.model import Exercise
 from app.exercises.probes import PROBES
 from app.exercises.probes.base import is_drawn, range_text
@@ -24,7 +22,7 @@ HOW_INPUTS_ARE_DRAWN = (
 )
 
 
-def _field_text(value: Any) -> str:
+def _field_text(value: object) -> str:
     if is_drawn(value):
         return range_text(value)
     if isinstance(value, dict):
@@ -44,7 +42,7 @@ def drawn_fields(spec: Spec) -> list[str]:
     """The names of a probe's fields drawn at grading time (nested ones as a.b)."""
     found: list[str] = []
 
-    def walk(value: Any, path: str) -> None:
+    def walk(value: object, path: str) -> None:
         if is_drawn(value):
             found.append(path)
         elif isinstance(value, dict):

@@ -16,7 +16,7 @@ import copy
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, TypeVar
 
 try:
     import tomllib
@@ -28,11 +28,15 @@ from app.exercises.probes import PROBE_KINDS, PROBES
 from app.lessons.kinds import CHECK_KINDS
 from app.lessons.schema import LESSONS_DIR, LessonError, Spec, inside, parse_spec
 
+if TYPE_CHECKING:
+    from collections.abc import Mapping
+
 _SLUG = re.compile(r"^[a-z][a-z0-9_]{2,48}$")
 _LESSON_DIR = re.compile(r"^(\d{2})_[a-z0-9_]+$")
 _NODE = re.compile(r"^(/[A-Za-z_][A-Za-z0-9_]*)+$")
 _CATALOG = frozenset(entry.name for entry in ENTRIES)
 DEFAULT_REVEAL_AFTER = 3  # failed checks before the reference solution may be shown
+T = TypeVar("T")
 
 
 class ExerciseError(LessonError):
@@ -67,7 +71,7 @@ class Exercise:
     path: Path = LESSONS_DIR
     # The statement's example as data (never the tested input): the test suite
     # generates a solution that replays it, and that solution must fail.
-    example: dict[str, Any] = field(default_factory=dict)
+    example: dict[str, object] = field(default_factory=dict)
     # A package exercise: the learner's ROS package of this name is graded; the
     # grader builds it with colcon, then `ros2 run package run` or `ros2 launch
     # package launch` (app.exercises.package_grading). Starter, reference and
@@ -89,7 +93,9 @@ class Exercise:
         return f"exercise:{self.slug}"
 
 
-def _field(data: dict[str, Any], key: str, kind: type, where: str, default: Any = None) -> Any:
+def _field(
+    data: Mapping[str, object], key: str, kind: type[T], where: str, default: T | None = None
+) -> T:
     if key not in data:
         if default is None:
             raise ExerciseError(f"{where}: missing field '{key}'")
@@ -100,7 +106,7 @@ def _field(data: dict[str, Any], key: str, kind: type, where: str, default: Any 
     return value
 
 
-def _probe(raw: Any, where: str) -> Spec:
+def _probe(raw: object, where: str) -> Spec:
     if not isinstance(raw, dict) or not isinstance(raw.get("kind"), str):
         raise ExerciseError(f"{where}: a probe is a table with a 'kind'")
     kind = raw["kind"]

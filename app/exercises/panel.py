@@ -15,7 +15,6 @@ import logging
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import viser
@@ -98,7 +97,7 @@ class ExercisePanel:
         supervisor: Supervisor,
         grader: Grader,
         hub: EditorHub,
-        side_window: Any,
+        side_window: viser.PanelHandle,
         settings: ExerciseSettings | None = None,
         open_code: Callable[[], None] | None = None,
         watch: Callable[[Path, str], None] | None = None,
@@ -275,7 +274,7 @@ class ExercisePanel:
             return
         self._message = "Stopping (Ctrl+C)…"
 
-        def stopped(status: Any) -> None:
+        def stopped(status: NodeStatus | None) -> None:
             self._message = "■ Stopped." if status else "Your node was not running."
 
         self._ui.run_job(

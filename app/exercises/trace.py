@@ -13,7 +13,24 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypedDict
+
+
+class TraceJson(TypedDict):
+    """A trace as ``Trace.to_json`` writes it (the attempt's folder keeps a list of these)."""
+
+    title: str
+    unit: str
+    times: list[float]
+    values: list[float]
+    low: float | None
+    high: float | None
+    broken_at: float | None
+    broken_why: str
+    judged_from: float
+    along: str
+    levels: list[str]
+    expected: list[float]
 
 
 @dataclass(frozen=True)
@@ -80,7 +97,7 @@ class Trace:
                 return t, v
         return None
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> TraceJson:
         return {
             "title": self.title,
             "unit": self.unit,

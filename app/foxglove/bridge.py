@@ -60,7 +60,7 @@ import threading
 import time
 from collections import deque
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import foxglove
 import foxglove.channel
@@ -102,6 +102,20 @@ from app.ros.names import ACTION_MARKER, QUIET_TOPICS, is_hidden_node, is_intern
 from app.ros.params import parameter_value, python_value
 from app.ros.qos import matching_qos
 
+if TYPE_CHECKING:
+    from collections.abc import Callable
+    from typing import Protocol
+
+    from foxglove import AnyNativeParameterValue
+    from rclpy.task import Future
+
+    class _ServiceType(Protocol):
+        """A generated service class: its request (and response) message classes."""
+
+        Request: type
+        Response: type
+
+
 log = logging.getLogger(__name__)
 
 SERVER_NAME = "ROS 2 Classroom"
@@ -126,7 +140,7 @@ class _Topic:
 
     name: str
     msgtype: str
-    py_type: Any
+    py_type: type  # the generated message class
     channel: foxglove.Channel
     subscription: Subscription | None = None
     gone_since: float | None = None
@@ -150,7 +164,7 @@ class _Publisher:
     """One ROS publisher per topic, shared by every client channel that publishes on it."""
 
     publisher: Publisher
-    py_type: Any
+    py_type: type  # the generated message class
     msgtype: str
     users: set[ClientKey] = field(default_factory=set)
 
@@ -161,7 +175,7 @@ class _Service:
 
     name: str
     srvtype: str
-    py_type: Any
+    py_type: _ServiceType
     client: RosClient | None = None  # made on its first call
     gone_since: float | None = None
 
@@ -178,17 +192,17 @@ class _Call:
     response: bytes | None = None
     error: str = ""
     over: bool = False  # its handler returned: nobody waits any more (under the lock)
-    request: Any = None  # deserialized, waiting for its server (the bridge's thread only)
-    future: Any = None  # rclpy's, once sent (the bridge's thread only)
+    request: object = None  # deserialized, waiting for its server (the bridge's thread only)
+    future: Future | None = None  # rclpy's, once sent (the bridge's thread only)
 
 
 @dataclass
 class _ParamSet:
     """Parameters to set on one node: waiting for its server, then for its answer."""
 
-    request: Any  # SetParameters.Request
+    request: SetParameters.Request
     started: float
-    future: Any = None
+    future: Future | None = None
 
 
 @dataclass
@@ -265,8 +279,8 @@ class FoxgloveBridge:
         self._new_calls: list[_Call] = []  # for the bridge's thread to send
         self._answered = 0
         # "/node.param" -> (ROS ParameterType, plain value): replaced whole by the bridge's thread.
-        self._param_cache: dict[str, tuple[int, Any]] = {}
-        self._param_sets: deque[tuple[str, Any]] = deque()
+        self._param_cache: dict[str, tuple[int, object]] = {}
+        self._param_sets: deque[tuple[str, AnyNativeParameterValue | None]] = deque()
         self._params_asked = False
         # The executor's thread only.
         self._forwarded = 0
@@ -544,7 +558,7 @@ class FoxgloveBridge:
             self._wake.wait(wait)
             self._wake.clear()  # what woke us is state, read again on the next round
 
-    def _step(self, work: Any) -> None:
+    def _step(self, work: Callable[[], None]) -> None:
         try:
             work()
         except Exception:  # one failed round must not end the bridge
@@ -648,7 +662,7 @@ class FoxgloveBridge:
         log_message = topic.channel.log
         limit = self.limits.max_forward_bytes
 
-        def forward(data: bytes, info: dict[str, Any]) -> None:
+        def forward(data: bytes, info: dict[str, int]) -> None:
             # The executor's thread: hand over and return. The time is when the middleware
             # received the message, as a bag records it.
             if len(data) > limit:
@@ -882,7 +896,7 @@ class FoxgloveBridge:
         if error:
             self._finish(call, error=error)
 
-    def _answer(self, call: _Call, future: Any) -> None:
+    def _answer(self, call: _Call, future: Future) -> None:
         """The executor's thread: the ROS service answered (or the call was cancelled)."""
         if future.cancelled():
             return
@@ -1011,7 +1025,7 @@ class FoxgloveBridge:
             if not pending.future.done():
                 still.append(pending)
                 continue
-            changed: dict[str, tuple[int, Any]] = {}
+            changed: dict[str, tuple[int, object]] = {}
             results = pending.future.result().results
             for param, result in zip(pending.request.parameters, results, strict=False):
                 name = f"{entry.fqn}.{param.name}"
@@ -1028,7 +1042,7 @@ class FoxgloveBridge:
         entry.setting = still
 
     def _store_parameters(
-        self, fqn: str, values: dict[str, tuple[int, Any]], *, replace: bool = True
+        self, fqn: str, values: dict[str, tuple[int, object]], *, replace: bool = True
     ) -> None:
         prefix = f"{fqn}."
         with self._lock:
@@ -1099,7 +1113,7 @@ def _foxglove_parameter(name: str, ros_type: int, value: Any) -> Parameter:
     return Parameter(name, value=value)
 
 
-def _as_ros(value: Any, ros_type: int | None) -> Any:
+def _as_ros(value: object, ros_type: int | None) -> object:
     """A client's value, made the parameter's ROS type where JSON lost it (2.0 sent as 2)."""
     if ros_type == RosParameterType.PARAMETER_DOUBLE and isinstance(value, int):
         return float(value)

@@ -36,7 +36,6 @@ import threading
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import asdict, replace
 from pathlib import Path
-from typing import Any
 from urllib.parse import urlsplit
 
 from tornado import ioloop, web
@@ -209,7 +208,7 @@ class ClassroomLti(LtiService):
                 queued += self.on_record(replace(record, learner=owner))
         return queued
 
-    def routes(self, prefix: str) -> list[tuple[str, type[web.RequestHandler], dict[str, Any]]]:
+    def routes(self, prefix: str) -> list[tuple[str, type[web.RequestHandler], dict[str, object]]]:
         back = (self.teacher_url, "The teacher page")
         return [*self.lms_routes(prefix), *gradebook_routes(prefix, self, TeacherToken, back=back)]
 

@@ -159,13 +159,13 @@ def gradebook_routes(
     auth: type,
     *,
     back: tuple[str, str] | None = None,
-) -> list[tuple[str, type[web.RequestHandler], dict[str, Any]]]:
+) -> list[tuple[str, type[web.RequestHandler], dict[str, object]]]:
     """The five routes, each handler behind ``auth`` (a mixin that names the teacher).
 
     ``back`` is the link from the gradebook to the teacher's page: (address, text).
     """
     base = prefix if prefix.endswith("/") else prefix + "/"
-    args: dict[str, Any] = {"lti": lti, "back": back}
+    args: dict[str, object] = {"lti": lti, "back": back}
     return [
         (base + path, type(f"{auth.__name__}{handler.__name__}", (auth, handler), {}), args)
         for path, handler in (

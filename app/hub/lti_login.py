@@ -16,7 +16,7 @@ teachers) still log in as before. deploy/lti_tool_config.py turns it on.
 from __future__ import annotations
 
 import json
-from typing import Any
+from typing import TYPE_CHECKING
 from urllib.parse import urlencode, urlsplit
 
 from jupyterhub.auth import Authenticator, PAMAuthenticator
@@ -25,6 +25,13 @@ from jupyterhub.utils import maybe_future, url_path_join
 from tornado import web
 from tornado.httpclient import AsyncHTTPClient, HTTPClientError
 from traitlets import Unicode
+
+if TYPE_CHECKING:
+    from collections.abc import Awaitable, Mapping
+
+    from jupyterhub.app import JupyterHub
+    from jupyterhub.orm import User as OrmUser
+    from jupyterhub.user import User
 
 HANDOFF_PAGE = "/lti-handoff"  # the hub adds its own prefix: /hub/lti-handoff
 # app.lti.learners.NAME_PREFIX (that module needs PyJWT; this one runs inside the hub).
@@ -69,10 +76,12 @@ class LtiHandoffMixin(Authenticator):
         help="The group an LMS instructor joins at launch (it opens the teacher's page)",
     )
 
-    def get_handlers(self, app: Any) -> list[tuple[str, type]]:
+    def get_handlers(self, app: JupyterHub) -> list[tuple[str, type]]:
         return [*super().get_handlers(app), (HANDOFF_PAGE, LtiHandoffHandler)]
 
-    async def authenticate(self, handler: Any, data: dict[str, Any]) -> Any:
+    async def authenticate(
+        self, handler: web.RequestHandler | None, data: dict[str, str]
+    ) -> str | dict[str, object] | None:
         ticket = (data or {}).get(TICKET_FIELD)
         if ticket is None:
             return await maybe_future(super().authenticate(handler, data))
@@ -85,18 +94,20 @@ class LtiHandoffMixin(Authenticator):
             "lti_teacher": bool(handoff["teacher"]),
         }
 
-    def add_user(self, user: Any) -> Any:
+    def add_user(self, user: User | OrmUser) -> Awaitable[None] | None:
         if user.name.startswith(LTI_USER_PREFIX):
             # An LMS learner has no system account (PAM's LocalAuthenticator wants one).
             return Authenticator.add_user(self, user)
         return super().add_user(user)
 
-    def check_allowed(self, username: str, authentication: Any = None) -> Any:
+    def check_allowed(
+        self, username: str, authentication: Mapping[str, object] | None = None
+    ) -> bool | Awaitable[bool]:
         if authentication and "lti_next" in authentication:
             return True  # the LMS's course decides who launches; the service checked the launch
         return super().check_allowed(username, authentication)
 
-    async def redeem(self, ticket: str) -> dict[str, Any] | None:
+    async def redeem(self, ticket: str) -> dict[str, object] | None:
         """Whom the service says this ticket logs in, or None (the log says why)."""
         url = url_path_join(self.lti_service_url, "lti/handoff")
         try:

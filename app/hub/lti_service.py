@@ -33,7 +33,7 @@ from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 from urllib.parse import quote, urlencode, urlsplit, urlunsplit
 
 from tornado import ioloop, web
@@ -66,6 +66,16 @@ from app.lti.routes import (
 from app.lti.time_book import TimeBook
 from app.lti.tool import GradedResult, LtiTool
 from app.teacher.record import MAX_HISTORY, LearnerRecord
+
+if TYPE_CHECKING:
+    from typing import TypedDict
+
+    class _Graded(TypedDict, total=False):
+        """The fields of a gradebook line that its exercise's attempt history fills."""
+
+        graded: int
+        last_graded: float | None
+
 
 log = logging.getLogger(__name__)
 
@@ -289,7 +299,7 @@ class LtiService:
             for line in lines
         ]
 
-    def _graded_of(self, line: GradebookLine) -> dict[str, Any]:
+    def _graded_of(self, line: GradebookLine) -> _Graded:
         """How many graded attempts at the line's exercise are known, and the newest's time."""
         if line.kind != "exercise" or not line.slug:
             return {}
@@ -342,9 +352,11 @@ class LtiService:
 
     # -- routes -----------------------------------------------------------------------------
 
-    def lms_routes(self, prefix: str) -> list[tuple[str, type[web.RequestHandler], dict[str, Any]]]:
+    def lms_routes(
+        self, prefix: str
+    ) -> list[tuple[str, type[web.RequestHandler], dict[str, object]]]:
         """What the LMS and the browsers it sends reach: login, launch, picker, keys."""
-        args = {"lti": self}
+        args: dict[str, object] = {"lti": self}
         base = _slashed(prefix).rstrip("/")
         return [
             (base + LOGIN_PATH, LoginHandler, args),
@@ -355,7 +367,7 @@ class LtiService:
             (base + REGISTER_PATH, RegisterHandler, args),
         ]
 
-    def routes(self, prefix: str) -> list[tuple[str, type[web.RequestHandler], dict[str, Any]]]:
+    def routes(self, prefix: str) -> list[tuple[str, type[web.RequestHandler], dict[str, object]]]:
         """The LMS's routes and the hub's ticket trade (the gradebook's come with its auth)."""
         base = _slashed(prefix).rstrip("/")
         return [*self.lms_routes(prefix), (base + HANDOFF_API, HandoffHandler, {"lti": self})]

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Any
 
 from app.access import TOKEN_ENV, TOKEN_HEADER, new_token
 
@@ -38,7 +37,7 @@ def learner_home() -> Path:
     return Path.home() / NAME
 
 
-def setup_ros2_classroom() -> dict[str, Any]:
+def setup_ros2_classroom() -> dict[str, object]:
     """jupyter-server-proxy's description of the dashboard (called once per Jupyter server)."""
     token = new_token()
     return {

@@ -213,7 +213,9 @@ class HubRefused(Exception):
         self.status = status
 
 
-def hub_request(url: str, token: str, form: dict[str, str] | None = None, body: Any = None) -> Any:
+def hub_request(
+    url: str, token: str, form: dict[str, str] | None = None, body: object = None
+) -> object:
     """One blocking call to the hub's API; JSON answer. Raises HubRefused."""
     headers = {"Authorization": f"token {token}"}
     data = None
@@ -241,7 +243,7 @@ def _utc_stamp(when: float) -> str:
 class Activity:
     """The learner's last request or click, sent to the hub's activity API for its idle culler."""
 
-    def __init__(self, settings: HubSettings, post: Callable[..., Any] = hub_request) -> None:
+    def __init__(self, settings: HubSettings, post: Callable[..., object] = hub_request) -> None:
         self._settings = settings
         self._post = post
         self.last = 0.0  # written from viser's thread, read here: a float, no lock needed
@@ -301,7 +303,7 @@ class HubLogin:
     def __init__(
         self,
         settings: HubSettings,
-        ask_hub: Callable[..., Any] = hub_request,
+        ask_hub: Callable[..., object] = hub_request,
         signer: Signer | None = None,
     ) -> None:
         self.settings = settings
@@ -320,7 +322,7 @@ class HubLogin:
 
     # -- asking the hub (viser's event loop; the blocking call in a worker thread) ----
 
-    async def _call(self, *args: Any, **kwargs: Any) -> Any:
+    async def _call(self, *args: object, **kwargs: object) -> object:
         return await asyncio.to_thread(self._ask_hub, *args, **kwargs)
 
     async def user_for_token(self, token: str) -> dict[str, Any] | None:
@@ -518,7 +520,7 @@ class HubLogin:
         async def handler(connection: ServerConnection) -> None:
             receive = connection.recv
 
-            async def recv(*args: Any, **kwargs: Any) -> Any:
+            async def recv(*args: bool | None, **kwargs: bool | None) -> Any:
                 message = await receive(*args, **kwargs)
                 activity.touch()
                 return message

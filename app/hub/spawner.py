@@ -41,7 +41,7 @@ import subprocess
 import sys
 import threading
 from concurrent.futures import ThreadPoolExecutor
-from typing import IO, Any, ClassVar
+from typing import IO, ClassVar
 
 from jupyterhub.spawner import LocalProcessSpawner, SimpleLocalProcessSpawner
 from jupyterhub.utils import random_port
@@ -100,7 +100,7 @@ class DomainPool:
             return dict(self._held)
 
 
-def with_project_commands(env: dict[str, Any], bin_dir: str | None = None) -> dict[str, Any]:
+def with_project_commands(env: dict[str, str], bin_dir: str | None = None) -> dict[str, str]:
     """The learner's server finds the project's commands first (``ros2``, ``colcon``).
 
     A lab-mode terminal inherits its server's PATH, which the spawner copies from
@@ -191,7 +191,7 @@ class ClassroomSystemUserSpawner(LocalProcessSpawner):
     def _owner(self) -> str:
         return self.user.name + (f":{self.name}" if self.name else "")
 
-    def get_env(self) -> dict[str, Any]:
+    def get_env(self) -> dict[str, str]:
         env = with_project_commands(super().get_env())
         self.domain_id = self.pool.take(self._owner(), self.first_domain_id, self.last_domain_id)
         env["ROS_DOMAIN_ID"] = str(self.domain_id)
@@ -242,13 +242,13 @@ class ClassroomSystemUserSpawner(LocalProcessSpawner):
 
     # A hub restarted with cleanup_servers=False finds its servers running: their ids
     # must stay held, or the next learner would get a running learner's domain.
-    def get_state(self) -> dict[str, Any]:
+    def get_state(self) -> dict[str, int]:
         state = super().get_state()
         if self.domain_id is not None:
             state["ros_domain_id"] = self.domain_id
         return state
 
-    def load_state(self, state: dict[str, Any]) -> None:
+    def load_state(self, state: dict[str, int]) -> None:
         super().load_state(state)
         if "ros_domain_id" in state:
             self.domain_id = int(state["ros_domain_id"])

@@ -64,7 +64,19 @@ from app.teacher.record import (
 )
 
 if TYPE_CHECKING:  # LTI needs PyJWT, which only a deployment with LTI installs
+    from collections.abc import Mapping
+    from typing import TypedDict
+
     from app.hub.lti_service import LtiService
+
+    class Notice(TypedDict):
+        """A teacher's message, as the dashboards' progress reports get it back."""
+
+        id: int
+        to: str  # a learner's key, or "" for everyone
+        text: str
+        stamp: float
+
 
 log = logging.getLogger(__name__)
 
@@ -78,7 +90,7 @@ class ClassState:
 
     def __init__(self) -> None:
         self.records: dict[str, LearnerRecord] = {}
-        self.notices: list[dict[str, Any]] = []  # {"id", "to", "text", "stamp"}
+        self.notices: list[Notice] = []
         self.reveal_after = 0  # 0: each exercise's own number
         self.rule = StuckRule()
         self.reports = 0
@@ -86,11 +98,11 @@ class ClassState:
         # Notice ids restart with the service: a dashboard that sees a new epoch asks anew.
         self.epoch = os.urandom(8).hex()
 
-    def notices_for(self, learner_key: str, since: int) -> list[dict[str, Any]]:
+    def notices_for(self, learner_key: str, since: int) -> list[Notice]:
         return [n for n in self.notices if n["id"] > since and n["to"] in ("", learner_key)]
 
-    def add_notice(self, to: str, text: str) -> dict[str, Any]:
-        notice = {
+    def add_notice(self, to: str, text: str) -> Notice:
+        notice: Notice = {
             "id": (self.notices[-1]["id"] + 1) if self.notices else 1,
             "to": to,
             "text": text,
@@ -176,8 +188,8 @@ class TeacherAuth(HubOAuthenticated):
     """
 
     @property
-    def hub_auth(self) -> Any:
-        settings: dict[str, Any] = getattr(self, "settings", {})
+    def hub_auth(self) -> HubOAuth:
+        settings: Mapping[str, object] = getattr(self, "settings", {})
         return settings.get("teacher_auth") or HubOAuth.instance()
 
 
@@ -308,7 +320,7 @@ class SettingsHandler(_TeacherBase):
         self.finish({"reveal_after": value})
 
 
-def _json_body(body: bytes) -> dict[str, Any]:
+def _json_body(body: bytes) -> dict[str, object]:
     try:
         data = json.loads(body or b"{}")
     except (UnicodeDecodeError, json.JSONDecodeError):
@@ -322,7 +334,7 @@ def make_app(
     prefix: str,
     state: ClassState | None = None,
     *,
-    hub_auth: Any = None,
+    hub_auth: HubAuth | None = None,
     teacher_auth: HubOAuth | None = None,
     lti: LtiService | None = None,
 ) -> web.Application:
@@ -330,8 +342,11 @@ def make_app(
     ``teacher_auth`` who opens a teacher's page (the hub's, unless a test points them at
     its own); ``lti`` serves LTI, sends grades and the gradebook (None: off)."""
     state = state or ClassState()
-    args = {"state": state}
-    routes: list[Any] = [
+    args: dict[str, object] = {"state": state}
+    routes: list[
+        tuple[str, type[web.RequestHandler]]
+        | tuple[str, type[web.RequestHandler], dict[str, object]]
+    ] = [
         (prefix, PageHandler, args),
         (url_path_join(prefix, "progress.json"), TableHandler, args),
         (url_path_join(prefix, "progress.csv"), CsvHandler, args),

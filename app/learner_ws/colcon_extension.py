@@ -21,12 +21,15 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from colcon_core.argument_parser import (
     ArgumentParserDecorator,
     ArgumentParserDecoratorExtensionPoint,
 )
+
+if TYPE_CHECKING:
+    import argparse
 
 TOOLCHAIN = Path(__file__).resolve().parent / "cmake" / "toolchain.cmake"
 
@@ -61,7 +64,7 @@ def with_defaults(given: list[str] | None) -> list[str]:
 
 
 class _Decorator(ArgumentParserDecorator):
-    def parse_args(self, *args: Any, **kwargs: Any) -> Any:
+    def parse_args(self, *args: object, **kwargs: object) -> argparse.Namespace:
         parsed = self._parser.parse_args(*args, **kwargs)
         # Only `colcon build` configures CMake; its cmake task adds --cmake-args.
         if getattr(parsed, "verb_name", None) == "build" and hasattr(parsed, "cmake_args"):
@@ -72,5 +75,7 @@ class _Decorator(ArgumentParserDecorator):
 class ClassroomCMakeArguments(ArgumentParserDecoratorExtensionPoint):
     """Registered in pyproject.toml (``colcon_core.argument_parser``: ``ros2_classroom``)."""
 
-    def decorate_argument_parser(self, *, parser: Any) -> Any:
+    def decorate_argument_parser(
+        self, *, parser: argparse.ArgumentParser | ArgumentParserDecorator
+    ) -> _Decorator:
         return _Decorator(parser)

@@ -148,7 +148,9 @@ class ProgressStore:
         with self._lock:
             return dict(self._data.get("exercises", {}).get(slug, {}))
 
-    def update_exercise(self, slug: str, **changes: Any) -> dict[str, Any]:
+    def update_exercise(
+        self, slug: str, **changes: int | float | str | Added | None
+    ) -> dict[str, Any]:
         """Merge ``changes`` into the exercise's record (numbers given as +N are added)."""
         with self._lock:
             record = self._data.setdefault("exercises", {}).setdefault(slug, {})

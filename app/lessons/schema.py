@@ -52,7 +52,7 @@ class Spec:
     def __getitem__(self, key: str) -> Any:
         return self.fields[key]
 
-    def get(self, key: str, default: Any = None) -> Any:
+    def get(self, key: str, default: object = None) -> Any:
         return self.fields.get(key, default)
 
     @property

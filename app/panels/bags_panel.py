@@ -14,7 +14,6 @@ import threading
 import time
 import zipfile
 from pathlib import Path
-from typing import Any
 
 import viser
 from rclpy.node import Node
@@ -212,11 +211,11 @@ class BagsPanel:
 
     # ------------------------------------------------------------ download
 
-    def _on_download(self, event: Any) -> None:
+    def _on_download(self, event: viser.GuiEvent[viser.GuiButtonHandle]) -> None:
         client = event.client
         self._ui.post(lambda: self._send_zip(client))
 
-    def _send_zip(self, client: Any) -> None:
+    def _send_zip(self, client: viser.ClientHandle | None) -> None:
         path = self._selected()
         if path is None or client is None:
             return

@@ -18,7 +18,7 @@ the UI thread selects topics and reads ``describe()``.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import viser
 from rclpy.node import Node
@@ -29,6 +29,28 @@ from app.scene.latest import LatestWorker
 from app.scene.qos import SCENE_CALLBACK_GROUP
 from app.scene.tf_view import TF_PATH, scene_name
 from app.scene.topic_picker import NONE
+
+if TYPE_CHECKING:
+    from typing import Literal, TypedDict
+
+    import numpy as np
+    import numpy.typing as npt
+    from typing_extensions import NotRequired, Unpack
+
+    class _ImageArgs(TypedDict):
+        """viser's ``add_image`` arguments after the name (``show_image`` passes them on)."""
+
+        image: np.ndarray
+        render_width: float
+        render_height: float
+        format: NotRequired[Literal["auto", "png", "jpeg"]]
+        jpeg_quality: NotRequired[int | None]
+        cast_shadow: NotRequired[bool]
+        receive_shadow: NotRequired[bool | float]
+        scale: NotRequired[float | tuple[float, float, float]]
+        wxyz: NotRequired[tuple[float, float, float, float] | np.ndarray]
+        position: NotRequired[tuple[float, float, float] | np.ndarray]
+        visible: NotRequired[bool]
 
 
 def frame_of(header_frame: str) -> str:
@@ -41,7 +63,7 @@ class FramedLayer:
 
     NODE_NAME = "layer"  # the scene node's name under its frame
     LATCHED = True  # ask for a latched subscription whenever every publisher offers one
-    MSG_TYPE: Any = None  # the generated message class the default ``subscribe`` takes
+    MSG_TYPE: type | None = None  # the generated message class the default ``subscribe`` takes
 
     def __init__(
         self,
@@ -103,7 +125,7 @@ class FramedLayer:
         return f"{note}, in `{frame}`"
 
     # --- worker thread ---
-    def draw(self, msg: Any) -> None:
+    def draw(self, msg: object) -> None:
         raise NotImplementedError
 
     def scene_path(self, frame: str) -> str:
@@ -116,7 +138,11 @@ class FramedLayer:
         return path
 
     def show_segments(
-        self, frame: str, segments: Any, colour: tuple[int, int, int], thickness: float
+        self,
+        frame: str,
+        segments: npt.NDArray[np.float32],
+        colour: tuple[int, int, int],
+        thickness: float,
     ) -> None:
         """Line segments (N, 2, 3) under ``frame``: updated in place when their count holds."""
         path = self.scene_path(frame)
@@ -129,7 +155,7 @@ class FramedLayer:
         else:
             handle.points = segments
 
-    def show_image(self, frame: str, **image: Any) -> None:
+    def show_image(self, frame: str, **image: Unpack[_ImageArgs]) -> None:
         """A picture laid under ``frame`` (viser's ``add_image`` arguments)."""
         path = self.scene_path(frame)
         self._handle = self._server.scene.add_image(path, **image)

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 import viser
@@ -28,6 +28,9 @@ from nav_msgs.msg import OccupancyGrid
 from rclpy.node import Node
 
 from app.scene.framed_layer import FramedLayer, frame_of
+
+if TYPE_CHECKING:
+    import numpy.typing as npt
 
 MAX_HZ = 2.0
 TYPES = ("nav_msgs/msg/OccupancyGrid",)
@@ -38,7 +41,7 @@ UNKNOWN_RGBA = (120, 130, 140, 60)
 NODE_NAME = "occupancy_grid"
 
 
-def grid_image(data: Any, width: int, height: int) -> np.ndarray:
+def grid_image(data: npt.ArrayLike, width: int, height: int) -> np.ndarray:
     """RGBA pixels (height, width, 4) of a map's cells, row 0 the map's first row.
 
     viser lays an image with its first row towards the plane's -y edge, so the

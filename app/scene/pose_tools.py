@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import viser
@@ -41,6 +41,11 @@ from app.ros.action_client import FeedbackMessage, ThreadSafeActionClient
 from app.scene.tf_view import TF_PATH, scene_name
 from app.ui import MarkdownView, code_block
 from app.ui.loop import UiLoop
+
+if TYPE_CHECKING:
+    import numpy.typing as npt
+    from builtin_interfaces.msg import Time
+    from rclpy.action.client import ClientGoalHandle
 
 MAP_FRAME = "map"
 INITIAL_POSE_TOPIC = "/initialpose"
@@ -69,7 +74,7 @@ HELP = (
 
 # --- pure geometry and messages (no ROS graph, no browser) ---
 def floor_point(
-    origin: Any, direction: Any, frame_pose: np.ndarray | None = None
+    origin: npt.ArrayLike, direction: npt.ArrayLike, frame_pose: np.ndarray | None = None
 ) -> tuple[float, float] | None:
     """Where a click's ray meets the floor (z = 0) of a frame, in that frame's x, y; or None.
 
@@ -107,7 +112,7 @@ def yaw_quaternion(yaw: float) -> tuple[float, float, float, float]:
 
 
 def initial_pose(
-    x: float, y: float, yaw: float, frame: str = MAP_FRAME, stamp: Any = None
+    x: float, y: float, yaw: float, frame: str = MAP_FRAME, stamp: Time | None = None
 ) -> PoseWithCovarianceStamped:
     """The message rviz's 2D Pose Estimate publishes."""
     msg = PoseWithCovarianceStamped()
@@ -125,8 +130,8 @@ def initial_pose(
 
 
 def navigation_goal(
-    x: float, y: float, yaw: float, frame: str = MAP_FRAME, stamp: Any = None
-) -> Any:
+    x: float, y: float, yaw: float, frame: str = MAP_FRAME, stamp: Time | None = None
+) -> NavigateToPose.Goal:
     """A NavigateToPose goal (the default behaviour tree), as rviz's Nav2 Goal sends it."""
     pose = PoseStamped()
     pose.header.frame_id = frame
@@ -207,12 +212,12 @@ class PoseTools:
         self._listening = False
         self._publisher: Any = None
         self._client: ThreadSafeActionClient | None = None
-        self._goal_handle: Any = None
+        self._goal_handle: ClientGoalHandle | None = None
         self._goal_seq = 0  # the goal the note follows; answers for older ones are dropped
         self._goal_text = ""
         self._command = ""
         self.sent: list[tuple[str, float, float, float]] = []  # (tool, x, y, yaw), newest last
-        self._marks: dict[str, Any] = {}
+        self._marks: dict[str, viser.SceneNodeHandle] = {}
 
     # --- viser's threads: post, nothing else ---
     def _on_button(self, event: viser.GuiEvent) -> None:
@@ -244,7 +249,7 @@ class PoseTools:
             + self._frame_warning()
         )
 
-    def clicked(self, origin: Any, direction: Any) -> None:
+    def clicked(self, origin: npt.ArrayLike, direction: npt.ArrayLike) -> None:
         """A click in the 3D view while a tool is armed: a point, then a heading."""
         tool = self.tool
         if tool is None:
@@ -313,7 +318,7 @@ class PoseTools:
         self._show(self._goal_text)
 
         def feedback(message: FeedbackMessage) -> None:  # executor thread
-            fb: Any = message.feedback
+            fb: NavigateToPose.Feedback = message.feedback
             distance = float(fb.distance_remaining)
             recoveries = int(fb.number_of_recoveries)
             self._ui.post(lambda: self._on_feedback(seq, where, distance, recoveries))
@@ -354,7 +359,7 @@ class PoseTools:
             return
         self._goal_handle = None
         try:
-            response: Any = future.result()
+            response: NavigateToPose.Impl.GetResultService.Response = future.result()
         except Exception as exc:
             self._goal_text = f"⚠️ No result came: {exc}"
             self._show(self._goal_text)

@@ -13,7 +13,7 @@ import json
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Protocol
 
 import viser
 from rclpy.node import Node
@@ -82,7 +82,7 @@ class Stage:
         gui: viser.GuiApi,
         ui: UiLoop,
         node: Node,
-        code_window: Any,
+        code_window: viser.PanelHandle,
         rates: SharedRates | None,
         links: PageLinks,
         rosout: RosoutLog,

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 from app.exercises.probes.base import (
     ProbeContext,
     draw,
@@ -34,7 +32,7 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
     goal_run = GoalRun(action, type_text, goal)
     name = f"action {action}" + (" (cancel)" if cancel_after else "")
 
-    def on_feedback(_msg: Any) -> None:
+    def on_feedback(_msg: object) -> None:
         if cancel_after and len(goal_run.feedback) == cancel_after:
             goal_run.cancel()
 

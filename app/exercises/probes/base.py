@@ -17,12 +17,18 @@ import random
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
 from app.exercises.report import Result
 from app.lessons.registry import CHECKS, Kind, add_kind, make_kind
 from app.lessons.schema import Spec
 from app.ros.context import CallContext
+
+if TYPE_CHECKING:
+    from collections.abc import Mapping
+    from typing import TypeGuard
+
+_V = TypeVar("_V")  # the values of a table, kept as they are
 
 # Names an ``expect`` expression may use besides the request's own fields.
 _SAFE_FUNCTIONS = {
@@ -72,7 +78,7 @@ class ProbeContext:
     example: dict[str, Any] = field(default_factory=dict)
 
 
-def expected_value(expression: str, names: dict[str, Any]) -> Any:
+def expected_value(expression: str, names: Mapping[str, object]) -> Any:
     """Evaluate an exercise author's formula ("a * b") on the request's fields.
 
     The names are globals, so a comprehension in the formula sees them too
@@ -81,7 +87,7 @@ def expected_value(expression: str, names: dict[str, Any]) -> Any:
     return eval(expression, {"__builtins__": {}, **_SAFE_FUNCTIONS, **names})
 
 
-def is_range(value: Any) -> bool:
+def is_range(value: object) -> TypeGuard[list[int | float]]:
     """``[low, high]`` of two numbers: a range to draw from (exercise data)."""
     return (
         isinstance(value, list)
@@ -90,16 +96,16 @@ def is_range(value: Any) -> bool:
     )
 
 
-def is_choice(value: Any) -> bool:
+def is_choice(value: object) -> TypeGuard[list[str]]:
     """A list of two or more words: one is drawn at grading time (exercise data)."""
     return isinstance(value, list) and len(value) >= 2 and all(isinstance(v, str) for v in value)
 
 
-def is_drawn(value: Any) -> bool:
+def is_drawn(value: object) -> bool:
     return is_range(value) or is_choice(value)
 
 
-def draw(rng: random.Random, value: Any) -> Any:
+def draw(rng: random.Random, value: object) -> Any:
     """A value drawn at grading time: ``[low, high]`` ints or floats, one of a list of
     words; a table draws each of its fields; anything else as is."""
     if isinstance(value, dict):
@@ -114,27 +120,27 @@ def draw(rng: random.Random, value: Any) -> Any:
     return round(rng.uniform(float(low), float(high)), 3)
 
 
-def range_text(value: Any) -> str:
+def range_text(value: object) -> str:
     """How a teacher reads a drawn field: "random in [-50, 50]", or the fixed value."""
     if is_choice(value):
         return "random, one of " + ", ".join(repr(v) for v in value)
     return f"random in [{value[0]}, {value[1]}]" if is_range(value) else repr(value)
 
 
-def fill_template(text: str, names: dict[str, Any]) -> str:
+def fill_template(text: str, names: Mapping[str, object]) -> str:
     """``"{a} + {b} = {a + b}"`` with each braced formula evaluated on ``names``."""
     return re.sub(r"\{([^{}]+)\}", lambda m: str(expected_value(m.group(1), names)), text)
 
 
-def values_text(values: dict[str, Any]) -> str:
+def values_text(values: Mapping[str, object]) -> str:
     return ", ".join(f"{k}={v!r}" for k, v in values.items())
 
 
-def random_inputs(rng: random.Random, ranges: dict[str, list[Any]]) -> dict[str, Any]:
+def random_inputs(rng: random.Random, ranges: Mapping[str, object]) -> dict[str, object]:
     return {name: draw(rng, value) for name, value in ranges.items()}
 
 
-def same(actual: Any, expected: Any, tolerance: float) -> bool:
+def same(actual: object, expected: object, tolerance: float) -> bool:
     """Equal, numbers within ``tolerance``; nested dicts and lists (messages) compared deeply."""
     if isinstance(actual, dict) and isinstance(expected, dict):
         return all(k in actual and same(actual[k], v, tolerance) for k, v in expected.items())
@@ -147,7 +153,7 @@ def same(actual: Any, expected: Any, tolerance: float) -> bool:
     return bool(actual == expected)
 
 
-def without_kind(table: dict[str, Any]) -> dict[str, Any]:
+def without_kind(table: Mapping[str, _V]) -> dict[str, _V]:
     return {k: v for k, v in table.items() if k != "kind"}
 
 
@@ -165,7 +171,7 @@ class ProbeKind:
     draws: str = ""  # what it draws at grading time, in words (`exercise explain` shows it)
     # Fields an exercise may leave out, with their values: the ranges inputs are drawn
     # from live here, so the exercise file can change them and explain shows them.
-    defaults: dict[str, Any] = field(default_factory=dict)
+    defaults: dict[str, object] = field(default_factory=dict)
     # It gives the node input (a request, messages, a parameter, a goal...); a kind that
     # only watches (a rate, QoS, a message on a topic) draws nothing.
     feeds: bool = True
@@ -181,7 +187,7 @@ def register_probe(
     optional: str = "",
     words: str,
     draws: str = "",
-    defaults: dict[str, Any] | None = None,
+    defaults: Mapping[str, object] | None = None,
     feeds: bool = True,
 ) -> Callable[[Probe], Probe]:
     """Decorator: ``run(ctx, probe) -> Result`` is the probe kind ``name``.

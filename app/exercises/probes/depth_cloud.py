@@ -5,7 +5,7 @@ back-projected through the pinhole model, must come out.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -13,6 +13,9 @@ from app.exercises.probes.base import ProbeContext, draw, register_probe
 from app.exercises.probes.topics import SEND_QOS, exchange, fmt, listen, wait_subscribed
 from app.exercises.report import Result
 from app.lessons.schema import Spec
+
+if TYPE_CHECKING:
+    from sensor_msgs.msg import PointCloud2
 
 DEPTH_SIZE = (160, 120)  # width, height
 DEPTH_FRAME = "depth_camera_optical_frame"
@@ -94,7 +97,7 @@ def _same_in_another_order(
     return _max_error(got, want) <= tolerance
 
 
-def _cloud_verdict(cloud: Any, depth: np.ndarray, p: Spec, index: int) -> str:
+def _cloud_verdict(cloud: PointCloud2, depth: np.ndarray, p: Spec, index: int) -> str:
     """'' when the cloud holds exactly the back-projected valid pixels, else what differs."""
     from nodes.common.pointcloud import pointcloud2_to_xyz_rgb
 

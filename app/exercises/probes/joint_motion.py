@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Any
+from typing import TYPE_CHECKING
 
 from rclpy.time import Time
 from sensor_msgs.msg import JointState
@@ -20,13 +20,21 @@ from app.exercises.report import Result
 from app.lessons.schema import Spec
 from app.ros.rotations import rotation_angle as quat_angle
 
+if TYPE_CHECKING:
+    from collections.abc import Iterable
+    from typing import SupportsFloat
 
-def _vec3(value: Any) -> tuple[float, float, float]:
+    from rclpy.publisher import Publisher
+
+
+def _vec3(value: Iterable[SupportsFloat]) -> tuple[float, float, float]:
     x, y, z = (float(v) for v in value)
     return (x, y, z)
 
 
-def _judge_joint(ctx: ProbeContext, buffer: Buffer, publisher: Any, p: Spec, value: float) -> str:
+def _judge_joint(
+    ctx: ProbeContext, buffer: Buffer, publisher: Publisher, p: Spec, value: float
+) -> str:
     """'' when the judged frame follows ``value`` within 3 s, else what is wrong."""
     joint, parent = p["joint"], p["parent"]
     frame = p.get("frame", p["child"])  # the frame judged: the child, or one fixed on it

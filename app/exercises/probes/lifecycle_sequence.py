@@ -6,7 +6,7 @@ publishes only while active.
 from __future__ import annotations
 
 import random
-from typing import Any
+from typing import TypedDict
 
 from app.exercises.probes.base import ProbeContext, draw, register_probe
 from app.exercises.report import Result
@@ -25,6 +25,17 @@ _VALID_TRANSITIONS = {
 _TRANSITIONS = ("configure", "activate", "deactivate", "cleanup")
 INVALID_SHARE = 0.3  # of a walk's requests, about this many are invalid from the state
 STATES = ("unconfigured", "inactive", "active")  # the plot's levels, bottom to top
+
+
+class _Request(TypedDict):
+    transition: str  # the transition asked for
+    state: str  # the state the node is in after it
+
+
+class WalkStep(_Request, total=False):
+    """One request of a drawn walk, as a step of ``steps`` is written."""
+
+    succeeds: bool  # False for a request the state machine refuses; left out when it succeeds
 
 
 @register_probe(
@@ -136,7 +147,7 @@ def _path(start: str, end: str) -> list[tuple[str, str]]:
 
 def lifecycle_walk(
     rng: random.Random, length: int, end: str = "active", avoid: list[str] | None = None
-) -> list[dict[str, Any]]:
+) -> list[WalkStep]:
     """A random order of lifecycle requests from unconfigured, invalid ones among them.
 
     Every walk has at least two invalid requests, reaches active, has a
@@ -146,6 +157,7 @@ def lifecycle_walk(
     """
     if end not in _VALID_TRANSITIONS:
         raise ValueError(f"end must be one of {sorted(_VALID_TRANSITIONS)}, not {end!r}")
+    steps: list[WalkStep]
     for _ in range(500):
         state, steps = "unconfigured", []
         for _ in range(length):

@@ -27,7 +27,7 @@ import math
 import random
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -40,6 +40,11 @@ from app.exercises.probes.topics import (
 )
 from app.exercises.report import Result
 from app.lessons.schema import Spec
+
+if TYPE_CHECKING:
+    from geometry_msgs.msg import PoseStamped
+    from nav_msgs.msg import OccupancyGrid
+    from sensor_msgs.msg import LaserScan
 
 # The statement's log-odds rule.
 HIT, MISS = 0.85, -0.4
@@ -368,7 +373,7 @@ def _looks_like(f: Frame, task: Task, mine: np.ndarray, expected: np.ndarray) ->
     return ""
 
 
-def messages(scan: Scan, number: int) -> tuple[Any, Any]:
+def messages(scan: Scan, number: int) -> tuple[PoseStamped, LaserScan]:
     """The ``PoseStamped`` and the ``LaserScan`` the grader sends for one scan, stamped
     ``number`` s."""
     from geometry_msgs.msg import PoseStamped
@@ -390,7 +395,7 @@ def messages(scan: Scan, number: int) -> tuple[Any, Any]:
     return pose, msg
 
 
-def map_info(grid: Any) -> tuple[int, int, float, float, float]:
+def map_info(grid: OccupancyGrid) -> tuple[int, int, float, float, float]:
     """An OccupancyGrid's (width, height, resolution, origin x, origin y)."""
     info = grid.info
     return (

@@ -13,7 +13,7 @@ the newest one from the topic's kept history.
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import TYPE_CHECKING
 
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
@@ -39,12 +39,19 @@ from app.lessons.schema import Spec
 from app.ros.convert import fill, import_type, to_plain
 from app.ros.monitor import TopicMonitor
 
+if TYPE_CHECKING:
+    from collections.abc import Mapping, Sequence
+
+    from rclpy.publisher import Publisher
+
+    from app.exercises.probes.topics import M
+
 LATE_QOS = QoSProfile(
     depth=10, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
 )
 
 
-def expected_fields(expect: Any, names: dict[str, Any]) -> Any:
+def expected_fields(expect: object, names: Mapping[str, object]) -> object:
     """The answer's fields: each formula of ``expect`` evaluated on the input's fields."""
     if isinstance(expect, dict):
         return {key: expected_fields(value, names) for key, value in expect.items()}
@@ -83,7 +90,7 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
         if late:
             return _late_joiner(ctx, p, publisher, inputs, name, tolerance)
         assert monitor is not None
-        previous: Any = None
+        previous: object = None
         for index, values in enumerate(inputs, start=1):
             want = expected_fields(p["expect"], values)
             answer = _answer(ctx, publisher, monitor, fill(in_type, values), want, previous, p)
@@ -108,13 +115,13 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
 
 def _answer(
     ctx: ProbeContext,
-    publisher: Any,
-    monitor: TopicMonitor,
-    message: Any,
-    want: Any,
-    previous: Any,
+    publisher: Publisher,
+    monitor: TopicMonitor[M],
+    message: object,
+    want: object,
+    previous: object,
     p: Spec,
-) -> Any | None:
+) -> M | None:
     """The node's answer to ``message``, sent again when nothing comes (discovery may lag).
 
     A late second answer to the previous input (it was sent twice) is skipped.
@@ -141,8 +148,8 @@ def _answer(
 def _late_joiner(
     ctx: ProbeContext,
     p: Spec,
-    publisher: Any,
-    inputs: list[dict[str, Any]],
+    publisher: Publisher,
+    inputs: Sequence[Mapping[str, object]],
     name: str,
     tolerance: float,
 ) -> Result:

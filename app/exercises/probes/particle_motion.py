@@ -25,7 +25,7 @@ import random
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -39,12 +39,17 @@ from app.exercises.probes.topics import (
 from app.exercises.report import Result
 from app.lessons.schema import Spec
 
+if TYPE_CHECKING:
+    from geometry_msgs.msg import Pose, PoseArray
+    from nav_msgs.msg import Odometry
+    from numpy.typing import ArrayLike, NDArray
+
 Pose2D = tuple[float, float, float]  # x, y, yaw
 PARTS = ("rot1", "trans", "rot2")
 UNITS = {"rot1": "rad", "trans": "m", "rot2": "rad"}
 
 
-def wrap(angle: Any) -> Any:
+def wrap(angle: ArrayLike) -> NDArray[np.float64] | np.float64:
     """An angle (or an array of them) in [-pi, pi)."""
     return (np.asarray(angle) + math.pi) % (2.0 * math.pi) - math.pi
 
@@ -228,7 +233,7 @@ def judge_moved(
     return "", found
 
 
-def odom_message(pose: Pose2D, sec: int) -> Any:
+def odom_message(pose: Pose2D, sec: int) -> Odometry:
     """The ``nav_msgs/msg/Odometry`` the grader sends for an odometry pose, stamped ``sec``."""
     from nav_msgs.msg import Odometry
 
@@ -241,7 +246,7 @@ def odom_message(pose: Pose2D, sec: int) -> Any:
     return msg
 
 
-def cloud_message(particles: np.ndarray) -> Any:
+def cloud_message(particles: np.ndarray) -> PoseArray:
     """The ``geometry_msgs/msg/PoseArray`` of a cloud of particles, in the map frame."""
     from geometry_msgs.msg import Pose, PoseArray
 
@@ -255,12 +260,12 @@ def cloud_message(particles: np.ndarray) -> Any:
     return msg
 
 
-def poses_of(msg: Any) -> np.ndarray:
+def poses_of(msg: PoseArray) -> np.ndarray:
     """(N, 3): the x, y and yaw of each pose of a ``PoseArray``."""
     return np.array([_pose2d(pose) for pose in msg.poses], dtype=float).reshape(-1, 3)
 
 
-def _pose2d(pose: Any) -> Pose2D:
+def _pose2d(pose: Pose) -> Pose2D:
     q = pose.orientation
     yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
     return pose.position.x, pose.position.y, yaw
@@ -306,7 +311,7 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
         odom_pub.publish(odom_message(pose, stamp[0]))
         return stamp[0]
 
-    def answer_to(sec: int, seen: int) -> Any | None:
+    def answer_to(sec: int, seen: int) -> PoseArray | None:
         deadline = time.monotonic() + 3.0
         while time.monotonic() < deadline:
             answers.wait_for_count(seen + 1, 0.1)

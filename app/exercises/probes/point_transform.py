@@ -5,7 +5,6 @@ pose), with the usual slips (no translation, transposed rotation, ...) named.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 
@@ -25,7 +24,9 @@ def _pose_matrices(pose: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
     return rotation, np.array([pose["x"], pose["y"], pose["z"]], dtype=float)
 
 
-def _transform_slips(pose: dict[str, float]) -> list[tuple[str, Callable[[np.ndarray], Any]]]:
+def _transform_slips(
+    pose: dict[str, float],
+) -> list[tuple[str, Callable[[np.ndarray], np.ndarray]]]:
     """The usual ways to get ``p_base = R p + t`` wrong, each with what to say."""
     from nodes.common.frames import rot_x, rot_y, rot_z
 

@@ -36,7 +36,7 @@ import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
@@ -50,6 +50,11 @@ from app.lessons.checks._world_map import WorldMap
 from app.ros import params
 from app.ros.calls import wait_for_server, wait_future
 from app.ros.errors import Ros2Error
+
+if TYPE_CHECKING:
+    from collections.abc import Mapping
+
+    from rclpy.client import Client
 
 READY_WAIT_SEC = 30.0  # a world starting on a busy machine: MuJoCo, the model, the camera
 SERVICE_SEC = 10.0  # a world stepping on a busy machine can be slow to answer
@@ -138,7 +143,7 @@ class Recorder:
             self._node.destroy_subscription(sub)
 
 
-def _parameter(name: str, value: Any) -> Parameter:
+def _parameter(name: str, value: object) -> Parameter:
     return Parameter(name=name, value=params.parameter_value(value))
 
 
@@ -148,9 +153,9 @@ class Services:
 
     def __init__(self, ctx: ProbeContext) -> None:
         self._ctx = ctx
-        self._clients: dict[tuple[str, type], Any] = {}
+        self._clients: dict[tuple[str, type], Client] = {}
 
-    def call(self, name: str, srv_type: type, request: Any) -> Any:
+    def call(self, name: str, srv_type: type, request: object) -> object:
         key = (name, srv_type)
         if key not in self._clients:
             self._clients[key] = self._ctx.call.node.create_client(srv_type, name)
@@ -159,16 +164,20 @@ class Services:
         wait_for_server(self._ctx.call, client.service_is_ready, SERVICE_SEC, what)
         return wait_future(self._ctx.call, client.call_async(request), SERVICE_SEC, what)
 
-    def get(self, node: str, names: list[str]) -> dict[str, Any]:
+    def get(self, node: str, names: list[str]) -> dict[str, object]:
         request = GetParameters.Request(names=names)
-        response = self.call(f"{node}/get_parameters", GetParameters, request)
+        response: GetParameters.Response = self.call(
+            f"{node}/get_parameters", GetParameters, request
+        )
         values = [params.python_value(v) for v in response.values]
         return dict(zip(names, values, strict=True))
 
-    def set(self, node: str, values: dict[str, Any]) -> None:
+    def set(self, node: str, values: Mapping[str, object]) -> None:
         """Set several parameters in one request; a refusal raises with the node's reason."""
         request = SetParameters.Request(parameters=[_parameter(k, v) for k, v in values.items()])
-        response = self.call(f"{node}/set_parameters", SetParameters, request)
+        response: SetParameters.Response = self.call(
+            f"{node}/set_parameters", SetParameters, request
+        )
         for name, result in zip(values, response.results, strict=False):
             if not result.successful:
                 raise Ros2Error(f"{node} refused {name}={values[name]!r}: {result.reason}")
@@ -189,7 +198,7 @@ class World:
 
     name: str
     plan: WorldMap
-    saved: dict[str, Any]
+    saved: dict[str, object]
     rtf: float
     services: Services
 
@@ -247,7 +256,7 @@ def release(
     world: World,
     recorder: Recorder,
     start: tuple[float, float, float],
-    learner: dict[str, Any] | None = None,
+    learner: Mapping[str, object] | None = None,
 ) -> float:
     """Put the robot at ``start`` (paused), tell the learner's node ``learner``, and go.
 
@@ -279,7 +288,7 @@ def release(
 
 def draw_pose(
     ctx: ProbeContext,
-    ranges: dict[str, Any],
+    ranges: Mapping[str, object],
     fits: Callable[[float, float, float], bool],
     tries: int = 20000,
 ) -> tuple[float, float, float]:

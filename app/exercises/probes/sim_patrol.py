@@ -545,7 +545,10 @@ def _wait_for_nav2(ctx: ProbeContext, services: Services, manager: str) -> None:
     why = "no answer"
     while time.monotonic() < deadline:
         try:
-            if services.call(f"{manager}/is_active", Trigger, Trigger.Request()).success:
+            answer: Trigger.Response = services.call(
+                f"{manager}/is_active", Trigger, Trigger.Request()
+            )
+            if answer.success:
                 return
             why = "it answers that they are not all active yet"
         except Ros2Error as exc:

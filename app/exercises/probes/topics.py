@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Protocol, TypeVar
 
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile
@@ -16,6 +16,13 @@ from app.ros.monitor import TopicMonitor
 from app.ros.names import node_fqn
 from app.ros.qos import matching_qos
 
+if TYPE_CHECKING:
+    from collections.abc import Iterable
+    from typing import SupportsFloat
+
+    from rclpy.publisher import Publisher
+    from std_msgs.msg import Header
+
 # Reaches reliable and best-effort subscribers alike.
 SEND_QOS = QoSProfile(depth=10)
 MATCH_WAIT_SEC = 5.0  # for the learner's subscription to appear
@@ -24,18 +31,28 @@ ANSWER_WAIT_SEC = 2.0  # for one answer to one input
 RESENDS = 3  # an input is sent again when no answer came (discovery may lag)
 
 
+class Stamped(Protocol):
+    """A message with a ``std_msgs/msg/Header``: its stamp tells which input an answer is to."""
+
+    header: Header
+
+
+M = TypeVar("M")  # the messages of a topic (their generated class is untyped)
+S = TypeVar("S", bound=Stamped)  # answers that carry a header
+
+
 def split_name(fqn: str) -> tuple[str, str]:
     namespace, _, name = fqn.rpartition("/")
     return namespace or "/", name
 
 
-def listen(ctx: ProbeContext, topic: str, msg_type: type) -> TopicMonitor:
+def listen(ctx: ProbeContext, topic: str, msg_type: type[M]) -> TopicMonitor[M]:
     """A reader for the node's answers, reliable when its publisher is (big messages)."""
     qos = matching_qos(ctx.call.node, topic, depth=20)
     return TopicMonitor(ctx.call.node, topic, msg_type, keep=20, qos=qos)
 
 
-def others_subscribed(node: Any, publisher: Any, topic: str) -> int:
+def others_subscribed(node: Node, publisher: Publisher, topic: str) -> int:
     """Readers matched by ``publisher`` other than ``node``'s own (the grader's recording of
     the attempt subscribes to every topic: it is not the learner's node listening)."""
     ours = sum(
@@ -46,7 +63,7 @@ def others_subscribed(node: Any, publisher: Any, topic: str) -> int:
     return max(0, int(publisher.get_subscription_count()) - ours)
 
 
-def wait_subscribed(ctx: ProbeContext, publisher: Any, topic: str) -> str:
+def wait_subscribed(ctx: ProbeContext, publisher: Publisher, topic: str) -> str:
     """'' once someone subscribes to ``topic``, else why not."""
     deadline = time.monotonic() + MATCH_WAIT_SEC
     while not others_subscribed(ctx.call.node, publisher, topic):
@@ -57,7 +74,7 @@ def wait_subscribed(ctx: ProbeContext, publisher: Any, topic: str) -> str:
     return ""
 
 
-def wait_matched(ctx: ProbeContext, ours: Sequence[tuple[Any, str]], theirs: str) -> str:
+def wait_matched(ctx: ProbeContext, ours: Sequence[tuple[Publisher, str]], theirs: str) -> str:
     """'' once the node subscribes to each of ``ours`` (publisher, topic), else why not; then
     up to a second more for its publisher on ``theirs`` to show (it may have none: the
     grading then says so), and a little for its writer to match our reader."""
@@ -89,8 +106,12 @@ def wait_answering(ctx: ProbeContext, monitor: TopicMonitor, timeout: float = 3.
 
 
 def exchange(
-    ctx: ProbeContext, publisher: Any, monitor: TopicMonitor, message: Any, stamp_sec: int
-) -> Any | None:
+    ctx: ProbeContext,
+    publisher: Publisher,
+    monitor: TopicMonitor[S],
+    message: Stamped,
+    stamp_sec: int,
+) -> S | None:
     """Send ``message`` stamped ``stamp_sec`` s and return the answer to it, or None.
 
     An answer with our stamp belongs to this input. One with a zero stamp (a
@@ -114,7 +135,7 @@ def exchange(
     return None
 
 
-def fmt(values: Any) -> str:
+def fmt(values: Iterable[SupportsFloat]) -> str:
     return "(" + ", ".join(f"{float(v):.3f}" for v in values) + ")"
 
 
@@ -149,7 +170,7 @@ def with_note(text: str, note: str) -> str:
     return f"{text} ({note})" if note else text
 
 
-def difference(actual: Any, expected: Any, tolerance: float, path: str) -> str:
+def difference(actual: object, expected: object, tolerance: float, path: str) -> str:
     """'' when ``actual`` has every expected field (deeply), else the first that differs."""
     if isinstance(expected, dict):
         if not isinstance(actual, dict):
