@@ -265,6 +265,14 @@ def busy_cores(request: pytest.FixtureRequest) -> Iterator[list[subprocess.Popen
             loop.wait(timeout=10)
 
 
+@pytest.hookimpl(tryfirst=True)  # before ``-m`` selects: "not ros" leaves them out
+def pytest_itemcollected(item: pytest.Item) -> None:
+    # A test that needs DDS, through any fixture, carries the ``ros`` mark even if its
+    # module forgot it (tests/unit/test_steady_executor.py did).
+    if "ros_env" in getattr(item, "fixturenames", ()):
+        item.add_marker(pytest.mark.ros)
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     # Every worker collects, and all must list the same order: the plan is a pure function.
     if os.environ.get("PYTEST_XDIST_WORKER"):

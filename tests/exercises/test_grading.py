@@ -27,6 +27,8 @@ from tests.conftest import fail_on_leftover_nodes
 from tests.exercises.cheats import EXEMPT, cheat_code
 from tests.exercises.grading_participant import grading_participant
 
+pytestmark = pytest.mark.ros  # each case runs a learner program over DDS
+
 BOOK = load_exercises()
 # Correct solutions written differently from the references: accepted/<slug>__<how>.py.
 ACCEPTED = Path(__file__).parent / "accepted"
