@@ -352,8 +352,10 @@ class Round:
         self.started.add(LEARNER_NODE)
         if self.page is not None:
             self.page_tool("Exercise")
-            if self.frame is None:  # the panel opens on the lesson's own exercise
-                self.page_choose("Exercise", self.exercise_label)
+            # Always picked (picking the one shown changes nothing): the panel follows the
+            # lesson to its own exercise, so a Next after the code was typed had moved it on
+            # (ci20, round 16, seed 758932: code, Next, then Run ran the counter exercise).
+            self.page_choose("Exercise", self.exercise_label)
             self.page_click("Run my node")
         else:
             self.choose("Exercise", self.exercise_label)
