@@ -323,9 +323,10 @@ class Dashboard:
         self.ui.wake()
 
     def _ui_loop(self) -> None:
-        # A cheap look at the node list every GRAPH_CHECK_SEC, and any posted
-        # intent, refresh at once; otherwise panels refresh at UI_PERIOD_SEC.
-        # A node shows up within a frame, a click's effect within one pass.
+        # Any posted intent, or a node list that changed, refreshes at once; otherwise
+        # panels refresh at UI_PERIOD_SEC. The node list is looked at with each refresh,
+        # and every GRAPH_CHECK_SEC while a program of ours starts or stops: its node
+        # shows up within a frame, a click's effect within one pass.
         last_nodes: list[tuple[str, str]] | None = None
         due = 0.0
         while not self._stop.is_set():
