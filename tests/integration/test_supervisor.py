@@ -14,7 +14,7 @@ from std_msgs.msg import String
 
 from app import PROJECT_ROOT
 from app.ros.monitor import TopicMonitor
-from app.supervisor import NodeState
+from app.supervisor import NodeState, NodeStatus
 from tests.conftest import wait_until
 
 pytestmark = pytest.mark.ros
@@ -221,12 +221,12 @@ def test_listeners_hear_each_start_stop_and_end(supervisor):
     heard: list[tuple[str, NodeState]] = []
     ended = threading.Event()
 
-    def broken(_status: object) -> None:
+    def broken(_status: NodeStatus) -> None:
         raise RuntimeError("a listener's bug")
 
-    def listen(status: object) -> None:
-        heard.append((status.name, status.state))  # type: ignore[attr-defined]
-        if status.state is NodeState.STOPPED:  # type: ignore[attr-defined]
+    def listen(status: NodeStatus) -> None:
+        heard.append((status.name, status.state))
+        if status.state is NodeState.STOPPED:
             ended.set()
 
     supervisor.on_change(broken)  # logged; the others are still told, the work goes on

@@ -41,7 +41,3 @@ def parameter(node: Node, fqn: str, name: str, timeout: float = 10.0) -> Any:
         return parameter_value_to_python(value)
     finally:
         node.destroy_client(client)
-
-
-def string_parameter(node: Node, fqn: str, name: str, timeout: float = 10.0) -> str:
-    return str(parameter(node, fqn, name, timeout))

@@ -42,7 +42,7 @@ from app.lessons.checks._world_map import load_world_map
 from app.ros.action_client import ThreadSafeActionClient
 from nodes.common.occupancy_grid import plan_distance
 from tests.conftest import wait_until
-from tests.nav.goal_helpers import pose_stamped, string_parameter, wait_future
+from tests.nav.goal_helpers import parameter, pose_stamped, wait_future
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(180)]
 
@@ -162,7 +162,7 @@ def test_boxes_not_on_the_map_are_driven_round_or_reported_and_a_cancel_stops_at
     wait_until(active, timeout=90, what=logs)
     up = time.monotonic() - started
     # The world with the boxes is the one running (a later -p world:= wins).
-    assert string_parameter(node, "/sim_world", "world") == str(world)
+    assert parameter(node, "/sim_world", "world") == str(world)
     navigator = ThreadSafeActionClient(node, NavigateToPose, "/navigate_to_pose")
     assert navigator.wait_for_server(timeout_sec=30)
 
