@@ -239,6 +239,7 @@ def send_goal(
         client.destroy()
 
 
+STEP_ANSWER_SEC = 5.0  # how long a step action waits for its service's answer
 LOST_AFTER_SEC = 3.0  # a request unanswered this long is asked again (a lost answer)
 
 
@@ -286,9 +287,29 @@ class ServicePoller:
             self._calls[key] = (future, result, sent_at)
             return result
 
-    def send(self, service: str, srv_type: type, request: object) -> None:
-        """Fire one request and forget the answer (a step action)."""
-        self.client(service, srv_type).call_async(request)
+    def call(
+        self, service: str, srv_type: type, request: object, timeout: float = STEP_ANSWER_SEC
+    ) -> object | None:
+        """Send one request and wait up to ``timeout`` s for the response (None: none came).
+
+        A step action: the step's next button (a drive after a reset) must find the
+        request done, also when the buttons run back to back on a loaded machine.
+        None is no error: a fresh client's answer can be lost while discovery lags
+        (see ``LOST_AFTER_SEC``), though the server has acted on the request.
+        """
+        client = self.client(service, srv_type)
+        deadline = time.monotonic() + timeout
+        while not client.service_is_ready():
+            if time.monotonic() > deadline:
+                raise Ros2Error(f"service '{service}' is not available (waited {timeout:g} s)")
+            time.sleep(0.1)
+        future = client.call_async(request)
+        answered = threading.Event()
+        future.add_done_callback(lambda _f: answered.set())
+        if answered.wait(max(0.0, deadline - time.monotonic())):
+            return future.result()
+        client.remove_pending_request(future)
+        return None
 
     def forget_answers(self) -> None:
         """Answers from before an action may be stale now."""

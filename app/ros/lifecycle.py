@@ -86,7 +86,7 @@ def change_state(ctx: CallContext, fqn: str, transition: str) -> tuple[bool, Tra
 
 
 def change_request(label: str) -> ChangeState.Request:
-    """A request the node resolves from its own state (for fire-and-forget senders)."""
+    """A request by label: the node resolves it from its own state (a step button's)."""
     if label not in TRANSITION_LABELS:
         raise Ros2Error(f"unknown lifecycle transition '{label}'")
     return ChangeState.Request(transition=Transition(label=label))

@@ -8,6 +8,7 @@ from lifecycle_msgs.srv import ChangeState
 
 from app.lessons.registry import register_action
 from app.ros import lifecycle
+from app.ros.calls import STEP_ANSWER_SEC
 
 if TYPE_CHECKING:
     from app.lessons.runtime import LessonRuntime
@@ -18,9 +19,15 @@ if TYPE_CHECKING:
     "lifecycle",
     required="node transition",
     optional="label",
-    words="ask a lifecycle node for a transition",
+    words="ask a lifecycle node for a transition and wait (briefly) for its answer",
 )
 def perform(rt: LessonRuntime, action: Spec) -> str:
     request = lifecycle.change_request(action["transition"])
-    rt.services.send(f"{action['node']}/change_state", ChangeState, request)
-    return f"Asked {action['node']} to {action['transition']}."
+    # Wait for the answer: a step's "configure" then "activate" must happen in that order.
+    asked = f"Asked {action['node']} to {action['transition']}"
+    response = rt.services.call(f"{action['node']}/change_state", ChangeState, request)
+    if response is None:
+        return f"{asked}; no answer within {STEP_ANSWER_SEC:g} s (it may be busy)."
+    if not getattr(response, "success", False):
+        return f"{asked}: it refused (that transition is not possible from its current state)."
+    return f"{asked}: done."

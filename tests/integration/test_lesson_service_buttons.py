@@ -1,0 +1,79 @@
+"""A step's service buttons return once the server has answered, so the next button
+comes after it.
+
+Lesson 19 puts the robot back at its start (``/reset_world``) and then drives it. The
+walk clicks both at once; when the reset was fired and forgotten it reached the world
+on a loaded machine only after the drive had begun, the robot jumped back mid-drive,
+covered only the rest of it and the scan check waited for a wall it never came near
+(ci of d081dc2). Lesson 11's configure and activate buttons have the same order.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import pytest
+from std_srvs.srv import Trigger
+
+from app.lessons.runtime import LessonRuntime
+from app.lessons.schema import Spec
+from app.ros.runtime import RosRuntime
+from tests.conftest import wait_until
+
+pytestmark = pytest.mark.ros
+ANSWER_AFTER_SEC = 1.0  # the server's work: longer than any button's own cost
+
+
+def test_a_service_button_returns_after_the_server_answered(probe, supervisor):
+    server = RosRuntime("slow_reset")
+    handled = threading.Event()
+
+    def reset(_request: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
+        time.sleep(ANSWER_AFTER_SEC)
+        handled.set()
+        response.success = True
+        return response
+
+    server.node.create_service(Trigger, "/slow_reset", reset)
+    lessons = LessonRuntime(probe.node, supervisor)
+    try:
+        button = Spec(
+            "call_service",
+            {"service": "/slow_reset", "type": "std_srvs/srv/Trigger", "request": {}},
+        )
+        began = time.monotonic()
+        said = lessons.perform(button)
+        assert handled.is_set(), f"the button returned before the server was done: {said!r}"
+        assert time.monotonic() - began >= ANSWER_AFTER_SEC
+        assert said == "Called /slow_reset: it answered."
+    finally:
+        lessons.close()
+        server.shutdown()
+
+
+def test_lifecycle_buttons_run_in_order_and_say_when_a_transition_is_refused(probe, supervisor):
+    lessons = LessonRuntime(probe.node, supervisor)
+    try:
+        supervisor.start("lifecycle_talker")
+        node = "/lifecycle_talker"
+        wait_until(
+            lambda: (
+                f"{node}/change_state"
+                in {name for name, _ in probe.node.get_service_names_and_types()}
+            ),
+            timeout=30,
+            what="lifecycle_talker's change_state service",
+        )
+
+        def button(transition: str) -> str:
+            return lessons.perform(Spec("lifecycle", {"node": node, "transition": transition}))
+
+        assert button("activate") == f"Asked {node} to activate: it refused " + (
+            "(that transition is not possible from its current state)."
+        )
+        # Back to back, as the walk clicks them: activate finds configure done.
+        assert button("configure") == f"Asked {node} to configure: done."
+        assert button("activate") == f"Asked {node} to activate: done."
+    finally:
+        lessons.close()
