@@ -307,7 +307,8 @@ class ServicePoller:
         answered = threading.Event()
         future.add_done_callback(lambda _f: answered.set())
         if answered.wait(max(0.0, deadline - time.monotonic())):
-            return future.result()
+            response: object = future.result()
+            return response
         client.remove_pending_request(future)
         return None
 

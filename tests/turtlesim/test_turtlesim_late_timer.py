@@ -22,7 +22,7 @@ pytestmark = pytest.mark.ros
 LATE_SEC = 0.2  # how late the timer is: about 12 steps due at once
 
 
-def test_steps_due_before_a_command_do_not_move_the_turtle_with_it(ros_env):
+def test_steps_due_before_a_command_do_not_move_the_turtle_with_it(ros_env, monkeypatch):
     rclpy.init()
     node = Turtlesim()
     try:
@@ -38,9 +38,14 @@ def test_steps_due_before_a_command_do_not_move_the_turtle_with_it(ros_env):
         assert 0.0 <= moved <= 2 * UPDATE_PERIOD + 1e-9, f"moved {moved:.3f} m"
         # From here on every due step moves the turtle at 1 m/s. Count the steps the
         # next update runs: a sleep on a busy computer lasts longer than it asks for.
-        steps = []
+        steps: list[float] = []
         step_world = node.step_world
-        node.step_world = lambda now: (steps.append(now), step_world(now))[1]
+
+        def counted(now: float) -> None:
+            steps.append(now)
+            step_world(now)
+
+        monkeypatch.setattr(node, "step_world", counted)
         time.sleep(10 * UPDATE_PERIOD)
         node.on_update()
         assert len(steps) >= 10, f"{len(steps)} steps ran after a sleep of 10 periods"
