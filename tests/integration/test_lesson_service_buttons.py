@@ -77,3 +77,30 @@ def test_lifecycle_buttons_run_in_order_and_say_when_a_transition_is_refused(pro
         assert button("activate") == f"Asked {node} to activate: done."
     finally:
         lessons.close()
+
+
+def test_a_parameter_button_says_done_or_why_the_node_refused(probe, supervisor):
+    lessons = LessonRuntime(probe.node, supervisor)
+    try:
+        supervisor.start("parameters_node")
+        node = "/parameters_node"
+        wait_until(
+            lambda: (
+                f"{node}/set_parameters"
+                in {name for name, _ in probe.node.get_service_names_and_types()}
+            ),
+            timeout=30,
+            what="parameters_node's set_parameters service",
+        )
+
+        def button(name: str, value: object) -> str:
+            return lessons.perform(Spec("set_param", {"node": node, "name": name, "value": value}))
+
+        before = time.monotonic()
+        assert button("greeting", "") == (
+            f"Set greeting = '' on {node}: it refused: greeting must not be empty."
+        )
+        assert button("greeting", "Hola") == f"Set greeting = 'Hola' on {node}: done."
+        assert lessons.changed_at > before  # a rate judged from here hears only the new value
+    finally:
+        lessons.close()

@@ -9,25 +9,30 @@ from rcl_interfaces.srv import SetParameters
 
 from app.lessons.registry import register_action
 from app.ros import params
+from app.ros.calls import STEP_ANSWER_SEC
 
 if TYPE_CHECKING:
-    from rclpy.task import Future
-
     from app.lessons.runtime import LessonRuntime
     from app.lessons.schema import Spec
 
 
 @register_action(
-    "set_param", required="node name value", optional="label", words="set a parameter on a node"
+    "set_param",
+    required="node name value",
+    optional="label",
+    words="set a parameter on a node and wait (briefly) for its answer",
 )
 def perform(rt: LessonRuntime, action: Spec) -> str:
     request = params.set_request(action["name"], action["value"])
-    client = rt.services.client(f"{action['node']}/set_parameters", SetParameters)
     rt.changed_at = time.monotonic()  # until the node answers, from the click
-
-    def answered(_future: Future) -> None:
-        # From now on the node runs with the new value: a rate judged later hears only it.
-        rt.changed_at = time.monotonic()
-
-    client.call_async(request).add_done_callback(answered)
-    return f"Set {action['name']} = {action['value']!r} on {action['node']}."
+    said = f"Set {action['name']} = {action['value']!r} on {action['node']}"
+    # Wait for the answer: the step's next button finds the node running with the value.
+    response = rt.services.call(f"{action['node']}/set_parameters", SetParameters, request)
+    if response is None:
+        return f"{said}; no answer within {STEP_ANSWER_SEC:g} s (it may be busy)."
+    # From now on the node runs with the new value: a rate judged later hears only it.
+    rt.changed_at = time.monotonic()
+    results = getattr(response, "results", [])
+    if results and not results[0].successful:
+        return f"{said}: it refused: {results[0].reason or 'no reason given'}."
+    return f"{said}: done."
