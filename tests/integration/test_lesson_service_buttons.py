@@ -69,8 +69,9 @@ def test_lifecycle_buttons_run_in_order_and_say_when_a_transition_is_refused(pro
         def button(transition: str) -> str:
             return lessons.perform(Spec("lifecycle", {"node": node, "transition": transition}))
 
-        assert button("activate") == f"Asked {node} to activate: it refused " + (
-            "(that transition is not possible from its current state)."
+        assert button("activate") == (
+            f"Asked {node} to activate: it refused (it is unconfigured, and activate does not "
+            "start there)."
         )
         # Back to back, as the walk clicks them: activate finds configure done.
         assert button("configure") == f"Asked {node} to configure: done."

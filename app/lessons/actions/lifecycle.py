@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from lifecycle_msgs.srv import ChangeState
+from lifecycle_msgs.srv import ChangeState, GetState
 
 from app.lessons.registry import register_action
 from app.ros import lifecycle
@@ -29,5 +29,8 @@ def perform(rt: LessonRuntime, action: Spec) -> str:
     if response is None:
         return f"{asked}; no answer within {STEP_ANSWER_SEC:g} s (it may be busy)."
     if not getattr(response, "success", False):
-        return f"{asked}: it refused (that transition is not possible from its current state)."
+        state = rt.services.call(f"{action['node']}/get_state", GetState, GetState.Request())
+        label = getattr(getattr(state, "current_state", None), "label", "")
+        where = f"it is {label}" if label else "its current state"
+        return f"{asked}: it refused ({where}, and {action['transition']} does not start there)."
     return f"{asked}: done."
