@@ -21,7 +21,9 @@ As in Nav2: nothing is published until an initial pose is known (from
 a global reinitialisation); the filter updates when the odometry moved more
 than ``update_min_d`` along x or y or turned more than ``update_min_a``;
 between updates the last ``map -> odom`` is sent again with each scan,
-stamped ``transform_tolerance`` ahead. Bad input is refused with a warning
+stamped ``transform_tolerance`` ahead; a map that comes after the first one
+replaces what the scans are weighed against and leaves the particles where
+they are. Bad input is refused with a warning
 and the node runs on: an initial pose in another frame, with NaNs or off the
 map, a map with no cells.
 
@@ -313,6 +315,13 @@ class AmclNode(LifecycleNode):
             pf = ParticleFilter(self.params, amcl_map, seed if seed >= 0 else None)
         except ValueError as exc:
             self.get_logger().error(f"Refusing the map: {exc}; keeping the one before (if any)")
+            return
+        if self.pf is not None:
+            # As Nav2's handleMapMessage: a new map changes what the scans are weighed
+            # against, never where the particles are. (Ours re-spread them round the
+            # initial pose: a map delivered again mid-drive threw the estimate back there.)
+            pf.take_particles(self.pf)
+            self.amcl_map, self.pf = amcl_map, pf
             return
         self.amcl_map, self.pf = amcl_map, pf
         self.first_map_received = True

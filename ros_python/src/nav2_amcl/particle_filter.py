@@ -279,6 +279,14 @@ class ParticleFilter:
         self.converged = False
         self.update_gathered()
 
+    def take_particles(self, other: ParticleFilter) -> None:
+        """Carry on from ``other``'s particles and averages (a new map, the same robot)."""
+        self.poses, self.weights = other.poses.copy(), other.weights.copy()
+        self.w_slow, self.w_fast = other.w_slow, other.w_fast
+        self.resample_count = other.resample_count
+        self.converged, self.gathered = other.converged, other.gathered
+        self.rng = other.rng
+
     def random_poses(self, n: int) -> np.ndarray:
         """Poses at the centres of random free cells, any heading."""
         x, y = self.map.cell_centres(self.rng.choice(self.free, n))
