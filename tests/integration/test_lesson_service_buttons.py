@@ -14,6 +14,7 @@ import threading
 import time
 
 import pytest
+from rclpy.node import Node
 from std_srvs.srv import Trigger
 
 from app.lessons.runtime import LessonRuntime
@@ -57,14 +58,7 @@ def test_lifecycle_buttons_run_in_order_and_say_when_a_transition_is_refused(pro
     try:
         supervisor.start("lifecycle_talker")
         node = "/lifecycle_talker"
-        wait_until(
-            lambda: (
-                f"{node}/change_state"
-                in {name for name, _ in probe.node.get_service_names_and_types()}
-            ),
-            timeout=30,
-            what="lifecycle_talker's change_state service",
-        )
+        _wait_for_service(probe.node, f"{node}/change_state")
 
         def button(transition: str) -> str:
             return lessons.perform(Spec("lifecycle", {"node": node, "transition": transition}))
@@ -85,14 +79,7 @@ def test_a_parameter_button_says_done_or_why_the_node_refused(probe, supervisor)
     try:
         supervisor.start("parameters_node")
         node = "/parameters_node"
-        wait_until(
-            lambda: (
-                f"{node}/set_parameters"
-                in {name for name, _ in probe.node.get_service_names_and_types()}
-            ),
-            timeout=30,
-            what="parameters_node's set_parameters service",
-        )
+        _wait_for_service(probe.node, f"{node}/set_parameters")
 
         def button(name: str, value: object) -> str:
             return lessons.perform(Spec("set_param", {"node": node, "name": name, "value": value}))
@@ -106,3 +93,11 @@ def test_a_parameter_button_says_done_or_why_the_node_refused(probe, supervisor)
         assert lessons.changed_at is not None and lessons.changed_at > before
     finally:
         lessons.close()
+
+
+def _wait_for_service(node: Node, service: str) -> None:
+    wait_until(
+        lambda: service in {name for name, _ in node.get_service_names_and_types()},
+        timeout=30,
+        what=f"the service {service}",
+    )
