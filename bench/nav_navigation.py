@@ -35,7 +35,9 @@ each a process of its own. This process uses Nav2's Python API
 Beside them, ``nav_localization_error_max_m``: how far amcl's ``/amcl_pose`` was from
 the ground truth at its stamp, at worst while driving (each goal's worst is printed
 with it): a goal missed with a large one was lost by localization, not by planning
-or control.
+or control, and the first moment amcl was more than 0.5 m off is printed (and is
+``localization_lost`` in the JSON): where its pose jumped from and to, and where the robot
+really went meanwhile.
 
 The stack's logs are kept in ``test-artifacts/bench-nav_navigation.log``.
 Also ``rtf_kept`` (simulated over wall seconds while driving) and the load
@@ -68,6 +70,7 @@ AIM_PLAN_RATIO = 1.5
 AIM_CPU_PERCENT = 100.0
 CLEARANCE = 0.4  # m: goals this far from any obstacle
 REACHED = 0.3  # m: the ground truth this close to the goal at the end
+LOST = 0.5  # m: amcl this far from the ground truth has lost the robot
 ROBOT_RADIUS = 0.15  # m: the costmap's robot_radius; closer than this is a collision
 MIN_LEG = 1.0  # m between consecutive goals
 GOAL_TIMEOUT = 120.0  # s wall for one goal
@@ -219,11 +222,26 @@ def run(goals_n: int, seed: int, rtf: float) -> dict[str, Any]:
     # (0.22 m "off" where amcl was right).
     unjudged: collections.deque[tuple[float, float, float]] = collections.deque(maxlen=300)
 
+    # The first moment amcl lost the robot, said once: where its pose went from and to, and
+    # where the robot really went meanwhile (a jump, or a slow drift, tells the cause apart).
+    judged: list[tuple[float, float, float, float, float]] = []  # the last: t, amcl x y, truth x y
+    lost_at: list[str] = []
+
     def judge_unjudged() -> None:  # with the lock held
         while unjudged and recent and recent[-1][0] >= unjudged[0][0]:
             t, ax, ay = unjudged.popleft()
             _t, x, y = min(recent, key=lambda r: abs(r[0] - t))  # the truth at its stamp
-            localization["worst"] = max(localization["worst"], math.hypot(ax - x, ay - y))
+            off = math.hypot(ax - x, ay - y)
+            if off > LOST and judged and not lost_at:
+                t0, ax0, ay0, x0, y0 = judged[-1]
+                lost_at.append(
+                    f"amcl lost the robot at {t:.1f} s of simulated time: its pose went from "
+                    f"({ax0:.2f}, {ay0:.2f}) to ({ax:.2f}, {ay:.2f}) in {t - t0:.1f} s while the "
+                    f"robot went from ({x0:.2f}, {y0:.2f}) to ({x:.2f}, {y:.2f})"
+                )
+                print(f"  {lost_at[0]}", flush=True)
+            judged[:] = [(t, ax, ay, x, y)]
+            localization["worst"] = max(localization["worst"], off)
             localization["samples"] += 1
 
     def on_amcl(msg: Any) -> None:
@@ -385,6 +403,7 @@ def run(goals_n: int, seed: int, rtf: float) -> dict[str, Any]:
             compared = localization["samples"]
         if compared:
             figures["nav_localization_error_max_m"] = worst_localization
+            figures["localization_lost"] = lost_at[0] if lost_at else None
         else:
             figures["errors"].append("no /amcl_pose came while the goals were driven")
         with lock:
