@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import threading
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 import pytest
 from rclpy.node import Node
@@ -20,6 +22,7 @@ from std_srvs.srv import Trigger
 from app.lessons.runtime import LessonRuntime
 from app.lessons.schema import Spec
 from app.ros.runtime import RosRuntime
+from app.supervisor import Supervisor
 from tests.conftest import wait_until
 
 pytestmark = pytest.mark.ros
@@ -54,11 +57,7 @@ def test_a_service_button_returns_after_the_server_answered(probe, supervisor):
 
 
 def test_lifecycle_buttons_run_in_order_and_say_when_a_transition_is_refused(probe, supervisor):
-    lessons = LessonRuntime(probe.node, supervisor)
-    try:
-        supervisor.start("lifecycle_talker")
-        node = "/lifecycle_talker"
-        _wait_for_service(probe.node, f"{node}/change_state")
+    with _buttons_for(probe, supervisor, "lifecycle_talker", "change_state") as (lessons, node):
 
         def button(transition: str) -> str:
             return lessons.perform(Spec("lifecycle", {"node": node, "transition": transition}))
@@ -70,16 +69,10 @@ def test_lifecycle_buttons_run_in_order_and_say_when_a_transition_is_refused(pro
         # Back to back, as the walk clicks them: activate finds configure done.
         assert button("configure") == f"Asked {node} to configure: done."
         assert button("activate") == f"Asked {node} to activate: done."
-    finally:
-        lessons.close()
 
 
 def test_a_parameter_button_says_done_or_why_the_node_refused(probe, supervisor):
-    lessons = LessonRuntime(probe.node, supervisor)
-    try:
-        supervisor.start("parameters_node")
-        node = "/parameters_node"
-        _wait_for_service(probe.node, f"{node}/set_parameters")
+    with _buttons_for(probe, supervisor, "parameters_node", "set_parameters") as (lessons, node):
 
         def button(name: str, value: object) -> str:
             return lessons.perform(Spec("set_param", {"node": node, "name": name, "value": value}))
@@ -91,6 +84,19 @@ def test_a_parameter_button_says_done_or_why_the_node_refused(probe, supervisor)
         assert button("greeting", "Hola") == f"Set greeting = 'Hola' on {node}: done."
         # A rate judged from here on hears only the new value.
         assert lessons.changed_at is not None and lessons.changed_at > before
+
+
+@contextmanager
+def _buttons_for(
+    probe: RosRuntime, supervisor: Supervisor, program: str, service: str
+) -> Iterator[tuple[LessonRuntime, str]]:
+    """A lesson runtime, with the catalog node ``program`` started and serving ``service``."""
+    lessons = LessonRuntime(probe.node, supervisor)
+    try:
+        supervisor.start(program)
+        node = f"/{program}"
+        _wait_for_service(probe.node, f"{node}/{service}")
+        yield lessons, node
     finally:
         lessons.close()
 
