@@ -11,6 +11,7 @@ from __future__ import annotations
 import threading
 import time
 
+import numpy as np
 import pytest
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Int64
@@ -51,7 +52,13 @@ def publish_at(publishers: list, rate_hz: float, seconds: float) -> list[float]:
 
 
 def true_rate(stamps: list[float]) -> float:
-    return (len(stamps) - 1) / (stamps[-1] - stamps[0])
+    """The rate sent: the least-squares slope of the publish times against their count.
+
+    Not the first and last times alone: on a loaded machine a stall near either end, and
+    the catch-up burst after it, moved those two (ci25: 485.6 Hz for 500 sent).
+    """
+    period = np.polyfit(np.arange(len(stamps)), np.asarray(stamps), 1)[0]
+    return float(1.0 / period)
 
 
 def test_published_rate_stays_true_when_a_starved_view_misses_samples(probe):
@@ -73,8 +80,8 @@ def test_published_rate_stays_true_when_a_starved_view_misses_samples(probe):
     truth = true_rate(sent)
     assert published is not None and arrived is not None
     assert published.fallback == "", published  # the middleware filled the info, raw too
-    # The sender's clock read after each publish() returned: on a loaded machine the last
-    # reads come late (seen: 492.0 against the stamps' 499.5 for 500 Hz sent), so 2.5 %.
+    # The sender's clock read after each publish() returned: on a loaded machine some reads
+    # come late (seen: 492.0 against the stamps' 499.5 for 500 Hz sent), so 2.5 %.
     assert abs(published.rate - truth) / truth < 0.025, (published, truth)
     assert arrived.rate < 0.85 * truth, (arrived.rate, truth)  # what `ros2 topic hz` would say
     assert published.missed is not None and published.missed > 0.1 * len(sent), published
