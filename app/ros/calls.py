@@ -298,19 +298,14 @@ class ServicePoller:
         (see ``LOST_AFTER_SEC``), though the server has acted on the request.
         """
         client = self.client(service, srv_type)
-        deadline = time.monotonic() + timeout
-        while not client.service_is_ready():
-            if time.monotonic() > deadline:
-                raise Ros2Error(f"service '{service}' is not available (waited {timeout:g} s)")
-            time.sleep(0.1)
+        ctx, what = CallContext(self._node), f"service '{service}'"
+        wait_for_server(ctx, client.service_is_ready, timeout, what)
         future = client.call_async(request)
-        answered = threading.Event()
-        future.add_done_callback(lambda _f: answered.set())
-        if answered.wait(max(0.0, deadline - time.monotonic())):
-            response: object = future.result()
-            return response
-        client.remove_pending_request(future)
-        return None
+        try:
+            return wait_future(ctx, future, timeout, what)
+        except NoAnswer:
+            client.remove_pending_request(future)
+            return None
 
     def forget_answers(self) -> None:
         """Answers from before an action may be stale now."""
