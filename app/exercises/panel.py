@@ -88,6 +88,8 @@ def _result_line(result: Result) -> str:
 
 
 class ExercisePanel:
+    calm = True  # once a second while idle (app.ui.Panel): a Check's result wakes the loop
+
     def __init__(
         self,
         gui: viser.GuiApi,

@@ -157,6 +157,8 @@ def _label(lesson: Lesson) -> str:
 
 
 class LessonsPanel:
+    calm = True  # once a second while idle (app.ui.Panel): checks; a step's button wakes the loop
+
     def __init__(
         self,
         gui: viser.GuiApi,

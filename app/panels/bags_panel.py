@@ -57,6 +57,8 @@ def bag_text(info: BagInfo) -> str:
 
 
 class BagsPanel:
+    calm = True  # once a second while idle (app.ui.Panel): a recording's counters
+
     def __init__(
         self, gui: viser.GuiApi, ui: UiLoop, node: Node, folder: Path | None = None
     ) -> None:

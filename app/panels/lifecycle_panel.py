@@ -31,6 +31,8 @@ LOG_LINES = 5  # the node's newest /rosout lines under the diagram
 
 
 class LifecyclePanel:
+    calm = True  # once a second while idle (app.ui.Panel): it polls every POLL_SEC anyway
+
     def __init__(
         self,
         gui: viser.GuiApi,

@@ -12,6 +12,8 @@ ALL_NODES = "(all nodes)"
 
 
 class LogsPanel:
+    calm = True  # once a second while idle (app.ui.Panel): a log read by a person
+
     def __init__(self, gui: viser.GuiApi, log: RosoutLog) -> None:
         self._log = log
         self._level = gui.add_dropdown("Min severity", list(LEVELS.values()), initial_value="INFO")

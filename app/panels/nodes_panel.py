@@ -35,6 +35,8 @@ def _notes(status: NodeStatus, stale: bool) -> str:
 
 
 class NodesPanel:
+    calm = True  # once a second while idle (app.ui.Panel): states change with a wake; output lines
+
     def __init__(
         self,
         gui: viser.GuiApi,

@@ -112,6 +112,8 @@ def describe_spec(spec: ParamSpec) -> str:
 
 
 class ParametersPanel:
+    calm = True  # once a second while idle (app.ui.Panel): values change when set, with a wake
+
     def __init__(
         self, gui: viser.GuiApi, ui: UiLoop, node: Node, rosout: RosoutLog | None = None
     ) -> None:

@@ -22,6 +22,8 @@ HIDDEN_SUFFIXES = (
 
 
 class ServicesPanel:
+    calm = True  # once a second while idle (app.ui.Panel): an answer wakes the loop
+
     def __init__(self, gui: viser.GuiApi, ui: UiLoop, node: Node) -> None:
         self._ui = ui
         self._node = node

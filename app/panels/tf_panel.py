@@ -193,6 +193,8 @@ def picture_html(svg: bytes, name: str) -> str:
 
 
 class TfPanel:
+    calm = True  # once a second while idle (app.ui.Panel): a tree of frames
+
     def __init__(self, gui: viser.GuiApi, ui: UiLoop, node: Node, supervisor: Supervisor) -> None:
         self._ui = ui
         self._supervisor = supervisor

@@ -20,7 +20,6 @@ import viser.uplot as uplot
 from rclpy.node import Node
 from rclpy.publisher import Publisher
 from rclpy.timer import Timer
-from rclpy.topic_endpoint_info import TopicEndpointInfo
 
 from app.ros.convert import (
     ConversionError,
@@ -47,7 +46,6 @@ ECHO_LINES = 36  # fewer messages are shown when each is long
 PLOT_WINDOW_SEC = 30.0
 PLOT_SAMPLES = 600
 STATS_WINDOW_SEC = 5.0
-COUNTS_PERIOD_SEC = 1.0
 MATCH_WAIT_SEC = 3.0
 MAX_RATE_HZ = 100.0
 
@@ -79,11 +77,6 @@ def plot_value(msg: object, path: str) -> float | None:
     return value if math.isfinite(value) else None
 
 
-def others_count(infos: list[TopicEndpointInfo], own_name: str, own_namespace: str) -> int:
-    """Endpoints not belonging to this dashboard (its own taps would confuse a learner)."""
-    return sum(1 for i in infos if (i.node_name, i.node_namespace) != (own_name, own_namespace))
-
-
 class TopicsPanel:
     def __init__(self, gui: viser.GuiApi, ui: UiLoop, node: Node) -> None:
         self._gui = gui
@@ -91,7 +84,6 @@ class TopicsPanel:
         self._node = node
         self._types: dict[str, str] = {}
         self._counts: dict[str, tuple[int, int]] = {}
-        self._counts_at = 0.0
         self._topic: str | None = None
         self._monitor: TopicMonitor[object] | None = None
         self._seen = 0
@@ -291,18 +283,11 @@ class TopicsPanel:
 
     def _refresh_list(self, graph: GraphSnapshot) -> None:
         types = {t.name: t.types[0] for t in graph.topics if t.types}
-        now = time.monotonic()
-        if types != self._types or now - self._counts_at > COUNTS_PERIOD_SEC:
-            self._counts_at = now
-            node = self._node
-            me = (node.get_name(), node.get_namespace())
-            self._counts = {
-                topic: (
-                    others_count(node.get_publishers_info_by_topic(topic), *me),
-                    others_count(node.get_subscriptions_info_by_topic(topic), *me),
-                )
-                for topic in types
-            }
+        # Counted without this dashboard's own taps, which would confuse a learner.
+        self._counts = {
+            t.name: (t.publishers - t.own_publishers, t.subscribers - t.own_subscribers)
+            for t in graph.topics
+        }
         rows = [
             topic_item(topic, type_text, *self._counts.get(topic, (0, 0)))
             for topic, type_text in sorted(types.items())

@@ -106,6 +106,8 @@ def pose_topics(graph: GraphSnapshot, sim_fqn: str) -> dict[str, str]:
 
 
 class TurtlesimPanel:
+    calm = True  # once a second while idle (app.ui.Panel): the drawing has its own thread
+
     def __init__(
         self,
         gui: viser.GuiApi,

@@ -96,6 +96,15 @@ GROUP_OF = {name: group for group, names in TOOL_GROUPS.items() for name in name
 
 
 class Panel(Protocol):
+    """A tool's widgets, refreshed by the UI thread.
+
+    A panel whose content never moves on its own faster than about once a second
+    (a table of states, a log, checks) says so with a class attribute
+    ``calm = True``: while nothing happens it is refreshed once a second, not at
+    every pass (what an idle dashboard costs); a click, a job's end or a node that
+    joins still refreshes it at once.
+    """
+
     def refresh(self, graph: GraphSnapshot) -> None: ...
 
     def close(self) -> None: ...

@@ -144,3 +144,25 @@ class UiLoop:
             lanes, self._lanes = list(self._lanes.values()), {}
         for executor in lanes:
             executor.shutdown(wait=False, cancel_futures=True)
+
+
+class FullPasses:
+    """Which passes of the UI thread ask for the graph again and refresh the calm panels
+    (``app.ui.Panel``) too: every pass after something happened (a click, a job's end)
+    and for ``settle`` seconds after the node list changed (a node's topics follow its
+    name), otherwise one pass every ``period`` seconds. The other passes refresh only
+    the live panels (the stage, echo, plots), which is what an idle lesson costs."""
+
+    def __init__(self, period: float, settle: float) -> None:
+        self._period = period
+        self._settle = settle
+        self._due = 0.0
+        self._settle_until = 0.0
+
+    def due(self, now: float, *, happened: bool, nodes_changed: bool) -> bool:
+        if nodes_changed:
+            self._settle_until = now + self._settle
+        if happened or now < self._settle_until or now >= self._due:
+            self._due = now + self._period
+            return True
+        return False
