@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from nav2_controller.regulated_pure_pursuit import RPPParameters, compute_velocity
+from nav2_controller.regulated_pure_pursuit import PathState, RPPParameters, compute_velocity
 from nav2_costmap_2d import INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE
 from nav2_costmap_2d.costmap_2d import Costmap2D, costmap_from_grid
 from nav2_planner.navfn_planner import PlannerOptions, create_plan, path_length
@@ -68,6 +68,26 @@ def test_pure_pursuit_turns_towards_the_path():
     behind = [(-0.1 * i, 0.0, math.pi) for i in range(1, 20)]  # the path is behind: turn first
     turn = compute_velocity((0.0, 0.0, 0.0), behind, (0.0, 0.0), RPPParameters())
     assert turn.linear == 0.0 and turn.angular != 0.0
+
+
+def test_pure_pursuit_keeps_turning_to_the_goal_heading_once_within_the_tolerance():
+    """Nav2's ``stateful``: a pose read 2 mm outside the tolerance after one inside it does
+    not send the robot back towards the goal point (the other way round)."""
+    goal = [(1.0, 0.0, 0.0)]  # what is left of the path: the goal, heading along +x
+    inside, outside = (1.149, 0.0, 0.3), (1.151, 0.0, 0.3)  # just past it, turned 0.3 rad left
+
+    def turn(robot, params, state):
+        command = compute_velocity(robot, goal, (0.0, 0.0), params, goal_dist_tol=0.15, state=state)
+        assert command.linear == 0.0  # both ways turn on the spot
+        return command.angular
+
+    state = PathState()
+    assert turn(inside, RPPParameters(), state) < 0  # right, to the goal's heading
+    assert turn(outside, RPPParameters(), state) < 0  # still to the heading
+    # Without the memory (Nav2's stateful: false) the goal point, behind, wins: left.
+    assert turn(outside, RPPParameters(stateful=False), PathState()) > 0
+    # A new path starts with a new state.
+    assert turn(outside, RPPParameters(), PathState()) > 0
 
 
 def corridor_with_a_box():

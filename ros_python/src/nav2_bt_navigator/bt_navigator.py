@@ -68,6 +68,7 @@ from rclpy.time import Time
 from tf2_ros.buffer import Buffer
 
 SUCCEEDED, CANCELED, ABORTED = 4, 5, 6  # action_msgs/GoalStatus
+FINAL_STATUSES = (SUCCEEDED, CANCELED, ABORTED)
 RECOVERIES = ("wait", "back up", "clear costmaps")  # in turn, as the tree's RoundRobin
 LETHAL = 100  # an obstacle on a published costmap (OccupancyGrid values)
 # ComputePathToPose's codes a planner recovery may help with (Nav2's WouldAPlannerRecoveryHelp)
@@ -381,6 +382,11 @@ class BtNavigator(LifecycleNode):
                     try:
                         path = self.plan(goals, stop)
                         failures = 0
+                        if follow is not None and not follow.running():
+                            # It ended while the planner worked: the loop's top reads how (a
+                            # new path now would throw a success away, as Nav2's tree only
+                            # updates a goal that is still executing).
+                            continue
                         follow = self.follow(path, stop, handle)
                         state["path"] = [(p.pose.position.x, p.pose.position.y) for p in path.poses]
                     except NavigationFailed:
@@ -570,6 +576,10 @@ class _Following:
 
     def done(self) -> bool:
         return self.future.done()
+
+    def running(self) -> bool:
+        """Still driving: no result yet, and no final status (the status can come first)."""
+        return not self.done() and self.status not in FINAL_STATUSES
 
     def result(self) -> Any:
         return self.future.result()

@@ -59,6 +59,7 @@ from nav2_controller.checkers import SimpleGoalChecker, SimpleProgressChecker
 from nav2_controller.regulated_pure_pursuit import (
     ControllerException,
     NoValidControl,
+    PathState,
     RPPParameters,
     closest_index,
     compute_velocity,
@@ -250,6 +251,7 @@ class ControllerServer(LifecycleNode):
             params = self.rpp_parameters()
             radius = float(self.costmap_ros.get_parameter("robot_radius").value)
             start = 0
+            state = PathState()  # this path's own (Nav2's setPlan starts it afresh)
             while True:
                 tick = time.monotonic()
                 with self.lock:
@@ -269,7 +271,18 @@ class ControllerServer(LifecycleNode):
                 if pose is None:
                     raise ControllerError(Result.TF_ERROR, "Failed to obtain robot pose")
                 self.update_speed()
-                if not self.progress_checker.check(pose, time.monotonic()):
+                # Nav2's order: the goal first, then progress (by the node's clock: simulated
+                # time under use_sim_time), then the command.
+                if checker.is_goal_reached(pose, path[-1]):
+                    self.get_logger().info("Reached the goal!")
+                    self.publish_zero_velocity()
+                    handle.succeed()
+                    with self.lock:
+                        if self.current is handle:
+                            self.current = None
+                    return result
+                now = self.get_clock().now().nanoseconds * 1e-9
+                if not self.progress_checker.check(pose, now):
                     raise ControllerError(Result.FAILED_TO_MAKE_PROGRESS, "Failed to make progress")
                 start = closest_index(path, pose, start)
                 try:
@@ -282,6 +295,7 @@ class ControllerServer(LifecycleNode):
                         costmap=self.costmap_ros.get_costmap(),
                         dt=period,
                         inscribed_radius=radius,
+                        state=state,
                     )
                 except NoValidControl as exc:
                     raise ControllerError(Result.NO_VALID_CONTROL, str(exc)) from exc
@@ -297,14 +311,6 @@ class ControllerServer(LifecycleNode):
                 )
                 feedback.speed = float(math.hypot(self.speed[0], 0.0))
                 handle.publish_feedback(feedback)
-                if checker.is_goal_reached(pose, path[-1]):
-                    self.get_logger().info("Reached the goal!")
-                    self.publish_zero_velocity()
-                    handle.succeed()
-                    with self.lock:
-                        if self.current is handle:
-                            self.current = None
-                    return result
                 spent = time.monotonic() - tick
                 if spent > period:
                     self.get_logger().warning(

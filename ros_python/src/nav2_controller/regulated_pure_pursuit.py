@@ -59,6 +59,9 @@ class RPPParameters:
     use_velocity_scaled_lookahead_dist: bool = True
     rotate_to_heading_angular_vel: float = 1.8
     use_rotate_to_heading: bool = True
+    # Nav2's ``stateful``: once within the goal tolerance, keep turning to the goal's heading
+    # for the rest of this path, even if the pose then reads a centimetre outside it.
+    stateful: bool = True
     rotate_to_heading_min_angle: float = 0.785
     max_angular_accel: float = 3.2
     use_regulated_linear_velocity_scaling: bool = True
@@ -124,6 +127,30 @@ def lookahead_point(path_robot: list[tuple[float, float]], lookahead: float) -> 
 
 
 @dataclass
+class PathState:
+    """What the controller keeps between two commands for one path; a new path starts a
+    new one (Nav2 resets it in ``setPlan`` and ``reset``)."""
+
+    # Nav2's ``has_reached_xy_tolerance_``: the robot came within the goal tolerance.
+    reached_xy_tolerance: bool = False
+
+
+def should_rotate_to_goal_heading(
+    goal_dist: float, goal_dist_tol: float, params: RPPParameters, state: PathState | None
+) -> bool:
+    """``shouldRotateToGoalHeading``: within the goal tolerance, or (``stateful``) ever within
+    it on this path: a pose that jitters across the tolerance's edge would otherwise flip the
+    robot between turning to the goal's heading and turning back towards the goal."""
+    if not params.use_rotate_to_heading:
+        return False
+    within = goal_dist < goal_dist_tol
+    if params.stateful and state is not None:
+        state.reached_xy_tolerance = state.reached_xy_tolerance or within
+        return state.reached_xy_tolerance
+    return within
+
+
+@dataclass
 class Command:
     linear: float
     angular: float
@@ -141,8 +168,10 @@ def compute_velocity(
     costmap: Costmap2D | None = None,
     dt: float = 0.05,
     inscribed_radius: float = 0.15,
+    state: PathState | None = None,
 ) -> Command:
-    """The velocity command (``computeVelocityCommands``) for a pruned path from the robot on.
+    """The velocity command (``computeVelocityCommands``) for a pruned path from the robot on;
+    ``state`` is the path's own (``PathState``; None: no memory between commands).
 
     Ours, beyond Nav2's: when the arc to the carrot would hit something, nearer carrots are
     tried (down to two costmap cells) before giving up, and when none will do, the robot
@@ -163,7 +192,7 @@ def compute_velocity(
     def at(distance: float) -> Command:
         return _command(
             robot, path, path_robot, speed, params, distance, goal_dist_tol, costmap, dt,
-            inscribed_radius,
+            inscribed_radius, state,
         )  # fmt: skip
 
     def free(command: Command) -> bool:
@@ -199,6 +228,7 @@ def _command(
     costmap: Costmap2D | None,
     dt: float,
     inscribed_radius: float,
+    state: PathState | None = None,
 ) -> Command:
     """Nav2's command for one lookahead distance: turn on the spot, or drive the arc."""
     carrot = lookahead_point(path_robot, lookahead)
@@ -209,7 +239,7 @@ def _command(
     goal_dist = math.hypot(goal[0] - robot[0], goal[1] - robot[1])
     linear = params.desired_linear_vel
     angular: float
-    if params.use_rotate_to_heading and goal_dist < goal_dist_tol:
+    if should_rotate_to_goal_heading(goal_dist, goal_dist_tol, params, state):
         angular = rotate_to(normalize(goal[2] - robot[2]), w_now, params, dt)
         linear = 0.0
     elif (
