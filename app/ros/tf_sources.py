@@ -55,7 +55,7 @@ log = logging.getLogger(__name__)
 
 TAPS_NODE = "_classroom_tf_panel"  # hidden, as `ros2 node list` hides '_' names
 POLL_SEC = 0.02  # take what arrived 50 times a second...
-IDLE_POLL_SEC = 0.1  # ...or 10 times while nothing has come for IDLE_AFTER_SEC
+IDLE_POLL_SEC = 0.25  # ...or 4 times while nothing has come for IDLE_AFTER_SEC
 IDLE_AFTER_SEC = 2.0
 MAX_TAKES = 400  # per topic and poll: a flood cannot starve the rest of the loop
 GRAPH_EVERY_SEC = 1.0  # re-read which GID belongs to which node...

@@ -185,6 +185,7 @@ class DriveControls:
         self._shown: bool | None = None
         self.follow.on_update(ui.callback(self._on_follow))
         self._stop = threading.Event()
+        self._follow_on = threading.Event()  # the follow thread sleeps until it is ticked
         self._thread = threading.Thread(target=self._run, name="scene-follow", daemon=True)
         self._thread.start()
 
@@ -205,6 +206,8 @@ class DriveControls:
 
     def _on_follow(self) -> None:
         self._following = self.follow.value is True
+        if self._following:
+            self._follow_on.set()
 
     # --- UI thread ---
     def refresh(self, graph: GraphSnapshot) -> None:
@@ -242,6 +245,7 @@ class DriveControls:
 
     def close(self) -> None:
         self._stop.set()
+        self._follow_on.set()
         self._thread.join(timeout=2.0)
         self._node.destroy_publisher(self._keys)
 
@@ -251,6 +255,9 @@ class DriveControls:
         while not self._stop.wait(1.0 / FOLLOW_HZ):
             if not self._following:
                 last = None
+                self._follow_on.clear()
+                if not self._following:  # not ticked meanwhile: sleep until it is
+                    self._follow_on.wait()
                 continue
             pose = self._frame_pose(ROBOT_FRAME)
             if pose is None:
