@@ -41,6 +41,7 @@ import math
 import sys
 import threading
 import time
+from collections.abc import Callable
 from typing import Any
 
 from geometry_msgs.msg import Twist
@@ -260,12 +261,9 @@ class ControllerServer(LifecycleNode):
                     handle.abort()
                     return result
                 if handle.is_cancel_requested:
-                    self.get_logger().info("Cancellation was successful. Stopping the robot.")
-                    self.publish_zero_velocity()
-                    handle.canceled()
-                    with self.lock:
-                        if self.current is handle:
-                            self.current = None
+                    self.end_goal(
+                        handle, handle.canceled, "Cancellation was successful. Stopping the robot."
+                    )
                     return result
                 pose = self.costmap_ros.get_robot_pose()
                 if pose is None:
@@ -274,12 +272,7 @@ class ControllerServer(LifecycleNode):
                 # Nav2's order: the goal first, then progress (by the node's clock: simulated
                 # time under use_sim_time), then the command.
                 if checker.is_goal_reached(pose, path[-1]):
-                    self.get_logger().info("Reached the goal!")
-                    self.publish_zero_velocity()
-                    handle.succeed()
-                    with self.lock:
-                        if self.current is handle:
-                            self.current = None
+                    self.end_goal(handle, handle.succeed, "Reached the goal!")
                     return result
                 now = self.get_clock().now().nanoseconds * 1e-9
                 if not self.progress_checker.check(pose, now):
@@ -332,6 +325,15 @@ class ControllerServer(LifecycleNode):
             result.error_msg = str(exc)
             handle.abort()
             return result
+
+    def end_goal(self, handle: Any, end: Callable[[], object], message: str) -> None:
+        """Say so, stop the robot, end the goal (succeed or canceled), free the server."""
+        self.get_logger().info(message)
+        self.publish_zero_velocity()
+        end()
+        with self.lock:
+            if self.current is handle:
+                self.current = None
 
     def check_goal(self, goal: Any) -> tuple[list[Pose2D], str]:
         if goal.controller_id not in ("", *self.controller_ids):
