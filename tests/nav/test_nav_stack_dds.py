@@ -18,11 +18,9 @@ import time
 import pytest
 import rclpy
 from nav2_simple_commander.robot_navigator import BasicNavigator, TaskResult
-from nav_msgs.msg import Odometry
 
 from app.catalog import lookup_group
-from tests.conftest import wait_until
-from tests.nav.commander_helpers import in_thread, map_pose
+from tests.nav.commander_helpers import Truth, in_thread, map_pose
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(300)]
 
@@ -46,13 +44,7 @@ def test_basic_navigator_drives_the_office_robot_through_a_door(ros_env, supervi
 
     rclpy.init()
     nav = BasicNavigator()
-    truth: list[tuple[float, float]] = []
-    nav.create_subscription(
-        Odometry,
-        "/ground_truth/odom",
-        lambda m: truth.append((m.pose.pose.position.x, m.pose.pose.position.y)),
-        10,
-    )
+    truth = Truth(nav)
     try:
         in_thread(nav.waitUntilNav2Active, 120, "Nav2 did not become active", logs)
         up = time.monotonic() - started
@@ -73,8 +65,7 @@ def test_basic_navigator_drives_the_office_robot_through_a_door(ros_env, supervi
         in_thread(until_done, 150, "the navigation did not end", logs)
         drive = time.monotonic() - driving
         assert nav.getResult() == TaskResult.SUCCEEDED, logs()
-        wait_until(lambda: truth, timeout=10, what="/ground_truth/odom")
-        x, y = truth[-1]
+        x, y = truth.now()
         assert math.hypot(x - GOAL[0], y - GOAL[1]) < REACHED, (x, y, logs())
         assert distances and distances[0] > 3.0, distances[:5]
         for name in group.members:

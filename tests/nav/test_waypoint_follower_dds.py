@@ -27,13 +27,12 @@ import pytest
 import rclpy
 from nav2_msgs.action import ComputePathToPose
 from nav2_simple_commander.robot_navigator import BasicNavigator, TaskResult
-from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
 
 from app.catalog import lookup_group
 from tests.integration.core_helpers import wait_for_output
-from tests.nav.commander_helpers import in_thread, map_pose
+from tests.nav.commander_helpers import Truth, in_thread, map_pose
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(240)]
 
@@ -45,17 +44,6 @@ BACK_IN_THE_CORRIDOR = (3.0, 0.0, math.pi)
 FAR_WEST = (-3.0, 0.0, math.pi)
 REACHED = 0.6  # m: the goal checker's 0.25 plus what amcl may be off on busy cores
 GOAL_OCCUPIED = ComputePathToPose.Result.GOAL_OCCUPIED
-
-
-class Truth:
-    def __init__(self, nav: BasicNavigator) -> None:
-        self.pose: tuple[float, float] | None = None
-        self.speed = 0.0
-        nav.create_subscription(Odometry, "/ground_truth/odom", self.on_odom, 10)
-
-    def on_odom(self, msg: Odometry) -> None:
-        self.pose = (msg.pose.pose.position.x, msg.pose.pose.position.y)
-        self.speed = math.hypot(msg.twist.twist.linear.x, msg.twist.twist.linear.y)
 
 
 def follow(
@@ -129,8 +117,7 @@ def test_follow_waypoints_with_basic_navigator(ros_env, supervisor):
         assert outcome == TaskResult.SUCCEEDED, (result, logs())
         assert list(result.missed_waypoints) == [], result
         assert seen == [0, 1], seen
-        assert truth.pose is not None
-        x, y = truth.pose
+        x, y = truth.now()
         assert math.hypot(x - MEETING_ROOM[0], y - MEETING_ROOM[1]) < REACHED, (x, y, logs())
         # The result comes over DDS; the follower's own lines through its output pipe, which
         # may trail it on a loaded machine (ci21: the result was in, the last lines not yet).
@@ -155,7 +142,7 @@ def test_follow_waypoints_with_basic_navigator(ros_env, supervisor):
         missed = [(m.index, m.error_code) for m in result.missed_waypoints]
         assert missed == [(0, GOAL_OCCUPIED)], missed
         assert seen[-1] == 1, seen
-        x, y = truth.pose
+        x, y = truth.now()
         goal = BACK_IN_THE_CORRIDOR
         assert math.hypot(x - goal[0], y - goal[1]) < REACHED, (x, y, logs())
         out = "\n".join(supervisor.output("waypoint_follower"))
