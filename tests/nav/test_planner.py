@@ -144,6 +144,30 @@ def test_pure_pursuit_swerves_round_a_box_close_ahead_without_entering_inscribed
     assert max(costs) < LETHAL_OBSTACLE
 
 
+def test_a_nearer_carrot_round_a_box_turns_no_faster_than_the_controller_turns_on_the_spot():
+    """Ours: when the far carrot's arc would hit a box, a nearer carrot's tight arc is taken,
+    driven slower along the same arc rather than at a turn rate a base would clamp (then it
+    would drive a wider arc than the one checked)."""
+    res = 0.01
+    grid = np.zeros((200, 200), np.int8)
+    grid[97:107, 113:117] = 100  # a box 0.13-0.17 m ahead of the robot, just right of the path
+    costmap = costmap_from_grid(grid, res, (0.0, 0.0))
+    heading = 0.5  # the path leaves the robot 0.5 rad to its left, in a straight line
+    path = [
+        (1.0 + 0.02 * i * math.cos(heading), 1.0 + 0.02 * i * math.sin(heading), heading)
+        for i in range(60)
+    ]
+    params = RPPParameters()
+    command = compute_velocity(
+        (1.0, 1.0, 0.0), path, (0.3, 0.0), params, goal_dist_tol=0.15, costmap=costmap
+    )
+    assert command.lookahead < 0.15  # a near carrot: the far ones' arcs hit the box
+    assert 0.0 < command.linear < params.regulated_linear_scaling_min_speed
+    assert abs(command.angular) <= params.rotate_to_heading_angular_vel + 1e-9
+    x, y = command.carrot  # still the arc through that carrot: curvature 2 y / L^2
+    assert command.angular / command.linear == pytest.approx(2.0 * y / (x * x + y * y))
+
+
 def test_pure_pursuit_slows_near_obstacles_as_nav2_regulates_by_cost():
     costmap = corridor_with_a_box()
     straight = [(1.0 + 0.05 * i, 1.0, 0.0) for i in range(40)]

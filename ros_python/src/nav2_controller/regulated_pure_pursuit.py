@@ -174,8 +174,9 @@ def compute_velocity(
     ``state`` is the path's own (``PathState``; None: no memory between commands).
 
     Ours, beyond Nav2's: when the arc to the carrot would hit something, nearer carrots are
-    tried (down to two costmap cells) before giving up, and when none will do, the robot
-    turns on the spot towards the nearest one (a round robot can always turn). A path that
+    tried (down to two costmap cells; such a tight arc is driven slower, so that it turns no
+    faster than ``rotate_to_heading_angular_vel``) before giving up, and when none will do,
+    the robot turns on the spot towards the nearest one (a round robot can always turn). A path that
     swerves round an obstacle just seen makes the far carrot's arc cut the corner into it;
     Nav2 gives up there ("detected collision ahead!") and leaves it to its recovery behaviours,
     which replan the same swerve from the same place.
@@ -210,11 +211,23 @@ def compute_velocity(
         shorter = max(shorter * 0.7, floor)
         command = at(shorter)
         if free(command):
-            return command
+            return within_turn_rate(command, params.rotate_to_heading_angular_vel)
     bearing = math.atan2(command.carrot[1], command.carrot[0])
     if params.use_rotate_to_heading and abs(bearing) > 0.1:
         return Command(0.0, rotate_to(bearing, speed[1], params, dt), command.carrot, shorter)
     raise NoValidControl("RegulatedPurePursuitController detected collision ahead!")
+
+
+def within_turn_rate(command: Command, limit: float) -> Command:
+    """The same arc, driven slower if it turns faster than ``limit`` (ours: a near carrot
+    curves tightly, and a base that clamps its turn rate would drive a wider arc than the
+    one checked against the costmap)."""
+    if abs(command.angular) <= limit:
+        return command
+    scale = limit / abs(command.angular)
+    return Command(
+        command.linear * scale, command.angular * scale, command.carrot, command.lookahead
+    )
 
 
 def _command(
