@@ -21,5 +21,10 @@ def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
     infos = rt.node.get_subscriptions_info_by_topic(c["topic"])
     count = sum(1 for info in infos if info.node_name != rt.node.get_name())
     if count >= c["at_least"]:
-        return CheckResult(PASS, f"{count} subscribers on {c['topic']}")
-    return CheckResult(FAIL, f"{count} of {c['at_least']} subscribers on {c['topic']}")
+        return CheckResult(PASS, f"{count} {_subscribers(count)} on {c['topic']}")
+    wanted = c["at_least"]
+    return CheckResult(FAIL, f"{count} of {wanted} {_subscribers(wanted)} on {c['topic']}")
+
+
+def _subscribers(n: int) -> str:
+    return "subscriber" if n == 1 else "subscribers"
