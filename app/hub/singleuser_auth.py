@@ -31,15 +31,10 @@ to the hub's activity API, so the hub's idle culler sees a learner at work.
 
 from __future__ import annotations
 
-import asyncio
-import base64
-import hashlib
-import hmac
 import http
 import json
 import logging
 import os
-import secrets
 import threading
 import time
 import urllib.error
@@ -57,13 +52,24 @@ from websockets.datastructures import Headers
 from websockets.http11 import Request, Response
 
 from app.access import Handler, ProcessRequest, same_origin
+from app.hub.hub_api import (
+    AskHub,
+    HubRefused,
+    HubUsers,
+    Signer,
+    authorize_query,
+    authorize_url,
+    grants,
+    header_token,
+    hub_request,
+    new_state,
+    same_state,
+)
 
 log = logging.getLogger(__name__)
 
-CACHE_SEC = 300.0  # how long the hub's answer about a token holds (HubAuth's default)
 COOKIE_MAX_AGE_SEC = 14 * 24 * 3600
 STATE_MAX_AGE_SEC = 600  # an OAuth round trip never takes longer than this
-HUB_TIMEOUT_SEC = 10.0
 DEFAULT_ACTIVITY_SEC = 300  # jupyterhub-singleuser's default
 
 _REQUIRED_ENV = (
@@ -131,8 +137,7 @@ class HubSettings:
         except ValueError:
             raise HubSettingsError("JUPYTERHUB_ACTIVITY_INTERVAL must be a number") from None
         # A hub on its own domain (subdomains) sets JUPYTERHUB_HOST; else browsers stay on ours.
-        hub_prefix = env.get("JUPYTERHUB_BASE_URL", "/").rstrip("/") + "/hub/"
-        authorize = env.get("JUPYTERHUB_HOST", "") + hub_prefix + "api/oauth2/authorize"
+        authorize = authorize_url(env)
         options = json.loads(env.get("JUPYTERHUB_COOKIE_OPTIONS") or "{}")
         return cls(
             user=env["JUPYTERHUB_USER"],
@@ -150,90 +155,6 @@ class HubSettings:
             activity_interval=interval,
             secure_cookies=bool(options.get("secure")),
         )
-
-
-def grants(held: set[str] | frozenset[str], required: frozenset[str]) -> bool:
-    """Whether scopes the hub lists for a token cover one of ``required``.
-
-    As ``jupyterhub.services.auth.check_scopes``: an unfiltered scope covers
-    all its filters, ``!user=x`` covers that user's servers; group filters
-    are not resolved here (the hub resolves them when it issues OAuth tokens
-    for a server, so a learner's own token holds the server's scope itself).
-    """
-    for want in required:
-        base, _, wanted = want.partition("!")
-        for have in held:
-            have_base, _, filt = have.partition("!")
-            if have_base != base:
-                continue
-            if not filt or filt == wanted:
-                return True
-            if filt.startswith("user=") and wanted.startswith("server="):
-                if wanted[len("server=") :].split("/", 1)[0] == filt[len("user=") :]:
-                    return True
-    return False
-
-
-class Signer:
-    """Values we hand to a browser and must get back unchanged (HMAC-SHA256, dated)."""
-
-    def __init__(self, secret: bytes | None = None) -> None:
-        # A fresh secret per process: a restarted server only sends browsers round the hub again.
-        self._secret = secret or secrets.token_bytes(32)
-
-    def _mac(self, name: str, payload: str) -> str:
-        return hmac.new(self._secret, f"{name}|{payload}".encode(), hashlib.sha256).hexdigest()
-
-    def sign(self, name: str, value: str, now: float | None = None) -> str:
-        data = base64.urlsafe_b64encode(value.encode()).decode().rstrip("=")
-        payload = f"{data}|{int(time.time() if now is None else now)}"
-        return f"{payload}|{self._mac(name, payload)}"
-
-    def unsign(self, name: str, signed: str | None, max_age: float) -> str | None:
-        """The value, or None if it was changed, made for another name, or is too old."""
-        if not signed or signed.count("|") != 2:
-            return None
-        payload, _, mac = signed.rpartition("|")
-        if not hmac.compare_digest(mac, self._mac(name, payload)):
-            return None
-        data, _, stamp = payload.partition("|")
-        if not stamp.isdigit() or time.time() - int(stamp) > max_age:
-            return None
-        try:
-            return base64.urlsafe_b64decode(data + "=" * (-len(data) % 4)).decode()
-        except (ValueError, UnicodeDecodeError):
-            return None
-
-
-class HubRefused(Exception):
-    """The hub could not be asked, or answered with an error (status and reason)."""
-
-    def __init__(self, status: int, reason: str) -> None:
-        super().__init__(reason)
-        self.status = status
-
-
-def hub_request(
-    url: str, token: str, form: dict[str, str] | None = None, body: object = None
-) -> object:
-    """One blocking call to the hub's API; JSON answer. Raises HubRefused."""
-    headers = {"Authorization": f"token {token}"}
-    data = None
-    if form is not None:
-        data = urllib.parse.urlencode(form).encode()
-        headers["Content-Type"] = "application/x-www-form-urlencoded"
-    elif body is not None:
-        data = json.dumps(body).encode()
-        headers["Content-Type"] = "application/json"
-    request = urllib.request.Request(url, data, headers, method="POST" if data else "GET")
-    try:
-        with urllib.request.urlopen(request, timeout=HUB_TIMEOUT_SEC) as answer:
-            text = answer.read()
-    except urllib.error.HTTPError as error:
-        raise HubRefused(error.code, error.read()[:300].decode(errors="replace")) from None
-    except OSError as error:
-        raise HubRefused(502, f"the hub's API at {url} did not answer: {error}") from None
-    return json.loads(text) if text else None
 
 
 def _utc_stamp(when: float) -> str:
@@ -287,12 +208,6 @@ class Activity:
             self.report()
 
 
-@dataclass
-class _Cached:
-    user: dict[str, Any] | None
-    expires: float
-
-
 class HubLogin:
     """The gate in front of the dashboard's server in the lean mode (app.access ``gate``).
 
@@ -303,13 +218,12 @@ class HubLogin:
     def __init__(
         self,
         settings: HubSettings,
-        ask_hub: Callable[..., object] = hub_request,
+        ask_hub: AskHub = hub_request,
         signer: Signer | None = None,
     ) -> None:
         self.settings = settings
-        self._ask_hub = ask_hub
+        self._users = HubUsers(settings.api_url, ask_hub)
         self._signer = signer or Signer()
-        self._cache: dict[str, _Cached] = {}  # sha256(token) -> the hub's answer
         self.activity = Activity(settings, ask_hub)
         self.installed = False
         self.refused = 0
@@ -320,28 +234,9 @@ class HubLogin:
         except metadata.PackageNotFoundError:
             self._hub_version = None
 
-    # -- asking the hub (viser's event loop; the blocking call in a worker thread) ----
-
-    async def _call(self, *args: object, **kwargs: object) -> object:
-        return await asyncio.to_thread(self._ask_hub, *args, **kwargs)
-
     async def user_for_token(self, token: str) -> dict[str, Any] | None:
         """The hub's user model for a token (with its scopes), or None if it knows none."""
-        key = hashlib.sha256(token.encode()).hexdigest()
-        cached = self._cache.get(key)
-        now = time.monotonic()
-        if cached is not None and cached.expires > now:
-            return cached.user
-        try:
-            user = await self._call(f"{self.settings.api_url}/user", token)
-        except HubRefused as error:
-            if error.status not in (401, 403, 404):
-                raise
-            user = None
-        if len(self._cache) > 1000:  # never grows without bound
-            self._cache = {k: v for k, v in self._cache.items() if v.expires > now}
-        self._cache[key] = _Cached(user if isinstance(user, dict) else None, now + CACHE_SEC)
-        return self._cache[key].user
+        return await self._users.user_for_token(token)
 
     def may_access(self, user: dict[str, Any] | None) -> bool:
         return user is not None and grants(
@@ -429,17 +324,10 @@ class HubLogin:
         return _response(http.HTTPStatus.OK, headers, body)
 
     def _login_redirect(self, request: Request) -> Response:
-        state = secrets.token_urlsafe(16)
+        state = new_state()
         next_url = request.path if request.path.startswith(self.settings.prefix) else "/"
         cookie = self._signer.sign(self.state_cookie_name, json.dumps([state, next_url]))
-        query = urllib.parse.urlencode(
-            {
-                "client_id": self.settings.client_id,
-                "redirect_uri": self.settings.callback_url,
-                "response_type": "code",
-                "state": state,
-            }
-        )
+        query = authorize_query(self.settings.client_id, self.settings.callback_url, state)
         return _redirect(
             f"{self.settings.authorize_url}?{query}",
             self._set_cookie(self.state_cookie_name, cookie, request, max_age=STATE_MAX_AGE_SEC),
@@ -457,8 +345,7 @@ class HubLogin:
             state, next_url = json.loads(saved) if saved else (None, None)
         except ValueError:
             state, next_url = None, None
-        got = args.get("state", "")
-        if not state or not secrets.compare_digest(str(state).encode(), got.encode()):
+        if not same_state(state, args.get("state", "")):
             return _text(
                 http.HTTPStatus.BAD_REQUEST,
                 "This login does not match the one this browser started (OAuth state): "
@@ -467,24 +354,16 @@ class HubLogin:
         if not args.get("code"):
             return _text(http.HTTPStatus.BAD_REQUEST, "The hub sent no OAuth code.\n")
         try:
-            answer = await self._call(
-                f"{self.settings.api_url}/oauth2/token",
-                self.settings.api_token,
-                form={
-                    "client_id": self.settings.client_id,
-                    "client_secret": self.settings.api_token,
-                    "grant_type": "authorization_code",
-                    "code": args["code"],
-                    "redirect_uri": self.settings.callback_url,
-                },
+            token = await self._users.token_for_code(
+                args["code"],
+                client_id=self.settings.client_id,
+                client_secret=self.settings.api_token,
+                redirect_uri=self.settings.callback_url,
             )
         except HubRefused as error:
             if error.status >= 500:
                 raise
             return _text(http.HTTPStatus.FORBIDDEN, f"The hub refused the OAuth code: {error}\n")
-        token = answer.get("access_token") if isinstance(answer, dict) else None
-        if not isinstance(token, str) or not token:
-            return _text(http.HTTPStatus.BAD_GATEWAY, "The hub's token answer held no token.\n")
         user = await self.user_for_token(token)
         if not self.may_access(user):
             name = user.get("name", "this login") if user else "this login"
@@ -535,11 +414,7 @@ class HubLogin:
 
 
 def _header_token(request: Request) -> str | None:
-    value = request.headers.get("Authorization", "")
-    scheme, _, token = value.strip().partition(" ")
-    if scheme.lower() in ("token", "bearer") and token.strip():
-        return token.strip()
-    return None
+    return header_token(request.headers.get("Authorization", ""))
 
 
 def _cookie(request: Request, name: str) -> str | None:

@@ -38,18 +38,18 @@ import logging
 import os
 import time
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NoReturn
 from urllib.parse import urlsplit
 
-from jupyterhub.services.auth import (
-    HubAuth,
-    HubOAuth,
-    HubOAuthCallbackHandler,
-    HubOAuthenticated,
-)
-from jupyterhub.utils import url_path_join
 from tornado import ioloop, web
 
+from app.hub.hub_api import HubRefused, header_token
+from app.hub.service_auth import (
+    HubLoginRequired,
+    OAuthCallbackHandler,
+    ServiceAuth,
+    ServiceSettings,
+)
 from app.teacher.http_report import ReportError, from_json
 from app.teacher.record import (
     COLUMNS,
@@ -64,7 +64,6 @@ from app.teacher.record import (
 )
 
 if TYPE_CHECKING:  # LTI needs PyJWT, which only a deployment with LTI installs
-    from collections.abc import Mapping
     from typing import TypedDict
 
     from app.hub.lti_service import LtiService
@@ -132,11 +131,16 @@ class ProgressReportHandler(_Base):
         return
 
     async def post(self) -> None:
-        hub_auth: HubAuth = self.settings["hub_auth"]
-        token = hub_auth.get_token(self, in_cookie=False)
+        hub_auth: ServiceAuth = self.settings["service_auth"]
+        token = header_token(self.request.headers.get("Authorization", ""))
         if not token:
             self._refuse(401, "send your hub API token: Authorization: token <token>")
-        user = await hub_auth.user_for_token(token, sync=False)
+        try:
+            user = await hub_auth.user_for_token(token)
+        except HubRefused as error:
+            raise web.HTTPError(
+                502, f"could not ask the hub whose token this is: {error}"
+            ) from None
         if not user or user.get("kind", "user") != "user":
             self._refuse(403, "the hub knows no user with this token")
         try:
@@ -168,7 +172,7 @@ class ProgressReportHandler(_Base):
             }
         )
 
-    def _refuse(self, status: int, reason: str) -> None:
+    def _refuse(self, status: int, reason: str) -> NoReturn:
         self.state.refused += 1
         raise web.HTTPError(status, reason)
 
@@ -180,17 +184,7 @@ def _int_arg(text: str) -> int:
         raise web.HTTPError(400, "since must be a whole number") from None
 
 
-class TeacherAuth(HubOAuthenticated):
-    """The hub's OAuth, and only users the hub grants this service (admins, the teachers' group).
-
-    Which ``HubOAuth`` asks the hub is the app's ``teacher_auth`` setting when
-    given (a test's stand-in hub), else the one the service's environment sets up.
-    """
-
-    @property
-    def hub_auth(self) -> HubOAuth:
-        settings: Mapping[str, object] = getattr(self, "settings", {})
-        return settings.get("teacher_auth") or HubOAuth.instance()
+TeacherAuth = HubLoginRequired  # the hub's OAuth; only users granted this service get in
 
 
 class _TeacherBase(TeacherAuth, _Base):
@@ -330,17 +324,20 @@ def _json_body(body: bytes) -> dict[str, object]:
     return data
 
 
+def _under(prefix: str, path: str) -> str:
+    return prefix.rstrip("/") + "/" + path
+
+
 def make_app(
     prefix: str,
     state: ClassState | None = None,
     *,
-    hub_auth: HubAuth | None = None,
-    teacher_auth: HubOAuth | None = None,
+    auth: ServiceAuth | None = None,
     lti: LtiService | None = None,
 ) -> web.Application:
-    """The service's tornado app. ``hub_auth`` answers whose token a report carries and
-    ``teacher_auth`` who opens a teacher's page (the hub's, unless a test points them at
-    its own); ``lti`` serves LTI, sends grades and the gradebook (None: off)."""
+    """The service's tornado app. ``auth`` asks the hub whose token a report or a teacher's
+    browser carries (the service's environment's hub, unless a test points it at its own);
+    ``lti`` serves LTI, sends grades and the gradebook (None: off)."""
     state = state or ClassState()
     args: dict[str, object] = {"state": state}
     routes: list[
@@ -348,13 +345,13 @@ def make_app(
         | tuple[str, type[web.RequestHandler], dict[str, object]]
     ] = [
         (prefix, PageHandler, args),
-        (url_path_join(prefix, "progress.json"), TableHandler, args),
-        (url_path_join(prefix, "progress.csv"), CsvHandler, args),
-        (url_path_join(prefix, "learner.json"), LearnerHandler, args),
-        (url_path_join(prefix, "notice"), NoticeHandler, args),
-        (url_path_join(prefix, "settings"), SettingsHandler, args),
-        (url_path_join(prefix, "api/progress"), ProgressReportHandler, args),
-        (url_path_join(prefix, "oauth_callback"), HubOAuthCallbackHandler),
+        (_under(prefix, "progress.json"), TableHandler, args),
+        (_under(prefix, "progress.csv"), CsvHandler, args),
+        (_under(prefix, "learner.json"), LearnerHandler, args),
+        (_under(prefix, "notice"), NoticeHandler, args),
+        (_under(prefix, "settings"), SettingsHandler, args),
+        (_under(prefix, "api/progress"), ProgressReportHandler, args),
+        (_under(prefix, "oauth_callback"), OAuthCallbackHandler),
     ]
     if lti is not None:
         from app.hub.lti_gradebook import gradebook_routes
@@ -363,11 +360,13 @@ def make_app(
         routes += gradebook_routes(prefix, lti, TeacherAuth, back=("./", "The class"))
     return web.Application(
         routes,
+        # A fresh secret per start: a restarted service only sends teachers round the hub again.
         cookie_secret=os.urandom(32),
-        login_url=url_path_join(prefix, "oauth_start"),  # replaced by HubOAuth's redirect
-        hub_auth=hub_auth if hub_auth is not None else HubAuth(),
-        teacher_auth=teacher_auth,
+        service_auth=auth
+        if auth is not None
+        else ServiceAuth(ServiceSettings.from_env(SERVICE_NAME)),
         xsrf_cookies=True,
+        xsrf_cookie_kwargs={"path": prefix},  # never the hub's own _xsrf, nor a learner's
         lti=lti,
     )
 

@@ -9,7 +9,8 @@ import json
 
 import pytest
 
-from app.hub.singleuser_auth import HubSettings, HubSettingsError, Signer, grants
+from app.hub.hub_api import Signer, grants
+from app.hub.singleuser_auth import HubSettings, HubSettingsError
 from tests.conftest import run_cli
 
 ENV = {

@@ -1,10 +1,10 @@
 """The real teacher service for the LTI tests: its tornado app on a loopback port, in a thread.
 
 No JupyterHub: what the service asks the hub is answered by ``TestHub``, a
-stand-in. Whose API token a progress report carries it answers in process,
-with the same two calls as ``HubAuth``; who opens a teacher's page it
+stand-in. Whose API token a progress report or a teacher's page carries it
 answers over HTTP, at the hub API's ``/user`` as JupyterHub does, to the
-service's real ``HubOAuth``, which then checks the user's scopes itself.
+service's real ``ServiceAuth`` (app/hub/service_auth.py), which then checks
+the user's scopes itself.
 Everything else is the service as it runs: ``make_app`` with its LTI side,
 the tool's folder on disk, the outbox pump on tornado's loop, and real HTTP
 in and out.
@@ -25,11 +25,11 @@ from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import Any, Protocol
 
-from jupyterhub.services.auth import HubOAuth
 from tornado.httpserver import HTTPServer
 from tornado.netutil import bind_sockets
 
 from app.hub.lti_service import LtiService
+from app.hub.service_auth import ServiceAuth, ServiceSettings
 from app.hub.teacher_service import SERVICE_NAME, make_app
 from app.lti.routes import ToolUrls
 from app.lti.tool import LtiTool
@@ -44,7 +44,7 @@ TEACHER_SCOPE = f"access:services!service={SERVICE_NAME}"  # what the hub's teac
 
 
 class TestHub:
-    """Whose hub API token is whose, as the hub would answer ``HubAuth``'s questions.
+    """Whose hub API token is whose, as the hub would answer the service's questions.
 
     Its ``/hub/api/user`` answers as JupyterHub's does: the token's user with
     their scopes (a teacher's token carries the service's access scope, as the
@@ -81,15 +81,15 @@ class TestHub:
         self._scopes[token] = [*self._scopes[token], TEACHER_SCOPE]
         return token
 
-    def oauth(self) -> HubOAuth:
-        """The service's ``HubOAuth`` as the hub's environment would set it up, aimed here."""
-        return HubOAuth(
-            api_url=self.api_url,
-            api_token="token-of-the-service",
-            oauth_client_id=f"service-{SERVICE_NAME}",
-            access_scopes={TEACHER_SCOPE},
-            cache_max_age=0,
-        )
+    def auth(self) -> ServiceAuth:
+        """The service's hub login as the hub's environment would set it up, aimed here."""
+        env = {
+            "JUPYTERHUB_API_URL": self.api_url,
+            "JUPYTERHUB_API_TOKEN": "token-of-the-service",
+            "JUPYTERHUB_SERVICE_PREFIX": PREFIX,
+            "JUPYTERHUB_OAUTH_ACCESS_SCOPES": json.dumps([TEACHER_SCOPE]),
+        }
+        return ServiceAuth(ServiceSettings.from_env(SERVICE_NAME, env), cache_sec=0)
 
     def _model(self, authorization: str) -> dict[str, Any] | None:
         token = authorization.partition(" ")[2].strip()
@@ -117,14 +117,6 @@ class TestHub:
                 self.wfile.write(body.encode())
 
         return Handler
-
-    def get_token(self, handler: Any, in_cookie: bool = True) -> str | None:
-        header = handler.request.headers.get("Authorization", "")
-        return header.removeprefix("token ").strip() or None
-
-    async def user_for_token(self, token: str, sync: bool = True) -> dict[str, str] | None:
-        name = self._tokens.get(token)
-        return {"name": name, "kind": "user"} if name else None
 
 
 class ToolUnderTest(Protocol):
@@ -217,7 +209,7 @@ class ServiceUnderTest:
         self.lti = LtiService(
             self.tool, service_prefix=PREFIX, hub_base=HUB_BASE, poll_sec=poll_sec
         )
-        app = make_app(PREFIX, hub_auth=self.hub, teacher_auth=self.hub.oauth(), lti=self.lti)
+        app = make_app(PREFIX, auth=self.hub.auth(), lti=self.lti)
         self._server = HTTPServer(app)
         self._server.add_sockets(sockets)
         self.lti.start()
