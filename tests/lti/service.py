@@ -56,6 +56,7 @@ class TestHub:
     def __init__(self) -> None:
         self._tokens: dict[str, str] = {}
         self._scopes: dict[str, list[str]] = {}
+        self._codes: dict[str, str] = {}  # OAuth code -> the token it is exchanged for
         self._server = ThreadingHTTPServer(("127.0.0.1", 0), self._handler())
         self._thread = threading.Thread(
             target=self._server.serve_forever, kwargs={"poll_interval": 0.05}, daemon=True
@@ -91,6 +92,12 @@ class TestHub:
         }
         return ServiceAuth(ServiceSettings.from_env(SERVICE_NAME, env), cache_sec=0)
 
+    def code_for(self, token: str) -> str:
+        """The code the hub's authorize page would send a browser back with, for ``token``."""
+        code = f"code-{len(self._codes)}"
+        self._codes[code] = token
+        return code
+
     def _model(self, authorization: str) -> dict[str, Any] | None:
         token = authorization.partition(" ")[2].strip()
         name = self._tokens.get(token)
@@ -111,6 +118,18 @@ class TestHub:
                 status = 200 if model and self.path == "/hub/api/user" else 403
                 body = json.dumps(model if status == 200 else {"error": "no such token"})
                 self.send_response(status)
+                self.send_header("Content-Type", "application/json")
+                self.send_header("Content-Length", str(len(body)))
+                self.end_headers()
+                self.wfile.write(body.encode())
+
+            def do_POST(self) -> None:  # the OAuth token endpoint: a code for its token
+                length = int(self.headers.get("Content-Length") or 0)
+                form = dict(urllib.parse.parse_qsl(self.rfile.read(length).decode()))
+                token = hub._codes.pop(form.get("code", ""), None)
+                ok = self.path == "/hub/api/oauth2/token" and token is not None
+                body = json.dumps({"access_token": token} if ok else {"error": "invalid_grant"})
+                self.send_response(200 if ok else 400)
                 self.send_header("Content-Type", "application/json")
                 self.send_header("Content-Length", str(len(body)))
                 self.end_headers()
