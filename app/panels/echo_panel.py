@@ -40,6 +40,10 @@ class EchoPanel:
         self._note = ""
         self._tap = TopicMonitor(node, TOPIC, String, keep=50, qos=10)
         self._view = MarkdownView(gui)
+        # The lines as of (tap, messages received): a pass with no new message formats
+        # nothing again (issue 43's idle CPU; deserializing ten messages 5 times a second).
+        self._lines_key: tuple[object, int] | None = None
+        self._lines: list[str] = []
 
     def inspect(self, kind: str, topic: str, type_text: str) -> None:
         """A topic clicked on the stage graph (UI thread): echo it instead."""
@@ -60,11 +64,14 @@ class EchoPanel:
 
     def refresh(self, graph: GraphSnapshot) -> None:
         topic = self._topic
-        recent = self._tap.recent(SHOWN_MESSAGES)
-        lines = [
-            f"[{time.strftime('%H:%M:%S', time.localtime(t))}] {message_text(msg)}"
-            for t, msg in recent
-        ]
+        key = (self._tap, self._tap.count)
+        if key != self._lines_key:
+            self._lines_key = key
+            self._lines = [
+                f"[{time.strftime('%H:%M:%S', time.localtime(t))}] {message_text(msg)}"
+                for t, msg in self._tap.recent(SHOWN_MESSAGES)
+            ]
+        lines = self._lines
         # The publisher's rate by its own clock; samples this view missed are
         # counted, not hidden in a lower rate.
         published = self._tap.published_rate(window_sec=RATE_WINDOW_SEC)

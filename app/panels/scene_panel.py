@@ -251,6 +251,9 @@ class ScenePanel:
             self._matrix = MarkdownView(gui)
             self._param_status = MarkdownView(gui)
         self._stamped_info = MarkdownView(gui)
+        # The snapshot the topic rows' options were made from: a new one comes with each
+        # full pass of the UI loop (once a second idle), so other passes skip that work.
+        self._options_from: GraphSnapshot | None = None
         with gui.add_folder("TF and robot model"):
             MarkdownView(
                 gui,
@@ -500,8 +503,10 @@ class ScenePanel:
             (self._marker_row, self.markers.worker, self.markers.topic),
             (self._joint_row, self.arm.worker, self.arm.topic),
         )
+        new_graph, self._options_from = graph is not self._options_from, graph
         for row, worker, topic in rows:
-            row.refresh_options(graph)
+            if new_graph:
+                row.refresh_options(graph)
             received, _drawn, rate, since = worker.stats()
             note = picker.liveness_note(graph, topic, received, since, row.offer.latched)
             if not note and rate:

@@ -11,11 +11,13 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 from rclpy.action.graph import (
     get_action_client_names_and_types_by_node,
     get_action_server_names_and_types_by_node,
 )
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 
 from app.ros.context import CallContext
@@ -85,20 +87,38 @@ def endpoint_owners(node: Node) -> tuple[list[TopicInfo], set[str]]:
     owners: set[str] = set()
     me = (node.get_name(), node.get_namespace())
     for name, types in node.get_topic_names_and_types():
-        publishers = node.get_publishers_info_by_topic(name)
-        subscribers = node.get_subscriptions_info_by_topic(name)
-        owners.update(node_fqn(e.node_name, e.node_namespace) for e in (*publishers, *subscribers))
+        publishers = _endpoint_nodes(node, name, publishers=True)
+        subscribers = _endpoint_nodes(node, name, publishers=False)
+        owners.update(node_fqn(*e) for e in (*publishers, *subscribers))
         topics.append(
             TopicInfo(
                 name,
                 tuple(types),
                 len(publishers),
                 len(subscribers),
-                sum(1 for e in publishers if (e.node_name, e.node_namespace) == me),
-                sum(1 for e in subscribers if (e.node_name, e.node_namespace) == me),
+                publishers.count(me),
+                subscribers.count(me),
             )
         )
     return topics, owners
+
+
+def _endpoint_nodes(node: Node, topic: str, *, publishers: bool) -> list[tuple[str, str]]:
+    """Who owns each publisher (or subscription) of a listed topic: (node name, namespace).
+
+    What ``get_publishers_info_by_topic`` (or subscriptions) answers, without the
+    ``TopicEndpointInfo`` and QoS objects rclpy builds for every endpoint: those were
+    70 % of the dashboard's graph snapshot, taken once a second (issue 43's idle CPU).
+    The topic is already a full name, as the graph listed it (rclpy would expand it).
+    """
+    query: Callable[[object, str, bool], list[dict[str, Any]]] = (
+        _rclpy.rclpy_get_publishers_info_by_topic
+        if publishers
+        else _rclpy.rclpy_get_subscriptions_info_by_topic
+    )
+    with node.handle:
+        found = query(node.handle, topic, False)
+    return [(e["node_name"], e["node_namespace"]) for e in found]
 
 
 def _live_and_ghosts(node: Node, owners: set[str]) -> tuple[list[str], list[str]]:

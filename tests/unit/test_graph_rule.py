@@ -7,15 +7,21 @@ made it necessary: a leftover name and a restarted node sharing one name.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import pytest
 
+from app.ros import graph as graph_module
 from app.ros.graph import live_and_ghost_nodes, snapshot
 
 
-@dataclass(frozen=True)
-class Endpoint:
-    node_name: str
-    node_namespace: str
+@pytest.fixture(autouse=True)
+def recorded_endpoints(monkeypatch: pytest.MonkeyPatch) -> None:
+    """app.ros.graph asks rclpy's own binding for each topic's endpoint owners; here, the
+    recorded graph answers instead."""
+    monkeypatch.setattr(
+        graph_module,
+        "_endpoint_nodes",
+        lambda node, topic, *, publishers: node.endpoint_nodes(topic, publishers),
+    )
 
 
 class RecordedGraph:
@@ -40,11 +46,8 @@ class RecordedGraph:
         topics = sorted(set(self.publishers) | set(self.subscribers))
         return [(t, ["std_msgs/msg/String"]) for t in topics]
 
-    def get_publishers_info_by_topic(self, topic):
-        return [Endpoint(n, ns) for n, ns in self.publishers.get(topic, ())]
-
-    def get_subscriptions_info_by_topic(self, topic):
-        return [Endpoint(n, ns) for n, ns in self.subscribers.get(topic, ())]
+    def endpoint_nodes(self, topic, publishers):
+        return list((self.publishers if publishers else self.subscribers).get(topic, ()))
 
     def get_service_names_and_types(self):
         return self.services
