@@ -72,7 +72,7 @@ LINK, ITEM = "link-1", "7"
 EXERCISE = "counter_publisher"
 SCORE_MAXIMUM = "5"
 REPORTERS = 8  # dashboards posting at the same moment
-BEACON_COLLECT_S = 0.5  # app/teacher/beacon.py's COLLECT_SEC; importing it loads rclpy
+BEACON_COLLECT_S = 1.0  # app/teacher/beacon.py's COLLECT_SEC; importing it loads rclpy
 
 
 # ---------------------------------------------------------------- pure helpers

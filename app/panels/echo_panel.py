@@ -21,6 +21,7 @@ TOPIC = "/chatter"
 SHOWN_MESSAGES = 10
 FAST_HZ = 50.0
 RATE_WINDOW_SEC = 5.0
+RATE_REFRESH_SEC = 1.0  # the rate is measured anew once a second, as `ros2 topic hz` prints
 MAX_LINES = 40  # of one message's YAML
 
 
@@ -44,6 +45,9 @@ class EchoPanel:
         # nothing again (issue 43's idle CPU; deserializing ten messages 5 times a second).
         self._lines_key: tuple[object, int] | None = None
         self._lines: list[str] = []
+        self._rate_of: object = None  # the tap the rate was measured on, redone each second
+        self._rate_at = 0.0
+        self._rate_text = ""
 
     def inspect(self, kind: str, topic: str, type_text: str) -> None:
         """A topic clicked on the stage graph (UI thread): echo it instead."""
@@ -72,15 +76,11 @@ class EchoPanel:
                 for t, msg in self._tap.recent(SHOWN_MESSAGES)
             ]
         lines = self._lines
-        # The publisher's rate by its own clock; samples this view missed are
-        # counted, not hidden in a lower rate.
-        published = self._tap.published_rate(window_sec=RATE_WINDOW_SEC)
-        rate = published.rate if published else None
-        rate_text = published.summary(self._tap.why_missed(), 1) if published else ""
-        rate_text = rate_text or "no messages lately"
-        if rate and rate > FAST_HZ:  # say so: most messages scroll by unseen
-            rate_text += f" · ⚠ too fast to read: showing only the newest {SHOWN_MESSAGES}"
-        header = f"`ros2 topic echo {topic}` · {self._tap.count} received · {rate_text}"
+        now = time.monotonic()
+        if self._tap is not self._rate_of or now - self._rate_at >= RATE_REFRESH_SEC:
+            self._rate_of, self._rate_at = self._tap, now
+            self._rate_text = self._rate_summary()
+        header = f"`ros2 topic echo {topic}` · {self._tap.count} received · {self._rate_text}"
         hint = ""
         if not graph.publishers(topic):
             start = " start **talker**." if topic == TOPIC else " start one."
@@ -90,6 +90,17 @@ class EchoPanel:
         self._view.show(
             header + hint + note + "\n\n" + code_block(lines, "(waiting for messages)") + pick
         )
+
+    def _rate_summary(self) -> str:
+        # The publisher's rate by its own clock; samples this view missed are
+        # counted, not hidden in a lower rate.
+        published = self._tap.published_rate(window_sec=RATE_WINDOW_SEC)
+        rate = published.rate if published else None
+        rate_text = published.summary(self._tap.why_missed(), 1) if published else ""
+        rate_text = rate_text or "no messages lately"
+        if rate and rate > FAST_HZ:  # say so: most messages scroll by unseen
+            rate_text += f" · ⚠ too fast to read: showing only the newest {SHOWN_MESSAGES}"
+        return rate_text
 
     def close(self) -> None:
         self._tap.close()

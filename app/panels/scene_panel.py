@@ -251,9 +251,9 @@ class ScenePanel:
             self._matrix = MarkdownView(gui)
             self._param_status = MarkdownView(gui)
         self._stamped_info = MarkdownView(gui)
-        # The snapshot the topic rows' options were made from: a new one comes with each
-        # full pass of the UI loop (once a second idle), so other passes skip that work.
-        self._options_from: GraphSnapshot | None = None
+        # The snapshot the texts were last made from: a new one comes with each full pass of
+        # the UI loop (once a second idle, every pass after a click).
+        self._texts_from: GraphSnapshot | None = None
         with gui.add_folder("TF and robot model"):
             MarkdownView(
                 gui,
@@ -493,6 +493,29 @@ class ScenePanel:
         )
 
     def refresh(self, graph: GraphSnapshot) -> None:
+        # What draws or moves, every pass; what is said about it (the topic rows' options
+        # and notes, each layer's text) with each new graph snapshot: once a second while
+        # idle, at once after a click (issue 43's idle CPU: most of this view's work).
+        self.world.refresh(graph)
+        self.more_robots.refresh(graph)
+        self.drive.refresh(graph)
+        self._follow_world()
+        self._follow_robot(graph)
+        self._follow_desk(graph)
+        self.plot.flush()
+        self.stamped.refresh(graph)
+        frames = (AUTO_FIXED, *self.tf_view.frame_names())
+        if frames != self._fixed_options:
+            if self._fixed.value not in frames:
+                frames = (*frames, str(self._fixed.value))  # a picked frame that went away
+            self._fixed_options = frames
+            self._fixed.options = frames
+        self.joint_sliders.show(self.tf_view.robot_joints)
+        if graph is not self._texts_from:
+            self._texts_from = graph
+            self._refresh_texts(graph)
+
+    def _refresh_texts(self, graph: GraphSnapshot) -> None:
         rows = (
             (self._cloud_row, self.clouds.worker, self.clouds.topic),
             (self._scan_row, self.scan.worker, self.scan.topic),
@@ -503,21 +526,13 @@ class ScenePanel:
             (self._marker_row, self.markers.worker, self.markers.topic),
             (self._joint_row, self.arm.worker, self.arm.topic),
         )
-        new_graph, self._options_from = graph is not self._options_from, graph
         for row, worker, topic in rows:
-            if new_graph:
-                row.refresh_options(graph)
+            row.refresh_options(graph)
             received, _drawn, rate, since = worker.stats()
             note = picker.liveness_note(graph, topic, received, since, row.offer.latched)
             if not note and rate:
                 note = f"{rate:.1f} Hz received"
             row.note.show(note)
-        self.world.refresh(graph)
-        self.more_robots.refresh(graph)
-        self.drive.refresh(graph)
-        self._follow_world()
-        self._follow_robot(graph)
-        self._follow_desk(graph)
         self._world_info.show(
             "\n\n".join(t for t in (self.world.describe(), self.more_robots.describe()) if t)
         )
@@ -531,18 +546,9 @@ class ScenePanel:
         self._image_info.show("\n\n".join(t for t in (self.images.info, note) if t))
         self._marker_info.show(self.markers.describe())
         self._arm_info.show(self.arm.describe())
-        self.plot.flush()
-        self.stamped.refresh(graph)
         self._stamped_info.show(self.stamped.describe())
         self._param_status.show(self.params.status)
-        frames = (AUTO_FIXED, *self.tf_view.frame_names())
-        if frames != self._fixed_options:
-            if self._fixed.value not in frames:
-                frames = (*frames, str(self._fixed.value))  # a picked frame that went away
-            self._fixed_options = frames
-            self._fixed.options = frames
         self._tf_status.show(self.tf_view.status())
-        self.joint_sliders.show(self.tf_view.robot_joints)
 
     def close(self) -> None:
         layers = (self.clouds, self.images, self.markers, self.arm, self.stamped, self.params)

@@ -2,7 +2,7 @@
 
 Threads, following the dashboard's model (app.ui):
 
-- The beacon's own thread asks the UI thread, twice a second, for a
+- The beacon's own thread asks the UI thread, once a second, for a
   ``LearnerRecord`` (``ui.post``): lesson position, the step's checks and the
   panels' other state belong to the UI thread, so only it reads them. The
   record comes back through a queue; the beacon thread alone keeps the
@@ -48,7 +48,11 @@ from app.ui.loop import UiLoop
 
 log = logging.getLogger(__name__)
 
-COLLECT_SEC = 0.5  # how stale the teacher's view of this learner may get
+COLLECT_SEC = 1.0  # how stale the teacher's view of this learner may get
+# How stale "when was this exercise's file last saved" may get: on a lesson without an
+# exercise of its own every exercise is a candidate, and a stat of each, each round, was
+# half of the beacon's work on the UI thread (issue 43's idle CPU).
+SAVED_CHECK_SEC = 5.0
 HEARTBEAT_SEC = 10.0
 
 
@@ -88,6 +92,7 @@ class ProgressBeacon:
         self._records: queue.SimpleQueue[tuple[LearnerRecord, float] | None] = queue.SimpleQueue()
         self._stop = threading.Event()
         self._crash_key: tuple | None = None  # UI thread: the crash text read once per process
+        self._saved_at: dict[str, tuple[float, float]] = {}  # UI thread: slug -> (read at, mtime)
         self._crash_text = ""
         self._attempts = AttemptReader()  # the beacon thread's: the kept attempts' folders
         # The beacon thread's too; kept beside the learner's progress across restarts.
@@ -249,10 +254,14 @@ class ProgressBeacon:
         return mine[0] if mine else None
 
     def _touched_at(self, exercise: Exercise, record: dict) -> float:
-        try:
-            saved = os.stat(self._sources.workspace.code_dir / f"{exercise.slug}.py").st_mtime
-        except OSError:
-            saved = 0.0
+        now = time.monotonic()
+        read_at, saved = self._saved_at.get(exercise.slug, (-SAVED_CHECK_SEC, 0.0))
+        if now - read_at >= SAVED_CHECK_SEC:
+            try:
+                saved = os.stat(self._sources.workspace.code_dir / f"{exercise.slug}.py").st_mtime
+            except OSError:
+                saved = 0.0
+            self._saved_at[exercise.slug] = (now, saved)
         return max(saved, record.get("last_checked", 0.0), record.get("first_opened", 0.0))
 
     def _last_error(self, exercise: Exercise, record: dict) -> str:

@@ -3,7 +3,7 @@
 The beacon (app/teacher/beacon.py) hands each record to ``send`` on its own
 thread. We POST it with the learner's own hub API token; the answer carries
 the teacher's new messages and the reveal setting. A failed POST raises: an
-unreachable service gets the newest record again half a second later, a
+unreachable service gets the newest record again a second later, a
 refusal (4xx/5xx, its reason logged) a heartbeat later. The record is the
 learner's whole state, so nothing is lost by a dropped report, and a
 restarted service has every row back within a heartbeat.

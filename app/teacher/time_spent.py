@@ -31,7 +31,7 @@ from pathlib import Path
 log = logging.getLogger(__name__)
 
 IDLE_AFTER_SEC = 300.0  # five minutes without anything the dashboard sees: not counted
-MAX_STEP_SEC = 5.0  # one count at most (the beacon counts twice a second)
+MAX_STEP_SEC = 5.0  # one count at most (the beacon counts once a second)
 SAVE_EVERY_SEC = 30.0  # a dashboard killed at once loses at most this much
 MAX_ACTIVITIES = 200  # the course has about 60 lessons and exercises
 MAX_SECONDS = 2**31 - 1
