@@ -554,10 +554,27 @@ def check_processes(mark: str, pids: list[int], number: int) -> float:
         time.sleep(0.1)
     took = time.monotonic() - started
     if left:
-        for item in marked(mark):
-            os.kill(item[0], signal.SIGKILL)
-        pytest.fail(f"round {number}: orphans {ORPHAN_WAIT_SEC:.0f} s after the kill: {left}")
+        states = {pid: _proc_state(pid) for pid, _cmd in marked(mark)}
+        for pid in states:
+            os.kill(pid, signal.SIGKILL)
+        pytest.fail(
+            f"round {number}: orphans {ORPHAN_WAIT_SEC:.0f} s after the kill: {left}; "
+            f"their state then: {states}"
+        )
     return took
+
+
+def _proc_state(pid: int) -> str:
+    """What an orphan was doing: its state, signal masks (did it block or catch SIGTERM?),
+    threads and where the kernel has it waiting. For the next time one outlives its parent."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+        wchan = Path(f"/proc/{pid}/wchan").read_text()
+    except OSError as error:
+        return f"unreadable ({error})"
+    keep = ("State", "PPid", "Threads", "SigPnd", "ShdPnd", "SigBlk", "SigIgn", "SigCgt")
+    lines = [line for line in status.splitlines() if line.split(":")[0] in keep]
+    return "; ".join([*lines, f"wchan: {wchan}"])
 
 
 def check_graph(probe: Any, started: set[str], number: int) -> None:
