@@ -26,6 +26,7 @@ from typing import Any
 
 CACHE_SEC = 300.0  # how long the hub's answer about a token holds (HubAuth's default)
 HUB_TIMEOUT_SEC = 10.0
+STATE_MAX_AGE_SEC = 600  # an OAuth round trip never takes longer than this
 
 AskHub = Callable[..., object]
 

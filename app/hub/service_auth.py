@@ -30,6 +30,7 @@ from tornado import web
 
 from app.hub.hub_api import (
     CACHE_SEC,
+    STATE_MAX_AGE_SEC,
     AskHub,
     HubRefused,
     HubUsers,
@@ -44,7 +45,7 @@ from app.hub.hub_api import (
 
 log = logging.getLogger(__name__)
 
-STATE_MAX_AGE_DAYS = 600 / 86400  # an OAuth round trip never takes longer than ten minutes
+STATE_MAX_AGE_DAYS = STATE_MAX_AGE_SEC / 86400  # tornado's signed cookies count in days
 
 
 class ServiceSettingsError(ValueError):

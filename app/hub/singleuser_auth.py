@@ -53,6 +53,7 @@ from websockets.http11 import Request, Response
 
 from app.access import Handler, ProcessRequest, same_origin
 from app.hub.hub_api import (
+    STATE_MAX_AGE_SEC,
     AskHub,
     HubRefused,
     HubUsers,
@@ -69,7 +70,6 @@ from app.hub.hub_api import (
 log = logging.getLogger(__name__)
 
 COOKIE_MAX_AGE_SEC = 14 * 24 * 3600
-STATE_MAX_AGE_SEC = 600  # an OAuth round trip never takes longer than this
 DEFAULT_ACTIVITY_SEC = 300  # jupyterhub-singleuser's default
 
 _REQUIRED_ENV = (
