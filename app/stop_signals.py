@@ -22,8 +22,14 @@ _PR_SET_PDEATHSIG = 1
 _libc = ctypes.CDLL(None, use_errno=True)
 
 
-def die_with(parent: int) -> Callable[[], None]:
+def die_with(parent: int, death_signal: int = signal.SIGTERM) -> Callable[[], None]:
     """What a child runs between fork and exec (``preexec_fn``): die with ``parent``.
+
+    ``death_signal`` is what the kernel sends the child when ``parent`` dies:
+    SIGTERM lets our own programs end cleanly (a node leaves the graph, a bag is
+    closed). A learner's program gets SIGKILL: code we did not write may catch
+    SIGTERM, block in it, or take its time ending, and nobody is left to follow
+    up (a CI rehearsal: a learner's service outlived its SIGKILLed dashboard).
 
     A fork keeps its parent's signal handlers until it execs, and ours (above)
     turn SIGTERM into a byte on a pipe: a parent that died in that moment sent
@@ -37,7 +43,7 @@ def die_with(parent: int) -> Callable[[], None]:
     def set_parent_death_signal() -> None:
         for number in STOP_SIGNALS:
             signal.signal(number, signal.SIG_DFL)
-        _libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
+        _libc.prctl(_PR_SET_PDEATHSIG, death_signal, 0, 0, 0)
         if os.getppid() != parent:
             os._exit(1)
 

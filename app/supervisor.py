@@ -341,10 +341,12 @@ class Supervisor:
 
     def _spawn(self, entry: Program, extra_ros_args: tuple[str, ...]) -> NodeStatus:
         env = self._env
+        death_signal = signal.SIGTERM  # our nodes end cleanly when the dashboard dies
         if isinstance(entry, LearnerProgram):
             argv, cwd = list(entry.argv), entry.cwd
             if entry.env:
                 env = {**self._env, **entry.env}
+            death_signal = signal.SIGKILL  # the learner's code might not (app/stop_signals.py)
         else:
             argv = [sys.executable, "-m", f"nodes.{entry.module}", *entry.argv_tail()]
             if extra_ros_args:
@@ -358,7 +360,7 @@ class Supervisor:
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
             start_new_session=True,  # own process group: signals reach the whole node
-            preexec_fn=die_with(os.getpid()),
+            preexec_fn=die_with(os.getpid(), death_signal),
         )
         proc = _Process(entry, popen, self._max_log_lines)
         with self._lock:

@@ -71,3 +71,51 @@ def test_a_parent_killed_just_before_its_child_execs_still_takes_the_child():
         parent.wait(10)
         if child is not None and child.is_running():
             child.kill()
+
+
+# A dashboard-like parent whose Supervisor starts a learner's program that shrugs off
+# SIGTERM (hostile, or only slow to end), then is killed: nobody is left to follow up.
+LEARNER = """
+import signal, time
+signal.signal(signal.SIGTERM, signal.SIG_IGN)
+print("ignoring SIGTERM", flush=True)
+time.sleep(60)
+"""
+DASHBOARD = """
+import os, sys, time
+from pathlib import Path
+from app.supervisor import LearnerProgram, Supervisor
+
+script = Path(sys.argv[1])
+supervisor = Supervisor(dict(os.environ))
+supervisor.start_program(LearnerProgram("learner", "/learner", (sys.executable, str(script)),
+                                        script.parent, names_its_node=False))
+deadline = time.monotonic() + 20
+while "ignoring SIGTERM" not in "\\n".join(supervisor.output("learner", last=5)):
+    assert time.monotonic() < deadline, supervisor.output("learner", last=5)
+    time.sleep(0.05)
+print("learner", supervisor.status("learner").pid, flush=True)
+time.sleep(60)
+"""
+
+
+def test_a_learners_program_that_ignores_sigterm_still_dies_with_a_killed_dashboard(tmp_path):
+    script = tmp_path / "stubborn.py"
+    script.write_text(LEARNER)
+    parent = subprocess.Popen([sys.executable, "-c", DASHBOARD, str(script)],
+                              stdout=subprocess.PIPE, cwd=PROJECT_ROOT, text=True)  # fmt: skip
+    learner = None
+    try:
+        assert parent.stdout is not None
+        line = parent.stdout.readline().split()
+        assert line[:1] == ["learner"], line
+        learner = psutil.Process(int(line[1]))
+        parent.kill()
+        parent.wait(10)
+        gone, _alive = psutil.wait_procs([learner], timeout=5)
+        assert gone, f"the learner's program (pid {learner.pid}) outlived its dashboard"
+    finally:
+        parent.kill()
+        parent.wait(10)
+        if learner is not None and learner.is_running():
+            learner.kill()
