@@ -16,8 +16,8 @@ Who counts as a teacher is the deployment's business, so the handlers here
 carry no authentication of their own: ``gradebook_routes`` mixes in the
 deployment's (the hub's OAuth in app/hub/teacher_service.py, the teacher's
 token in the classroom mode, app/hub/lti_classroom.py). The mixin comes
-first in the bases and supplies ``get_current_user``; ``@web.authenticated``
-refuses everyone it does not name.
+first in the bases and names the current user (``prepare`` or
+``get_current_user``); ``@web.authenticated`` refuses everyone it does not name.
 """
 
 from __future__ import annotations

@@ -74,7 +74,14 @@ class ServiceSettings:
                 f"the teacher service runs as a JupyterHub service (missing {', '.join(missing)})"
             )
         prefix = env.get("JUPYTERHUB_SERVICE_PREFIX") or f"/services/{service_name}/"
-        scopes = json.loads(env.get("JUPYTERHUB_OAUTH_ACCESS_SCOPES") or "[]")
+        try:
+            scopes = json.loads(env.get("JUPYTERHUB_OAUTH_ACCESS_SCOPES") or "[]")
+        except ValueError as error:
+            raise ServiceSettingsError(
+                f"JUPYTERHUB_OAUTH_ACCESS_SCOPES is not JSON: {error}"
+            ) from None
+        if not isinstance(scopes, list) or not all(isinstance(x, str) for x in scopes):
+            raise ServiceSettingsError("JUPYTERHUB_OAUTH_ACCESS_SCOPES must be a list of scopes")
         return cls(
             api_url=env["JUPYTERHUB_API_URL"].rstrip("/"),
             api_token=env["JUPYTERHUB_API_TOKEN"],
