@@ -92,8 +92,8 @@ class ProgressBeacon:
         self._records: queue.SimpleQueue[tuple[LearnerRecord, float] | None] = queue.SimpleQueue()
         self._stop = threading.Event()
         self._crash_key: tuple | None = None  # UI thread: the crash text read once per process
-        self._saved_at: dict[str, tuple[float, float]] = {}  # UI thread: slug -> (read at, mtime)
         self._crash_text = ""
+        self._saved_at: dict[str, tuple[float, float]] = {}  # UI thread: slug -> (read at, mtime)
         self._attempts = AttemptReader()  # the beacon thread's: the kept attempts' folders
         # The beacon thread's too; kept beside the learner's progress across restarts.
         self._time = TimeSpent(file_for(sources.workspace.progress.path))
