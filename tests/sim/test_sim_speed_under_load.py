@@ -99,13 +99,18 @@ def test_faster_than_real_time_passes_on_a_loaded_computer_and_says_what_it_reac
 def test_a_factor_the_computer_cannot_reach_passes_and_says_how_far_it_got(
     lessons, supervisor, busy_cores
 ):
-    """50x is out of reach here (the world runs flat out at 5-20x, fewer with the cores
-    taken): the learner is told what the computer reached, and the check still passes."""
-    supervisor.start("sim_world", ["-p", "camera_rate:=0.0"])
+    """100x (the most the world takes) is out of reach: with the cores taken, and its
+    sensors at high rates (each simulated second costs that many more messages), the
+    world runs at a few times real time. Without those rates it reached 45x of the 50x
+    once asked here (ci31), so the machine's speed alone must not be what keeps it out of
+    reach. The learner is told what the computer reached, and the check still passes."""
+    heavy = ["camera_rate:=0.0", "imu_rate:=500.0", "odom_rate:=200.0", "scan_rate:=50.0"]
+    supervisor.start("sim_world", [arg for p in heavy for arg in ("-p", p)])
     wait_until(lambda: lessons.graph.has_node("/sim_world"), timeout=30, what="/sim_world")
-    ok, reason = params.set_value(CallContext(lessons.node), "/sim_world", "real_time_factor", 50.0)
+    call = CallContext(lessons.node)
+    ok, reason = params.set_value(call, "/sim_world", "real_time_factor", 100.0)
     assert ok, reason
-    unreachable = Spec("sim_time_factor", {"requested": 50.0, "at_least": 1.1})
+    unreachable = Spec("sim_time_factor", {"requested": 100.0, "at_least": 1.1})
     wait_until(
         lambda: lessons.evaluate(unreachable).state == PASS,
         timeout=45,
@@ -114,9 +119,9 @@ def test_a_factor_the_computer_cannot_reach_passes_and_says_how_far_it_got(
     )
     result = lessons.evaluate(unreachable)
     print(result.reason)
-    found = re.search(r"your computer runs the world at ([\d.]+)x of the 50x asked", result.reason)
+    found = re.search(r"your computer runs the world at ([\d.]+)x of the 100x asked", result.reason)
     assert found, result.reason
-    assert 1.1 <= float(found[1]) < 45, result.reason
+    assert 1.1 <= float(found[1]) < 90, result.reason
     assert "simulated time still runs faster than the wall clock" in result.reason
 
 
