@@ -62,15 +62,27 @@ def test_a_parent_killed_just_before_its_child_execs_still_takes_the_child():
             time.sleep(0.01)
         child = children[0]
         time.sleep(0.3)  # inside its slow moment, its death signal set
-        parent.kill()
-        parent.wait(10)
-        gone, _alive = psutil.wait_procs([child], timeout=8)
-        assert gone, f"the child (pid {child.pid}) outlived its parent"
+        _kill_and_expect_gone(parent, child, 8.0, "the child")
     finally:
-        parent.kill()
-        parent.wait(10)
-        if child is not None and child.is_running():
-            child.kill()
+        _end(parent, child)
+
+
+def _kill_and_expect_gone(
+    parent: subprocess.Popen, child: psutil.Process, timeout: float, what: str
+) -> None:
+    """SIGKILL ``parent`` (nothing of it runs after) and wait for ``child`` to end too."""
+    parent.kill()
+    parent.wait(10)
+    gone, _alive = psutil.wait_procs([child], timeout=timeout)
+    assert gone, f"{what} (pid {child.pid}) outlived its parent"
+
+
+def _end(parent: subprocess.Popen, child: psutil.Process | None) -> None:
+    """Whatever happened, neither process outlives the test."""
+    parent.kill()
+    parent.wait(10)
+    if child is not None and child.is_running():
+        child.kill()
 
 
 # A dashboard-like parent whose Supervisor starts a learner's program that shrugs off
@@ -110,12 +122,6 @@ def test_a_learners_program_that_ignores_sigterm_still_dies_with_a_killed_dashbo
         line = parent.stdout.readline().split()
         assert line[:1] == ["learner"], line
         learner = psutil.Process(int(line[1]))
-        parent.kill()
-        parent.wait(10)
-        gone, _alive = psutil.wait_procs([learner], timeout=5)
-        assert gone, f"the learner's program (pid {learner.pid}) outlived its dashboard"
+        _kill_and_expect_gone(parent, learner, 5.0, "the learner's program")
     finally:
-        parent.kill()
-        parent.wait(10)
-        if learner is not None and learner.is_running():
-            learner.kill()
+        _end(parent, learner)
