@@ -138,7 +138,7 @@ def main(args=None) -> None:
             node = TeleopTurtle()
             executor = SingleThreadedExecutor()
             executor.add_node(node)
-            ros_started()
+            ros_started(executor)
             print(BANNER, flush=True)
             if sys.stdin.isatty():
                 spinner = threading.Thread(target=executor.spin, daemon=True)

@@ -68,14 +68,13 @@ def spin_node(
                     raise
                 print(f"{program}: error: {exc}", file=sys.stderr)
                 raise SystemExit(EXIT_BAD_PARAMETER) from None
-            ros_started()
-            if executor is None:
-                _stop_watch.spinning = rclpy.get_global_executor()  # what rclpy.spin uses
+            if executor is not None:
+                spinner = _make_executor(executor, node)
+                spinner.add_node(node)
+            ros_started(spinner)
+            if spinner is None:
                 rclpy.spin(node)
             else:
-                spinner = _make_executor(executor, node)
-                _stop_watch.spinning = spinner
-                spinner.add_node(node)
                 spinner.spin()
     finally:
         _teardown(node, spinner, before_shutdown)
@@ -134,13 +133,21 @@ def init_ros(args: list[str] | None = None) -> None:
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
 
 
-def ros_started() -> None:
+def ros_started(spinner: Executor | None = None) -> None:
     """The node is made: from now on rclpy's handlers end the spin (the context shuts down).
 
     A stop held during start-up ends it here, at a safe point
     (KeyboardInterrupt). rclpy's handlers go in before the start counts as
     done, so a signal in between is held, not lost.
+
+    ``spinner`` is the executor that will spin the node, made already; by
+    default rclpy's global one, which ``rclpy.spin`` uses, is made here. It
+    must exist before the handlers go in: rclpy's signal thread shutting the
+    context down in the middle of ``Executor()`` leaves a half-made guard
+    condition whose ``__del__`` prints a traceback (seen: ci33, turtlesim
+    stopped between this call and ``rclpy.spin``).
     """
+    _stop_watch.spinning = spinner if spinner is not None else rclpy.get_global_executor()
     install_signal_handlers(SignalHandlerOptions.ALL)
     _stop_watch.start()
     _start.end()

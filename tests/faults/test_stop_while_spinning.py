@@ -68,3 +68,46 @@ def test_sigterm_ends_a_spin_that_rclpys_signal_thread_did_not_end(ros_env):
     assert "Traceback" not in output, output
     assert code == 0, output
     assert took < 5, f"ended {took:.1f} s after SIGTERM"
+
+
+# A stop just after start-up, before spinning: rclpy's signal thread shuts the context
+# down while the executor would be made (ci33: turtlesim printed the __del__ tracebacks
+# of a half-made SingleThreadedExecutor). The hook sends it at exactly that moment.
+STOPPED_BEFORE_SPIN = """
+import os, signal, time
+import rclpy
+from rclpy.node import Node
+from nodes.common import run
+
+started = run.ros_started
+
+def started_then_stopped(*args):
+    started(*args)
+    os.kill(os.getpid(), signal.SIGTERM)
+    deadline = time.monotonic() + 5
+    while rclpy.ok() and time.monotonic() < deadline:
+        time.sleep(0.01)
+    print("context down" if not rclpy.ok() else "context still up", flush=True)
+
+run.ros_started = started_then_stopped
+run.spin_node(lambda: Node("stopped_before_spin"){executor})
+"""
+
+
+@pytest.mark.parametrize("executor", ["", ", executor=MultiThreadedExecutor"])
+def test_a_stop_between_start_up_and_spinning_ends_quietly(ros_env, executor):
+    program = STOPPED_BEFORE_SPIN.format(executor=executor)
+    if executor:
+        program = "from rclpy.executors import MultiThreadedExecutor\n" + program
+    done = subprocess.run(
+        [sys.executable, "-c", program],
+        env=ros_env,
+        cwd=PROJECT_ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        timeout=30,
+    )
+    assert "context down" in done.stdout, done.stdout
+    assert "Traceback" not in done.stdout, done.stdout
+    assert done.returncode == 0, done.stdout
