@@ -6,7 +6,12 @@ import math
 
 import numpy as np
 import pytest
-from nav2_controller.regulated_pure_pursuit import PathState, RPPParameters, compute_velocity
+from nav2_controller.regulated_pure_pursuit import (
+    PathState,
+    RPPParameters,
+    closest_index,
+    compute_velocity,
+)
 from nav2_costmap_2d import INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE
 from nav2_costmap_2d.costmap_2d import Costmap2D, costmap_from_grid
 from nav2_planner.navfn_planner import PlannerOptions, create_plan, path_length
@@ -178,3 +183,32 @@ def test_pure_pursuit_slows_near_obstacles_as_nav2_regulates_by_cost():
                             costmap=costmap)  # fmt: skip
     assert open_floor.linear == pytest.approx(0.5)
     assert RPPParameters().regulated_linear_scaling_min_speed <= slow.linear < 0.45
+
+
+def _loop_path() -> list[tuple[float, float, float]]:
+    """3 m east along y = 0, a half circle up, 3 m back west along y = 0.3 (5 cm steps)."""
+    out = [(0.05 * i, 0.0, 0.0) for i in range(61)]
+    out += [(3.0 + 0.15 * math.sin(a), 0.15 - 0.15 * math.cos(a), a) for a in
+            np.linspace(0.1, math.pi, 10)]  # fmt: skip
+    out += [(3.0 - 0.05 * i, 0.3, math.pi) for i in range(1, 61)]
+    return out
+
+
+def test_the_nearest_pose_is_searched_only_max_robot_pose_search_dist_along_the_path():
+    path = _loop_path()
+    robot = (0.5, 0.28, 0.0)  # at the start of the way out, nearer the way back
+    # Unbounded, the way back is nearer: the robot would skip the whole loop.
+    assert closest_index(path, robot, 0) > 61
+    # Bounded by Nav2's default 1.5 m along the path from where it was pruned: the way out.
+    assert closest_index(path, robot, 0, 1.5) == 10
+    # From further on, the bound moves with the pruned start (8 m along: the way back).
+    assert closest_index(path, robot, 40, 1.5) < 71
+    assert closest_index(path, robot, 40, 8.0) > 61
+
+
+def test_at_least_two_poses_stay_when_the_nearest_is_the_last_searched():
+    path = [(0.1 * i, 0.0, 0.0) for i in range(11)]
+    assert closest_index(path, (1.2, 0.0, 0.0), 0) == 9  # past the end: the last two stay
+    # 0.25 m along ends the search before pose 3; the nearest searched (2) is the last: 1.
+    assert closest_index(path, (0.5, 0.0, 0.0), 0, 0.25) == 1
+    assert closest_index(path, (0.5, 0.0, 0.0), 10) == 10  # one pose left: it stays

@@ -127,6 +127,11 @@ class ControllerServer(LifecycleNode):
         self.get_logger().info("getting progress checker plugins..")
         self.get_logger().info("getting goal checker plugins..")
         self.frequency = float(g("controller_frequency").value)
+        if float(g("FollowPath.max_robot_pose_search_dist").value) < 0.0:
+            self.get_logger().warning(
+                "Max robot search distance is negative, setting to max to search every point "
+                "on path for the closest value."
+            )
         self.get_logger().info(f"Controller frequency set to {self.frequency:.4f}Hz")
         self.controller_ids = [str(v) for v in g("controller_plugins").value or []]
         for cid in self.controller_ids:
@@ -250,6 +255,9 @@ class ControllerServer(LifecycleNode):
             path, frame = self.check_goal(handle.request)
             checker = self.make_goal_checker()
             params = self.rpp_parameters()
+            search_dist = params.max_robot_pose_search_dist
+            if search_dist < 0.0:  # Nav2 warns at configure and then searches the whole path
+                search_dist = math.inf
             radius = float(self.costmap_ros.get_parameter("robot_radius").value)
             start = 0
             state = PathState()  # this path's own (Nav2's setPlan starts it afresh)
@@ -277,7 +285,7 @@ class ControllerServer(LifecycleNode):
                 now = self.get_clock().now().nanoseconds * 1e-9
                 if not self.progress_checker.check(pose, now):
                     raise ControllerError(Result.FAILED_TO_MAKE_PROGRESS, "Failed to make progress")
-                start = closest_index(path, pose, start)
+                start = closest_index(path, pose, start, search_dist)
                 try:
                     command = compute_velocity(
                         pose,

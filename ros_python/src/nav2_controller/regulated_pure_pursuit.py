@@ -75,6 +75,10 @@ class RPPParameters:
     cost_scaling_dist: float = 0.6
     cost_scaling_gain: float = 1.0
     inflation_cost_scaling_factor: float = 3.0
+    # How far along the path (m) to look for the pose nearest the robot. Nav2's default is
+    # half its local costmap's larger side, 1.5 m for nav2_params.yaml's 3 m window; ours is
+    # that figure (our local costmap spans the map). Negative: the whole path is searched.
+    max_robot_pose_search_dist: float = 1.5
 
 
 def normalize(angle: float) -> float:
@@ -87,13 +91,30 @@ def to_robot_frame(robot: Pose2D, x: float, y: float) -> tuple[float, float]:
     return (c * dx + s * dy, -s * dx + c * dy)
 
 
-def closest_index(path: list[Pose2D], robot: Pose2D, start: int = 0) -> int:
-    """The path pose nearest the robot, searched from ``start`` on (the path is pruned)."""
+def closest_index(
+    path: list[Pose2D], robot: Pose2D, start: int = 0, max_search_dist: float = math.inf
+) -> int:
+    """Where the pruned path begins now: the pose nearest the robot (Nav2's transformGlobalPlan).
+
+    The search runs from ``start`` up to the first pose more than
+    ``max_search_dist`` along the path from it (``max_robot_pose_search_dist``):
+    a path that loops back near the robot further on is not cut short there.
+    When the nearest pose is the last one searched, the one before it is taken,
+    so at least two poses stay to give the path's direction at its end.
+    """
+    end, along = len(path), 0.0
+    for i in range(start, len(path) - 1):  # nav2_util's first_after_integrated_distance
+        along += math.hypot(path[i + 1][0] - path[i][0], path[i + 1][1] - path[i][1])
+        if along > max_search_dist:
+            end = i + 1
+            break
     best, best_d = start, math.inf
-    for i in range(start, len(path)):
+    for i in range(start, end):
         d = math.hypot(path[i][0] - robot[0], path[i][1] - robot[1])
         if d < best_d:
             best, best_d = i, d
+    if len(path) - start > 1 and best == end - 1:
+        best = max(end - 2, start)
     return best
 
 
