@@ -76,9 +76,7 @@ class StandIns:
         self._map = self.node.create_publisher(OccupancyGrid, "/map", LATCHED)
         self._map.publish(room)
         self.follow = ActionClient(self.node, FollowPath, "follow_path")
-        self.change_state = self.node.create_client(
-            ChangeState, "/controller_server/change_state"
-        )
+        self.change_state = self.node.create_client(ChangeState, "/controller_server/change_state")
         self._executor = MultiThreadedExecutor(num_threads=2, context=self.context)
         self._executor.add_node(self.node)
         self._spinner = threading.Thread(target=self._executor.spin, daemon=True)
