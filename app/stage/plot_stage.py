@@ -175,11 +175,23 @@ def _draw(chart: viser.GuiUplotHandle, history: History) -> None:
             for i, name in enumerate(history.names)
         ),
     )
+    data = history.data()
     if len(chart.series) != len(series) or any(
         a.get("label") != b.get("label") for a, b in zip(chart.series, series, strict=True)
     ):
-        chart.series = series
-    chart.data = history.data()
+        # Never more lines than data arrays, not even for one frame. viser sends the two
+        # as separate messages, which a loaded page may draw apart; new lines drawn with
+        # the old data throw inside uPlot's first draw, and that chart then ignores every
+        # resize and update for good (ci34: the rate chart stuck at 157 px wide). uPlot
+        # ignores data arrays beyond its lines, so a line added gets its data first.
+        if len(series) > len(chart.series):
+            chart.data = data
+            chart.series = series
+        else:
+            chart.series = series
+            chart.data = data
+    else:
+        chart.data = data
     chart.visible = True
 
 
