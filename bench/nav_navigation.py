@@ -15,7 +15,8 @@ each a process of its own. This process uses Nav2's Python API
   within 0.3 m of it (aim >= 95 %);
 - ``nav_collisions``: times the robot's centre came closer than its radius
   (0.15 m) to an obstacle of the floor plan, by ground truth (aim 0), where
-  (``collisions_at``), and ``nav_min_clearance_m`` the closest it came;
+  (``collisions_at``), and ``nav_min_clearance_m`` the closest it came (where:
+  ``min_clearance_at``);
 - ``nav_path_ratio``: the driven length (ground truth) over the optimal
   8-connected grid path's length on the same map (cells the robot's radius
   fits in), summed over the goals reached (aim <= 1.2);
@@ -198,7 +199,13 @@ def run(goals_n: int, seed: int, rtf: float, plan_repeats: int = 3) -> dict[str,
     truth: dict[str, Any] = {"pose": None, "t": 0.0, "path": 0.0, "record": False}
     recent: collections.deque[tuple[float, float, float]] = collections.deque(maxlen=300)
     localization = {"worst": 0.0, "samples": 0}  # amcl against the truth, while recording
-    clearance: dict[str, Any] = {"min": math.inf, "collisions": 0, "inside": False, "at": []}
+    clearance: dict[str, Any] = {
+        "min": math.inf,
+        "min_at": None,
+        "collisions": 0,
+        "inside": False,
+        "at": [],
+    }
 
     def on_truth(msg: Any) -> None:
         p = msg.pose.pose.position
@@ -213,7 +220,8 @@ def run(goals_n: int, seed: int, rtf: float, plan_repeats: int = 3) -> dict[str,
             truth["pose"], truth["t"] = (p.x, p.y), t
             recent.append((t, p.x, p.y))
             judge_unjudged()
-            clearance["min"] = min(clearance["min"], d)
+            if d < clearance["min"]:
+                clearance["min"], clearance["min_at"] = d, (round(p.x, 2), round(p.y, 2))
             if d < ROBOT_RADIUS and not clearance["inside"]:
                 clearance["collisions"] += 1
                 clearance["at"].append((round(p.x, 2), round(p.y, 2)))
@@ -413,6 +421,7 @@ def run(goals_n: int, seed: int, rtf: float, plan_repeats: int = 3) -> dict[str,
         with lock:
             figures["nav_collisions"] = clearance["collisions"]
             figures["nav_min_clearance_m"] = clearance["min"]
+            figures["min_clearance_at"] = clearance["min_at"]
             figures["collisions_at"] = list(clearance["at"])
     except Exception as exc:  # reported, never quiet
         figures["errors"].append(str(exc))
