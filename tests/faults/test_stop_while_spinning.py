@@ -15,6 +15,7 @@ import signal
 import subprocess
 import sys
 import time
+from typing import Any
 
 import pytest
 
@@ -44,15 +45,20 @@ spin_node(Ticker)
 """
 
 
+def _python(program: str, env: dict[str, str]) -> dict[str, Any]:
+    """How each test starts its program: this project's Python, output and errors as text."""
+    return {
+        "args": [sys.executable, "-c", program],
+        "env": env,
+        "cwd": PROJECT_ROOT,
+        "stdout": subprocess.PIPE,
+        "stderr": subprocess.STDOUT,
+        "text": True,
+    }
+
+
 def test_sigterm_ends_a_spin_that_rclpys_signal_thread_did_not_end(ros_env):
-    proc = subprocess.Popen(
-        [sys.executable, "-c", PROGRAM],
-        env=ros_env,
-        cwd=PROJECT_ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-    )
+    proc = subprocess.Popen(**_python(PROGRAM, ros_env))
     try:
         assert proc.stdout is not None
         assert proc.stdout.readline().strip() == "spinning"
@@ -99,15 +105,7 @@ def test_a_stop_between_start_up_and_spinning_ends_quietly(ros_env, executor):
     program = STOPPED_BEFORE_SPIN.format(executor=executor)
     if executor:
         program = "from rclpy.executors import MultiThreadedExecutor\n" + program
-    done = subprocess.run(
-        [sys.executable, "-c", program],
-        env=ros_env,
-        cwd=PROJECT_ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-        timeout=30,
-    )
+    done = subprocess.run(**_python(program, ros_env), timeout=30)
     assert "context down" in done.stdout, done.stdout
     assert "Traceback" not in done.stdout, done.stdout
     assert done.returncode == 0, done.stdout
