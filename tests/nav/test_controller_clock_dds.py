@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import threading
 import time
-from typing import Any
 
 import pytest
 import rclpy
@@ -35,7 +34,7 @@ from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 
 from app.catalog import lookup
-from tests.conftest import wait_until
+from tests.nav.goal_helpers import wait_future
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(120)]
 
@@ -109,15 +108,10 @@ class StandIns:
         rclpy.try_shutdown(context=self.context)
 
 
-def _wait(future: Any, what: str) -> Any:
-    wait_until(future.done, timeout=30, what=what)
-    return future.result()
-
-
 def _transition(stand_ins: StandIns, transition: int) -> None:
     assert stand_ins.change_state.wait_for_service(timeout_sec=30), "no controller_server"
     request = ChangeState.Request(transition=Transition(id=transition))
-    answer = _wait(stand_ins.change_state.call_async(request), "change_state's answer")
+    answer = wait_future(stand_ins.change_state.call_async(request), 30, "change_state's answer")
     assert answer.success, f"controller_server refused transition {transition}"
 
 
@@ -141,12 +135,13 @@ def test_no_progress_is_judged_in_simulated_time(supervisor):
         _transition(stand_ins, Transition.TRANSITION_ACTIVATE)
         assert stand_ins.follow.wait_for_server(timeout_sec=30)
         sim0, wall0 = stand_ins.sim_sec(), time.monotonic()
-        handle = _wait(
+        handle = wait_future(
             stand_ins.follow.send_goal_async(FollowPath.Goal(path=_east_path(3.0))),
+            30,
             "follow_path's answer",
         )
         assert handle.accepted
-        outcome = _wait(handle.get_result_async(), "follow_path's result")
+        outcome = wait_future(handle.get_result_async(), 30, "follow_path's result")
         sim, wall = stand_ins.sim_sec() - sim0, time.monotonic() - wall0
         assert outcome.status == ABORTED, f"the goal ended with status {outcome.status}"
         code = outcome.result.error_code
