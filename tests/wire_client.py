@@ -84,14 +84,16 @@ def decode_frame(frame: bytes) -> list[dict[str, Any]]:
 class WireClient:
     """Connects, reads every frame in a thread, and keeps the GUI state it was sent."""
 
-    def __init__(self, url: str, *, headers: dict[str, str] | None = None) -> None:
+    def __init__(
+        self, url: str, *, headers: dict[str, str] | None = None, open_timeout: float = 10.0
+    ) -> None:
         self.url = url.replace("http://", "ws://", 1)
         self.ws: ClientConnection = connect_quietly(
             self.url,
             subprotocols=[f"viser-v{viser.__version__}"],  # type: ignore[list-item]
             additional_headers=headers or {},
             max_size=None,
-            open_timeout=10,
+            open_timeout=open_timeout,
         )
         self.lock = threading.Lock()
         self.gui: dict[str, dict[str, Any]] = {}  # uuid -> {"type", "props"...}

@@ -18,6 +18,7 @@ under way, the moment a user would see it and could stop it.
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import os
 import queue
 import signal
@@ -172,23 +173,26 @@ def endings(request) -> dict[str, Ending]:
 
     def slot(index: int) -> None:
         domain = FIRST_DOMAIN + index
-        probe = RosRuntime(f"sigterm_probe_{index}", domain_id=domain, quiet=True)
-        try:
-            while True:
-                try:
-                    name = todo.get_nowait()
-                except queue.Empty:
-                    return
-                try:
-                    entry = catalog.lookup(name)
-                    if name in LEARNER_ARGS:  # run as the tutorials run them
-                        entry = dataclasses.replace(entry, args=LEARNER_ARGS[name][0])
-                        entry = dataclasses.replace(entry, ros_args=LEARNER_ARGS[name][1])
-                    results[name] = _stop_one(entry, _env(domain), probe)
-                except BaseException as exc:  # reported by that node's test
-                    results[name] = Ending(False, note=f"test error: {exc!r}")
-        finally:
-            probe.shutdown()
+        for number in itertools.count():
+            try:
+                name = todo.get_nowait()
+            except queue.Empty:
+                return
+            # A probe of its own for each node: one that saw the previous node of this
+            # domain remembers it until its lease ends when its goodbye was lost (ci38:
+            # one of the five robot_state_publishers outlived the 25 s wait). A new
+            # participant hears only the living.
+            probe = RosRuntime(f"sigterm_probe_{index}_{number}", domain_id=domain, quiet=True)
+            try:
+                entry = catalog.lookup(name)
+                if name in LEARNER_ARGS:  # run as the tutorials run them
+                    entry = dataclasses.replace(entry, args=LEARNER_ARGS[name][0])
+                    entry = dataclasses.replace(entry, ros_args=LEARNER_ARGS[name][1])
+                results[name] = _stop_one(entry, _env(domain), probe)
+            except BaseException as exc:  # reported by that node's test
+                results[name] = Ending(False, note=f"test error: {exc!r}")
+            finally:
+                probe.shutdown()
 
     workers = [threading.Thread(target=slot, args=(i,)) for i in range(SLOTS)]
     for worker in workers:
