@@ -47,6 +47,7 @@ from app.ros.rosout import RosoutLog
 from app.ros.runtime import RosRuntime
 from app.ros2cli.console_panel import ConsolePanel
 from app.scene.grid import add_floor_grid
+from app.scene.point_shader import keep_point_shader
 from app.stage.window import Stage
 from app.supervisor import NodeState, Supervisor
 from app.ui import GROUP_OF, TAB_NAMES, TOOL_GROUPS, TOOLS, Inspector, MarkdownView, Panel
@@ -142,6 +143,7 @@ class Dashboard:
         self.server.scene.configure_environment_map(None)
         self.server.scene.configure_default_lights(cast_shadow=False)
         add_floor_grid(self.server.scene)  # 4 m, half-metre cells: see app/scene/grid.py
+        keep_point_shader(self.server.scene)  # no recompile per scan: app/scene/point_shader.py
         # One line: where am I (the domain learners compare when two dashboards share a room).
         gui.add_markdown(
             f"**ROS 2 Classroom** · Domain id **{os.environ.get('ROS_DOMAIN_ID', '0')}** · "

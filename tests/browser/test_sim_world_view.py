@@ -56,6 +56,25 @@ CAMERA_IN_JS = """(frame) => {
 }"""
 
 
+# Counts WebGL's program links and frames (clears), from before the page's first script.
+COUNT_GL_JS = """(() => {
+  const counts = (window.__glCounts = { linkProgram: 0, clear: 0 });
+  for (const proto of [WebGLRenderingContext.prototype, WebGL2RenderingContext.prototype])
+    for (const name of Object.keys(counts)) {
+      const real = proto[name];
+      proto[name] = function (...args) { counts[name] += 1; return real.apply(this, args); };
+    }
+})()"""
+# The uuid of the material the scan's points are drawn with (viser makes a new one each
+# time the colours change).
+SCAN_MATERIAL_JS = """() => {
+  const obj = window.__viserMutable && window.__viserMutable.nodeRefFromName["/laser_scan/points"];
+  let uuid = null;
+  if (obj) obj.traverse((c) => { if (c.isPoints) uuid = c.material.uuid; });
+  return uuid;
+}"""
+
+
 def count(page: Page, prefix: str) -> int:
     return int(page.evaluate(COUNT_JS, prefix))
 
@@ -78,6 +97,8 @@ def drive_forward(page: Page, presses: int) -> None:
 
 
 def test_the_world_is_drawn_and_the_robot_drives_from_the_keyboard(page: Page) -> None:
+    page.add_init_script(COUNT_GL_JS)
+    page.reload()
     start_group(page, "sim_drive")
     open_tab(page, "3D view")
     choose(page, "On stage", "3D scene")  # the canvas, not the live graph, in the middle
@@ -97,6 +118,15 @@ def test_the_world_is_drawn_and_the_robot_drives_from_the_keyboard(page: Page) -
     expect_text(page, "On the camera at TF frame camera_optical_frame", timeout=30_000)
     expect_text(page, "from its camera_info", timeout=30_000)
     page.wait_for_timeout(1_500)  # the camera settles on the room's overview
+
+    # Each scan comes with new colours (by range), so viser makes the cloud a new material;
+    # the point shader is not compiled again for it (app/scene/point_shader.py).
+    material, before = page.evaluate(SCAN_MATERIAL_JS), page.evaluate("({...window.__glCounts})")
+    page.wait_for_function(f"(m) => ({SCAN_MATERIAL_JS})() !== m", arg=material, timeout=10_000)
+    page.wait_for_timeout(2_000)
+    after = page.evaluate("({...window.__glCounts})")
+    assert after["clear"] - before["clear"] >= 5, (before, after)  # the scene was drawn on
+    assert after["linkProgram"] == before["linkProgram"], (before, after)
     page.screenshot(path=str(ARTIFACTS / "sim-world-view.png"))
 
     # The up arrow: the drawn base_link moves forward (+x: the robot starts facing +x).
