@@ -100,11 +100,12 @@ def test_the_world_is_drawn_and_the_robot_drives_from_the_keyboard(page: Page) -
     page.add_init_script(COUNT_GL_JS)
     page.reload()
     start_group(page, "sim_drive")
+    # The room from /sim_world/static_markers, under TF's world frame: floor, 4 walls, 3 objects.
+    # Drawn whichever tool is open; the page builds it before it is asked for more (software
+    # WebGL on a loaded machine answered no click for 30 s while it did: the CI run of 2026-12-01).
+    wait_count(page, f"{WORLD}/sim_world/", 8)
     open_tab(page, "3D view")
     choose(page, "On stage", "3D scene")  # the canvas, not the live graph, in the middle
-
-    # The room from /sim_world/static_markers, under TF's world frame: floor, 4 walls, 3 objects.
-    wait_count(page, f"{WORLD}/sim_world/", 8)
     wait_count(page, f"{WORLD}/sim_objects/cube_", 1)  # the loose cube
     # The robot from /robot_description (its URDF) and the arm from /arm/robot_description.
     wait_count(page, f"{BASE}/visual", 1)
