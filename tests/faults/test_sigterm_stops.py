@@ -179,7 +179,7 @@ def endings(request) -> dict[str, Ending]:
             except queue.Empty:
                 return
             # A probe of its own for each node: one that saw the previous node of this
-            # domain remembers it until its lease ends when its goodbye was lost (ci38:
+            # domain remembers it until its lease ends when its goodbye was lost (CI, 2026-12-01:
             # one of the five robot_state_publishers outlived the 25 s wait). A new
             # participant hears only the living.
             probe = RosRuntime(f"sigterm_probe_{index}_{number}", domain_id=domain, quiet=True)

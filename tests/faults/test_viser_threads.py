@@ -45,7 +45,7 @@ RUN_SEC = 60.0
 # A short GIL switch interval preempts a thread inside Event.set's walk over the
 # waiters far more often (at the default 5 ms: no crash in 60 s).
 SWITCH_INTERVAL = 1e-5
-# What this test looks for is a crash, not speed: on a loaded CI machine (ci38) a
+# What this test looks for is a crash, not speed: on a loaded CI machine (2026-12-01) a
 # churner's websocket handshake took more than websockets' default 10 s while ~40
 # threads at that switch interval shared the GIL with the server's loop. A loop that
 # hangs still fails: its handshakes outlast this, and the churner's thread its join.
