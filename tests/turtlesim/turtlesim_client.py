@@ -212,13 +212,18 @@ RATE_WINDOWS = 3  # one-second windows of turtle1's poses; the rate is the best 
 def rate_by_window(sent: list[tuple[int, int]], windows: int) -> list[float]:
     """Poses a second in each of ``windows`` one-second windows of ``sent`` ((number,
     send time ns) of each pose that arrived), by the numbers and times turtlesim sent
-    them: a pose this reader lost still counts, as it was sent."""
+    them: a pose this reader lost still counts, as it was sent. A window with fewer than
+    two poses (the sender stalled through it) has rate 0."""
     rates = []
     for k in range(windows):
         low = sent[0][1] + k * 1_000_000_000
         inside = [pose for pose in sent if low <= pose[1] < low + 1_000_000_000]
+        if len(inside) < 2:
+            rates.append(0.0)
+            continue
         (first_number, first_sent), (last_number, last_sent) = inside[0], inside[-1]
-        rates.append((last_number - first_number) / ((last_sent - first_sent) * 1e-9))
+        span = (last_sent - first_sent) * 1e-9
+        rates.append((last_number - first_number) / span if span > 0 else 0.0)
     return rates
 
 
