@@ -25,7 +25,6 @@ from lifecycle_msgs.msg import Transition
 from lifecycle_msgs.srv import ChangeState
 from nav2_msgs.action import FollowPath
 from nav_msgs.msg import OccupancyGrid, Path
-from rclpy.action import ActionClient
 from rclpy.context import Context
 from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
@@ -34,6 +33,7 @@ from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 
 from app.catalog import lookup
+from app.ros.action_client import ThreadSafeActionClient
 from tests.nav.goal_helpers import wait_future
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(120)]
@@ -75,7 +75,9 @@ class StandIns:
         room.data = [0] * (120 * 120)
         self._map = self.node.create_publisher(OccupancyGrid, "/map", LATCHED)
         self._map.publish(room)
-        self.follow = ActionClient(self.node, FollowPath, "follow_path")
+        # Goals go from the test's thread while the executor spins in another: rclpy's own
+        # ActionClient can drop the answer then ("Ignoring unexpected goal response", seen).
+        self.follow = ThreadSafeActionClient(self.node, FollowPath, "follow_path")
         self.change_state = self.node.create_client(ChangeState, "/controller_server/change_state")
         self._executor = MultiThreadedExecutor(num_threads=2, context=self.context)
         self._executor.add_node(self.node)

@@ -107,7 +107,15 @@ def test_follow_waypoints_with_basic_navigator(ros_env, supervisor):
     nav = BasicNavigator()
     truth = Truth(nav)
     try:
-        in_thread(nav.waitUntilNav2Active, 120, "Nav2 did not become active", logs)
+        # The manager activates the waypoint follower last, after bt_navigator, the navigator
+        # waitUntilNav2Active waits for by default (as upstream's): a route sent the moment
+        # bt_navigator was active reached a follower still activating, which rejected it.
+        in_thread(
+            lambda: nav.waitUntilNav2Active(navigator="waypoint_follower"),
+            120,
+            "Nav2 did not become active",
+            logs,
+        )
         up = time.monotonic() - started
 
         # 1. Two waypoints: along the corridor, then into the meeting room.
