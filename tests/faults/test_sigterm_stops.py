@@ -46,9 +46,9 @@ STOP_TIMEOUT = 20.0
 # Exit codes that are the node's Ctrl+C codes too: view_frames stopped while it listens
 # reports that it wrote no picture (1), on SIGINT as on SIGTERM.
 CTRL_C_CODES = {"view_frames": (0, 1)}
-# Seven catalog entries are named /listener. A node that ends says goodbye to the
-# others; when that one UDP message is lost (busy cores), the probe still sees it until
-# its lease runs out: Fast DDS's default lease is 20 s.
+# Seven catalog entries are named /listener, five /robot_state_publisher. Each node is
+# looked for by a probe made after the previous one ended (see ``slot``), which never
+# heard of it: this wait is for a process of that name that is really still there.
 GRAPH_CLEAR_TIMEOUT = 25.0
 ABORT = "terminate called"
 
