@@ -276,8 +276,10 @@ def test_event_handlers_include_group_and_timer(tmp_path, prefix):
                 RegisterEventHandler(OnExecutionComplete(target_action=first,
                                                          on_completion=[LogInfo(msg="first complete")])),
                 RegisterEventHandler(OnProcessExit(target_action=failing, on_exit=on_exit)),
+                # 3 s after `first` ends: `failing` (a node's Python start) has ended by then
+                # on a loaded machine too (at 0.3 s the shutdown once came first, on CI).
                 RegisterEventHandler(OnProcessExit(target_action=first, on_exit=[
-                    TimerAction(period=0.3, actions=[
+                    TimerAction(period=3.0, actions=[
                         OpaqueFunction(function=lambda context: [LogInfo(msg="timer fired")]),
                         EmitEvent(event=ShutdownEvent(reason="all done")),
                     ]),
