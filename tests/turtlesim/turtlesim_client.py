@@ -248,7 +248,6 @@ def scenario_start(node: TurtleClient) -> dict:
         "pose": as_dict(first),
         "pose_rate_hz": max(rates),
         "pose_rates_hz": rates,
-        "poses_received_share": (len(sent) - 1) / (sent[-1][0] - sent[0][0]),
         "color": node.color("turtle1"),
         "topics": sorted(node.topics()),
     }
