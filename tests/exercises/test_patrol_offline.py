@@ -15,7 +15,14 @@ import random
 import pytest
 
 from app.exercises.model import load_exercises
-from app.exercises.probes.sim import Sample, Touch
+from app.exercises.probes.sim import (
+    SILENT_DRIVE,
+    Command,
+    Sample,
+    SilentDrive,
+    Touch,
+    silent_drives,
+)
 from app.exercises.probes.sim_patrol import (
     MIN_GAP,
     PATH_CLEARANCE,
@@ -30,6 +37,7 @@ from app.exercises.probes.sim_patrol import (
     reach_times,
     route_problems,
     speeds,
+    spoiled_by,
     world_grid,
 )
 from app.lessons.checks._sim_topics import world_map
@@ -225,3 +233,52 @@ def test_another_seed_draws_another_route():
         tuple(draw_route(random.Random(s), grid, (0.0, 0.0), 3, [1.0, 2.0])) for s in range(6)
     }
     assert len(routes) == 6
+
+
+def _commands(*times_and_motion):
+    return [Command(sent, moving) for sent, moving in times_and_motion]
+
+
+def test_a_moving_command_followed_by_silence_is_a_silent_drive_on_the_worlds_clock():
+    # The world sent sample k at wall time 100 + k/50 with simulation time 10 + k/50, but
+    # from wall 101 on it ran at half speed (a busy machine): wall 103 is simulated 12.0.
+    clock = [(100.0 + k / 50, 10.0 + k / 50) for k in range(51)]
+    clock += [(101.0 + k / 50, 11.0 + k / 100) for k in range(1, 101)]
+    every = [(100.0 + k / 20, True) for k in range(21)]  # 20 Hz until wall 101
+    commands = _commands(*every, (101.9, True), (102.0, False), (102.9, False))
+    drives = silent_drives(commands, clock, t0=10.0)
+    # 101.0 -> 101.9 wall is 11.0 -> 11.45 simulated: one silent drive; the gap after the
+    # zero command (the robot was told to stop) is none.
+    assert drives == [SilentDrive(pytest.approx(1.0), pytest.approx(0.45, abs=0.011))]
+    assert silent_drives(commands, clock, t0=11.5) == []  # before the trial: not its own
+    assert silent_drives(commands[:21], clock, t0=10.0) == []  # 20 Hz: never silent
+    slow = _commands((100.0, True), (100.0 + SILENT_DRIVE * 0.9, True))
+    assert silent_drives(slow, clock, t0=9.0) == []  # a late tick is no silent drive
+    assert silent_drives(commands, [], t0=0.0) == []
+
+
+def test_a_route_lost_to_a_starved_controller_proves_nothing_and_a_script_mistake_does():
+    samples = drive([ROUTE[2]])  # waypoints 1 and 2 driven through
+    skipped = judge(samples, 0.0, ROUTE, TOL, FAR, samples[-1].t)
+    starved = [SilentDrive(2.0, 0.8)]
+    why = spoiled_by(starved, skipped, finished=True)
+    assert "sent no command for 0.8 s at 2.0 s" in why and "too busy" in why
+    assert spoiled_by([], skipped, finished=True) == ""  # the script's own doing
+    # Still driving its first route when the trial ended: a second would meet it.
+    assert spoiled_by(starved, skipped, finished=False) == ""
+    late = [SilentDrive(samples[-1].t + 1.0, 0.8)]  # after the trial was lost
+    assert spoiled_by(late, skipped, finished=True) == ""
+    passed = judge(drive(ROUTE), 0.0, ROUTE, TOL, FAR, drive(ROUTE)[-1].t)
+    assert passed.passed and spoiled_by(starved, passed, finished=True) == ""
+    touched = judge(samples, 0.0, ROUTE, TOL, Touch(0.0, "sofa", 3.5), samples[-1].t)
+    assert spoiled_by(starved, touched, finished=True)  # drove into it on an old command
+    assert spoiled_by([SilentDrive(4.0, 0.8)], touched, finished=True) == ""  # touched first
+
+
+def test_a_goal_off_the_route_or_a_jump_is_never_excused_by_a_busy_machine():
+    samples = drive(ROUTE)
+    stray = judge(samples, 0.0, ROUTE, TOL, FAR, samples[-1].t, sent=[(5.0, 5.0), *ROUTE])
+    assert not stray.passed and spoiled_by([SilentDrive(1.0, 1.0)], stray, True) == ""
+    jumped = [Sample(0.0, 0.0, 0.0, 0.0), *(Sample(t, *ROUTE[0], 0.0) for t in (0.02, 5.0))]
+    verdict = judge(jumped, 0.0, ROUTE, TOL, FAR, 5.0)
+    assert "not driven" in verdict.text and spoiled_by([SilentDrive(0.0, 1.0)], verdict, True) == ""

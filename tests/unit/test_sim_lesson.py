@@ -8,12 +8,18 @@ loads; its distances are checked here against the room's known geometry
 from __future__ import annotations
 
 import math
+import random
 import textwrap
 
 import pytest
 
 from app.lessons.checks._world_map import (
+    Circle,
+    Nearest,
     WorldMapError,
+    _polygon_distance,
+    _polygon_point_distance,
+    footprint,
     load_world_map,
 )
 from app.lessons.kinds import CHECK_KINDS
@@ -56,6 +62,27 @@ def test_the_room_plan_has_its_walls_and_objects_and_leaves_out_what_moves():
         "table",
     }  # fmt: skip  (the cube has a joint, the floor is a plane, the robots are attached)
     assert plan.skipped == ()
+
+
+@pytest.mark.parametrize("world", ["room", "office"])
+def test_clearance_measures_only_what_can_be_closest_and_finds_what_measuring_all_does(world):
+    plan = load_world_map(world)
+    rng = random.Random(3)
+
+    def every_obstacle(x: float, y: float, yaw: float) -> Nearest:
+        body, best = footprint(x, y, yaw), Nearest(math.inf, "")
+        for o in plan.obstacles:
+            if isinstance(o, Circle):
+                d = _polygon_point_distance(body, (o.x, o.y)) - o.radius
+            else:
+                d = _polygon_distance(body, o.corners())
+            if d < best.distance:
+                best = Nearest(d, o.name)
+        return best
+
+    # Poses all over the plan, many touching or inside furniture and walls.
+    poses = [(rng.uniform(-6, 6), rng.uniform(-5, 5), rng.uniform(-4, 4)) for _ in range(1500)]
+    assert [plan.clearance(*pose) for pose in poses] == [every_obstacle(*p) for p in poses]
 
 
 def test_distances_rays_and_clearance_in_the_room():

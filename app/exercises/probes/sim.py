@@ -30,10 +30,11 @@ One trial:
 
 from __future__ import annotations
 
+import bisect
 import math
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -50,6 +51,7 @@ from app.lessons.checks._world_map import WorldMap
 from app.ros import params
 from app.ros.calls import wait_for_server, wait_future
 from app.ros.errors import Ros2Error
+from app.ros.monitor import MessageInfo
 
 if TYPE_CHECKING:
     from collections.abc import Mapping
@@ -66,6 +68,9 @@ ASKED_SPEED, ASKED_TURN = 0.01, 0.02  # a /cmd_vel below both asks for no real m
 DEFAULT_RTF = 2.0
 QUIET_WAIT = 3.0  # s at most for the samples sent before a pause to arrive
 WORLD_PARAMS = ("x", "y", "yaw", "real_time_factor", "camera_rate")
+# A command that asked for motion, then nothing for this long (simulated s; a controller
+# sends one every 0.05 s): the wheels drove on an old command, as on a starved computer.
+SILENT_DRIVE = 0.3
 
 
 @dataclass(frozen=True)
@@ -78,13 +83,32 @@ class Sample:
     yaw: float
 
 
-class Recorder:
-    """Every /ground_truth/odom and /odom message as planar poses, and when /cmd_vel last
-    asked for motion (the executor thread writes).
+@dataclass(frozen=True)
+class Command:
+    """One /cmd_vel message: when its publisher sent it (s, wall clock) and whether it
+    asked for motion."""
 
-    /cmd_vel only tells the probe when to stop watching (a robot that stands still while
-    its node still asks it to move was held up, e.g. by a busy machine, and is watched on);
-    the verdict comes from the ground truth.
+    sent: float
+    moving: bool
+
+
+@dataclass(frozen=True)
+class SilentDrive:
+    """The wheels ran on an old command: from ``at`` (s into the trial) for ``seconds`` of
+    simulation, nothing new came."""
+
+    at: float
+    seconds: float
+
+
+class Recorder:
+    """Every /ground_truth/odom and /odom message as planar poses, and every /cmd_vel
+    (the executor thread writes).
+
+    /cmd_vel tells the probe when to stop watching (a robot that stands still while
+    its node still asks it to move was held up, e.g. by a busy machine, and is watched on)
+    and whether the node that drives was silent while the robot drove; the verdict comes
+    from the ground truth.
     """
 
     def __init__(self, ctx: ProbeContext) -> None:
@@ -92,17 +116,25 @@ class Recorder:
         self._lock = threading.Lock()
         self.truth: list[Sample] = []
         self.odom: list[Pose] = []
+        # When the world sent each ground-truth sample (s, its wall clock) and the sample's
+        # simulation time: a command's send time in simulated seconds.
+        self.clock: list[tuple[float, float]] = []
+        self.commands: list[Command] = []
         # Simulation time (the newest ground-truth stamp) when /cmd_vel last asked for motion.
         self.moving_asked = -math.inf
+        sub = self._node.create_subscription
         self._subs = [
-            self._node.create_subscription(Odometry, "/ground_truth/odom", self._on_truth, 50),
-            self._node.create_subscription(Odometry, "/odom", self._on_odom, 50),
-            self._node.create_subscription(Twist, "/cmd_vel", self._on_cmd_vel, 50),
+            sub(Odometry, "/ground_truth/odom", self._on_truth, 50),  # type: ignore[arg-type]
+            sub(Odometry, "/odom", self._on_odom, 50),
+            sub(Twist, "/cmd_vel", self._on_cmd_vel, 50),  # type: ignore[arg-type]
         ]
 
-    def _on_cmd_vel(self, msg: Twist) -> None:
-        if abs(msg.linear.x) > ASKED_SPEED or abs(msg.angular.z) > ASKED_TURN:
-            with self._lock:
+    # Two parameters: rclpy passes the message info (a dict) as the second.
+    def _on_cmd_vel(self, msg: Twist, info: MessageInfo) -> None:
+        moving = abs(msg.linear.x) > ASKED_SPEED or abs(msg.angular.z) > ASKED_TURN
+        with self._lock:
+            self.commands.append(Command(_sent(info), moving))
+            if moving:
                 self.moving_asked = self.truth[-1].t if self.truth else 0.0
 
     def asked_to_move(self, within: float = 1.0) -> bool:
@@ -113,10 +145,11 @@ class Recorder:
             newest = self.truth[-1].t if self.truth else 0.0
             return 0.0 <= newest - self.moving_asked < within  # < 0: time reset since
 
-    def _on_truth(self, msg: Odometry) -> None:
+    def _on_truth(self, msg: Odometry, info: MessageInfo) -> None:
         pose = pose_of(msg)
         with self._lock:
             self.truth.append(Sample(pose.t, pose.x, pose.y, pose.yaw))
+            self.clock.append((_sent(info), pose.t))
 
     def _on_odom(self, msg: Odometry) -> None:
         with self._lock:
@@ -138,9 +171,53 @@ class Recorder:
         with self._lock:
             return [p for p in self.odom if p.t > t0]
 
+    def sim_time_at(self, wall: float) -> float | None:
+        """The simulation time when the world's wall clock read ``wall``: that of the last
+        ground-truth sample it sent by then (None: none yet). Not the newest sample heard,
+        which lags behind when this process is short of the processor."""
+        with self._lock:
+            return sim_time_at(self.clock, wall)
+
+    def silent_drives(self, t0: float) -> list[SilentDrive]:
+        """Since simulation time ``t0``: each time the wheels drove on an old command."""
+        with self._lock:
+            return silent_drives(self.commands, self.clock, t0)
+
     def close(self) -> None:
         for sub in self._subs:
             self._node.destroy_subscription(sub)
+
+
+def _sent(info: MessageInfo) -> float:
+    """When the publisher sent a message (s, wall clock); now if the middleware said not."""
+    stamp = info.get("source_timestamp") or 0
+    return stamp * 1e-9 if stamp > 0 else time.time()
+
+
+def sim_time_at(clock: Sequence[tuple[float, float]], wall: float) -> float | None:
+    """The simulation time of the last ground-truth sample the world sent by wall-clock
+    time ``wall`` (None: none by then); ``clock``: (wall send time, simulation time) pairs
+    in the order sent."""
+    at = bisect.bisect_right(clock, (wall, math.inf)) - 1
+    return clock[at][1] if at >= 0 else None
+
+
+def silent_drives(
+    commands: Sequence[Command], clock: Sequence[tuple[float, float]], t0: float
+) -> list[SilentDrive]:
+    """Each command that asked for motion and was followed by nothing for more than
+    SILENT_DRIVE simulated seconds (the world's cmd_vel timeout stops the wheels later),
+    after simulation time ``t0``. ``clock``: (wall send time, simulation time) pairs of
+    the ground truth, in order, which put each command's send time on the simulation's
+    clock (the world may run slower than the wall clock on a busy machine)."""
+    out = []
+    for before, after in zip(commands, commands[1:], strict=False):
+        start, end = sim_time_at(clock, before.sent), sim_time_at(clock, after.sent)
+        if start is None or end is None:
+            continue  # sent before the world's first sample: not the trial's
+        if before.moving and start > t0 and end - start > SILENT_DRIVE:
+            out.append(SilentDrive(start - t0, end - start))
+    return out
 
 
 def _parameter(name: str, value: object) -> Parameter:

@@ -19,6 +19,7 @@ No ROS and no MuJoCo here: plain geometry, testable alone.
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 import xml.etree.ElementTree as ET
@@ -33,6 +34,8 @@ BODY_BAND = (0.02, 0.2)  # m above the floor: the diffbot's chassis, wheels and 
 # The diffbot's outline around base_link (nodes/robots/diffbot/robot.xml): the chassis
 # runs from x = -0.11 to 0.07 m, the wheels stick out to y = +-0.089 m.
 FOOTPRINT = (-0.11, 0.07, -0.09, 0.09)  # x_min, x_max, y_min, y_max in base_link
+# Every point of the body lies this close to base_link (its farthest corner).
+BODY_RADIUS = max(math.hypot(x, y) for x in FOOTPRINT[:2] for y in FOOTPRINT[2:])
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_-]*$")
 
 
@@ -77,6 +80,9 @@ class Nearest:
     bearing: float = 0.0  # rad, in the robot's frame (0 ahead, +pi/2 to the left)
 
 
+_Shape = tuple[list[tuple[float, float]] | None, float, float, float]
+
+
 @dataclass(frozen=True)
 class WorldMap:
     """The fixed obstacles of a world at the robot's height, in the world frame."""
@@ -119,18 +125,43 @@ class WorldMap:
                 best = Nearest(hit.distance, hit.name, bearing)
         return best
 
+    @functools.cached_property
+    def _shapes(self) -> tuple[_Shape, ...]:
+        """Per obstacle: its corners (None: a circle) and a circle around it (x, y, radius)."""
+        out: list[_Shape] = []
+        for obstacle in self.obstacles:
+            if isinstance(obstacle, Circle):
+                out.append((None, obstacle.x, obstacle.y, obstacle.radius))
+                continue
+            corners = obstacle.corners()
+            cx = sum(px for px, _ in corners) / len(corners)
+            cy = sum(py for _, py in corners) / len(corners)
+            out.append((corners, cx, cy, max(math.dist(c, (cx, cy)) for c in corners)))
+        return tuple(out)
+
     def clearance(self, x: float, y: float, yaw: float) -> Nearest:
         """How far the robot's body (FOOTPRINT at this pose) is from the closest obstacle.
 
         Zero or less: the body touches or overlaps it.
         """
         body = footprint(x, y, yaw)
+
+        def gap(k: int) -> float:
+            corners, cx, cy, radius = self._shapes[k]
+            if corners is None:
+                return _polygon_point_distance(body, (cx, cy)) - radius
+            return _polygon_distance(body, corners)
+
+        # Called for every ground-truth sample: obstacles whose surrounding circle lies
+        # farther than one exact gap (the obstacle nearest by centre) cannot be the closest,
+        # and are not measured. The same answer as measuring all, at a tenth of the cost.
+        lows = [math.hypot(cx - x, cy - y) - r - BODY_RADIUS for _, cx, cy, r in self._shapes]
+        limit = gap(min(range(len(lows)), key=lows.__getitem__)) if lows else math.inf
         best = Nearest(math.inf, "")
-        for obstacle in self.obstacles:
-            if isinstance(obstacle, Circle):
-                d = _polygon_point_distance(body, (obstacle.x, obstacle.y)) - obstacle.radius
-            else:
-                d = _polygon_distance(body, obstacle.corners())
+        for k, obstacle in enumerate(self.obstacles):
+            if lows[k] > limit:
+                continue
+            d = gap(k)
             if d < best.distance:
                 best = Nearest(d, obstacle.name)
         return best
