@@ -405,12 +405,15 @@ class LessonsPanel:
         results = [(check, self._live.evaluate(check)) for check in step.checks]
         if results and all(result.state == PASS for _, result in results):
             self._progress.mark_passed(lesson.id, index)
-        # What is left to do comes first; each line keeps its full reason.
+        # What is left to do comes first, a line per check; a reason is said once for the
+        # checks that wait on the same thing (four frames, one missing /tf).
         ordered = sorted(results, key=lambda pair: pair[1].state == PASS)
-        lines = [
-            f"- {_MARKS[result.state]} **{_WORDS[result.state]}**: {result.reason}"
-            for _, result in ordered
-        ]
+        lines, said = [], set()
+        for _, result in ordered:
+            key = (result.state, result.reason)
+            reason = "the same as above" if key in said else result.reason
+            said.add(key)
+            lines.append(f"- {_MARKS[result.state]} **{_WORDS[result.state]}**: {reason}")
         passed = set(self._progress.lesson(lesson.id)["passed"])
         status = "✓ step done" if index in passed else ""
         not_passed = sum(result.state != PASS for _, result in results)

@@ -28,6 +28,17 @@ COURSE = load_course()
 
 
 @pytest.fixture
+def ros_env(ros_env, tmp_path, monkeypatch):
+    """The conftest's, with a home folder of the test's own: a lesson's ``~/maps/office``
+    lands there (for the nodes it starts and the checks that read it), never in the real
+    home, where a later run's "Save the map" check would find it already saved."""
+    home = tmp_path / "home"
+    home.mkdir()
+    monkeypatch.setenv("HOME", str(home))
+    return {**ros_env, "HOME": str(home)}
+
+
+@pytest.fixture
 def dashboard_node(ros_env):
     """The same ROS node the dashboard has, so graph checks see the same names."""
     from app.ros.runtime import RosRuntime

@@ -97,7 +97,10 @@ def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
     found = rt.watch("map", MapWatch).figures(world)
     if found is None:
         if not rt.publishers(MAP):
-            return CheckResult(FAIL, f"no publisher on {MAP}: is a mapping node running?")
+            return CheckResult(
+                FAIL,
+                f"no publisher on {MAP}: nothing serves a map yet (a mapper or map_server does)",
+            )
         return CheckResult(WAITING, f"waiting for the first map on {MAP}")
     msg, coverage, agreement, known = found
     info = msg.info
