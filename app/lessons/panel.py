@@ -28,6 +28,7 @@ from app.ui.starting import StartRequests
 
 # How a check reads on the card. Not passed yet is "to do", not "fail": most steps open
 # with their checks unmet, and a learner who has not acted yet has failed nothing.
+_SECTION = re.compile(r"^#{1,6} (.+?)\s*#*\s*$")  # a Markdown heading line
 _MARKS = {PASS: "✓", FAIL: "○", WAITING: "…"}
 _WORDS = {PASS: "pass", FAIL: "to do", WAITING: "waiting"}
 # A step button's icon says what it does; the label says it in words.
@@ -63,9 +64,18 @@ FIRST_SCREEN = (
 
 
 def _without_title(markdown: str) -> str:
-    """Drop a leading '# Title' line: the step title is already shown above."""
+    """Drop a leading '# Title' line: the step title is already shown above. A section
+    heading inside ('## Try it') is drawn in bold: as a heading it came out larger than the
+    step's own title (code blocks, whose '#' lines are comments, are left as they are)."""
     first, _, rest = markdown.lstrip().partition("\n")
-    return rest.lstrip() if first.startswith("# ") else markdown
+    body = rest.lstrip() if first.startswith("# ") else markdown
+    lines, in_code = [], False
+    for line in body.split("\n"):
+        if line.lstrip().startswith("```"):
+            in_code = not in_code
+        heading = _SECTION.match(line)
+        lines.append(f"**{heading.group(1)}**" if heading and not in_code else line)
+    return "\n".join(lines)
 
 
 @lru_cache(maxsize=32)
