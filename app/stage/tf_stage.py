@@ -34,9 +34,9 @@ STATIC_RATE = 10000.0  # what view_frames reports for a static transform
 REDRAW_SEC = 1.0
 MAX_FRAMES = 200
 NOTE = (
-    "Each arrow points from a parent frame to its child, labelled as `ros2 run tf2_tools "
-    "view_frames` labels it. Frames appear as broadcasters send them on `/tf` and "
-    "`/tf_static`."
+    "Each arrow points from a parent frame to its child, with the broadcaster, rate and "
+    "buffer that `ros2 run tf2_tools view_frames` writes beside it. Frames appear as "
+    "broadcasters send them on `/tf` and `/tf_static`."
 )
 
 
