@@ -28,7 +28,6 @@ from app.ui.starting import StartRequests
 
 # How a check reads on the card. Not passed yet is "to do", not "fail": most steps open
 # with their checks unmet, and a learner who has not acted yet has failed nothing.
-_SECTION = re.compile(r"^#{1,6} (.+?)\s*#*\s*$")  # a Markdown heading line
 _MARKS = {PASS: "✓", FAIL: "○", WAITING: "…"}
 _WORDS = {PASS: "pass", FAIL: "to do", WAITING: "waiting"}
 # A step button's icon says what it does; the label says it in words.
@@ -61,6 +60,9 @@ FIRST_SCREEN = (
     "**step card** below explains the step, then gives its buttons and live checks (✓ "
     "when done); the tools are in the tabs under it."
 )
+
+
+_SECTION = re.compile(r"^#{1,6} (.+?)\s*#*\s*$")  # a Markdown heading line
 
 
 def _without_title(markdown: str) -> str:

@@ -136,17 +136,16 @@ def draw_state_machine(current: str | None, available: Collection[str], link: Li
     finalize = f'<path d="M230,330 L230,{BOXES["finalized"][1]}" stroke="{DEAD}" fill="none" '
     finalize += 'stroke-width="1.5" marker-end="url(#dead)"/>'
     # With no node (or none in a state), nothing is blue: say what makes edges clickable.
-    first = (
-        "Click a blue edge to take that transition; italic names are the transition"
+    said = (
+        ("Click a blue edge to take that transition; italic names are the transition",
+         "states a node passes through on the way.")
         if primary
-        else "No node's state yet: once it has one, its transitions turn blue; italic names"
-    )
-    note = _text(10, 30, first, fill="#495057", font_size="12") + _text(
-        10,
-        46,
-        "states a node passes through on the way." if primary else "are the transition states.",
-        fill="#495057",
-        font_size="12",
+        else ("No node's state yet: once it has one, its transitions turn blue; italic names",
+              "are the transition states.")
+    )  # fmt: skip
+    note = "".join(
+        _text(10, y, line, fill="#495057", font_size="12")
+        for y, line in zip((30, 46), said, strict=True)
     )
     return (
         f'<svg viewBox="0 0 {WIDTH} {HEIGHT}" width="100%" role="img" '

@@ -210,9 +210,9 @@ def silent_drives(
     after simulation time ``t0``. ``clock``: (wall send time, simulation time) pairs of
     the ground truth, in order, which put each command's send time on the simulation's
     clock (the world may run slower than the wall clock on a busy machine)."""
+    times = [sim_time_at(clock, command.sent) for command in commands]
     out = []
-    for before, after in zip(commands, commands[1:], strict=False):
-        start, end = sim_time_at(clock, before.sent), sim_time_at(clock, after.sent)
+    for before, start, end in zip(commands, times, times[1:], strict=False):
         if start is None or end is None:
             continue  # sent before the world's first sample: not the trial's
         if before.moving and start > t0 and end - start > SILENT_DRIVE:
