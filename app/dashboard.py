@@ -51,10 +51,11 @@ from app.scene.point_shader import keep_point_shader
 from app.stage.window import Stage
 from app.supervisor import NodeState, Supervisor
 from app.ui import GROUP_OF, TAB_NAMES, TOOL_GROUPS, TOOLS, Inspector, MarkdownView, Panel
-from app.ui.loop import FullPasses, UiLoop
+from app.ui.loop import FullPasses, HiddenPasses, UiLoop
 from app.ui.page_fixes import page_fixes_html
 from app.ui.page_links import PageLinks, link_sender_html
 from app.ui.page_script import page_script
+from app.ui.shown_tools import ShownTools
 from app.ui.starting import StartRequests
 from app.ui.tab_opener import TabOpener
 
@@ -79,6 +80,11 @@ UNWATCHED_CHECK_SEC = 0.5
 # UI thread's work on an idle lesson with a talker and listener (measured: 0.25 s and
 # 0.33 s of CPU each 30 s, of 0.68 s).
 CALM_PERIOD_SEC = 1.0
+# A tool no page shows (app.ui.shown_tools) is refreshed this often while nothing happens,
+# and at every pass after something did: it keeps up, but nobody waits for it. Refreshing
+# the hidden tools as the shown ones were most of the UI thread's idle work (measured,
+# bench/results/findings.md).
+HIDDEN_PERIOD_SEC = 5.0
 # Runs in the page (app.ui.page_script): what the address asks to open, reported once per
 # page load to the page link of its kind (values the links take: a-z, 0-9, '_', '.', '-').
 _OPEN_FROM_ADDRESS = """
@@ -127,6 +133,9 @@ class Dashboard:
         self._lesson_programs: frozenset[str] = frozenset()  # what its buttons start
         self.graph = GraphSnapshot()
         self._tools: dict[str, Panel] = {}
+        # What the pages show: the first group's first tool until a page says.
+        first = next(iter(TOOL_GROUPS.values()))[0]
+        self._shown = ShownTools([*TOOL_GROUPS, *TAB_NAMES], frozenset({first}), self.ui.wake)
         self._panels: list[Panel] = self._build_gui()
         self._ui_thread = threading.Thread(target=self._ui_loop, name="ui-refresh", daemon=True)
 
@@ -137,6 +146,9 @@ class Dashboard:
         )
         gui.add_html(page_fixes_html())  # contrast and button names viser leaves out
         gui.add_html(link_sender_html())  # clicks on links in drawings (graph, lifecycle)
+        gui.add_html(  # which tools the page shows: the others are refreshed less often
+            self._shown.script_html(self.page_links.register_value("shown", self._shown.report))
+        )
         # Both cost a lot where WebGL runs in software (no GPU: headless
         # browsers, many classroom VMs). The shadow pass of the arm on the grid
         # alone stalled the page ~100 ms on every redraw (measured; findings.md).
@@ -337,6 +349,7 @@ class Dashboard:
         last_nodes: list[tuple[str, str]] | None = None
         due = 0.0
         full = FullPasses(CALM_PERIOD_SEC, GRAPH_BURST_SEC)
+        hidden_passes = HiddenPasses(HIDDEN_PERIOD_SEC)
         while not self._stop.is_set():
             watched = bool(self.server.get_clients())
             if not watched:
@@ -364,8 +377,13 @@ class Dashboard:
                     self.lessons.graph = self.graph
                 except Exception:  # the graph may be unreadable a moment: keep the panels going
                     log.exception("graph snapshot failed")
+            eventful = happened or full.settling(now)
+            refresh_hidden = hidden_passes.due(now, eventful=eventful, full=full_pass)
+            hidden = set() if refresh_hidden else self._hidden_tools()
             for panel in self._panels:
                 if not full_pass and getattr(panel, "calm", False):
+                    continue
+                if id(panel) in hidden:
                     continue
                 try:
                     panel.refresh(self.graph)
@@ -373,6 +391,15 @@ class Dashboard:
                     log.exception("refresh of %s failed", type(panel).__name__)
             # Send now: viser otherwise holds a lone update up to one 60 Hz window.
             self.server.flush()
+
+    def _hidden_tools(self) -> set[int]:
+        """The tools (by id) that no page shows and that have no work to do unseen."""
+        shown = self._shown.shown()
+        return {
+            id(tool)
+            for name, tool in self._tools.items()
+            if name not in shown and not getattr(tool, "hidden_work", False)
+        }
 
     def stop(self) -> None:
         """Stop the UI thread, then close every panel (their subscriptions, timers)."""

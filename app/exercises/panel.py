@@ -89,6 +89,7 @@ def _result_line(result: Result) -> str:
 
 class ExercisePanel:
     calm = True  # once a second while idle (app.ui.Panel): a Check's result wakes the loop
+    hidden_work = True  # a grading's results and the program's output keep coming in
 
     def __init__(
         self,

@@ -170,6 +170,7 @@ def _label(lesson: Lesson) -> str:
 
 class LessonsPanel:
     calm = True  # once a second while idle (app.ui.Panel): checks; a step's button wakes the loop
+    hidden_work = True  # the step card above the tools shows its checks whichever tool is open
 
     def __init__(
         self,

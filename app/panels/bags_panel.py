@@ -58,6 +58,7 @@ def bag_text(info: BagInfo) -> str:
 
 class BagsPanel:
     calm = True  # once a second while idle (app.ui.Panel): a recording's counters
+    hidden_work = True  # a recording's output is read and its failure caught, shown or not
 
     def __init__(
         self, gui: viser.GuiApi, ui: UiLoop, node: Node, folder: Path | None = None

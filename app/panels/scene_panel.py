@@ -154,6 +154,8 @@ class _TopicRow:
 
 
 class ScenePanel:
+    hidden_work = True  # it draws into the 3D scene, which every page shows (app.ui.Panel)
+
     def __init__(self, server: viser.ViserServer, ui: UiLoop, node: Node) -> None:
         gui, scene = server.gui, server.scene
         self._server = server

@@ -103,6 +103,11 @@ class Panel(Protocol):
     ``calm = True``: while nothing happens it is refreshed once a second, not at
     every pass (what an idle dashboard costs); a click, a job's end or a node that
     joins still refreshes it at once.
+
+    A tool no page shows (``app.ui.shown_tools``) is refreshed every few seconds
+    and whenever something happens, unless it says ``hidden_work = True``: its
+    refresh does work that matters unseen (the 3D view draws into the scene every
+    page shows, the lesson's checks mark progress, a recording is watched).
     """
 
     def refresh(self, graph: GraphSnapshot) -> None: ...

@@ -166,3 +166,23 @@ class FullPasses:
             self._due = now + self._period
             return True
         return False
+
+    def settling(self, now: float) -> bool:
+        """Whether the node list changed less than ``settle`` seconds ago."""
+        return now < self._settle_until
+
+
+class HiddenPasses:
+    """Which passes of the UI thread refresh the tools no page shows (``app.ui.Panel``):
+    every pass after something happened or while the node list settles, otherwise one
+    full pass every ``period`` seconds (so a calm hidden tool is refreshed too)."""
+
+    def __init__(self, period: float) -> None:
+        self._period = period
+        self._due = 0.0
+
+    def due(self, now: float, *, eventful: bool, full: bool) -> bool:
+        if eventful or (full and now >= self._due):
+            self._due = now + self._period
+            return True
+        return False

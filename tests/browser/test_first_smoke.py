@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import time
 
 import pytest
 from playwright.sync_api import expect
@@ -20,6 +21,18 @@ def test_start_watch_and_stop_talker_and_listener(page):
     expect(page.get_by_text(re.compile(r"data: 'Hello World: \d+'")).first).to_be_visible(
         timeout=30_000
     )
+    # The page told the dashboard it shows Echo: each message shows as it comes (a tool no
+    # page shows is refreshed every few seconds; app.ui.shown_tools). Watched once the
+    # nodes' start has settled: until then every tool is refreshed at each pass.
+    page.wait_for_timeout(4_000)
+    counts = set()
+    until = time.monotonic() + 6.0
+    while time.monotonic() < until:
+        texts = page.get_by_text(re.compile(r"data: 'Hello World: \d+'")).all_inner_texts()
+        numbers = [int(n) for t in texts for n in re.findall(r"Hello World: (\d+)", t)]
+        counts.add(max(numbers, default=-1))
+        page.wait_for_timeout(100)
+    assert len(counts) >= 4, f"Echo showed {sorted(counts)} in 6 s of a talker at 1 Hz"
 
     open_tab(page, "Graph")
     expect_text(page, "/listener")

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from app.ui.loop import FullPasses
+from app.ui.loop import FullPasses, HiddenPasses
 
 
 def test_idle_passes_are_full_once_a_period() -> None:
@@ -32,3 +32,14 @@ def test_a_changed_node_list_keeps_passes_full_while_its_topics_arrive() -> None
     assert all(passes.due(t, happened=False, nodes_changed=False) for t in settling)
     assert not passes.due(3.4, happened=False, nodes_changed=False)  # settled: calm again
     assert passes.due(4.0, happened=False, nodes_changed=False)
+
+
+def test_hidden_tools_are_refreshed_after_events_and_at_a_full_pass_now_and_then() -> None:
+    passes = HiddenPasses(period=5.0)
+    assert passes.due(0.0, eventful=False, full=True)  # the first pass: everything
+    assert not passes.due(1.0, eventful=False, full=True)  # idle: not before the period
+    assert not passes.due(5.2, eventful=False, full=False)  # due, but a calm tool would miss it
+    assert passes.due(6.0, eventful=False, full=True)  # ...so it waits for a full pass
+    assert passes.due(6.2, eventful=True, full=False)  # a click, a node joining: at once
+    assert not passes.due(7.0, eventful=False, full=True)
+    assert passes.due(11.2, eventful=False, full=True)
