@@ -154,7 +154,9 @@ def main(argv: list[str] | None = None) -> int:
         pass
     finally:
         executor.shutdown(timeout_sec=2.0)
-        if spinner is not None:  # the node is destroyed only once nothing spins it
+        # The node is destroyed only once nothing spins it. A SIGTERM can land between the
+        # thread's creation and its start (seen on a loaded machine): nothing to wait for then.
+        if spinner is not None and spinner.ident is not None:
             spinner.join(timeout=2.0)
         node.destroy_node()
         rclpy.try_shutdown()
