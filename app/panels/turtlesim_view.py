@@ -209,7 +209,9 @@ class TurtlesimView:
     def _run(self) -> None:
         last_frame = 0.0
         while not self._stop.is_set():
-            self._wake.wait(0.5)
+            # Everything that gives work sets the wake, and so does stop(): no timeout
+            # (ten such workers waking twice a second cost an idle dashboard ~0.1 %).
+            self._wake.wait()
             self._wake.clear()
             wait = last_frame + 1.0 / MAX_HZ - time.monotonic()
             if wait > 0 and self._stop.wait(wait):

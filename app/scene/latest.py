@@ -69,7 +69,9 @@ class LatestWorker(Generic[M]):
     def _run(self) -> None:
         last_draw = 0.0
         while not self._stop.is_set():
-            self._wake.wait(0.5)
+            # Everything that gives work sets the wake, and so does stop(): no timeout
+            # (ten such workers waking twice a second cost an idle dashboard ~0.1 %).
+            self._wake.wait()
             self._wake.clear()
             wait = last_draw + self._min_interval - time.monotonic()
             if wait > 0 and self._stop.wait(wait):
