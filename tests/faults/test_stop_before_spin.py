@@ -1,8 +1,12 @@
-"""A stop signal that lands between making a node and spinning it ends the program quietly.
+"""A stop signal that lands at an awkward moment ends the program quietly.
 
-rclpy's signal handler shuts the context down; a program that then calls
-``rclpy.spin(node)`` finds rclpy's global executor already reset to None
-(a CI run: amcl printed two AttributeErrors on SIGTERM and exited 1).
+- Between making a node and spinning it: rclpy's signal handler shuts the
+  context down; a program that then calls ``rclpy.spin(node)`` finds rclpy's
+  global executor already reset to None (a CI run: amcl printed two
+  AttributeErrors on SIGTERM and exited 1).
+- After tf2_monitor has made its spinning thread and before it has started
+  it (a rehearsal, ci44): its clean-up joined a thread never started and
+  printed "cannot join thread before it is started".
 """
 
 from __future__ import annotations
@@ -41,9 +45,31 @@ run_program(main)
 """
 
 
-def test_a_shutdown_just_before_spin_ends_quietly(ros_env):
+# The signal, landing exactly there: the spinner's start raises what SIGTERM raises.
+TF2_MONITOR_STOPPED_BEFORE_ITS_SPINNER_STARTS = """
+import sys, threading
+from tf2_ros.tools import tf2_monitor
+
+start = threading.Thread.start
+
+def start_or_stop(thread):
+    if getattr(getattr(thread, "_target", None), "__name__", "") == "spin":
+        raise KeyboardInterrupt
+    start(thread)
+
+threading.Thread.start = start_or_stop
+sys.exit(tf2_monitor.main(["tf2_monitor"]))
+"""
+
+
+@pytest.mark.parametrize(
+    "program",
+    [PROGRAM, TF2_MONITOR_STOPPED_BEFORE_ITS_SPINNER_STARTS],
+    ids=["shutdown_just_before_spin", "tf2_monitor_before_its_spinner_starts"],
+)
+def test_a_stop_at_an_awkward_moment_ends_quietly(ros_env, program):
     done = subprocess.run(
-        [sys.executable, "-c", PROGRAM],
+        [sys.executable, "-c", program],
         env=ros_env,
         cwd=PROJECT_ROOT,
         capture_output=True,
