@@ -70,7 +70,8 @@ class LatestWorker(Generic[M]):
         last_draw = 0.0
         while not self._stop.is_set():
             # Everything that gives work sets the wake, and so does stop(): no timeout
-            # (ten such workers waking twice a second cost an idle dashboard ~0.1 %).
+            # (a dozen such threads waking twice a second cost each dashboard of a class of 20
+            # about 0.4 % of a core: bench/results/findings.md).
             self._wake.wait()
             self._wake.clear()
             wait = last_draw + self._min_interval - time.monotonic()
