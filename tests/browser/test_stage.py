@@ -196,16 +196,19 @@ def test_every_step_in_course_order_puts_its_stage_on_with_its_text_in_view(
 
 
 # How many times each edge's dots have reached its end so far, by the page's own
-# animation clock (a dot arrives each time its motion completes), and which picture.
+# animation clock (a dot arrives each time an iteration of its keyframes completes), and
+# which picture.
 _ARRIVALS = """() => {
   const svg = document.querySelector('svg.stage-graph');
   svg.__id = svg.__id || Math.random();
-  const now = svg.getCurrentTime();
   const counts = {};
-  for (const motion of svg.querySelectorAll('circle.sg-dot > animateMotion')) {
-    const edge = motion.parentElement.dataset.edge;
-    const done = Math.floor((now - motion.getStartTime()) / motion.getSimpleDuration());
-    counts[edge] = (counts[edge] || 0) + Math.max(0, done);
+  let now = 0;
+  for (const dot of svg.querySelectorAll('circle.sg-dot')) {
+    const [motion] = dot.getAnimations();
+    if (!motion) continue;
+    const timing = motion.effect.getComputedTiming();
+    now = motion.currentTime / 1000;  // since the picture was drawn
+    counts[dot.dataset.edge] = (counts[dot.dataset.edge] || 0) + (timing.currentIteration || 0);
   }
   return {picture: svg.__id, at: now, counts};
 }"""
@@ -265,7 +268,7 @@ def test_the_graph_grows_and_messages_move_on_chatter(browser, dashboard, probe,
         for edge in ("/talker>/chatter", "/chatter>/listener"):
             assert 1.5 <= rates.get(edge, 0) <= 2.5, f"{edge}: {rates} dots/s at 2 Hz"
         # ...without the server resending the picture for them (a steady 2 Hz draws once).
-        alive = page.evaluate("() => document.querySelector('svg.stage-graph').getCurrentTime()")
+        alive = page.evaluate(_ARRIVALS)["at"]
         assert alive > 2.5, f"the picture was replaced {alive:.1f} s ago"
         # A click on a box inspects it, as `ros2 topic info` / `ros2 node info` would.
         page.locator('svg.stage-graph g.sg-vertex[data-name="/chatter"] a').click()

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 import shutil
 from pathlib import Path
@@ -12,7 +13,15 @@ from app.lessons.schema import LESSONS_DIR, LessonError, load_course, load_lesso
 from app.panels.graph_svg import Edge, Vertex, graph_picture, topics_to_measure
 from app.ros.graph import NodeEndpoints
 from app.stage import DEFAULT_STAGE, STAGES
-from app.stage.graph_view import MAX_DOTS, PulseView, StablePlaces, dot_timing, stage_svg
+from app.stage.graph_view import (
+    MAX_DOTS,
+    PulseView,
+    StablePlaces,
+    _curve_points,
+    _motion,
+    dot_timing,
+    stage_svg,
+)
 
 
 def test_every_lesson_names_a_known_stage():
@@ -153,20 +162,37 @@ def test_the_svg_animates_dots_on_both_edges_of_a_topic():
     edges = [Edge("node:/talker", "topic:/chatter", "2.0 Hz"), Edge("topic:/chatter", "node:/l")]
     svg = stage_svg(StablePlaces().place(vertices, edges), edges, {"/chatter": 2.0})
     assert svg.count('class="sg-dot" data-topic="/chatter"') == 4
-    assert svg.count("<animateMotion") == 4
+    assert svg.count('infinite"/>') == 4  # each dot loops on its keyframes
+    (name,) = set(re.findall(r'data-edge="/talker>/chatter"[^>]*animation:(sg-m\w+) ', svg))
+    assert f"@keyframes {name}{{" in svg
     assert "2.0 Hz" in svg
     quiet = stage_svg(StablePlaces().place(vertices, edges), edges, {})
     assert '<circle class="sg-dot"' not in quiet
 
 
+def test_a_motion_runs_the_whole_curve_at_an_even_pace_then_waits_at_its_end():
+    """The keyframes start on the publisher's side, end at the arrow, take equal steps,
+    and a slow topic's dot (share 0.5) travels in the first half and waits at the end."""
+    path = "M100,60 C100,90 300,90 300,120"
+    points = _curve_points(path)
+    assert points[0] == pytest.approx((100, 60)) and points[-1] == pytest.approx((300, 120))
+    steps = [math.dist(a, b) for a, b in zip(points, points[1:], strict=False)]
+    assert max(steps) - min(steps) < 0.05 * max(steps)
+    name, frames = _motion(path, 0.5)
+    percents = [float(p) for p in re.findall(r"([\d.]+)%\{", frames)]
+    assert percents[0] == 0.0 and percents[-2] == 50.0 and percents[-1] == 100.0
+    assert frames.startswith(f"@keyframes {name}{{")
+    assert frames.count("translate(300.0px,120.0px)") == 2  # arrives, then waits there
+
+
 def _pulse_legs_in(svg: str) -> list[tuple[str, str, float, bool]]:
     """(kind, name, begin s, travels backwards) of each pulse leg drawn in ``svg``."""
     legs = re.findall(
-        r'<g class="sg-pulse" data-kind="(\w+)" data-name="([^"]+)".*?'
-        r'<animateMotion begin="(-?[\d.]+)s"([^>]*)>',
+        r'<g class="sg-pulse" data-kind="(\w+)" data-name="([^"]+)" visibility="hidden" '
+        r'style="animation:sg-m\w+ 0.6s linear (-?[\d.]+)s 1( reverse)?">',
         svg,
     )
-    return [(kind, name, float(b), 'keyPoints="1;0"' in rest) for kind, name, b, rest in legs]
+    return [(kind, name, float(b), rest == " reverse") for kind, name, b, rest in legs]
 
 
 def test_a_call_travels_from_its_caller_to_the_server_and_back():
