@@ -26,9 +26,12 @@ _GROUP_NAMES = frozenset(group.name for group in GROUPS)
 STALE_NOTE = " · ⚠ still listed in the ROS graph until its DDS lease expires (about 20 s)"
 
 
-def _notes(status: NodeStatus, stale: bool) -> str:
-    """What the state alone hides: a dead node the graph still lists, lost log lines."""
+def _notes(status: NodeStatus, stale: bool, elsewhere: str = "") -> str:
+    """What the state alone hides: a dead node the graph still lists, the same node started
+    by another process (``elsewhere``: its name), lost log lines."""
     notes = STALE_NOTE if stale else ""
+    if elsewhere:
+        notes += f" · {elsewhere} is on the graph: started elsewhere (a terminal, a launch file)"
     if status.dropped_lines:
         notes += f" · dropping log lines ({status.dropped_lines} so far)"
     return notes
@@ -167,11 +170,20 @@ class NodesPanel:
         statuses = self._supervisor.statuses()
         stale = self._supervisor.stale_in_graph(graph.nodes)
         rows = ["| node | state |", "|---|---|"]
+
+        def elsewhere(name: str, status: NodeStatus) -> str:
+            """A catalog node this dashboard does not run, yet on the graph: the learner
+            started it from a terminal (the lessons teach `ros2 run`), so 'stopped' alone
+            would contradict the stage."""
+            node = lookup(name).node_name
+            quiet = status.state not in ACTIVE_STATES and name not in stale
+            return node if quiet and graph.has_node(node) else ""
+
         for entry in ENTRIES:
             status = statuses.get(entry.name, NodeStatus(entry.name, NodeState.STOPPED))
             rows.append(
                 f"| {entry.name} | {_STATE_ICONS[status.state]} {status.describe()}"
-                f"{_notes(status, entry.name in stale)} |"
+                f"{_notes(status, entry.name in stale, elsewhere(entry.name, status))} |"
             )
         self._overview.show("\n".join(rows))
 
@@ -181,7 +193,7 @@ class NodesPanel:
         self._details.show(
             f"**{name}**: {entry.summary}\n\n"
             f"State: {_STATE_ICONS[status.state]} **{status.describe()}**"
-            f"{_notes(status, name in stale)}\n\n"
+            f"{_notes(status, name in stale, elsewhere(name, status))}\n\n"
             f"In a terminal: `{entry.ros2_run_command()}`"
         )
         active = status.state in ACTIVE_STATES

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import os
 import signal
+import subprocess
+import sys
 import time
 import urllib.request
 import uuid
@@ -12,6 +14,7 @@ from pathlib import Path
 import psutil
 import pytest
 
+from app import PROJECT_ROOT
 from app.panels.nodes_panel import STALE_NOTE
 from app.supervisor import NodeState
 from tests.browser.helpers import expect_text, open_tab
@@ -55,6 +58,33 @@ def test_sigkilled_node_is_reported_crashed_and_stale_then_restarts(dashboard):
         seconds_to_show=round(shown_after, 2),
         restarted_with_new_pid=True,
     )
+
+
+def test_a_talker_started_in_a_terminal_is_named_on_the_graph_not_just_stopped(dashboard):
+    """The lessons teach `ros2 run`: a talker the learner started outside the dashboard is
+    on the stage's graph, so the Nodes tool says so beside 'stopped', until it ends."""
+    client = WireClient(dashboard.url)
+    outside = subprocess.Popen([sys.executable, "-m", "nodes.talker"], cwd=PROJECT_ROOT)
+    try:
+        row = wait_until(
+            lambda: "started elsewhere" in (r := _row(client, "talker")) and r,
+            timeout=30,
+            what="the outside talker named in the Nodes tool",
+        )
+        assert "○ stopped · /talker is on the graph" in row, row
+        assert "started elsewhere" not in _row(client, "listener")
+        outside.terminate()
+        outside.wait(timeout=10)
+        wait_until(
+            lambda: "started elsewhere" not in _row(client, "talker"),
+            timeout=30,
+            what="the note gone with the talker",
+        )
+    finally:
+        if outside.poll() is None:
+            outside.kill()
+            outside.wait()
+        client.close()
 
 
 def test_supervisor_knows_which_pids_ended(supervisor, probe):
