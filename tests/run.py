@@ -58,7 +58,7 @@ NAMESPACES = "CLASSROOM_RUN_NAMESPACES"  # the file where workers note their nam
 # Three workers on two cores, measured: the whole suite in 16-17 min instead of
 # 47, a core still idle a third of the time. Four took 15 min but saturated the
 # cores: eight tests that wait on real time failed (a MuJoCo run, turtlesim). So
-# three take any test, and two more only tests that wait (tests/worker_plan.py).
+# three take any test, and four more only tests that wait (tests/worker_plan.py).
 DEFAULT_WORKERS = GENERAL_WORKERS + WAITING_WORKERS
 FORWARDED = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 LOADED = "loaded"  # the mark of tests that take the cores on purpose (tests/conftest.py)

@@ -15,6 +15,7 @@ import re
 import tempfile
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypedDict
 
@@ -102,6 +103,12 @@ class ProgressStore:
         self.warning = ""
         self._lock = threading.Lock()
         self._data = self._load()
+        self._listeners: list[Callable[[], None]] = []
+
+    def on_change(self, listener: Callable[[], None]) -> None:
+        """Call ``listener()`` after each save, on the saving thread and under the store's
+        lock: it must only note the change (set an event), never read the store."""
+        self._listeners.append(listener)
 
     def _load(self) -> dict[str, Any]:
         try:
@@ -186,3 +193,5 @@ class ProgressStore:
             os.fsync(dir_fd)
         finally:
             os.close(dir_fd)
+        for listener in self._listeners:
+            listener()

@@ -48,7 +48,11 @@ from app.ui.loop import UiLoop
 
 log = logging.getLogger(__name__)
 
-COLLECT_SEC = 1.0  # how stale the teacher's view of this learner may get
+# How stale the teacher's view of this learner may get. A saved change of progress (a step
+# passed, Next, an exercise checked) is collected at once: a loaded class's teacher saw a
+# learner's Next more than 2 s late when the beacon waited out its second.
+COLLECT_SEC = 1.0
+NUDGE_GAP_SEC = 0.2
 # How stale "when was this exercise's file last saved" may get: on a lesson without an
 # exercise of its own every exercise is a candidate, and a stat of each, each round, was
 # half of the beacon's work on the UI thread (issue 43's idle CPU).
@@ -91,6 +95,8 @@ class ProgressBeacon:
         # Each record with when its exercise was last opened, saved or checked.
         self._records: queue.SimpleQueue[tuple[LearnerRecord, float] | None] = queue.SimpleQueue()
         self._stop = threading.Event()
+        self._due = threading.Event()  # collect now: progress was saved, or closing
+        sources.workspace.progress.on_change(self._due.set)
         self._crash_key: tuple | None = None  # UI thread: the crash text read once per process
         self._crash_text = ""
         self._saved_at: dict[str, tuple[float, float]] = {}  # UI thread: slug -> (read at, mtime)
@@ -116,6 +122,7 @@ class ProgressBeacon:
 
     def close(self) -> None:
         self._stop.set()
+        self._due.set()
         self._records.put(None)  # wake the beacon thread now
         self._thread.join(timeout=2.0)
         self._time.save()
@@ -128,7 +135,13 @@ class ProgressBeacon:
         activity = progress = time.time()
         acted = 0.0  # the last change the learner made (the start of the dashboard is none)
         sent_at = 0.0
-        while not self._stop.wait(COLLECT_SEC):
+        # At most one collection each NUDGE_GAP_SEC (an editor saving at each pause must not
+        # keep the UI thread collecting), and one each COLLECT_SEC at least.
+        while not self._stop.wait(NUDGE_GAP_SEC):
+            self._due.wait(COLLECT_SEC - NUDGE_GAP_SEC)
+            self._due.clear()
+            if self._stop.is_set():
+                return
             self._ui.post(self._collect, refresh=False)  # reads only: no redraw
             try:
                 collected = self._records.get(timeout=COLLECT_SEC * 4)

@@ -156,6 +156,9 @@ def test_every_lesson_puts_its_stage_on_and_the_learner_can_switch(browser, dash
         for name, label in STAGES.items():  # the learner's own choice
             choose(page, "On stage", label)
             _wait_stage(page, name)
+            # The 3D canvas is drawn only when it is the stage (covered, it cost the page
+            # a third of a core with a scene that moves).
+            expect(page.locator("canvas[data-engine]")).to_be_visible(visible=name == "scene")
     finally:
         page.screenshot(path=str(ARTIFACTS / f"stage-lessons-{size[0]}.png"))
         page.context.close()

@@ -10,7 +10,7 @@ import sys
 import time
 
 from app import PROJECT_ROOT
-from app.lessons.progress import ProgressStore
+from app.lessons.progress import Added, ProgressStore
 
 
 def test_round_trip_and_reset(tmp_path):
@@ -95,3 +95,18 @@ def test_a_version_1_file_follows_its_lessons_to_their_new_numbers(tmp_path):
     assert store.lesson("02_first_node") == {"step": 0, "passed": []}  # the old id is gone
     store.set_position("04_first_node", 4)
     assert json.loads((tmp_path / "ada.json").read_text(encoding="utf-8"))["version"] == 2
+
+
+def test_each_save_is_told_to_the_listeners_after_it_is_on_disk(tmp_path):
+    """The teacher's beacon collects at once when progress changes (a Next, a pass, a
+    check), instead of up to a second later: the store tells it after each save."""
+    store = ProgressStore("ada", tmp_path)
+    seen: list[dict] = []
+    store.on_change(lambda: seen.append(json.loads(store.path.read_text(encoding="utf-8"))))
+    store.set_position("03_nodes", 2)
+    store.mark_passed("03_nodes", 2)
+    store.mark_passed("03_nodes", 2)  # no news, no save, nothing told
+    store.update_exercise("talker", attempts=Added(1))
+    assert [s["lessons"]["03_nodes"]["step"] for s in seen] == [2, 2, 2]
+    assert seen[1]["lessons"]["03_nodes"]["passed"] == [2]
+    assert seen[2]["exercises"]["talker"]["attempts"] == 1
