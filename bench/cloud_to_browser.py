@@ -370,11 +370,14 @@ def measure_round(
 
 
 def pick_cloud_topic(browser, url: str) -> None:
-    """Once, like a learner: 3D view tab, Cloud topic dropdown, our topic."""
+    """Once, like a learner: the 3D scene on stage (another stage takes the canvas out of
+    the page, and nothing would be drawn), 3D view tab, Cloud topic dropdown, our topic."""
     context = browser.new_context(viewport={"width": 1280, "height": 800})
     try:
         page = context.new_page()
         page.goto(url)
+        page.get_by_label("On stage").click()
+        page.get_by_role("option", name="3D scene", exact=True).click()
         open_tool(page, "3D view")
         deadline = time.monotonic() + 30
         while True:
