@@ -68,7 +68,8 @@ _TOAST_STYLE = (
 # panel), yet viser's canvas still drew every change of the scene: with the camera and
 # arm running, 29 % of a core in the page for nothing seen (software WebGL, measured).
 # Out of the layout, viser's in-view watch stops its drawing; back, it draws at once.
-# The element hidden is viser's wrapper of three.js's canvas (data-engine="three.js ...").
+# The element hidden is viser's wrapper of three.js's canvas (data-engine="three.js ...");
+# a browser without CSS :has() (Firefox before 121) keeps drawing it, as before.
 _CANVAS_OFF_STYLE = "<style>div:has(> div > div > canvas[data-engine]){display:none}</style>"
 
 
