@@ -25,7 +25,7 @@ from lifecycle_msgs.msg import Transition
 from lifecycle_msgs.srv import ChangeState
 from nav2_msgs.action import ComputePathToPose, FollowPath, NavigateToPose
 from nav_msgs.msg import Path
-from rclpy.action import ActionClient, ActionServer
+from rclpy.action import ActionServer
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.context import Context
 from rclpy.executors import MultiThreadedExecutor
@@ -34,6 +34,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from tf2_msgs.msg import TFMessage
 
 from app.catalog import lookup
+from app.ros.action_client import ThreadSafeActionClient
 from tests.conftest import wait_until
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(120)]
@@ -82,7 +83,10 @@ class StandIns:
         tf.transform.rotation.w = 1.0
         self._static = self.node.create_publisher(TFMessage, "/tf_static", LATCHED)
         self._static.publish(TFMessage(transforms=[tf]))
-        self.navigate = ActionClient(self.node, NavigateToPose, "navigate_to_pose")
+        # Goals go from the test's thread while the executor spins in another: rclpy's own
+        # ActionClient may then drop the goal's answer (ci50, one core busy: "Ignoring
+        # unexpected goal response", 30 s unanswered). See app/ros/action_client.py.
+        self.navigate = ThreadSafeActionClient(self.node, NavigateToPose, "navigate_to_pose")
         self.change_state = self.node.create_client(ChangeState, "/bt_navigator/change_state")
         self._executor = MultiThreadedExecutor(num_threads=4, context=self.context)
         self._executor.add_node(self.node)
