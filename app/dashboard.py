@@ -279,6 +279,7 @@ class Dashboard:
     def _new_lesson(self, programs: frozenset[str]) -> None:
         """Another lesson was opened (UI thread): the views forget what the last one left."""
         cast(ScenePanel, self._tools["3D view"]).forget_unpublished(self.graph)
+        cast(ExercisePanel, self._tools["Exercise"]).follow_the_lesson()
         self._stage.forget()
         self._lesson_since = time.time()
         self._lesson_programs = programs

@@ -13,7 +13,7 @@ import re
 import threading
 import time
 from collections import Counter
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import msgspec
@@ -102,6 +102,9 @@ class WireClient:
         self.bytes = 0
         self.last_frame_at = 0.0
         self.closed_reason: str | None = None
+        # Called with each message once it is applied, under ``lock`` (on the reader thread):
+        # what a test sees at the moment a message arrives, in the order they were sent.
+        self.on_message: Callable[[dict[str, Any]], None] | None = None
         self._closing = threading.Event()
         self._reader = threading.Thread(target=self._read, name="wire-reader", daemon=True)
         self._reader.start()
@@ -120,6 +123,8 @@ class WireClient:
                     self.last_frame_at = time.monotonic()
                     for message in messages:
                         self._apply(message)
+                        if self.on_message is not None:
+                            self.on_message(message)
         except ConnectionClosed as exc:
             self.closed_reason = str(exc)
         except Exception as exc:  # reported, then the test fails on it

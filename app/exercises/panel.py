@@ -434,8 +434,11 @@ class ExercisePanel:
 
     # -- refresh ----------------------------------------------------------------
 
-    def _follow_the_lesson(self) -> None:
-        """When the learner moves to another unit, its exercise is the one shown."""
+    def follow_the_lesson(self) -> None:
+        """When the learner moves to another unit, its exercise is the one shown: told by
+        the dashboard as the lesson opens (so a pick made just after the learner's Next is
+        not undone by a later refresh), and checked at each refresh (after a check that was
+        running then)."""
         current = self._workspace.progress.current_lesson() or ""
         if current == self._lesson_seen or self._checking:
             return
@@ -447,7 +450,7 @@ class ExercisePanel:
     def refresh(self, graph: GraphSnapshot) -> None:
         if self._exercise is None:
             return
-        self._follow_the_lesson()
+        self.follow_the_lesson()
         exercise = self._exercise
         record = self._workspace.progress.exercise(exercise.slug)
         passed = "passed_at" in record

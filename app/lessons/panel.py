@@ -299,13 +299,15 @@ class LessonsPanel:
         """Show ``step`` of ``lesson``; ``reading``: bring its text into view (a new step is
         read first; the tool the learner has open stays open under the card)."""
         step = max(0, min(step, len(lesson.steps) - 1))
-        if lesson is not self._lesson:  # a lesson starts clean: nothing of the last one
+        opened = lesson is not self._lesson
+        if opened:  # a lesson starts clean: nothing of the last one
             self._leftovers = sorted(
                 name for name, status in self._statuses().items() if status.active
             )
-            self._new_lesson(lesson.programs)
         self._lesson, self._step = lesson, step
         self._progress.set_position(lesson.id, step)
+        if opened:  # told after the position is saved: the Exercise tool reads it
+            self._new_lesson(lesson.programs)
         current = lesson.steps[step]
         self._card.label = f"Step {step + 1} of {len(lesson.steps)}: {current.title}"
         number = self._course.lessons.index(lesson) + 1
