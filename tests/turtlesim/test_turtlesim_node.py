@@ -48,7 +48,7 @@ def test_turtle1_starts_at_the_centre_and_pose_comes_at_62_5_hz(report):
     assert start["pose"]["x"] == pytest.approx(CENTRE, abs=1e-5)
     assert start["pose"]["y"] == pytest.approx(CENTRE, abs=1e-5)
     assert start["pose"]["theta"] == 0.0
-    assert 50.0 <= start["pose_rate_hz"] <= 66.0, start["pose_rates_hz"]
+    assert 50.0 <= start["pose_rate_hz"] <= 66.0, (start["pose_rate_hz"], start["pose_rates_hz"])
     assert start["color"] == UNPAINTED  # nothing drawn under it yet (transparent canvas)
     for topic in ("/turtle1/cmd_vel", "/turtle1/pose", "/turtle1/color_sensor"):
         assert topic in start["topics"]
