@@ -277,7 +277,8 @@ class Dashboard:
         self.server.gui.add_html(page_script(script, "open what the address names"))
 
     def _new_lesson(self, programs: frozenset[str]) -> None:
-        """Another lesson was opened (UI thread): the views forget what the last one left."""
+        """Another lesson was opened (UI thread): the views forget what the last one left,
+        and the Exercise tool opens the new lesson's exercise."""
         cast(ScenePanel, self._tools["3D view"]).forget_unpublished(self.graph)
         cast(ExercisePanel, self._tools["Exercise"]).follow_the_lesson()
         self._stage.forget()

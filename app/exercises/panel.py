@@ -439,6 +439,8 @@ class ExercisePanel:
         the dashboard as the lesson opens (so a pick made just after the learner's Next is
         not undone by a later refresh), and checked at each refresh (after a check that was
         running then)."""
+        if self._exercise is None:  # no exercise could be loaded: nothing to follow with
+            return
         current = self._workspace.progress.current_lesson() or ""
         if current == self._lesson_seen or self._checking:
             return
