@@ -12,11 +12,11 @@ import threading
 import time
 
 import pytest
-from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 from app.bags import folder as bag_folder
 from app.learner_ws import folder as ws_folder
 from app.learner_ws import overlay
+from app.lessons.checks._sim_speed import SimSpeedWatch
 from app.lessons.kinds import CHECK_KINDS
 from app.lessons.runtime import FAIL, PASS, LessonRuntime
 from app.lessons.schema import Spec, load_course
@@ -172,38 +172,25 @@ def test_every_step_of_the_lesson_passes_on_real_nodes(live, world, lesson, requ
             )
 
 
-class WorldClock:
-    """The simulated world's ``/clock`` as the walk last heard it, to count a step's
-    seconds as the world counts them while it runs."""
-
-    HEARD_SEC = 2.0  # a /clock older than this: the world is not running (now)
-
-    def __init__(self, node) -> None:
-        from rosgraph_msgs.msg import Clock
-
-        self._lock = threading.Lock()
-        self._sim: float | None = None
-        self._heard = 0.0
-        qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT)
-        self._subscription = node.create_subscription(Clock, "/clock", self._on_clock, qos)
-
-    def _on_clock(self, msg) -> None:
-        with self._lock:
-            self._sim = msg.clock.sec + msg.clock.nanosec * 1e-9
-            self._heard = time.monotonic()
-
-    def now(self) -> float | None:
-        """Simulated seconds now, or None while no world runs."""
-        with self._lock:
-            fresh = time.monotonic() - self._heard < self.HEARD_SEC
-            return self._sim if fresh else None
+# A /clock older than this (by the world's own send time): no world runs now.
+WORLD_HEARD_SEC = 2.0
 
 
 @pytest.fixture
 def world(dashboard_node):
-    clock = WorldClock(dashboard_node)
-    yield clock
-    dashboard_node.destroy_subscription(clock._subscription)
+    """The simulated world's /clock, heard as the lessons' speed checks hear it."""
+    watch = SimSpeedWatch(dashboard_node)
+    yield watch
+    watch.close()
+
+
+def _world_now(world: SimSpeedWatch) -> float | None:
+    """Simulated seconds now, or None while no world runs."""
+    with world.lock:
+        newest = world.clock[-1] if world.clock else None
+    if newest is None or time.time() - newest[0] > WORLD_HEARD_SEC:
+        return None
+    return newest[1]
 
 
 # While a world runs, a check waits its limit in wall seconds *and* in the world's seconds
@@ -214,14 +201,14 @@ def world(dashboard_node):
 SLOWEST_WORLD = 4.0
 
 
-def _wait_for_check(live, world: WorldClock, check: Spec, limit: float, what) -> None:
+def _wait_for_check(live, world: SimSpeedWatch, check: Spec, limit: float, what) -> None:
     started = time.monotonic()
     simulated = 0.0  # simulated seconds counted while waiting (a world reset counts none)
-    last = world.now()
+    last = _world_now(world)
     while live.evaluate(check).state != PASS:
         time.sleep(0.2)
         wall = time.monotonic() - started
-        now = world.now()
+        now = _world_now(world)
         if now is not None and last is not None and now >= last:
             simulated += now - last
         last = now
