@@ -29,6 +29,7 @@ from app.exercises.panel import ExerciseSettings
 from app.exercises.workspace import Workspace
 from app.lessons.runtime import LessonRuntime
 from app.lessons.schema import Course
+from app.lessons.progress import ProgressStore
 from app.ros.side_participant import SideParticipant
 from app.supervisor import Supervisor
 from app.teacher import wire
@@ -49,8 +50,8 @@ from app.ui.loop import UiLoop
 log = logging.getLogger(__name__)
 
 # How stale the teacher's view of this learner may get. A saved change of progress (a step
-# passed, Next, an exercise checked) is collected at once: a loaded class's teacher saw a
-# learner's Next more than 2 s late when the beacon waited out its second.
+# passed, Next, an exercise checked) and a program started or ended are collected at once
+# (``collect_on_changes``).
 COLLECT_SEC = 1.0
 NUDGE_GAP_SEC = 0.2
 # How stale "when was this exercise's file last saved" may get: on a lesson without an
@@ -58,6 +59,16 @@ NUDGE_GAP_SEC = 0.2
 # half of the beacon's work on the UI thread (issue 43's idle CPU).
 SAVED_CHECK_SEC = 5.0
 HEARTBEAT_SEC = 10.0
+
+
+def collect_on_changes(progress: ProgressStore, supervisor: Supervisor, due: threading.Event) -> None:
+    """Set ``due`` when progress is saved or a program starts, stops or ends.
+
+    The teacher's row shows both; waiting out the beacon's second made a loaded hub show a
+    learner's Next, or a node they started, more than 2 s late.
+    """
+    progress.on_change(due.set)
+    supervisor.on_change(lambda _status: due.set())
 
 
 @dataclass(frozen=True)
@@ -95,8 +106,8 @@ class ProgressBeacon:
         # Each record with when its exercise was last opened, saved or checked.
         self._records: queue.SimpleQueue[tuple[LearnerRecord, float] | None] = queue.SimpleQueue()
         self._stop = threading.Event()
-        self._due = threading.Event()  # collect now: progress was saved, or closing
-        sources.workspace.progress.on_change(self._due.set)
+        self._due = threading.Event()  # collect now: something the teacher sees changed
+        collect_on_changes(sources.workspace.progress, sources.supervisor, self._due)
         self._crash_key: tuple | None = None  # UI thread: the crash text read once per process
         self._crash_text = ""
         self._saved_at: dict[str, tuple[float, float]] = {}  # UI thread: slug -> (read at, mtime)

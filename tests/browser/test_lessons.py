@@ -33,9 +33,23 @@ def complete_by_clicking(page, lesson, done_within_ms: int = 45_000) -> None:
         for check in step.checks:
             if check.kind == "quiz":
                 answer_quiz(page, check)
-        expect(page.get_by_text("✓ step done")).to_be_visible(timeout=done_within_ms)
+        try:
+            expect(page.get_by_text("✓ step done")).to_be_visible(timeout=done_within_ms)
+        except AssertionError as error:
+            # the lesson panel's own lines say what the step still waits for
+            raise AssertionError(
+                f"step {index + 1} ({step.title}) not done within {done_within_ms} ms; "
+                f"the lesson panel says: {_checks_text(page)}"
+            ) from error
         if index + 1 < len(lesson.steps):
             click_next(page)
+
+
+def _checks_text(page) -> str:
+    """The lesson panel's Checks block as the learner reads it (what is left, and why)."""
+    body = page.inner_text("body", timeout=10_000)
+    start = body.find("Checks")
+    return " / ".join(body[start : start + 400].splitlines()) if start >= 0 else "(no Checks)"
 
 
 def done_cells(page):

@@ -342,15 +342,19 @@ def test_param_lifecycle_and_hidden_names_golden(supervisor, probe, ros2):
     ros2.until("param list /parameters_node", "  greeting")
 
     # hidden topics stay hidden unless asked for (--include-hidden abbreviates as in ros2)
-    out = ros2.until("node info /turtlesim", "/turtle1/pose: turtlesim/msg/Pose")
+    # discovery brings a node's readers and writers separately: wait for both ends
+    out = ros2.until(
+        "node info /turtlesim",
+        lambda o: "/turtle1/pose: turtlesim/msg/Pose" in o
+        and "/turtle1/cmd_vel: geometry_msgs/msg/Twist" in o,
+    )
     assert "_trails" not in out and "/_action/" not in out, out
     assert out.splitlines()[1:4] == [
         "  Subscribers:",
         "    /turtle1/cmd_vel: geometry_msgs/msg/Twist",
         "  Publishers:",
     ], out
-    code, lines = ros2("node info /turtlesim --include-hidden")
-    assert "    /turtlesim/_trails_request: std_msgs/msg/Empty" in lines, lines
+    ros2.until("node info /turtlesim --include-hidden", "    /turtlesim/_trails_request: std_msgs/msg/Empty")
     code, lines = ros2("topic list")
     assert "/turtle1/pose" in lines and not any("/_" in line for line in lines), lines
     code, lines = ros2("topic list --include-hidden")
