@@ -95,6 +95,7 @@ class TopicsPanel:
         self._timer: Timer | None = None
         self._sent = 0  # written only by the timer's callback (executor thread)
         self._pub_message = ""
+        self._echo_rows = 1  # the lines Echo keeps for the topic's messages (UI thread)
 
         gui.add_markdown(
             "Every topic on the graph. Counts leave out this dashboard's own "
@@ -160,6 +161,7 @@ class TopicsPanel:
             self._monitor = None
         self._topic, self._seen = chosen, 0
         self._latest.clear()
+        self._echo_rows = 1
         self._pub_message = ""
         fields: list[str] = []
         cls = None
@@ -171,6 +173,7 @@ class TopicsPanel:
         if chosen and cls is not None:
             qos = matching_qos(self._node, chosen, depth=KEEP)
             self._monitor = TopicMonitor(self._node, chosen, cls, keep=KEEP, qos=qos)
+            self._echo_rows = echo_rows(cls)
             fields = numeric_fields(cls)
         form = self._form_slot.show(
             (chosen, type_text), (lambda: (cls, type_text or "")) if cls is not None else None
@@ -180,6 +183,10 @@ class TopicsPanel:
         self._clear_plot()
         for button in (self._once, self._start):
             button.disabled = form is None
+        # Echo's room and the plot's note at once, not at the next refresh: the Publish buttons
+        # below are where they will stay when the learner first sees them.
+        self._show_topic(self._topic, self._monitor, [])
+        self._show_plot()
 
     def _clear_plot(self) -> None:
         self._samples.clear()
@@ -354,17 +361,20 @@ class TopicsPanel:
             arrived = monitor.rate(window_sec=STATS_WINDOW_SEC)
             if published.missed and arrived:
                 hz += (
-                    f" · {arrived.rate:.2f} Hz arrived here: this view missed "
+                    f"; {arrived.rate:.2f} Hz arrived here: this view missed "
                     f"{published.missed:,} of {published.published:,} "
                     f"({monitor.why_missed()})"
                 )
             else:
-                hz += f" · none missed in the last {STATS_WINDOW_SEC:g} s"
+                hz += f", none missed in {STATS_WINDOW_SEC:g} s"
         bw = f"**{band.ros2_text().splitlines()[0]}**" if band else idle
+        # Short lines, the commands on their own: the block keeps its height while the first
+        # figures arrive (a wrapped line would move the Publish buttons under the pointer).
         self._stats.show(
-            f"Rate: {hz} · `ros2 topic hz {topic}`\n\n"
-            f"Bandwidth: {bw} · `ros2 topic bw {topic}`\n\n"
-            f"Messages received: {monitor.count}"
+            f"Rate: {hz}\n\n"
+            f"Bandwidth: {bw}\n\n"
+            f"Messages received: {monitor.count}\n\n"
+            f"`ros2 topic hz {topic}` · `ros2 topic bw {topic}`"
         )
         if fresh or not self._latest:
             latest = list(self._latest)
@@ -374,9 +384,11 @@ class TopicsPanel:
                 if shown and sum(t.count("\n") + 1 for t in shown) + text.count("\n") > ECHO_LINES:
                     break
                 shown.insert(0, text)
+            body = "\n".join(shown) or f"(no message on {topic} yet)"
+            blank = max(0, self._echo_rows - body.count("\n") - 1)
             self._echo.show(
                 f"Latest messages · `ros2 topic echo {topic}`\n\n"
-                + code_block(shown, f"(no message on {topic} yet)")
+                + code_block([body + "\n" * blank])
             )
 
     def _show_plot(self) -> None:
@@ -424,3 +436,18 @@ class TopicsPanel:
         if self._monitor is not None:
             self._monitor.close()
             self._monitor = None
+
+
+def echo_rows(msg_type: type) -> int:
+    """The lines Echo keeps for a topic from the moment it is picked.
+
+    As many as ``SHOWN_MESSAGES`` messages of the type take (``ECHO_LINES`` at most). Echo's
+    block then stands still while the first messages arrive, and so do the Publish buttons
+    below it: on a slow computer a click on a button that moved between the press and the
+    release was lost.
+    """
+    try:
+        per_message = to_yaml(msg_type()).count("\n") + 2  # and its '---' line
+    except Exception:  # a type that cannot be built empty: no room kept
+        return 1
+    return min(ECHO_LINES, per_message * SHOWN_MESSAGES)

@@ -27,9 +27,9 @@ from app.exercises.attempts import attempts_root
 from app.exercises.model import Exercise, ExerciseBook
 from app.exercises.panel import ExerciseSettings
 from app.exercises.workspace import Workspace
+from app.lessons.progress import ProgressStore
 from app.lessons.runtime import LessonRuntime
 from app.lessons.schema import Course
-from app.lessons.progress import ProgressStore
 from app.ros.side_participant import SideParticipant
 from app.supervisor import Supervisor
 from app.teacher import wire
@@ -61,7 +61,9 @@ SAVED_CHECK_SEC = 5.0
 HEARTBEAT_SEC = 10.0
 
 
-def collect_on_changes(progress: ProgressStore, supervisor: Supervisor, due: threading.Event) -> None:
+def collect_on_changes(
+    progress: ProgressStore, supervisor: Supervisor, due: threading.Event
+) -> None:
     """Set ``due`` when progress is saved or a program starts, stops or ends.
 
     The teacher's row shows both; waiting out the beacon's second made a loaded hub show a

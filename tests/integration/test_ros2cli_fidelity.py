@@ -345,8 +345,10 @@ def test_param_lifecycle_and_hidden_names_golden(supervisor, probe, ros2):
     # discovery brings a node's readers and writers separately: wait for both ends
     out = ros2.until(
         "node info /turtlesim",
-        lambda o: "/turtle1/pose: turtlesim/msg/Pose" in o
-        and "/turtle1/cmd_vel: geometry_msgs/msg/Twist" in o,
+        lambda o: (
+            "/turtle1/pose: turtlesim/msg/Pose" in o
+            and "/turtle1/cmd_vel: geometry_msgs/msg/Twist" in o
+        ),
     )
     assert "_trails" not in out and "/_action/" not in out, out
     assert out.splitlines()[1:4] == [
@@ -354,7 +356,10 @@ def test_param_lifecycle_and_hidden_names_golden(supervisor, probe, ros2):
         "    /turtle1/cmd_vel: geometry_msgs/msg/Twist",
         "  Publishers:",
     ], out
-    ros2.until("node info /turtlesim --include-hidden", "    /turtlesim/_trails_request: std_msgs/msg/Empty")
+    ros2.until(
+        "node info /turtlesim --include-hidden",
+        "    /turtlesim/_trails_request: std_msgs/msg/Empty",
+    )
     code, lines = ros2("topic list")
     assert "/turtle1/pose" in lines and not any("/_" in line for line in lines), lines
     code, lines = ros2("topic list --include-hidden")

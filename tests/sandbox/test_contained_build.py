@@ -264,6 +264,9 @@ while True:
 """
 
 
+# Its 32 spinning processes take both cores for a moment (load average 88 in ci55, while
+# two browser pages starved): it runs with the loaded tests, alone.
+@pytest.mark.loaded
 def test_a_fork_bomb_in_setup_py_hits_the_process_limit_and_nothing_is_left(
     classroom: Classroom, supervisor: Supervisor
 ):
