@@ -344,7 +344,15 @@ class TopicsPanel:
             )
         if monitor is None:
             return
-        idle = "silent" if monitor.count else "waiting…"
+        # No figure yet: nothing came, a message came a moment ago (a rate needs two), or the
+        # topic went quiet.
+        heard = self._latest[-1][0] if self._latest else None
+        if heard is None:
+            idle = "waiting…"
+        elif time.time() - heard < STATS_WINDOW_SEC:
+            idle = "measuring…"
+        else:
+            idle = "silent"
         published = monitor.published_rate(window_sec=STATS_WINDOW_SEC)
         band = monitor.bandwidth(window_sec=STATS_WINDOW_SEC)
         if published is None:
