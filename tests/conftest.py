@@ -291,3 +291,23 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
         print("\nFAILED: processes started by the tests were still running (killed now):")
         print("\n".join(f"  {line}" for line in left))
         session.exitstatus = 1
+
+
+# When each test ran, per worker, and how loaded the machine was as it began: a test that
+# starved (a page that answered nothing for 30 s) can then be laid beside what the other
+# workers ran at that moment (test-artifacts/<worker>/timeline.txt).
+def pytest_runtest_logstart(nodeid: str, location: tuple) -> None:
+    _timeline(f"start {nodeid} load {os.getloadavg()[0]:.1f}")
+
+
+def pytest_runtest_logfinish(nodeid: str, location: tuple) -> None:
+    _timeline(f"end   {nodeid}")
+
+
+def _timeline(line: str) -> None:
+    try:
+        ARTIFACTS.mkdir(parents=True, exist_ok=True)
+        with open(ARTIFACTS / "timeline.txt", "a", encoding="utf-8") as out:
+            out.write(f"{time.strftime('%H:%M:%S')} {line}\n")
+    except OSError:  # a read-only checkout: the timeline is a diagnosis aid only
+        pass
