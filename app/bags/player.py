@@ -220,10 +220,19 @@ class Player:
         return paused_for
 
     def _wait_for_subscribers(self, cancel: threading.Event) -> None:
-        """Up to a second for each publisher to meet a subscriber, so the first messages count."""
+        """Up to a second for each publisher to meet the subscribers the graph shows on its
+        topic (one at least), so the first messages reach them all. Meeting just one was not
+        enough: this dashboard's own subscription matches at once, a learner's listener in
+        another process a moment later (ci60, one core busy: it missed the first message)."""
         deadline = time.monotonic() + MATCH_WAIT_SEC
+
+        def met(pub: Publisher) -> bool:
+            return pub.get_subscription_count() >= max(
+                1, self._node.count_subscribers(pub.topic_name)
+            )
+
         while time.monotonic() < deadline:
-            if all(p.get_subscription_count() > 0 for p in self._publishers.values()):
+            if all(met(p) for p in self._publishers.values()):
                 return
             if cancel.wait(0.05):
                 raise Cancelled()
