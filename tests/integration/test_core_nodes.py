@@ -136,15 +136,14 @@ def test_fibonacci_feedback_result_rejection_cancel_and_preemption(supervisor, p
     wait_until(client.server_is_ready, timeout=DISCOVERY_TIMEOUT, what="the /fibonacci server")
     _wait_feedback_flows(client)
 
-    # Feedback grows one number per step; the result has order + 1 numbers.
+    # Feedback grows one number per step; the result has order + 1 numbers. Feedback
+    # is a topic and the result a service: rclpy's ActionClient forgets a goal's
+    # feedback callback once its result is in, so the last step's feedback may be
+    # dropped when the result overtakes it (CI: got up to [0, 1, 1, 2, 3, 5]).
     goal = ProbeGoal(client, 6)
     assert goal.handle.accepted
     assert goal.result() == (GoalStatus.STATUS_SUCCEEDED, [0, 1, 1, 2, 3, 5, 8])
-    wait_until(
-        lambda: goal.feedback and goal.feedback[-1] == fib(6),
-        what=lambda: f"the last feedback (got {goal.feedback})",
-    )
-    assert len(goal.feedback) >= 3
+    assert len(goal.feedback) >= 3, goal.feedback
     assert all(fb == fib(len(fb) - 1) for fb in goal.feedback)
     lengths = [len(fb) for fb in goal.feedback]
     assert lengths == sorted(set(lengths))  # one new number per feedback message
