@@ -304,6 +304,13 @@ def pytest_runtest_logfinish(nodeid: str, location: tuple) -> None:
     _timeline(f"end   {nodeid}")
 
 
+def pytest_runtest_logreport(report: pytest.TestReport) -> None:
+    """A failure (of a test or its fixtures) in the timeline too, as it happens: a run
+    still going shows which test failed, not only that one did."""
+    if report.failed:
+        _timeline(f"FAILED {report.when} {report.nodeid}")
+
+
 def _timeline(line: str) -> None:
     try:
         ARTIFACTS.mkdir(parents=True, exist_ok=True)

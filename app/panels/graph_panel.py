@@ -90,7 +90,10 @@ class GraphPanel:
             rates.watch(topics_to_measure(shape, endpoints, heavy_too=self._heavy.value))
         else:
             rates.watch({})
-        labels = {topic: rate_text(rates.rate(topic)) for topic in rates.watched()}
+        labels = {}
+        for topic in rates.watched():
+            rate = rates.rate(topic)
+            labels[topic] = rate_text(rate, rate == 0 and rates.heard(topic))
         vertices, edges = graph_picture(endpoints, labels, show_quiet=quiet)
         svg = render_svg(vertices, edges)
         if svg != self._svg:

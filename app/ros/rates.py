@@ -119,10 +119,16 @@ class RateBoard:
         return steady_rate(entry[1].rate_hz, window_sec)  # as published, not as received
 
     def latest(self, topic: str) -> tuple[float, object] | None:
-        """The newest message of a watched topic with its arrival time (monotonic), or None."""
+        """The newest message of a watched topic with its arrival time (wall clock), or None."""
         with self._lock:
             entry = self._monitors.get(topic)
         return None if entry is None else entry[1].message()
+
+    def heard(self, topic: str, window_sec: float = RATE_WINDOW_SEC) -> bool:
+        """Whether a message of ``topic`` arrived in the last ``window_sec``."""
+        with self._lock:
+            entry = self._monitors.get(topic)
+        return entry is not None and bool(entry[1].samples(window_sec))
 
     def close(self) -> None:
         with self._lock:
@@ -167,6 +173,9 @@ class SharedRates:
     def latest(self, topic: str) -> tuple[float, object] | None:
         return self._board.latest(topic)
 
+    def heard(self, topic: str, window_sec: float = RATE_WINDOW_SEC) -> bool:
+        return self._board.heard(topic, window_sec)
+
     def watched(self) -> list[str]:
         return self._board.watched()
 
@@ -191,6 +200,9 @@ class SharedRatesClient:
     def latest(self, topic: str) -> tuple[float, object] | None:
         return self._shared.latest(topic)
 
+    def heard(self, topic: str, window_sec: float = RATE_WINDOW_SEC) -> bool:
+        return self._shared.heard(topic, window_sec)
+
     def watched(self) -> list[str]:
         """What this drawing asked for and is measured."""
         return [t for t in self._shared.watched() if t in self._wanted]
@@ -199,10 +211,15 @@ class SharedRatesClient:
         self.watch({})
 
 
-def rate_text(rate: float | None) -> str:
-    """'2.0 Hz', 'silent', or '' when not measured."""
+MEASURING = "measuring…"
+
+
+def rate_text(rate: float | None, heard: bool = False) -> str:
+    """'2.0 Hz', 'silent', or '' when not measured; 'measuring…' for no rate yet from a
+    topic ``heard`` a moment ago (a rate takes two messages: a talker that just started
+    is not silent)."""
     if rate is None:
         return ""
     if rate <= 0:
-        return "silent"
+        return MEASURING if heard else "silent"
     return f"{rate:.1f} Hz" if rate < 100 else f"{rate:.0f} Hz"

@@ -157,7 +157,9 @@ class GraphStage:
         shape = graph_picture(endpoints, show_quiet=quiet)
         self._rates.watch(topics_to_measure(shape, endpoints))
         rates = {topic: self._steady_rate(topic) for topic in self._rates.watched()}
-        labels = {topic: rate_text(rate) for topic, rate in rates.items()}
+        labels = {
+            t: rate_text(rate, rate <= 0 and self._rates.heard(t)) for t, rate in rates.items()
+        }
         vertices, edges = graph_picture(endpoints, labels, show_quiet=quiet)
         edges = self._mark_undelivered(edges)
         vertices += [Vertex("node", name, STARTING) for name in starting]

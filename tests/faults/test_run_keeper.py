@@ -19,7 +19,7 @@ import pytest
 
 from app import PROJECT_ROOT
 from tests.conftest import wait_until
-from tests.worker_plan import GENERAL_WORKERS, ONE_WORKER, WAITING_MODULES, WAITING_WORKERS
+from tests.worker_plan import GENERAL_WORKERS, ONE_WORKER, WAITING_MODULES
 
 # Starts a program in a session of its own (as the dashboard fixture does),
 # says its pid, then either waits to be killed or exits at once.
@@ -166,7 +166,9 @@ def test_a_one_worker_module_runs_whole_on_one_worker_and_the_rest_is_shared():
 def test_the_workers_after_the_general_ones_take_only_tests_that_wait():
     waiting, general = "tests/turtlesim/test_ros2_run.py", "tests/unit/test_cli.py"
     assert waiting in WAITING_MODULES and general not in WAITING_MODULES
-    workers_of = _workers_of(GENERAL_WORKERS + WAITING_WORKERS, waiting, general)
-    extra = {f"gw{n}" for n in range(GENERAL_WORKERS, GENERAL_WORKERS + WAITING_WORKERS)}
+    # One waiting worker shows the rule as well as WAITING_WORKERS of them, and a nested run
+    # of seven workers took more than 3 min just to start them on a loaded machine (ci62).
+    workers_of = _workers_of(GENERAL_WORKERS + 1, waiting, general)
+    extra = {f"gw{GENERAL_WORKERS}"}
     assert workers_of[waiting] & extra, workers_of  # the extra workers did take some
     assert not workers_of[general] & extra, workers_of

@@ -171,6 +171,25 @@ def _row(page: Page, user: str):
     return page.locator(f"#class tbody tr[data-learner='{user}']")
 
 
+def _seen_after_start(page: Page, teacher: Page, user: str, node: str) -> tuple[float, float]:
+    """Seconds from a Start click until the learner's page, and the teacher's row, show it.
+
+    Both are watched in one loop so a slow row can be told from a slow Start.
+    """
+    clicked = time.monotonic()
+    started = page.get_by_text(f"Started {node}").filter(visible=True)
+    row = _row(teacher, user)
+    seen: dict[str, float] = {}
+    while len(seen) < 2 and time.monotonic() - clicked < 60:
+        if "learner" not in seen and started.count():
+            seen["learner"] = time.monotonic() - clicked
+        if "teacher" not in seen and node in (row.text_content() or ""):
+            seen["teacher"] = time.monotonic() - clicked
+        time.sleep(0.05)
+    assert len(seen) == 2, f"after 60 s only {seen} showed {node} started"
+    return seen["learner"], seen["teacher"]
+
+
 def test_each_learner_sees_only_their_own_nodes_and_the_teacher_sees_rows_move(hub, room):
     teacher = room.teacher
     assert teacher is not None
@@ -184,11 +203,13 @@ def test_each_learner_sees_only_their_own_nodes_and_the_teacher_sees_rows_move(h
         for node in ("talker", OWN_NODE[user]):
             choose(page, "Catalog node", node)
             click(page, "Start")
-            clicked = time.monotonic()
-            expect(_row(teacher, user)).to_contain_text(node, timeout=2_000)
-            moved = time.monotonic() - clicked
-            print(f"{user}: the teacher's row showed {node} {moved:.2f} s after Start")
-            expect_text(page, f"Started {node}")
+            learner_saw, teacher_saw = _seen_after_start(page, teacher, user, node)
+            print(
+                f"{user}: {node} Started on the learner's page after {learner_saw:.2f} s, "
+                f"on the teacher's row after {teacher_saw:.2f} s"
+            )
+            # The teacher sees what the learner does within 2 s.
+            assert teacher_saw <= 2.0, (user, node, learner_saw, teacher_saw)
     for user in LEARNERS:  # the talker and their own node, on their own stage graph
         page = room.classrooms[user]
         for node in ("talker", OWN_NODE[user]):

@@ -96,3 +96,7 @@ def test_rate_text():
     assert rate_text(0.0) == "silent"
     assert rate_text(2.04) == "2.0 Hz"
     assert rate_text(1234.0) == "1234 Hz"
+    # One message heard, a rate needs two: the edge of a talker that just started.
+    assert rate_text(0.0, heard=True) == "measuring…"
+    assert rate_text(2.04, heard=True) == "2.0 Hz"
+    assert rate_text(None, heard=True) == ""
