@@ -30,9 +30,12 @@ from app.ros2cli.run import Programs, programs_of
 _ARGUMENT = re.compile(r"^[A-Za-z_][\w.-]*:=[^\n\x00]*$")
 _STARTED = re.compile(r"^\[INFO\] \[(?P<label>[^\]]+)\]: process started with pid \[\d+\]$")
 _INTERRUPTED = "[WARNING] [launch]: user interrupted with ctrl-c (SIGINT)"
-# How long the verb shows a starting launch: until every process has printed a line
-# (several rclpy nodes starting at once on a loaded machine take a while).
+# How long the verb shows a starting launch: until every process has printed a line,
+# or this long once one has (a node may stay silent until it hears something)...
 STARTUP_WAIT_SEC = 10.0
+# ...or this long while none has: several rclpy nodes starting at once on a loaded
+# computer can take that long (CI of 2026-12-03: no turtlesim had greeted after 10 s).
+SLOW_START_LIMIT_SEC = 30.0
 STOP_WAIT_SEC = 20.0  # above the supervisor's SIGINT -> SIGTERM -> SIGKILL escalation
 
 
@@ -97,7 +100,7 @@ def _show_start(
     """What ros2 launch prints while its processes start; all of it if it ends meanwhile."""
     shown = 0
     waited = 0.0
-    limit = STARTUP_WAIT_SEC  # not a stream: the Console limit for streams does not apply
+    # Not a stream: the Console's limit for streams does not apply.
     while True:
         lines = programs.output(key)
         for line in lines[shown:]:
@@ -110,6 +113,7 @@ def _show_start(
             return 0 if status.exit_code == 0 else 1
         labels = [m["label"] for line in lines if (m := _STARTED.match(line))]
         spoke = {label for label in labels if any(x.startswith(f"[{label}] ") for x in lines)}
+        limit = STARTUP_WAIT_SEC if spoke else SLOW_START_LIMIT_SEC
         if (labels and len(spoke) == len(labels)) or waited >= limit:
             break
         ctx.sleep(0.1)

@@ -104,8 +104,12 @@ EXECUTABLES: dict[tuple[str, str], str] = {
     **UPSTREAM,
 }
 
-STARTUP_WAIT_SEC = 5.0  # the longest the verb shows a starting node's output
-STARTUP_QUIET_SEC = 1.0  # ...and it stops once the node is up and this long quiet
+STARTUP_WAIT_SEC = 5.0  # how long the verb shows a node that keeps talking, or stays silent
+STARTUP_QUIET_SEC = 1.0  # ...and it stops sooner once the node is up and this long quiet
+# The longest it waits for a node that has neither spoken nor joined the graph: on a
+# loaded computer a Python node can take many seconds just to import rclpy (CI of
+# 2026-12-03: turtlesim had not greeted after 5 s, and the Console showed no greeting).
+SLOW_START_LIMIT_SEC = 30.0
 POLL_SEC = 0.1
 _NAME = r"[~/]?[A-Za-z_{][\w/{}~]*"  # a ROS name as a remap rule may write it
 _REMAP = re.compile(rf"^(?:(?P<node>[A-Za-z_]\w*):)?(?P<from>{_NAME}|__node|__ns)"
@@ -329,14 +333,16 @@ def follow_start(
 ) -> NodeStatus:
     """Write what a starting program says until it is up and has gone quiet; its status.
 
-    Up is ``is_up()`` (its node on the graph) with at least one line shown;
-    the start-up messages of a node come in a burst (turtlesim: its greeting,
-    then the first turtle), so the verb waits for STARTUP_QUIET_SEC without a
-    new line. A program that ends meanwhile has all its output written.
+    Up is ``is_up()`` (its node on the graph). The start-up messages of a node come
+    in a burst (turtlesim: its greeting, then the first turtle), so the verb waits for
+    STARTUP_QUIET_SEC without a new line. A node that keeps talking is shown for
+    STARTUP_WAIT_SEC from its first line, a silent one for as long once it is up; one
+    that has done neither yet is waited for up to SLOW_START_LIMIT_SEC (Stop ends the
+    wait sooner). A program that ends meanwhile has all its output written.
     """
     shown = 0
     waited = quiet = 0.0
-    limit = min(STARTUP_WAIT_SEC, ctx.limits.max_seconds or STARTUP_WAIT_SEC)
+    spoke_at = up_at = None
     while True:
         now_shown = write_new_output(ctx, programs, key, shown)
         quiet = 0.0 if now_shown != shown else quiet
@@ -345,7 +351,17 @@ def follow_start(
         if not status.active:
             write_new_output(ctx, programs, key, shown)
             return status
-        if (shown and quiet >= STARTUP_QUIET_SEC and is_up()) or waited >= limit:
+        if shown and spoke_at is None:
+            spoke_at = waited
+        if up_at is None and is_up():
+            up_at = waited
+        if spoke_at is not None:
+            done = (up_at is not None and quiet >= STARTUP_QUIET_SEC) or (
+                waited - spoke_at >= STARTUP_WAIT_SEC
+            )
+        else:
+            done = up_at is not None and waited - up_at >= STARTUP_WAIT_SEC
+        if done or waited >= SLOW_START_LIMIT_SEC:
             return status
         ctx.sleep(POLL_SEC)
         waited += POLL_SEC

@@ -50,6 +50,21 @@ CLICKED = ((0.6, -0.2), (0.6, 0.4))  # the robot's spot, then a point straight a
 GOAL_CLICKED = ((0.2, 0.4), (-0.4, 0.4))  # where to go, then a point behind it (-x)
 
 
+NAV_LAYERS = ("particle_cloud", "nav_path", "occupancy_grid")
+
+
+def wait_scene_nodes(page: Page, names: list[str], timeout_ms: int = 60_000) -> None:
+    """Wait until the scene has every node of ``names``; on a timeout, say which are missing."""
+    try:
+        page.wait_for_function(
+            f"(names) => names.every({HAS_NODE_JS})", arg=names, polling=200, timeout=timeout_ms
+        )
+    except PlaywrightTimeout:
+        present = page.evaluate(f"(names) => names.filter({HAS_NODE_JS})", names)
+        missing = [name for name in names if name not in present]
+        raise AssertionError(f"not in the 3D scene after {timeout_ms} ms: {missing}") from None
+
+
 def click_floor(page: Page, points: tuple[tuple[float, float], ...]) -> None:
     """Click each floor point of `map` in the canvas, waiting for the first to be taken.
 
@@ -141,10 +156,7 @@ def test_particles_and_the_plan_lie_on_the_map_and_two_clicks_set_the_pose(page,
     try:
         open_tab(page, "3D view")
         choose(page, "On stage", "3D scene")  # the canvas, not the live graph, in the middle
-        for name in ("particle_cloud", "nav_path", "occupancy_grid"):
-            page.wait_for_function(
-                HAS_NODE_JS, arg=f"/tf_view/frames/map/{name}", polling=200, timeout=30_000
-            )
+        wait_scene_nodes(page, [f"/tf_view/frames/map/{name}" for name in NAV_LAYERS])
         expect(page.get_by_text(f"{PARTICLES} particles, spread 0.").first).to_be_visible(
             timeout=20_000
         )
