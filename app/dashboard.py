@@ -197,7 +197,7 @@ class Dashboard:
                 self.progress,
                 side_window,
                 self._exercise_marks,
-                stage.show,
+                stage.show_step,
                 step_card=step_card,
                 open_tool=opener.open,
                 start_requests=self.start_requests,

@@ -91,11 +91,13 @@ def picture_html(image: str, alt: str) -> str:
     data = base64.b64encode(path.read_bytes()).decode("ascii")
     mime = IMAGE_TYPES[path.suffix.lower()]
     # Nearly the panel's full width (it keeps clear of the scroll bar): the
-    # diagrams' smallest text stays about 12 px in the side panel.
+    # diagrams' smallest text stays about 12 px in the side panel. On a wide stage
+    # the window's height is the bound: the whole diagram in view, its shape kept.
     return (
         '<div style="padding:2px 10px 10px 4px">'
         f'<img src="data:{mime};base64,{data}" alt="{html.escape(alt, quote=True)}" '
-        'style="display:block;width:100%;height:auto"></div>'
+        'style="display:block;width:100%;height:auto;max-height:calc(100vh - 120px);'
+        'object-fit:contain"></div>'
     )
 
 
@@ -181,7 +183,7 @@ class LessonsPanel:
         progress: ProgressStore,
         side_window: viser.PanelHandle,
         exercise_marks: Callable[[str], str] = lambda _lesson_id: "",
-        show_stage: Callable[[str], None] = lambda _stage: None,
+        show_stage: Callable[[str, str], None] = lambda _stage, _picture: None,
         *,
         step_card: viser.GuiFolderHandle | None = None,
         open_tool: Callable[[str], None] = lambda _tool: None,
@@ -204,7 +206,7 @@ class LessonsPanel:
         self._live = live
         self._progress = progress
         self._exercise_marks = exercise_marks
-        self._show_stage = show_stage  # the stage shows what each step names
+        self._show_stage = show_stage  # the stage shows what each step names (and its picture)
         self._open_tool = open_tool
         self._to_top = to_top
         self._requests = start_requests or StartRequests()  # the stage shows a Start at once
@@ -319,10 +321,13 @@ class LessonsPanel:
         self._header.show(f"### {lesson.title}\n{lesson.summary}")
         self._goals.show("\n".join(f"- {goal}" for goal in lesson.goals))
         self._text.show(_without_title(current.text))
-        self._picture.show(picture_html(current.image, current.image_alt) if current.image else "")
+        stage = current.stage or lesson.stage
+        picture = picture_html(current.image, current.image_alt) if current.image else ""
+        # A diagram on stage is not shown again, smaller, in the step's text.
+        self._picture.show("" if stage == "picture" else picture)
         self._command.show(f"In a terminal: `{current.command}`" if current.command else "")
         self._code.show(step_code.listing(lesson, current))
-        self._show_stage(current.stage or lesson.stage)
+        self._show_stage(stage, picture)
         self._message.show("")
         self._rebuild_step_widgets()
         self._back.disabled = step == 0

@@ -272,6 +272,9 @@ def load_lesson(directory: Path) -> Lesson:
         ] if "checks" in raw else []  # fmt: skip
         command = _require(raw, "command", str, step_where) if "command" in raw else ""
         image, image_alt = _step_image(raw, step_where)
+        step_stage = _stage(raw, step_where, "")
+        if (step_stage or stage) == "picture" and not image:
+            raise LessonError(f"{step_where}: its stage is the step's diagram, but it has no image")
         steps.append(
             Step(
                 title=_require(raw, "title", str, step_where),
@@ -281,7 +284,7 @@ def load_lesson(directory: Path) -> Lesson:
                 checks=tuple(checks),
                 image=image,
                 image_alt=image_alt,
-                stage=_stage(raw, step_where, ""),
+                stage=step_stage,
                 code=_code_list(raw, step_where),
             )
         )

@@ -18,5 +18,6 @@ STAGES: dict[str, str] = {
     "scene": "3D scene",
     "tf": "TF tree",
     "code": "Code",  # the lesson's or the learner's, with its output under it
+    "picture": "This step's diagram",  # for a step about an idea rather than a live thing
 }
 DEFAULT_STAGE = "graph"  # a unit that names none: units 1-11 are about the graph

@@ -27,6 +27,7 @@ from app.stage.code_stage import CodeStage
 from app.stage.graph_stage import GraphStage
 from app.stage.image_stage import ImageStage
 from app.stage.lifecycle_stage import LifecycleStage
+from app.stage.picture_stage import PictureStage
 from app.stage.plot_stage import PlotStage
 from app.stage.replay_stage import ReplayStage
 from app.stage.tf_stage import TfStage
@@ -138,6 +139,7 @@ class Stage:
             self.replay = ReplayStage(gui, ui)
             self.turtlesim = TurtlesimStage(gui, ui, node, links)
             self.tf = TfStage(gui, node)
+            self.picture = PictureStage(gui)
         # Under the code: what the learner's program printed (the exercise's output).
         self.code = CodeStage(gui, code_window, program_output)
         self.parts: dict[str, StagePart] = {
@@ -150,6 +152,7 @@ class Stage:
             "turtlesim": self.turtlesim,
             "tf": self.tf,
             "code": self.code,
+            "picture": self.picture,
         }
         self.show(DEFAULT_STAGE)
 
@@ -225,6 +228,12 @@ class Stage:
         now = time.monotonic()
         self._widths_due = [now + delay for delay in WIDTH_RESENDS]
         self._place_control_panel()
+
+    def show_step(self, stage: str, picture: str) -> None:
+        """A lesson step: its stage on, and its picture (HTML, '' for none) for the
+        diagram stage, the learner's to pick too."""
+        self.picture.set_picture(picture)
+        self.show(stage)
 
     def watch(self, bag: Path, heading: str = "") -> None:
         """Play the recording ``bag`` on stage (a graded attempt: its verdict as ``heading``)."""

@@ -49,3 +49,28 @@ def test_a_step_shows_its_picture_and_the_next_step_does_not(page, lesson, index
     expect_text(page, f"Step {index + 2} of {len(lesson.steps)}")
     if not lesson.steps[index + 1].image:
         expect(page.get_by_role("img", name=step.image_alt, exact=True)).to_have_count(0)
+
+
+def test_a_diagram_on_stage_fills_the_stage_and_is_not_repeated_in_the_text(page):
+    """A step about an idea puts its diagram on stage: whole, in view, as large as the
+    window lets it be, and not a second time in the column."""
+    lesson, index = next(
+        (lesson, index)
+        for lesson in COURSE.lessons
+        for index, step in enumerate(lesson.steps)
+        if (step.stage or lesson.stage) == "picture"
+    )
+    step = lesson.steps[index]
+    open_tab(page, "Lessons")
+    go_to_step(page, lesson, index)
+    expect_text(page, f"Step {index + 1} of {len(lesson.steps)}: {step.title}")
+    picture = page.get_by_role("img", name=step.image_alt, exact=True)
+    expect(picture).to_have_count(1)
+    expect(picture).to_be_visible(timeout=10_000)
+    view = page.viewport_size
+    assert view is not None
+    box = picture.bounding_box()
+    assert box is not None
+    assert box["x"] < 40, box  # on the stage, at the window's left
+    assert 0 <= box["y"] and box["y"] + box["height"] <= view["height"], (box, view)
+    assert box["height"] >= 0.6 * view["height"], (box, view)  # bigger than the column's

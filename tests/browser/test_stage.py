@@ -74,6 +74,7 @@ _STAGE_SIGNS: dict[str, tuple[str, object]] = {
     "code": ("tabs", ["Code of this lesson", "Program output"]),
     "turtlesim": ("contains", "Arrow keys drive turtle1 while this window"),
     "tf": ("css", "div.stage-tf"),
+    "picture": ("exact", "This step's diagram"),  # its folder's title
 }
 
 _ON_STAGE_JS = """(signs) => {

@@ -63,6 +63,14 @@ def test_an_unknown_stage_is_a_clear_error(tmp_path):
         load_lesson(_copy(tmp_path / "c", "stage = 3\n"))
 
 
+def test_the_diagram_stage_needs_a_picture(tmp_path):
+    # 05_topics's first step has no image: its diagram cannot be on stage.
+    with pytest.raises(LessonError, match=r"steps\[0\]: its stage is the step's diagram"):
+        load_lesson(_copy(tmp_path, 'stage = "graph"\n', 'stage = "picture"\n'))
+    with pytest.raises(LessonError, match=r"its stage is the step's diagram, but it has no image"):
+        load_lesson(_copy(tmp_path / "b", 'stage = "picture"\n'))
+
+
 def _endpoints(name: str, publishes=(), subscribes=()) -> NodeEndpoints:
     kind = "std_msgs/msg/String"
     return NodeEndpoints(
