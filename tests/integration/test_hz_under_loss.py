@@ -112,10 +112,15 @@ def test_two_publishers_on_one_topic_and_the_hz_verb(probe, ros2):
     else:  # Jazzy's rclpy does not: the interleaved sequences are noticed, arrival rate used
         assert stats.fallback == INTERLEAVED and stats.published is None, stats
         # What arrived, as said ("the average above is what arrived"). Arrivals follow
-        # the subscriber's executor, so on a loaded machine they lag the sending (seen:
-        # 177.6 Hz for 200 sent); only the publisher's clock would be exact.
+        # the subscriber's executor, so on a loaded machine they lag the sending and the
+        # queue of 10 overflows (seen: 177.6 Hz for 200 sent; rehearsal ci65 at load 29:
+        # 137.5 Hz for 185.9 sent); only the publisher's clock would be exact. Both
+        # publishers' arrivals count: one alone would be half the rate sent.
         assert stats.rate == pytest.approx(arrived.rate, rel=1e-6), (stats, arrived)
-        assert stats.rate == pytest.approx(true_rate(sent), rel=0.25)
+        assert 0.55 * true_rate(sent) < stats.rate < 1.25 * true_rate(sent), (
+            stats,
+            true_rate(sent),
+        )
 
     # `ros2 topic hz` keeps ros2's lines and adds the publisher's rate after them.
     pub = probe.node.create_publisher(Int64, "/hz_probe", 10)
