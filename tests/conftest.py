@@ -296,12 +296,53 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
 # When each test ran, per worker, and how loaded the machine was as it began: a test that
 # starved (a page that answered nothing for 30 s) can then be laid beside what the other
 # workers ran at that moment (test-artifacts/<worker>/timeline.txt).
+# With the CPU seconds the test's processes took (the worker and everything below it):
+# the suite is bound by the cores on two of them, so that is what a slow test costs.
 def pytest_runtest_logstart(nodeid: str, location: tuple) -> None:
+    _cpu_at_start[nodeid] = _tree_cpu_seconds()
     _timeline(f"start {nodeid} load {os.getloadavg()[0]:.1f}")
 
 
 def pytest_runtest_logfinish(nodeid: str, location: tuple) -> None:
-    _timeline(f"end   {nodeid}")
+    before, now = _cpu_at_start.pop(nodeid, None), _tree_cpu_seconds()
+    cpu = f" cpu {now - before:.1f}" if before is not None and now is not None else ""
+    _timeline(f"end   {nodeid}{cpu}")
+
+
+_cpu_at_start: dict[str, float | None] = {}
+_TICKS = os.sysconf("SC_CLK_TCK")
+
+
+def _tree_cpu_seconds() -> float | None:
+    """CPU seconds taken so far by this process and every live one below it, with the
+    children each of them has reaped (their time is then counted in the reaper's); None
+    where /proc cannot be read. A process left to init's care is not counted."""
+    parent_of: dict[int, int] = {}
+    ticks: dict[int, int] = {}
+    try:
+        entries = [e.name for e in os.scandir("/proc") if e.name.isdigit()]
+    except OSError:
+        return None
+    for name in entries:
+        try:
+            with open(f"/proc/{name}/stat", "rb") as stat:
+                data = stat.read()
+            # After the command name (in parentheses, which may hold spaces): state, ppid,
+            # ... then utime, stime, cutime and cstime at 11-14.
+            fields = data[data.rindex(b")") + 2 :].split()
+            parent_of[int(name)] = int(fields[1])
+            ticks[int(name)] = sum(int(x) for x in fields[11:15])
+        except (OSError, ValueError, IndexError):
+            continue  # ended meanwhile
+    children: dict[int, list[int]] = {}
+    for pid, parent in parent_of.items():
+        children.setdefault(parent, []).append(pid)
+    total, todo = 0, [os.getpid()]
+    while todo:
+        pid = todo.pop()
+        total += ticks.get(pid, 0)
+        todo += children.get(pid, [])
+    return total / _TICKS
 
 
 def pytest_runtest_logreport(report: pytest.TestReport) -> None:
