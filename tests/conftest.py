@@ -18,6 +18,19 @@ from app.dds import configure_dds_env
 from bench import _reaper
 from tests import worker_plan
 
+# pytest keeps each test module with its asserts rewritten in __pycache__, unless Python
+# is told not to write bytecode (PYTHONDONTWRITEBYTECODE, set on this project's machines):
+# then each of tests/run.py's workers rewrote all ~380 modules at its start, 10 CPU-s
+# each. Allowed while collecting, in this process only (the programs tests start keep the
+# environment's setting); tests/run.py collects once ahead of the workers to fill it.
+_DONT_WRITE_BYTECODE = sys.dont_write_bytecode
+sys.dont_write_bytecode = False
+
+
+def pytest_collection_finish(session: pytest.Session) -> None:
+    sys.dont_write_bytecode = _DONT_WRITE_BYTECODE
+
+
 # One folder per xdist worker (tests/run.py): workers live in namespaces of
 # their own, so two of them may serve on the same port number and would write
 # the same dashboard-<port>.log.

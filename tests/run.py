@@ -132,9 +132,10 @@ def _another_run(proc: Path) -> bool:
     return theirs is not None and theirs.decode(errors="replace") != os.environ.get(NAMESPACES)
 
 
-def keep(command: list[str]) -> int:
+def keep(command: list[str], quiet: bool = False) -> int:
     """Run ``command`` in this namespace, then end everything it left; its exit code."""
-    child = subprocess.Popen(command)
+    out = subprocess.DEVNULL if quiet else None
+    child = subprocess.Popen(command, stdout=out, stderr=out)
 
     def forward(signum: int, _frame: object) -> None:
         if child.poll() is None:
@@ -192,17 +193,40 @@ def worker(python_args: list[str]) -> int:
     return 1  # not reached
 
 
-def pytest_command(args: list[str]) -> list[str]:
-    """pytest with ``--workers N`` (default DEFAULT_WORKERS) turned into xdist's workers."""
-    workers = DEFAULT_WORKERS
+def _take_workers(args: list[str]) -> tuple[int, list[str]]:
+    """``--workers N`` out of pytest's arguments: (N, or DEFAULT_WORKERS; the rest)."""
     if "--workers" in args[:-1]:
         at = args.index("--workers")
-        workers, args = int(args[at + 1]), [*args[:at], *args[at + 2 :]]
+        return int(args[at + 1]), [*args[:at], *args[at + 2 :]]
+    return DEFAULT_WORKERS, list(args)
+
+
+def pytest_command(args: list[str]) -> list[str]:
+    """pytest with ``--workers N`` (default DEFAULT_WORKERS) turned into xdist's workers."""
+    workers, args = _take_workers(args)
     command = [sys.executable, "-m", "pytest", *args]
     if workers <= 1:
         return command
     spawn = f"{workers}*popen//python={sys.executable} {Path(__file__).resolve()} --worker"
     return [*command, "--tx", spawn, "--dist", "loadscope"]  # scheduler: tests/worker_plan.py
+
+
+def collect_ahead(args: list[str], keeper: bool) -> None:
+    """Collect the tests once, in one process, before the workers start.
+
+    Every xdist worker collects the whole suite, and on a fresh clone each
+    rewrote the asserts of every test module (10 CPU-s a worker, seven workers
+    on two cores at once). One collection first leaves the rewritten modules in
+    __pycache__ (tests/conftest.py), and the workers read them. Whatever it
+    finds wrong, the run itself reports.
+    """
+    workers, rest = _take_workers(args)
+    if workers > 1:
+        command = [sys.executable, "-m", "pytest", *rest, "--collect-only", "-q"]
+        if keeper:
+            keep(command, quiet=True)
+        else:
+            subprocess.call(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
 
 def pytest_phases(args: list[str]) -> list[list[str]]:
@@ -214,10 +238,7 @@ def pytest_phases(args: list[str]) -> list[list[str]]:
     """
     if any(arg == "-m" or arg.startswith("-m") and not arg.startswith("--") for arg in args):
         return [pytest_command(args)]
-    alone = list(args)
-    if "--workers" in alone[:-1]:
-        at = alone.index("--workers")
-        del alone[at : at + 2]
+    _, alone = _take_workers(args)
     return [
         pytest_command([*args, "-m", f"not ({SECOND_PHASE})"]),
         pytest_command([*alone, "--workers", "1", "-m", SECOND_PHASE]),
@@ -288,9 +309,13 @@ def main() -> int:
     else:
         phases = pytest_phases(args)
         if not keeper:
+            collect_ahead(args, keeper=False)
             return run_phases(phases, keeper=False)
         with tempfile.NamedTemporaryFile("w", prefix="classroom-run-", suffix=".netns") as noted:
+            # First this run's own file: a run inside a run must not end the outer one's
+            # workers when its collection ends (it inherited the outer run's file).
             os.environ[NAMESPACES] = noted.name
+            collect_ahead(args, keeper=True)
             return run_phases(phases, keeper=True)
     if not keeper:
         os.execv(sys.executable, command)

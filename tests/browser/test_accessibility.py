@@ -16,7 +16,6 @@ from pathlib import Path
 import pytest
 from playwright.sync_api import Browser, Page, expect
 
-from app.lessons.schema import load_course
 from app.supervisor import Supervisor
 from tests.browser.helpers import (
     NEXT_OR_SKIP,
@@ -27,12 +26,13 @@ from tests.browser.helpers import (
     step_reads_top_down,
 )
 from tests.conftest import ARTIFACTS, DashboardProcess, fail_on_leftover_nodes, free_port
+from tests.course_data import shared_course
 from tests.outside_report import private_dds_env
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
 AXE = Path(__file__).parent / "axe" / "node_modules" / "axe-core" / "axe.min.js"
-COURSE = load_course()
+COURSE = shared_course()
 ZOOM_125 = {"viewport": {"width": 1093, "height": 614}, "device_scale_factor": 1.25}  # 1366x768
 # The steps with the most controls (buttons + answers + checks): they must fit too.
 CROWDED = [("20_workspaces_packages", 9), ("21_bags", 3), ("03_turtlesim_record_launch", 7)]

@@ -8,12 +8,12 @@ import signal
 
 from playwright.sync_api import Page, expect
 
-from app.exercises.model import load_exercises
 from tests.browser.helpers import choose, click, expect_editor_loaded, expect_text, open_tab
 from tests.browser.test_ros2_panels import expect_regex, field
 from tests.conftest import DashboardProcess, free_port
+from tests.course_data import shared_exercises
 
-EXERCISE = load_exercises().get("multiply_service")
+EXERCISE = shared_exercises().get("multiply_service")
 WRONG = (EXERCISE.path / "mistakes" / "adds.py").read_text(encoding="utf-8")
 
 

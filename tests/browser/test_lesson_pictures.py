@@ -5,11 +5,11 @@ from __future__ import annotations
 import pytest
 from playwright.sync_api import expect
 
-from app.lessons.schema import load_course
 from tests.browser.helpers import click_next, expect_text, go_to_step, open_tab
+from tests.course_data import shared_course
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
-COURSE = load_course()
+COURSE = shared_course()
 
 
 def _picture_steps():

@@ -10,7 +10,6 @@ import time
 import pytest
 from playwright.sync_api import Page, expect
 
-from app.lessons.schema import load_course
 from tests.browser.helpers import (
     NEXT_OR_SKIP,
     choose,
@@ -20,11 +19,12 @@ from tests.browser.helpers import (
     start_node,
 )
 from tests.conftest import ARTIFACTS
+from tests.course_data import shared_course
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
 SIZES = [(1366, 768), (1920, 1080)]
-COURSE = load_course()
+COURSE = shared_course()
 LAMP = "/tf_view/frames/lamp"  # the frame in the 3D view (its axes and name hang under it)
 # Drawn in the scene: the page holds its 3D object (a removed node's entry is null).
 _HAS_NODE = "(n) => !!(window.__viserMutable && window.__viserMutable.nodeRefFromName[n])"

@@ -7,7 +7,6 @@ import json
 import pytest
 from playwright.sync_api import expect
 
-from app.lessons.schema import load_course
 from tests.browser.helpers import (
     answer_quiz,
     click,
@@ -17,9 +16,10 @@ from tests.browser.helpers import (
     open_tab,
 )
 from tests.conftest import DashboardProcess, free_port
+from tests.course_data import shared_course
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
-COURSE = load_course()
+COURSE = shared_course()
 
 
 def complete_by_clicking(page, lesson, done_within_ms: int = 45_000) -> None:

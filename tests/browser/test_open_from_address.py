@@ -8,12 +8,11 @@ import re
 
 from playwright.sync_api import expect
 
-from app.exercises.model import load_exercises
-from app.lessons.schema import load_course
 from tests.browser.helpers import expect_text
+from tests.course_data import shared_course, shared_exercises
 
-LESSON = next(lesson for lesson in load_course().lessons if lesson.unit == 5)
-EXERCISE = load_exercises().get("wall_stop")
+LESSON = next(lesson for lesson in shared_course().lessons if lesson.unit == 5)
+EXERCISE = shared_exercises().get("wall_stop")
 
 
 def test_the_address_opens_a_lesson_or_an_exercise(browser, dashboard):

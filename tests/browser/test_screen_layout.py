@@ -7,7 +7,6 @@ from __future__ import annotations
 import pytest
 from playwright.sync_api import expect
 
-from app.lessons.schema import load_course
 from tests.browser.helpers import (
     NEXT_OR_SKIP,
     expect_text,
@@ -18,6 +17,7 @@ from tests.browser.helpers import (
 )
 from tests.browser.stage_layout import settled_layout, stage_fills
 from tests.conftest import ARTIFACTS
+from tests.course_data import shared_course
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
@@ -38,7 +38,7 @@ def test_the_stage_is_all_the_room_left_of_the_column_in_every_lesson(browser, d
         viewport={"width": width, "height": height}, device_scale_factor=zoom
     )
     page = context.new_page()
-    course = {lesson.id: lesson for lesson in load_course().lessons}
+    course = {lesson.id: lesson for lesson in shared_course().lessons}
     try:
         page.goto(dashboard.url)
         page.get_by_role("tab", name="Lessons").wait_for()
@@ -87,13 +87,13 @@ def test_the_webgl_notice_shows_once_per_browser(browser, dashboard):
 def test_the_first_screen_says_how_it_works_and_shows_the_dashboards_node(browser, dashboard, size):
     context = browser.new_context(viewport={"width": size[0], "height": size[1]})
     page = context.new_page()
-    first = load_course().lessons[0]
+    first = shared_course().lessons[0]
     try:
         page.goto(dashboard.url)
         page.get_by_role("tab", name="Lessons").wait_for()
         intro = page.get_by_text("shows what the current step is about").filter(visible=True)
         expect(intro).to_be_visible()
-        expect(page.get_by_text(f"Lesson 1 of {len(load_course().lessons)}")).to_be_visible()
+        expect(page.get_by_text(f"Lesson 1 of {len(shared_course().lessons)}")).to_be_visible()
         # Its check says the dashboard is on the graph: the stage draws it, not "nothing".
         expect_text(page, "pass: /classroom_dashboard is on the graph", timeout=30_000)
         own = page.locator('svg.stage-graph g.sg-vertex[data-name="/classroom_dashboard"]')

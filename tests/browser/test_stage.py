@@ -9,7 +9,6 @@ import time
 import pytest
 from playwright.sync_api import Page, expect
 
-from app.lessons.schema import load_course
 from app.stage import STAGES
 from tests.browser.helpers import (
     NEXT_OR_SKIP,
@@ -23,6 +22,7 @@ from tests.browser.helpers import (
 )
 from tests.browser.stage_layout import settled_layout, stage_fills
 from tests.conftest import ARTIFACTS, DashboardProcess, free_port, wait_until
+from tests.course_data import shared_course
 from tests.integration.core_helpers import DISCOVERY_TIMEOUT
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -40,7 +40,7 @@ def _open(browser, dashboard, size: tuple[int, int]) -> Page:
 
 def _open_lesson_ending(page: Page, suffix: str) -> None:
     """Open the lesson whose id ends with ``suffix`` (numbers change, names stay)."""
-    open_lesson(page, next(x for x in load_course().lessons if x.id.endswith(suffix)))
+    open_lesson(page, next(x for x in shared_course().lessons if x.id.endswith(suffix)))
 
 
 def _node_names(node) -> list[str]:
@@ -147,7 +147,7 @@ def test_every_lesson_puts_its_stage_on_and_the_learner_can_switch(browser, dash
     try:
         _wait_side_by_side(page, size)
         # The course as the dashboard loaded it (lessons are being written in this tree).
-        for lesson in load_course().lessons:
+        for lesson in shared_course().lessons:
             open_lesson(page, lesson)
             _wait_stage(page, lesson.steps[0].stage or lesson.stage)
             # The card reads top to bottom: title and text in view, the text before the
@@ -174,7 +174,7 @@ def test_every_step_in_course_order_puts_its_stage_on_with_its_text_in_view(
     step shows the stage its data names, filling the room left of the column; its title
     and text open in view, above its buttons; and every control is whole and uncovered."""
     page = _open(browser, dashboard, size)
-    lessons = load_course().lessons
+    lessons = shared_course().lessons
     wrong: list[str] = []
     try:
         open_lesson(page, lessons[0])
@@ -528,7 +528,7 @@ def test_the_bag_stage_shows_a_recording_as_it_ends(browser, ros_env, tmp_path):
 def test_the_code_stage_shows_what_the_lessons_node_prints(page):
     """Lesson 4: the node the step starts prints under its code, not 'Nothing has run yet';
     another lesson does not show it, and coming back to lesson 4 shows it again."""
-    lesson = next(les for les in load_course().lessons if les.id == "04_first_node")
+    lesson = next(les for les in shared_course().lessons if les.id == "04_first_node")
     open_lesson(page, lesson)
     _wait_stage(page, "code")
     click_next(page)  # step 2 starts the node
@@ -540,7 +540,7 @@ def test_the_code_stage_shows_what_the_lessons_node_prints(page):
         timeout=30_000
     )
     # Another lesson's code stage: what lesson 4 ran (still running) is not its output.
-    open_lesson(page, next(les for les in load_course().lessons if les.unit == 20))
+    open_lesson(page, next(les for les in shared_course().lessons if les.unit == 20))
     _wait_stage(page, "code")
     expect(page.get_by_text(re.compile("Nothing has run yet in this lesson"))).to_be_visible()
     expect(page.get_by_text(re.compile(r"^minimal_node · running"))).to_have_count(0)

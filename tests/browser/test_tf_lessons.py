@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import pytest
 
-from app.lessons.schema import load_course
 from tests.browser.helpers import expect_text, open_tab
 from tests.browser.test_lessons import complete_by_clicking
+from tests.course_data import shared_course
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
-COURSE = load_course()
+COURSE = shared_course()
 
 
 def test_complete_the_urdf_unit_by_clicking(page):

@@ -11,13 +11,13 @@ from pathlib import Path
 import pytest
 from playwright.sync_api import Page, expect
 
-from app.exercises.model import load_exercises
 from tests.bags.readers import mcap_messages
 from tests.browser.helpers import click, expect_text
 from tests.browser.replay_helpers import go_to_moments, grade_in_browser, newest_at
 from tests.conftest import ARTIFACTS, DashboardProcess, free_port
+from tests.course_data import shared_exercises
 
-EXERCISE = load_exercises().get("turtle_follower")
+EXERCISE = shared_exercises().get("turtle_follower")
 MISTAKE = next(m for m in EXERCISE.mistakes if m.path.stem == "inverted_lookup")
 
 

@@ -31,7 +31,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
 from app.exercises import runner
-from app.exercises.model import Exercise, load_exercises
+from app.exercises.model import Exercise
+from tests.course_data import shared_exercises
 from tests.exercises.cheats import EXEMPT, cheat_code
 
 BURN = "import time\nwhile True:\n    sum(i * i for i in range(10000)); time.sleep(0.001)\n"
@@ -100,7 +101,7 @@ def main() -> int:
     from app.supervisor import Supervisor
 
     configure_dds_env(os.environ, domain_id=60 + os.getpid() % 30, network=False)
-    book = load_exercises()
+    book = shared_exercises()
     exercises = [e for e in book.exercises if args.slugs is None or e.slug in args.slugs]
     burners = [
         subprocess.Popen([sys.executable, "-c", BURN], start_new_session=True)

@@ -26,14 +26,14 @@ from app.exercises.attempt_folders import (
 )
 from app.exercises.attempts import AttemptStore, keep_graded_code, next_attempt_path
 from app.exercises.grader import Grader
-from app.exercises.model import load_exercises
 from app.exercises.report import Report
 from tests.bags.readers import mcap_messages
 from tests.conftest import fail_on_leftover_nodes
+from tests.course_data import shared_exercises
 from tests.exercises.grading_participant import grading_participant
 
 SLUG = "multiply_service"
-EXERCISE = load_exercises().get(SLUG)
+EXERCISE = shared_exercises().get(SLUG)
 
 
 def _attempt(root: Path, slug: str, name: str, size: int = 10) -> Path:

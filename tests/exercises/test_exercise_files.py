@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 from app.exercises.lint import lint, refuses_to_run
-from app.exercises.model import load_exercises
+from tests.course_data import shared_exercises
 
-book = load_exercises()
+book = shared_exercises()
 
 
 def test_every_exercise_file_is_valid():

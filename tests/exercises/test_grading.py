@@ -19,17 +19,18 @@ import pytest
 from app.exercises import runner
 from app.exercises.attempts import AttemptStore
 from app.exercises.grader import Grader
-from app.exercises.model import Exercise, load_exercises
+from app.exercises.model import Exercise
 from app.exercises.package_grading import grade_package
 from app.exercises.report import Report
 from tests.bags.readers import mcap_messages
 from tests.conftest import fail_on_leftover_nodes
+from tests.course_data import shared_exercises
 from tests.exercises.cheats import EXEMPT, cheat_code
 from tests.exercises.grading_participant import grading_participant
 
 pytestmark = pytest.mark.ros  # each case runs a learner program over DDS
 
-BOOK = load_exercises()
+BOOK = shared_exercises()
 # Correct solutions written differently from the references: accepted/<slug>__<how>.py.
 ACCEPTED = Path(__file__).parent / "accepted"
 

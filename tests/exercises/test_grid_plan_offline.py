@@ -17,7 +17,6 @@ from pathlib import Path
 
 import pytest
 
-from app.exercises.model import load_exercises
 from app.exercises.probes.grid_plan import (
     Frame,
     Grid,
@@ -25,8 +24,9 @@ from app.exercises.probes.grid_plan import (
     judge_plan,
     shortest,
 )
+from tests.course_data import shared_exercises
 
-EXERCISE = load_exercises().get("grid_planner")
+EXERCISE = shared_exercises().get("grid_planner")
 PROBE = next(p for p in EXERCISE.probes if p.kind == "grid_plan")
 SEEDS = range(8)  # each mistake fails on every seed: 8 keep the suite quick
 

@@ -16,7 +16,6 @@ from pathlib import Path
 
 import pytest
 
-from app.exercises.model import load_exercises
 from app.exercises.probes.log_odds_map import (
     Frame,
     draw_task,
@@ -25,9 +24,10 @@ from app.exercises.probes.log_odds_map import (
     map_info,
     messages,
 )
+from tests.course_data import shared_exercises
 from tests.exercises.stand_in_node import load_solution, node_of
 
-EXERCISE = load_exercises().get("log_odds_mapper")
+EXERCISE = shared_exercises().get("log_odds_mapper")
 PROBE = next(p for p in EXERCISE.probes if p.kind == "log_odds_map")
 ACCEPTED = sorted((Path(__file__).parent / "accepted").glob("log_odds_mapper__*.py"))
 FRAME = Frame(

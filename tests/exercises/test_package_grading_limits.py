@@ -12,10 +12,10 @@ import pytest
 from app.containment.policy import RunPolicy
 from app.exercises import package_grading
 from app.exercises.grader import Grader
-from app.exercises.model import load_exercises
 from app.supervisor import Supervisor
+from tests.course_data import shared_exercises
 
-EXERCISE = load_exercises().get("package_doubler")
+EXERCISE = shared_exercises().get("package_doubler")
 
 
 @pytest.fixture

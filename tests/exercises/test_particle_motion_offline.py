@@ -19,7 +19,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.exercises.model import load_exercises
 from app.exercises.probes.particle_motion import (
     Motion,
     cloud_message,
@@ -29,9 +28,10 @@ from app.exercises.probes.particle_motion import (
     odom_message,
     poses_of,
 )
+from tests.course_data import shared_exercises
 from tests.exercises.stand_in_node import load_solution, node_of
 
-EXERCISE = load_exercises().get("particle_update")
+EXERCISE = shared_exercises().get("particle_update")
 PROBE = next(p for p in EXERCISE.probes if p.kind == "particle_motion")
 ACCEPTED = sorted((Path(__file__).parent / "accepted").glob("particle_update__*.py"))
 ALPHAS = PROBE["alphas"]

@@ -14,7 +14,6 @@ import random
 
 import pytest
 
-from app.exercises.model import load_exercises
 from app.exercises.probes.sim import (
     SILENT_DRIVE,
     Command,
@@ -41,8 +40,9 @@ from app.exercises.probes.sim_patrol import (
     world_grid,
 )
 from app.lessons.checks._sim_topics import world_map
+from tests.course_data import shared_exercises
 
-EXERCISE = load_exercises().get("patrol")
+EXERCISE = shared_exercises().get("patrol")
 PROBE = next(p for p in EXERCISE.probes if p.kind == "sim_patrol")
 ROUTE = [(1.0, 0.2), (2.5, -0.2), (1.5, 0.3)]
 TOL = 0.3

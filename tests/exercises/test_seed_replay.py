@@ -9,10 +9,10 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from app.exercises.model import load_exercises
 from tests.conftest import run_cli
+from tests.course_data import shared_exercises
 
-EXERCISE = load_exercises().get("running_sum")
+EXERCISE = shared_exercises().get("running_sum")
 MISTAKE = next(m for m in EXERCISE.mistakes if m.path.stem == "resets_total")
 FED = re.compile(r"published (\[[-0-9, ]+\])")
 

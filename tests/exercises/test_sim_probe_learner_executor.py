@@ -26,13 +26,13 @@ from random import Random
 
 import pytest
 
-from app.exercises.model import load_exercises
 from app.exercises.probes.base import ProbeContext
 from app.exercises.probes.sim import simulation
 from app.ros.context import CallContext, Limits
 from app.ros.errors import Ros2Error
 from app.ros.graph import snapshot
 from app.supervisor import LearnerProgram
+from tests.course_data import shared_exercises
 from tests.exercises.cheats import cheat_code
 
 LEARNERS = 3
@@ -48,7 +48,7 @@ JOIN_SEC = 30.0  # a fresh process on a loaded machine: import rclpy, join the g
 
 @pytest.mark.timeout(TRIALS_SEC + JOIN_SEC + 120)  # + starting the world, stopping it all
 def test_multithreaded_learners_outlive_many_simulation_trials(probe, supervisor, tmp_path):
-    exercise = next(e for e in load_exercises().exercises if e.slug == "wall_follower")
+    exercise = next(e for e in shared_exercises().exercises if e.slug == "wall_follower")
     source = cheat_code(exercise)
     assert "MultiThreadedExecutor()" in source
     script = tmp_path / "wall_follower.py"

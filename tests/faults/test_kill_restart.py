@@ -52,11 +52,10 @@ from app import PROJECT_ROOT
 from app.bags.errors import BagError
 from app.bags.info import read_info
 from app.bags.repair import reindex
-from app.exercises.model import load_exercises
 from app.lessons.panel import NEXT_LABEL
-from app.lessons.schema import load_course
 from tests.browser.helpers import EDITOR_TAKES_TYPING
 from tests.conftest import ARTIFACTS, DashboardProcess, free_port, wait_until
+from tests.course_data import shared_course, shared_exercises
 from tests.faults.helpers import live_children, record
 from tests.wire_client import WireClient, connect_quietly, frames_until_closed
 
@@ -120,7 +119,7 @@ class Course:
     """Lesson positions as one linear index, and the line the page shows for each."""
 
     def __init__(self) -> None:
-        self.lessons = load_course().lessons
+        self.lessons = shared_course().lessons
         self.starts: dict[str, int] = {}
         total = 0
         for lesson in self.lessons:
@@ -736,7 +735,7 @@ def test_twenty_sigkills_lose_nothing_and_leave_no_orphans(ros_env, probe, brows
     var = tmp_path / "var"
     course = Course()
     learner = Learner()
-    exercise = load_exercises().get(SLUG)
+    exercise = shared_exercises().get(SLUG)
     Round.reference = exercise.reference
     Round.exercise_label = f"{exercise.unit:02d} · {exercise.title}"
     kills: list[dict[str, Any]] = []

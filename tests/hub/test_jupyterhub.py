@@ -27,7 +27,6 @@ import pytest
 from playwright.sync_api import Browser, BrowserContext, Page, expect
 
 from app.dds import configure_dds_env
-from app.lessons.schema import load_course
 from app.teacher.http_report import to_json
 from app.teacher.record import COLUMNS, LearnerRecord
 from tests.browser.helpers import (
@@ -41,6 +40,7 @@ from tests.browser.helpers import (
 )
 from tests.browser.test_exercise import EXERCISE, _open_editor
 from tests.conftest import ARTIFACTS, fail_on_leftover_nodes, in_private_netns, wait_until
+from tests.course_data import shared_course
 from tests.hub.local_hub import PASSWORD, LocalHub
 
 # A watchdog, not a budget: the first test also spawns three learners' servers, which
@@ -237,7 +237,7 @@ def _type_code(page: Page, frame_locator, code: str) -> None:
 def test_each_learner_passes_a_lesson_step_and_an_exercise(hub, room):
     teacher = room.teacher
     assert teacher is not None
-    lesson = load_course().lessons[0]
+    lesson = shared_course().lessons[0]
     for user in LEARNERS:
         page = room.classrooms[user]
         open_tab(page, "Lessons")

@@ -25,14 +25,14 @@ import pytest
 from playwright.sync_api import expect
 
 from app import PROJECT_ROOT
-from app.exercises.model import load_exercises
 from tests.browser.helpers import choose, expect_editor_loaded, expect_text, open_tab, start_node
 from tests.conftest import ARTIFACTS, free_port, wait_until
+from tests.course_data import shared_exercises
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
 JUPYTER_TOKEN = "hub-test-token-0123456789"
-EXERCISE = load_exercises().get("multiply_service")
+EXERCISE = shared_exercises().get("multiply_service")
 
 
 class JupyterServer:

@@ -14,9 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from app.exercises.model import load_exercises
-from app.lessons.schema import load_course
 from tests.conftest import wait_until
+from tests.course_data import shared_course, shared_exercises
 from tests.wire_client import NEXT_OR_SKIP, WireClient
 
 pytestmark = pytest.mark.ros
@@ -29,7 +28,7 @@ REFRESHES_SEC = 3.0  # the Exercise tool refreshes once a second while idle
 @pytest.fixture
 def progress_dir(tmp_path) -> Path:
     """The learner is on the last step of lesson 4."""
-    course = load_course()
+    course = shared_course()
     steps = len(course.lesson(FROM).steps)  # type: ignore[union-attr]
     folder = tmp_path / "progress"
     folder.mkdir()
@@ -41,7 +40,7 @@ def progress_dir(tmp_path) -> Path:
     return folder
 
 
-BOOK = load_exercises()
+BOOK = shared_exercises()
 
 
 def _label(slug: str) -> str:
@@ -50,7 +49,7 @@ def _label(slug: str) -> str:
 
 
 def test_a_pick_made_just_after_next_is_kept(dashboard):
-    course = load_course()
+    course = shared_course()
     number = [lesson.id for lesson in course.lessons].index(INTO) + 1
     opened = f"Lesson {number} of {len(course.lessons)} · Step 1 of"
     first_of_into = BOOK.for_lesson(INTO)[0].slug

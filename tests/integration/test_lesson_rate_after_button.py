@@ -19,16 +19,16 @@ import time
 import pytest
 
 from app.lessons.runtime import PASS, WAITING, LessonRuntime
-from app.lessons.schema import load_course
 from app.ros.graph import snapshot
 from tests.conftest import wait_until
+from tests.course_data import shared_course
 
 pytestmark = pytest.mark.ros
 RATE = re.compile(r"at ([\d.]+) Hz over")
 
 
 def test_the_rate_after_the_button_is_the_new_one_only(probe, supervisor):
-    lesson = next(each for each in load_course().lessons if each.id == "10_parameters")
+    lesson = next(each for each in shared_course().lessons if each.id == "10_parameters")
     change, measure = lesson.steps[1], lesson.steps[2]
     (button,) = change.actions
     (check,) = measure.checks

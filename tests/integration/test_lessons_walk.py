@@ -19,14 +19,15 @@ from app.learner_ws import overlay
 from app.lessons.checks._sim_speed import SimSpeedWatch
 from app.lessons.kinds import CHECK_KINDS
 from app.lessons.runtime import FAIL, PASS, LessonRuntime
-from app.lessons.schema import Spec, load_course
+from app.lessons.schema import Spec
 from app.ros.context import CONSOLE_LIMITS, CallContext
 from app.ros.graph import snapshot
 from app.ros2cli import run_text
 from tests.conftest import wait_until
+from tests.course_data import shared_course
 
 pytestmark = pytest.mark.ros
-COURSE = load_course()
+COURSE = shared_course()
 
 
 @pytest.fixture

@@ -16,7 +16,6 @@ from pathlib import Path
 import pytest
 
 from app.containment.policy import RunPolicy
-from app.exercises.model import load_exercises
 from app.exercises.package_grading import grade_learner_package
 from app.learner_ws import build, folder, overlay
 from app.learner_ws.folder import LearnerWorkspace, OutsideWorkspace
@@ -29,6 +28,7 @@ from app.ros.graph import GraphSnapshot
 from app.ros2cli import run_text
 from app.ros2cli.pkg import setup_workspace
 from app.supervisor import Supervisor
+from tests.course_data import shared_exercises
 
 
 @dataclass
@@ -161,7 +161,7 @@ def test_without_a_learner_workspace_the_checks_fail_with_a_reason(ws):
 
 
 def test_check_button_without_the_package_says_how_to_create_it(ws):
-    exercise = load_exercises().get("package_doubler")
+    exercise = shared_exercises().get("package_doubler")
     report = grade_learner_package(None, exercise, Path("/nonexistent"), RunPolicy())  # type: ignore[arg-type]
     assert not report.passed
     assert "no package py_doubler in ~/ros2_ws/src" in report.problem
@@ -215,7 +215,7 @@ def test_check_button_builds_the_package_of_that_name_in_the_learners_src(ws, tm
     from app.exercises.grader import Grader
 
     workspace, rt, _console = ws
-    exercise = load_exercises().get("package_adder")
+    exercise = shared_exercises().get("package_adder")
     broken = next(m.path for m in exercise.mistakes if m.path.parent.name == "setup_syntax_error")
     shutil.copytree(broken, workspace.src / "py_adder")
     grader = Grader(None, rt.supervisor)  # type: ignore[arg-type]  (the build fails first)

@@ -31,6 +31,7 @@ from app.lti.learners import hub_user_name
 from app.lti.registration import load_registrations
 from app.lti.tool import PLATFORMS_FILE
 from app.teacher.record import LearnerRecord
+from tests.course_data import shared_course, shared_exercises
 from tests.lti.platform import CLIENT_ID, DEPLOYMENT_ID, TestPlatform
 from tests.lti.service import (
     PREFIX,
@@ -464,11 +465,9 @@ def test_the_jwks_url_serves_the_key_that_signs_the_tools_answers(
 
 def test_the_picker_lists_exactly_what_the_course_loaders_load() -> None:
     # The loaders check lessons against the ROS layer, so this imports it (no ROS runs).
-    from app.exercises.model import load_exercises
-    from app.lessons.schema import load_course
 
     listed = [(a.kind, a.slug) for a in course_activities()]
-    course, book = load_course(), load_exercises()
+    course, book = shared_course(), shared_exercises()
     assert sorted(s for k, s in listed if k == "lesson") == sorted(
         lesson.id for lesson in course.lessons
     )

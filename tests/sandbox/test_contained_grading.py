@@ -8,12 +8,12 @@ import pytest
 from app.containment.policy import RunPolicy, RunRefused
 from app.exercises import runner
 from app.exercises.grader import Grader
-from app.exercises.model import load_exercises
+from tests.course_data import shared_exercises
 from tests.sandbox.conftest import Classroom
 
 pytestmark = pytest.mark.ros
 
-EXERCISE = load_exercises().get("multiply_service")
+EXERCISE = shared_exercises().get("multiply_service")
 
 
 def test_reference_passes_contained_and_a_wrong_one_fails(classroom: Classroom, probe, supervisor):

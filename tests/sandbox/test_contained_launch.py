@@ -14,10 +14,10 @@ import pytest
 from app.containment.policy import RunPolicy, RunRefused
 from app.containment.sandbox import sandbox_available
 from app.exercises import runner
-from app.exercises.model import load_exercises
 from app.launch_prefix import LaunchRefused, find_launch_file, launch_program
+from tests.course_data import shared_exercises
 
-EXERCISE = load_exercises().get("launch_pair")
+EXERCISE = shared_exercises().get("launch_pair")
 
 
 def test_a_learners_launch_file_is_contained_when_served_to_others(tmp_path: Path):

@@ -16,10 +16,10 @@ import threading
 import pytest
 
 from app.lessons.runtime import PASS
-from app.lessons.schema import load_course
 from app.ros.context import CONSOLE_LIMITS, CallContext
 from app.ros2cli import run_text
 from tests.conftest import wait_until
+from tests.course_data import shared_course
 from tests.sim.test_sim_speed_under_load import lessons  # noqa: F401 (a fixture)
 
 pytestmark = [pytest.mark.ros, pytest.mark.loaded]
@@ -32,7 +32,7 @@ def test_drive_steps_pass_on_a_world_slower_than_real_time_and_say_so(
     supervisor,
     busy_cores,
 ):
-    course = load_course()
+    course = shared_course()
     lesson = next(each for each in course.lessons if each.id == "19_wheeled_robot")
     commands: list[tuple[CallContext, threading.Thread]] = []
 

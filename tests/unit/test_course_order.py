@@ -9,6 +9,7 @@ from __future__ import annotations
 import shutil
 
 from app.lessons.schema import LESSONS_DIR, load_course
+from tests.course_data import shared_course
 
 COURSE_ORDER = [
     "01_ros2_and_dds", "02_turtlesim_cli", "03_turtlesim_record_launch", "04_first_node",
@@ -26,7 +27,7 @@ LONG_ON_PURPOSE = {"20_workspaces_packages"}
 
 
 def test_lessons_are_numbered_one_to_n_in_course_order_with_the_capstone_last():
-    course = load_course()
+    course = shared_course()
     assert not course.errors
     assert [lesson.id for lesson in course.lessons] == COURSE_ORDER
     assert [lesson.unit for lesson in course.lessons] == list(range(1, len(COURSE_ORDER) + 1))
@@ -38,7 +39,7 @@ def test_lessons_are_numbered_one_to_n_in_course_order_with_the_capstone_last():
 def test_no_lesson_is_too_long_to_follow():
     long = {
         lesson.id: len(lesson.steps)
-        for lesson in load_course().lessons
+        for lesson in shared_course().lessons
         if len(lesson.steps) > MOST_STEPS
     }
     assert set(long) == LONG_ON_PURPOSE, long

@@ -5,12 +5,12 @@ from __future__ import annotations
 import pytest
 
 from app.exercises.mistakes import matched_mistake
-from app.exercises.model import load_exercises
 from app.exercises.report import Report, Result
 from app.exercises.workspace import Workspace
 from app.lessons.progress import ProgressStore
+from tests.course_data import shared_exercises
 
-BOOK = load_exercises()
+BOOK = shared_exercises()
 WALL_STOP = BOOK.get("wall_stop")  # mistakes: front_is_index_zero, publish_on_change
 PACKAGE = BOOK.get("package_adder")  # mistakes are package folders: wrong_module/py_adder
 

@@ -9,12 +9,12 @@ import pytest
 from app.exercises import runner
 from app.exercises.editor_server import PREFIX, _file_for
 from app.exercises.lint import lint, refuses_to_run
-from app.exercises.model import load_exercises
 from app.exercises.workspace import CodeTooLong, Workspace
 from app.lessons.progress import ProgressStore
 from tests.conftest import run_cli
+from tests.course_data import shared_exercises
 
-EXERCISE = load_exercises().get("multiply_service")
+EXERCISE = shared_exercises().get("multiply_service")
 
 
 @pytest.fixture

@@ -13,10 +13,11 @@ except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib
 
 from app.lessons.schema import LESSONS_DIR, LessonError, load_course, load_lesson
+from tests.course_data import shared_course
 
 
 def test_the_course_loads_without_errors():
-    course = load_course()
+    course = shared_course()
     assert course.errors == ()
     assert len(course.lessons) >= 2
     units = [lesson.unit for lesson in course.lessons]

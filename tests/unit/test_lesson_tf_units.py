@@ -7,13 +7,14 @@ from __future__ import annotations
 import pytest
 
 from app.lessons.kinds import CHECK_KINDS
-from app.lessons.schema import LessonError, load_course, parse_spec
+from app.lessons.schema import LessonError, parse_spec
+from tests.course_data import shared_course
 
 TF_KINDS = {"tf_frame", "tf_transform", "tf_moves", "tf_late_joiner"}
 
 
 def test_the_units_use_every_tf_check_kind():
-    course = load_course()
+    course = shared_course()
     used = {
         check.kind
         for lesson_id in ("16_tf2_turtlesim", "17_tf2_time", "18_urdf_robot")

@@ -9,13 +9,14 @@ from __future__ import annotations
 import pytest
 
 from app.lessons.kinds import CHECK_KINDS
-from app.lessons.schema import LessonError, load_course, parse_spec
+from app.lessons.schema import LessonError, parse_spec
+from tests.course_data import shared_course
 
 POSE = "turtlesim/msg/Pose"
 
 
 def test_the_turtlesim_lessons_use_the_new_kinds():
-    course = load_course()
+    course = shared_course()
     kinds = {
         check.kind
         for lesson_id in ("02_turtlesim_cli", "03_turtlesim_record_launch")

@@ -4,9 +4,9 @@ of checks not passed, or the course's end (where it leads nowhere)."""
 from __future__ import annotations
 
 from app.lessons.panel import COURSE_END, _next_label
-from app.lessons.schema import load_course
+from tests.course_data import shared_course
 
-COURSE = load_course()
+COURSE = shared_course()
 
 
 def test_next_names_the_lesson_it_opens_on_a_lessons_last_step():

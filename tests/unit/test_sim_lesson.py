@@ -23,13 +23,14 @@ from app.lessons.checks._world_map import (
     load_world_map,
 )
 from app.lessons.kinds import CHECK_KINDS
-from app.lessons.schema import LessonError, load_course, parse_spec
+from app.lessons.schema import LessonError, parse_spec
+from tests.course_data import shared_course
 
 SIM_KINDS = {"robot_moved", "odom_drift", "scan_nearest", "sim_time_stamps", "sim_paused"}
 
 
 def test_the_unit_uses_every_simulation_check_kind():
-    lesson = load_course().lesson("19_wheeled_robot")
+    lesson = shared_course().lesson("19_wheeled_robot")
     assert lesson is not None
     used = {check.kind for step in lesson.steps for check in step.checks}
     assert SIM_KINDS <= used and SIM_KINDS <= set(CHECK_KINDS)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from app.lessons.schema import LESSONS_DIR, LessonError, load_course, load_lesson
+from app.lessons.schema import LESSONS_DIR, LessonError, load_lesson
 from app.panels.graph_svg import Edge, Vertex, graph_picture, topics_to_measure
 from app.ros.graph import NodeEndpoints
 from app.stage import DEFAULT_STAGE, STAGES
@@ -22,10 +22,11 @@ from app.stage.graph_view import (
     dot_timing,
     stage_svg,
 )
+from tests.course_data import shared_course
 
 
 def test_every_lesson_names_a_known_stage():
-    course = load_course()
+    course = shared_course()
     assert course.errors == ()
     for lesson in course.lessons:
         text = (lesson.path / "lesson.toml").read_text(encoding="utf-8")

@@ -15,11 +15,12 @@ import pytest
 from app import PROJECT_ROOT
 from app.lessons.panel import LessonsPanel, picture_html
 from app.lessons.progress import ProgressStore
-from app.lessons.schema import LESSONS_DIR, STATIC_DIR, LessonError, load_course, load_lesson
+from app.lessons.schema import LESSONS_DIR, STATIC_DIR, LessonError, load_lesson
 from app.ui.loop import UiLoop
+from tests.course_data import shared_course
 from tests.unit.fake_gui import FakeGui, FakeHandle, drain
 
-COURSE = load_course()
+COURSE = shared_course()
 IMAGE_STEPS = [
     (lesson, index, step)
     for lesson in COURSE.lessons

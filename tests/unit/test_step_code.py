@@ -7,7 +7,8 @@ import pytest
 from app.learner_ws import folder
 from app.learner_ws.folder import LearnerWorkspace
 from app.lessons import step_code
-from app.lessons.schema import LessonError, _code_list, load_course
+from app.lessons.schema import LessonError, _code_list
+from tests.course_data import shared_course
 
 
 @pytest.fixture
@@ -19,7 +20,7 @@ def workspace(tmp_path):
 
 
 def _step(lesson_id: str, title: str):
-    lesson = next(x for x in load_course().lessons if x.id == lesson_id)
+    lesson = next(x for x in shared_course().lessons if x.id == lesson_id)
     return lesson, next(s for s in lesson.steps if s.title == title)
 
 
