@@ -16,7 +16,7 @@ import pytest
 from app import PROJECT_ROOT
 from app.dds import configure_dds_env
 from bench import _reaper
-from tests import worker_plan
+from tests import heavy_slots, worker_plan
 
 # pytest keeps each test module with its asserts rewritten in __pycache__, unless Python
 # is told not to write bytecode (PYTHONDONTWRITEBYTECODE, set on this project's machines):
@@ -247,6 +247,21 @@ def page(browser, dashboard, request):
 def pytest_xdist_make_scheduler(config: pytest.Config, log: object) -> object:
     """tests/run.py's workers share the tests as tests/worker_plan.py says."""
     return worker_plan.make_scheduler(config, log)
+
+
+_HEAVY_SLOTS = heavy_slots.for_this_worker()
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> Iterator[None]:
+    """A test that keeps a core busy waits for one of the run's slots (tests/heavy_slots.py)."""
+    waited = _HEAVY_SLOTS.before(item)
+    if waited >= 1:
+        _timeline(f"waited {waited:.0f} s for a core's slot: {item.nodeid}")
+    try:
+        return (yield)
+    finally:
+        _HEAVY_SLOTS.after(item, nextitem)
 
 
 # Tests that take the cores on purpose (to prove a check holds on a slow

@@ -24,7 +24,7 @@ from types import FrameType
 from typing import Any, TypeVar
 
 import rclpy
-from rclpy.exceptions import InvalidHandle
+from rclpy.exceptions import InvalidHandle, NotInitializedException
 from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
@@ -87,9 +87,9 @@ def stopped_quietly() -> Iterator[None]:
     rclpy's signal thread shuts the context down while the main thread may be
     inside any ROS call: spinning (ExternalShutdownException), publishing or
     waiting for a server (RCLError: "context is invalid"), creating an entity
-    (ValueError), using one already destroyed (InvalidHandle), or starting to
-    spin (AttributeError: the global executor is gone). With ROS still up,
-    those are real errors and go on.
+    (ValueError) or a node (NotInitializedException), using one already
+    destroyed (InvalidHandle), or starting to spin (AttributeError: the global
+    executor is gone). With ROS still up, those are real errors and go on.
     """
     global _ending
     try:
@@ -102,6 +102,13 @@ def stopped_quietly() -> Iterator[None]:
         # this clause (seen: view_frames stopped while creating its node).
         _ending = True
         if rclpy.ok():
+            raise
+    except NotInitializedException:
+        # A node made after the signal shut the context down (seen: planner_server's
+        # costmap making its tf listener's node, SIGTERM during start-up). A program that
+        # never called rclpy.init() has no context handle: that error goes on.
+        _ending = True
+        if rclpy.ok() or rclpy.get_default_context().handle is None:
             raise
     except AttributeError as exc:
         # rclpy.spin(node) just after the signal shut the context down: rclpy's global

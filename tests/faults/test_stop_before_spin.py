@@ -4,6 +4,9 @@
   context down; a program that then calls ``rclpy.spin(node)`` finds rclpy's
   global executor already reset to None (a CI run: amcl printed two
   AttributeErrors on SIGTERM and exited 1).
+- While a program makes a second node (planner_server's costmap makes one for
+  its tf listener; a rehearsal, ci70): the shutdown makes rclpy refuse it with
+  NotInitializedException.
 - After tf2_monitor has made its spinning thread and before it has started
   it (a rehearsal, ci44): its clean-up joined a thread never started and
   printed "cannot join thread before it is started".
@@ -45,6 +48,28 @@ run_program(main)
 """
 
 
+# The shutdown lands as the second node is made; a program that never called rclpy.init()
+# still gets its error (NEVER_INITIALIZED, below).
+SECOND_NODE = """
+import rclpy
+from nodes.common.run import run_program
+
+def main():
+    rclpy.init()
+    first = rclpy.create_node("first_node")
+    rclpy.get_default_context().shutdown()  # what rclpy's signal handler does
+    rclpy.create_node("costmap_listener")
+
+run_program(main)
+"""
+NEVER_INITIALIZED = """
+import rclpy
+from nodes.common.run import run_program
+
+run_program(lambda: rclpy.create_node("too_early"))
+"""
+
+
 # The signal, landing exactly there: the spinner's start raises what SIGTERM raises.
 TF2_MONITOR_STOPPED_BEFORE_ITS_SPINNER_STARTS = """
 import sys, threading
@@ -64,8 +89,12 @@ sys.exit(tf2_monitor.main(["tf2_monitor"]))
 
 @pytest.mark.parametrize(
     "program",
-    [PROGRAM, TF2_MONITOR_STOPPED_BEFORE_ITS_SPINNER_STARTS],
-    ids=["shutdown_just_before_spin", "tf2_monitor_before_its_spinner_starts"],
+    [PROGRAM, SECOND_NODE, TF2_MONITOR_STOPPED_BEFORE_ITS_SPINNER_STARTS],
+    ids=[
+        "shutdown_just_before_spin",
+        "shutdown_as_a_second_node_is_made",
+        "tf2_monitor_before_its_spinner_starts",
+    ],
 )
 def test_a_stop_at_an_awkward_moment_ends_quietly(ros_env, program):
     done = subprocess.run(
@@ -79,3 +108,16 @@ def test_a_stop_at_an_awkward_moment_ends_quietly(ros_env, program):
     output = done.stdout + done.stderr
     assert "Traceback" not in output, output
     assert done.returncode == 0, output
+
+
+def test_a_program_that_never_started_ros_still_gets_its_error(ros_env):
+    done = subprocess.run(
+        [sys.executable, "-c", NEVER_INITIALIZED],
+        env=ros_env,
+        cwd=PROJECT_ROOT,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode != 0
+    assert "NotInitializedException" in done.stderr, done.stderr

@@ -1,0 +1,120 @@
+"""No more tests that each take a whole core at once than the machine has cores.
+
+tests/run.py's workers share the tests (tests/worker_plan.py), and three of
+them may take any test. On a machine half as fast as the one the plan was
+measured on, three such tests at once (two patrol gradings, each with a
+MuJoCo world and Nav2, beside a browser test with a world of its own) held
+the load at 26 on two cores, and the page answered no click for 30 s
+(rehearsal ci70; the CI run of 9043cb1 failed nine browser tests so).
+
+So a test that keeps about a core busy for most of its time (``is_heavy``:
+a Chromium, a simulated world, a busy grading, or a module measured so)
+first takes one of ``os.cpu_count()`` slots: a lock on a file named after the
+run's namespaces file (tests/run.py), which every worker of the run shares.
+A worker whose next test is heavy waits for a slot; the cores are full then
+anyway. The kernel drops the lock when a worker dies, so a crash frees its
+slot. A run with one worker, or pytest by hand, has nothing to share.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import os
+import time
+from collections.abc import Callable
+from typing import IO, Any
+
+from tests.run import NAMESPACES  # one file per run, named by its keeper
+from tests.worker_plan import busy_cases, unit_of
+
+# Measured (rehearsal ci70, 2 cores, a worker's process tree): these keep 0.6-1.3 of a
+# core busy over their wall time.
+HEAVY_MODULES = (
+    "tests/exercises/test_sim_probe_learner_executor.py",
+    "tests/faults/test_outside_clients.py",
+    "tests/faults/test_sigterm_stops.py",
+    "tests/faults/test_start_stop_cycles.py",
+    "tests/faults/test_viser_threads.py",
+    "tests/faults/test_load.py",
+    "tests/hub/",
+    "tests/nav/test_amcl_dds.py",
+    "tests/nav/test_mapping_dds.py",
+    "tests/nav/test_nav_stack_dds.py",
+    "tests/nav/test_navigation_dds.py",
+    "tests/nav/test_obstacles_dds.py",
+    "tests/nav/test_waypoint_follower_dds.py",
+    "tests/sim/test_sim_physics.py",
+    "tests/sim/test_sim_world_ros.py",
+)
+# Modules whose tests each grade an exercise or walk a lesson; a busy one takes a core.
+CASE_MODULES = ("tests/exercises/test_grading.py", "tests/integration/test_lessons_walk.py")
+POLL_S = 0.5
+
+
+def is_heavy(nodeid: str, fixturenames: Any, busy: frozenset[str] | set[str]) -> bool:
+    """Whether the test keeps about a core busy: it drives a Chromium, is in
+    HEAVY_MODULES, or grades or walks a ``busy`` case (tests/worker_plan.py)."""
+    if "browser" in fixturenames:
+        return True
+    module, _, name = nodeid.partition("::")
+    if module.startswith(HEAVY_MODULES):
+        return True
+    case = name.partition("[")[2].rstrip("]")
+    return module in CASE_MODULES and any(
+        case == item or case.startswith(f"{item}-") for item in busy
+    )
+
+
+def slot_files(run_file: str, cores: int) -> list[str]:
+    return [f"{run_file}.heavy{number}" for number in range(max(1, cores))]
+
+
+def take_slot(paths: list[str], sleep: Callable[[float], None] = time.sleep) -> IO[str]:
+    """The first of ``paths`` this process can lock, waiting until one is free."""
+    while True:
+        for path in paths:
+            handle = open(path, "a", encoding="ascii")  # held until released
+            try:
+                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                return handle
+            except BlockingIOError:
+                handle.close()
+        sleep(POLL_S)
+
+
+class HeavySlots:
+    """One worker's side of the run's slots: taken before a heavy test, kept while
+    the next test is heavy and of the same unit (a module-scoped world lives on
+    between them), given back otherwise."""
+
+    def __init__(self, run_file: str | None, cores: int | None = None):
+        self.paths = slot_files(run_file, cores or os.cpu_count() or 1) if run_file else []
+        self.busy = frozenset(busy_cases())
+        self.held: IO[str] | None = None
+
+    def heavy(self, item: Any) -> bool:
+        return bool(self.paths) and is_heavy(item.nodeid, item.fixturenames, self.busy)
+
+    def before(self, item: Any) -> float:
+        """Take a slot for ``item`` if it is heavy; the seconds waited for it."""
+        if self.held is not None or not self.heavy(item):
+            return 0.0
+        began = time.monotonic()
+        self.held = take_slot(self.paths)
+        return time.monotonic() - began
+
+    def after(self, item: Any, nextitem: Any) -> None:
+        keep = (
+            nextitem is not None
+            and self.heavy(nextitem)
+            and unit_of(nextitem.nodeid) == unit_of(item.nodeid)
+        )
+        if self.held is not None and not keep:
+            self.held.close()  # closing the file drops the lock
+            self.held = None
+
+
+def for_this_worker() -> HeavySlots:
+    """The slots of the run this xdist worker belongs to; none outside a run's workers."""
+    shared = os.environ.get("PYTEST_XDIST_WORKER") and os.environ.get(NAMESPACES)
+    return HeavySlots(shared or None)

@@ -1,0 +1,118 @@
+"""The run's slots for tests that each keep a core busy (tests/heavy_slots.py)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from types import SimpleNamespace
+
+import pytest
+
+from app import PROJECT_ROOT
+from tests.heavy_slots import HEAVY_MODULES, HeavySlots, is_heavy, slot_files, take_slot
+
+BUSY = frozenset({"patrol", "24_navigation"})
+
+
+class Waited(Exception):
+    """take_slot would have slept: every slot was taken."""
+
+
+def _refuse_to_wait(_seconds: float) -> None:
+    raise Waited
+
+
+def _item(nodeid: str, fixtures: tuple[str, ...] = ()) -> SimpleNamespace:
+    return SimpleNamespace(nodeid=nodeid, fixturenames=fixtures)
+
+
+@pytest.mark.parametrize(
+    ("nodeid", "fixtures", "heavy"),
+    [
+        ("tests/lti/test_gradebook.py::test_a", ("page", "browser", "dashboard"), True),
+        ("tests/lti/test_gradebook.py::test_b", ("dashboard",), False),
+        ("tests/exercises/test_grading.py::test_grading[patrol-reference]", (), True),
+        ("tests/exercises/test_grading.py::test_grading[patrol_x-reference]", (), False),
+        ("tests/exercises/test_grading.py::test_grading[talker-reference]", (), False),
+        ("tests/integration/test_lessons_walk.py::test_walk[24_navigation]", (), True),
+        ("tests/hub/test_lean_hub.py::test_x", (), True),
+        ("tests/nav/test_nav2_bringup_dds.py::test_x", (), False),
+        ("tests/unit/test_cli.py::test_x", (), False),
+    ],
+)
+def test_what_keeps_a_core_busy_is_heavy(nodeid, fixtures, heavy):
+    assert is_heavy(nodeid, fixtures, BUSY) is heavy
+
+
+def test_every_heavy_module_or_folder_exists():
+    # A renamed module would silently run beside the others again.
+    missing = [path for path in HEAVY_MODULES if not (PROJECT_ROOT / path).exists()]
+    assert not missing, missing
+
+
+def test_a_slot_is_taken_once_and_free_again_when_given_back(tmp_path):
+    paths = slot_files(str(tmp_path / "run.netns"), cores=2)
+    first, second = take_slot(paths), take_slot(paths)
+    with pytest.raises(Waited):
+        take_slot(paths, sleep=_refuse_to_wait)
+    second.close()
+    third = take_slot(paths, sleep=_refuse_to_wait)
+    assert third.name == second.name
+    first.close()
+    third.close()
+
+
+def test_a_worker_that_dies_frees_its_slot(tmp_path):
+    paths = slot_files(str(tmp_path / "run.netns"), cores=1)
+    holder = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import sys, time; from tests.heavy_slots import take_slot;"
+            f" slot = take_slot({paths!r}); print('held', flush=True); time.sleep(60)",
+        ],
+        cwd=PROJECT_ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    try:
+        assert holder.stdout.readline().strip() == "held", holder.communicate(timeout=10)
+        with pytest.raises(Waited):
+            take_slot(paths, sleep=_refuse_to_wait)
+        holder.kill()
+        holder.wait(timeout=10)
+        take_slot(paths, sleep=_refuse_to_wait).close()
+    finally:
+        holder.kill()
+        holder.wait(timeout=10)
+
+
+def test_a_slot_is_kept_through_a_one_worker_module_and_given_back_after_it(tmp_path):
+    slots = HeavySlots(str(tmp_path / "run.netns"), cores=1)
+    world = "tests/sim/test_sim_physics.py"  # one worker runs it whole (tests/worker_plan.py)
+    first, second = _item(f"{world}::test_a"), _item(f"{world}::test_b")
+    light = _item("tests/unit/test_cli.py::test_x")
+    slots.before(first)
+    slots.after(first, second)
+    with pytest.raises(Waited):  # the world lives on between its tests: the slot stays taken
+        take_slot(slots.paths, sleep=_refuse_to_wait)
+    assert slots.before(second) == 0.0
+    slots.after(second, light)
+    take_slot(slots.paths, sleep=_refuse_to_wait).close()
+    assert slots.before(light) == 0.0 and slots.held is None
+
+
+def test_two_tests_shared_out_one_by_one_each_take_the_slot_again(tmp_path):
+    slots = HeavySlots(str(tmp_path / "run.netns"), cores=1)
+    first = _item("tests/browser/test_x.py::test_a", ("browser",))
+    second = _item("tests/browser/test_x.py::test_b", ("browser",))
+    slots.before(first)
+    slots.after(first, second)  # another worker may take it meanwhile
+    take_slot(slots.paths, sleep=_refuse_to_wait).close()
+
+
+def test_outside_a_run_nothing_is_shared():
+    slots = HeavySlots(None)
+    assert slots.before(_item("tests/browser/test_x.py::test_a", ("browser",))) == 0.0
+    assert slots.held is None
