@@ -236,7 +236,9 @@ def browser():
 def page(browser, dashboard, request):
     context = browser.new_context(viewport={"width": 1400, "height": 900})
     page = context.new_page()
-    page.goto(dashboard.url)
+    from tests.browser.helpers import open_page  # playwright: imported by browser tests only
+
+    open_page(page, dashboard.url)
     yield page
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     page.screenshot(path=str(ARTIFACTS / f"{request.node.name}.png"))

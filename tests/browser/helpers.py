@@ -17,6 +17,20 @@ from tests.wire_client import NEXT_OR_SKIP
 # A tool's tab opened as a learner does: its group's tab first (Inspect, then Echo).
 open_tab = open_tool
 
+# A fresh page parses viser's bundle and has the whole GUI replayed over its
+# websocket before any control exists. On a 2-core machine at load 12 that took
+# more than Playwright's 30 s default (CI of 8a4ebc1: the Bags panel's Record
+# button never came), so a page's first sight has its own wait, and the test's
+# own waits count from a page that is there.
+FIRST_LOAD_MS = 90_000
+
+
+def open_page(page: Page, url: str, role: str = "tab", name: str = "Learn") -> Page:
+    """Go to ``url`` and wait until the control ``role`` ``name`` is on the page."""
+    page.goto(url, timeout=FIRST_LOAD_MS)
+    page.get_by_role(role, name=name, exact=True).first.wait_for(timeout=FIRST_LOAD_MS)
+    return page
+
 
 def choose(page: Page, label: str, option: str) -> None:
     """Pick ``option`` in the dropdown ``label``, as a learner does: when the list closed

@@ -22,6 +22,7 @@ from tests.browser.helpers import (
     click,
     expect_text,
     go_to_step,
+    open_page,
     open_tab,
     step_reads_top_down,
 )
@@ -58,8 +59,7 @@ def dashboard_with_chatter(tmp_path_factory) -> Iterator[DashboardProcess]:
 def _page(browser: Browser, url: str, **context: object) -> Page:
     options = {"viewport": {"width": 1366, "height": 768}, **context}
     page = browser.new_context(**options).new_page()  # type: ignore[arg-type]
-    page.goto(url)
-    page.get_by_role("tab", name="Learn", exact=True).wait_for()
+    open_page(page, url)
     return page
 
 

@@ -14,7 +14,7 @@ import pytest
 from playwright.sync_api import Page, expect
 
 from tests.bags.readers import mcap_messages
-from tests.browser.helpers import click, expect_text
+from tests.browser.helpers import click, expect_text, open_page
 from tests.browser.replay_helpers import go_to_moments, grade_in_browser, newest_at
 from tests.conftest import ARTIFACTS, DashboardProcess, free_port
 from tests.course_data import shared_exercises
@@ -46,7 +46,7 @@ def test_a_failed_simulation_attempt_is_plotted_and_replayed(browser, ros_env, t
     dashboard = DashboardProcess(env, free_port(), ["--progress-dir", str(tmp_path / "p")])
     page = browser.new_page(viewport={"width": 1400, "height": 900})
     try:
-        page.goto(dashboard.url)
+        open_page(page, dashboard.url)
         grade_in_browser(page, EXERCISE, MISTAKE.path.read_text(encoding="utf-8"))
         verdict = re.compile(r"of the wall ahead at (\d+\.\d) s: closer than the bound")
         expect_text(page, verdict, 150_000)

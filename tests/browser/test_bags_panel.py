@@ -15,7 +15,7 @@ from app.panels.bags_panel import BagsPanel
 from app.ros.graph import GraphSnapshot
 from app.ros.monitor import TopicMonitor
 from app.ui.loop import UiLoop
-from tests.browser.helpers import click, cut_off_at_panel_edge, expect_text
+from tests.browser.helpers import click, cut_off_at_panel_edge, expect_text, open_page
 from tests.conftest import free_port, wait_until
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -40,7 +40,7 @@ def bags_page(browser, probe, tmp_path):
     thread.start()
     context = browser.new_context(viewport={"width": 1400, "height": 900})
     page = context.new_page()
-    page.goto(f"http://127.0.0.1:{server.get_port()}")
+    open_page(page, f"http://127.0.0.1:{server.get_port()}", "button", "Record")
     yield page, tmp_path / "bags"
     context.close()
     stop.set()

@@ -8,7 +8,14 @@ import signal
 
 from playwright.sync_api import Page, expect
 
-from tests.browser.helpers import choose, click, expect_editor_loaded, expect_text, open_tab
+from tests.browser.helpers import (
+    choose,
+    click,
+    expect_editor_loaded,
+    expect_text,
+    open_page,
+    open_tab,
+)
 from tests.browser.test_ros2_panels import expect_regex, field
 from tests.conftest import DashboardProcess, free_port
 from tests.course_data import shared_exercises
@@ -86,7 +93,7 @@ def test_wrong_then_right_then_survives_reload_and_sigkill(page, dashboard, ros_
     dashboard.proc.wait(10)
     again = DashboardProcess(ros_env, free_port(), ["--progress-dir", str(progress_dir)])
     try:
-        page.goto(again.url)
+        open_page(page, again.url)
         open_tab(page, "Exercise")
         choose(page, "Exercise", f"{EXERCISE.unit:02d} · {EXERCISE.title}  ✓")
         choose(page, "On stage", "Code")  # a new dashboard: lesson 1's stage again

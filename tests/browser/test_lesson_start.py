@@ -15,6 +15,7 @@ from tests.browser.helpers import (
     choose,
     expect_text,
     open_lesson,
+    open_page,
     open_tab,
     start_node,
 )
@@ -64,8 +65,7 @@ def test_a_new_lesson_starts_clean_and_names_what_is_left(browser, dashboard, si
     context = browser.new_context(viewport={"width": size[0], "height": size[1]})
     page = context.new_page()
     try:
-        page.goto(dashboard.url)
-        page.get_by_role("tab", name="Lessons").wait_for()
+        open_page(page, dashboard.url)
         _open_lesson(page, "05_topics")
         total = len(COURSE.lessons)
         number = [lesson.id for lesson in COURSE.lessons].index("05_topics") + 1
@@ -123,8 +123,7 @@ def test_a_new_lesson_starts_clean_and_names_what_is_left(browser, dashboard, si
 def test_a_stop_with_nothing_to_stop_is_greyed(browser, dashboard):
     page = browser.new_page(viewport={"width": 1366, "height": 768})
     try:
-        page.goto(dashboard.url)
-        page.get_by_role("tab", name="Lessons").wait_for()
+        open_page(page, dashboard.url)
         _open_lesson(page, "05_topics")
         lesson = COURSE.lesson("05_topics")
         assert lesson is not None

@@ -13,6 +13,7 @@ from tests.browser.helpers import (
     click_next,
     expect_text,
     open_lesson,
+    open_page,
     open_tab,
 )
 from tests.conftest import DashboardProcess, free_port
@@ -75,7 +76,7 @@ def test_complete_a_lesson_and_keep_progress(page, dashboard, ros_env, progress_
     dashboard.stop()
     restarted = DashboardProcess(ros_env, free_port(), ["--progress-dir", str(progress_dir)])
     try:
-        page.goto(restarted.url)
+        open_page(page, restarted.url)
         open_tab(page, "Lessons")
         expect(done_cells(page)).to_have_count(1, timeout=15_000)
         expect_text(page, lesson.title)

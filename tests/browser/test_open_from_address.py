@@ -8,7 +8,7 @@ import re
 
 from playwright.sync_api import expect
 
-from tests.browser.helpers import expect_text
+from tests.browser.helpers import expect_text, open_page
 from tests.course_data import shared_course, shared_exercises
 
 LESSON = next(lesson for lesson in shared_course().lessons if lesson.unit == 5)
@@ -19,7 +19,7 @@ def test_the_address_opens_a_lesson_or_an_exercise(browser, dashboard):
     context = browser.new_context(viewport={"width": 1400, "height": 900})
     page = context.new_page()
     try:
-        page.goto(f"{dashboard.url}?lesson={LESSON.id}")
+        open_page(page, f"{dashboard.url}?lesson={LESSON.id}")
         position = re.compile(rf"Lesson 5 of \d+ · Step 1 of {len(LESSON.steps)}")
         expect_text(page, position)
         expect(page.get_by_label("Lesson", exact=True)).to_have_value(

@@ -11,6 +11,7 @@ from tests.browser.helpers import (
     NEXT_OR_SKIP,
     expect_text,
     open_lesson,
+    open_page,
     out_of_view,
     step_controls,
     step_reads_top_down,
@@ -40,8 +41,7 @@ def test_the_stage_is_all_the_room_left_of_the_column_in_every_lesson(browser, d
     page = context.new_page()
     course = {lesson.id: lesson for lesson in shared_course().lessons}
     try:
-        page.goto(dashboard.url)
-        page.get_by_role("tab", name="Lessons").wait_for()
+        open_page(page, dashboard.url)
         for lesson_id in WALK:
             lesson = course[lesson_id]
             open_lesson(page, lesson)
@@ -89,8 +89,7 @@ def test_the_first_screen_says_how_it_works_and_shows_the_dashboards_node(browse
     page = context.new_page()
     first = shared_course().lessons[0]
     try:
-        page.goto(dashboard.url)
-        page.get_by_role("tab", name="Lessons").wait_for()
+        open_page(page, dashboard.url)
         intro = page.get_by_text("shows what the current step is about").filter(visible=True)
         expect(intro).to_be_visible()
         expect(page.get_by_text(f"Lesson 1 of {len(shared_course().lessons)}")).to_be_visible()

@@ -16,6 +16,7 @@ from tests.browser.helpers import (
     click_next,
     expect_text,
     open_lesson,
+    open_page,
     open_tab,
     start_node,
     step_reads_top_down,
@@ -33,8 +34,7 @@ SIZES = [(1366, 768), (1920, 1080)]
 def _open(browser, dashboard, size: tuple[int, int]) -> Page:
     context = browser.new_context(viewport={"width": size[0], "height": size[1]})
     page = context.new_page()
-    page.goto(dashboard.url)
-    page.get_by_role("tab", name="Lessons").wait_for()
+    open_page(page, dashboard.url)
     return page
 
 

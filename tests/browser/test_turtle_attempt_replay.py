@@ -12,7 +12,7 @@ import pytest
 from playwright.sync_api import Page, expect
 
 from tests.bags.readers import mcap_messages
-from tests.browser.helpers import click, expect_text
+from tests.browser.helpers import click, expect_text, open_page
 from tests.browser.replay_helpers import go_to_moments, grade_in_browser, newest_at
 from tests.conftest import ARTIFACTS, DashboardProcess, free_port
 from tests.course_data import shared_exercises
@@ -47,7 +47,7 @@ def test_a_failed_turtlesim_attempt_plays_in_turtlesims_window(browser, ros_env,
     dashboard = DashboardProcess(env, free_port(), ["--progress-dir", str(tmp_path / "p")])
     page = browser.new_page(viewport={"width": 1400, "height": 900})
     try:
-        page.goto(dashboard.url)
+        open_page(page, dashboard.url)
         grade_in_browser(page, EXERCISE, MISTAKE.path.read_text(encoding="utf-8"))
         expect_text(page, re.compile(r"needed below 1 m"), 150_000)
         told = page.get_by_text(re.compile(r"ros2 bag info attempts/")).first

@@ -53,7 +53,7 @@ from app.bags.errors import BagError
 from app.bags.info import read_info
 from app.bags.repair import reindex
 from app.lessons.panel import NEXT_LABEL
-from tests.browser.helpers import EDITOR_TAKES_TYPING
+from tests.browser.helpers import EDITOR_TAKES_TYPING, open_page
 from tests.conftest import ARTIFACTS, DashboardProcess, free_port, wait_until
 from tests.course_data import shared_course, shared_exercises
 from tests.faults.helpers import live_children, record
@@ -763,8 +763,7 @@ def test_twenty_sigkills_lose_nothing_and_leave_no_orphans(ros_env, probe, brows
             if number % BROWSER_EVERY == 0:
                 context = browser.new_context(viewport={"width": 1400, "height": 900})
                 page = context.new_page()
-                page.goto(dash.url)
-                page.get_by_role("tab", name="Learn", exact=True).wait_for(timeout=60_000)
+                open_page(page, dash.url)
             work = Round(number, dash, learner, course, rng, page)
             client = work.client = WireClient(dash.url)
             wait_until(lambda: next_button(client), what="the lessons")  # noqa: B023

@@ -17,7 +17,7 @@ import pytest
 from app import PROJECT_ROOT
 from app.panels.nodes_panel import STALE_NOTE
 from app.supervisor import NodeState
-from tests.browser.helpers import expect_text, open_tab
+from tests.browser.helpers import expect_text, open_page, open_tab
 from tests.conftest import wait_until
 from tests.faults.helpers import live_children, overview, record
 from tests.wire_client import WireClient
@@ -115,7 +115,7 @@ def test_a_killed_browser_leaves_the_server_serving(browser, dashboard):
         args=["--no-sandbox", "--disable-dev-shm-usage", marker],
     )
     page = doomed.new_page()
-    page.goto(dashboard.url)
+    open_page(page, dashboard.url)
     open_tab(page, "Nodes")
     expect_text(page, "Catalog node")
     tagged = [p for p in psutil.process_iter(["cmdline"]) if marker in (p.info["cmdline"] or [])]
@@ -134,7 +134,7 @@ def test_a_killed_browser_leaves_the_server_serving(browser, dashboard):
     context = browser.new_context()
     try:
         fresh = context.new_page()
-        fresh.goto(dashboard.url)
+        open_page(fresh, dashboard.url)
         open_tab(fresh, "Nodes")
         expect_text(fresh, "Catalog node")
     finally:
