@@ -102,8 +102,8 @@ def baseline_main(topic: str, t0: float, t1: float, out: Path) -> None:
 
 def dashboard_main(t0: float, t1: float, out: Path) -> None:
     """The dashboard as `serve` builds it, plus echo + hz views of every load topic."""
-    import viser
 
+    from app.access import make_server
     from app.dashboard import Dashboard
     from app.exercises.editor_server import EditorHub
     from app.exercises.workspace import Workspace
@@ -115,7 +115,7 @@ def dashboard_main(t0: float, t1: float, out: Path) -> None:
     from app.ui import MarkdownView, code_block
 
     Int64, Image = load_types()
-    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    server, _ = make_server("127.0.0.1", 0, None)  # as app/cli.py makes it
     runtime = RosRuntime()
     supervisor = Supervisor({})
     progress = ProgressStore("bench", LOGS / "bench-p")

@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import re
 import threading
+import traceback
 import zipfile
 
 import pytest
-import viser
 from playwright.sync_api import expect
 from std_msgs.msg import String
 
+from app.access import make_server
 from app.panels.bags_panel import BagsPanel
 from app.ros.graph import GraphSnapshot
 from app.ros.monitor import TopicMonitor
@@ -24,17 +25,21 @@ pytestmark = [pytest.mark.browser, pytest.mark.ros]
 @pytest.fixture
 def bags_page(browser, probe, tmp_path):
     """Only the Bags panel on a viser server, refreshed as the dashboard's UI thread does."""
-    server = viser.ViserServer(host="127.0.0.1", port=free_port(), verbose=False)
+    server, _ = make_server("127.0.0.1", free_port(), None)  # as the dashboard makes its own
     ui = UiLoop()
     panel = BagsPanel(server.gui, ui, probe.node, tmp_path / "bags")
     stop = threading.Event()
+    failures: list[str] = []  # a refresh that raised: told at the end, not a silent dead loop
 
     def refresh_loop() -> None:
         while not stop.is_set():
-            ui.wait(0.2)
-            ui.apply_pending()
-            panel.refresh(GraphSnapshot())
-            server.flush()
+            try:
+                ui.wait(0.2)
+                ui.apply_pending()
+                panel.refresh(GraphSnapshot())
+                server.flush()
+            except Exception:
+                failures.append(traceback.format_exc())
 
     thread = threading.Thread(target=refresh_loop, daemon=True)
     thread.start()
@@ -48,6 +53,7 @@ def bags_page(browser, probe, tmp_path):
     ui.close()
     panel.close()
     server.stop()
+    assert not failures, failures[0]
 
 
 def test_record_stop_inspect_and_replay_in_the_panel(bags_page, supervisor, probe):

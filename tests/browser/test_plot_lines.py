@@ -18,6 +18,7 @@ from typing import Any
 import pytest
 import viser
 
+from app.access import make_server
 from app.stage.plot_stage import History, _draw
 from tests.conftest import free_port, wait_until
 
@@ -62,7 +63,7 @@ def _chart_box(page: Any) -> dict[str, float]:
 
 
 def test_a_second_line_arriving_apart_from_its_data_leaves_the_chart_whole(browser):
-    server = viser.ViserServer(host="127.0.0.1", port=free_port(), verbose=False)
+    server, _ = make_server("127.0.0.1", free_port(), None)  # as the dashboard makes its own
     context = browser.new_context(viewport={"width": 1366, "height": 768})
     errors: list[str] = []
     try:

@@ -253,3 +253,19 @@ class LocalHub:
                 proc.kill()
         self._log.close()
         return alive
+
+
+def log_in(page: Any, login_url: str, user: str) -> None:
+    """Sign ``user`` in on the hub's login page, as a person does (a Playwright page).
+
+    The login page is a page's first sight: on a loaded 2-core machine its
+    Sign in button took more than Playwright's 30 s default to be ready
+    (rehearsal ci72, load 16), so it gets the first-load wait of every page.
+    """
+    from tests.browser.helpers import open_page  # playwright: for browser tests only
+
+    open_page(page, login_url, "button", "Sign in")
+    page.get_by_label("Username").fill(user)
+    page.get_by_label("Password").fill(PASSWORD)
+    with page.expect_navigation(wait_until="commit"):
+        page.get_by_role("button", name="Sign in").click()

@@ -41,7 +41,7 @@ from tests.browser.helpers import (
 from tests.browser.test_exercise import EXERCISE, _open_editor
 from tests.conftest import ARTIFACTS, fail_on_leftover_nodes, in_private_netns, wait_until
 from tests.course_data import shared_course
-from tests.hub.local_hub import PASSWORD, LocalHub
+from tests.hub.local_hub import LocalHub, log_in
 
 # A watchdog, not a budget: the first test also spawns three learners' servers, which
 # on two busy shared cores has taken minutes.
@@ -99,11 +99,7 @@ def hub(tmp_path_factory) -> Iterator[LocalHub]:
 
 
 def _log_in(hub: LocalHub, page: Page, user: str, after: str = "") -> None:
-    page.goto(f"{hub.base}/hub/login{after}")
-    page.get_by_label("Username").fill(user)
-    page.get_by_label("Password").fill(PASSWORD)
-    with page.expect_navigation(wait_until="commit"):
-        page.get_by_role("button", name="Sign in").click()
+    log_in(page, f"{hub.base}/hub/login{after}", user)
 
 
 @pytest.fixture(scope="module")

@@ -25,7 +25,7 @@ from websockets.exceptions import InvalidStatus
 from app.dds import configure_dds_env
 from tests.browser.helpers import choose, click, expect_text, open_tab
 from tests.conftest import ARTIFACTS, fail_on_leftover_nodes, in_private_netns, wait_until
-from tests.hub.local_hub import ADMIN_TOKEN, PASSWORD, LocalHub
+from tests.hub.local_hub import ADMIN_TOKEN, LocalHub, log_in
 
 # A watchdog, not a budget: the first test also spawns two learners' servers, which
 # on two busy shared cores has taken minutes.
@@ -82,11 +82,11 @@ def room(hub: LocalHub, browser: Browser) -> Iterator[Browsers]:
             context.on("request", lambda request, urls=urls: urls.append(request.url))
             page = context.new_page()
             page.on("websocket", lambda socket, urls=urls: urls.append(socket.url))
-            page.goto(f"{hub.base}/hub/login" + (f"?next={SERVICE}" if user == TEACHER else ""))
-            page.get_by_label("Username").fill(user)
-            page.get_by_label("Password").fill(PASSWORD)
-            with page.expect_navigation(wait_until="commit"):
-                page.get_by_role("button", name="Sign in").click()
+            log_in(
+                page,
+                f"{hub.base}/hub/login" + (f"?next={SERVICE}" if user == TEACHER else ""),
+                user,
+            )
             room.pages[user] = page
         yield room
     finally:

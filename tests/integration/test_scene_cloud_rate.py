@@ -6,10 +6,10 @@ import time
 
 import numpy as np
 import pytest
-import viser
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import PointCloud2
 
+from app.access import make_server
 from app.ros.runtime import RosRuntime
 from app.scene.pointclouds import PointCloudLayer
 from nodes.common.pointcloud import xyz_to_pointcloud2 as encode_cloud
@@ -19,7 +19,7 @@ pytestmark = [pytest.mark.ros]
 
 
 def test_cloud_layer_receives_most_frames_of_a_fast_cloud(probe):
-    server = viser.ViserServer(host="127.0.0.1", port=free_port(), verbose=False)
+    server, _ = make_server("127.0.0.1", free_port(), None)  # as the dashboard makes its own
     dash = RosRuntime("scene_rate_dashboard")
     pub = probe.node.create_publisher(
         PointCloud2, "/rate/cloud", QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)

@@ -9,10 +9,10 @@ and a static frame whose broadcaster has left is not drawn on a later look.
 from __future__ import annotations
 
 import pytest
-import viser
 from geometry_msgs.msg import TransformStamped
 from tf2_ros import StaticTransformBroadcaster
 
+from app.access import make_server
 from app.ros import tf_sources
 from app.ros.runtime import RosRuntime
 from app.stage.tf_stage import STATIC_RATE, TfStage
@@ -30,7 +30,7 @@ def _static(parent: str, child: str) -> TransformStamped:
 
 
 def test_the_tree_has_latched_frames_new_broadcasters_and_forgets_gone_ones(probe, supervisor):
-    server = viser.ViserServer(host="127.0.0.1", port=free_port(), verbose=False)
+    server, _ = make_server("127.0.0.1", free_port(), None)  # as the dashboard makes its own
     dash = RosRuntime("tf_stage_dashboard")
     sender: RosRuntime | None = RosRuntime("tf_stage_static_sender")
     shared = tf_sources.shared(dash.node)  # the TF tool's reader, open before the stage
