@@ -87,6 +87,18 @@ sys.exit(tf2_monitor.main(["tf2_monitor"]))
 """
 
 
+def _run(program: str, env: dict[str, str]) -> subprocess.CompletedProcess[str]:
+    """``program`` run to its end by a fresh Python, its output kept."""
+    return subprocess.run(
+        [sys.executable, "-c", program],
+        env=env,
+        cwd=PROJECT_ROOT,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+
+
 @pytest.mark.parametrize(
     "program",
     [PROGRAM, SECOND_NODE, TF2_MONITOR_STOPPED_BEFORE_ITS_SPINNER_STARTS],
@@ -97,27 +109,13 @@ sys.exit(tf2_monitor.main(["tf2_monitor"]))
     ],
 )
 def test_a_stop_at_an_awkward_moment_ends_quietly(ros_env, program):
-    done = subprocess.run(
-        [sys.executable, "-c", program],
-        env=ros_env,
-        cwd=PROJECT_ROOT,
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
+    done = _run(program, ros_env)
     output = done.stdout + done.stderr
     assert "Traceback" not in output, output
     assert done.returncode == 0, output
 
 
 def test_a_program_that_never_started_ros_still_gets_its_error(ros_env):
-    done = subprocess.run(
-        [sys.executable, "-c", NEVER_INITIALIZED],
-        env=ros_env,
-        cwd=PROJECT_ROOT,
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
+    done = _run(NEVER_INITIALIZED, ros_env)
     assert done.returncode != 0
     assert "NotInitializedException" in done.stderr, done.stderr
