@@ -88,7 +88,6 @@ def test_published_rate_stays_true_when_a_starved_view_misses_samples(probe):
     assert published.fallback == "", published  # the middleware filled the info, raw too
     # The sender's clock read after each publish() returned: on a loaded machine some reads
     # come late (seen: 492.0 against the stamps' 499.5 for 500 Hz sent), so 2.5 %.
-    assert len(seen) == published.received, (len(seen), published)
     assert abs(published.rate - truth) / truth < 0.025, (published, truth)
     assert arrived.rate < 0.85 * truth, (arrived.rate, truth)  # what `ros2 topic hz` would say
     assert published.missed is not None and published.missed > 0.1 * len(sent), published
