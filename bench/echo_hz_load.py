@@ -102,7 +102,6 @@ def baseline_main(topic: str, t0: float, t1: float, out: Path) -> None:
 
 def dashboard_main(t0: float, t1: float, out: Path) -> None:
     """The dashboard as `serve` builds it, plus echo + hz views of every load topic."""
-
     from app.access import make_server
     from app.dashboard import Dashboard
     from app.exercises.editor_server import EditorHub
