@@ -13,6 +13,8 @@ import math
 import random
 
 import pytest
+from geometry_msgs.msg import TransformStamped
+from tf2_msgs.msg import TFMessage
 
 from app.exercises.probes.sim import (
     SILENT_DRIVE,
@@ -26,12 +28,14 @@ from app.exercises.probes.sim_patrol import (
     MIN_GAP,
     PATH_CLEARANCE,
     WAYPOINT_CLEARANCE,
+    AmclWatch,
     distances_from,
     draw_route,
     first_jump,
     goals_in,
     headings,
     judge,
+    nav2_failures,
     new_lines,
     reach_times,
     route_problems,
@@ -163,6 +167,42 @@ def test_goals_are_read_from_the_navigators_log_after_where_it_stood():
     assert new_lines([], old) == old
     assert new_lines(["gone"], old) == old  # the tail itself was pushed out: all is new
     assert new_lines(old[-10:], old) == []
+
+
+def test_a_failed_trial_quotes_what_nav2s_navigator_said():
+    lines = [
+        "[INFO] [2.0] [bt_navigator]: Goal succeeded",
+        "[ERROR] [3.0] [bt_navigator]: Goal failed: No valid path found (error code 206)",
+        "[ERROR] [4.0] [bt_navigator]: Goal failed: Start occupied (error code 207)",
+    ]
+    said = nav2_failures(lines)
+    assert (
+        said == "; Nav2's navigator said: Goal failed: Start occupied (error code 207) (and 1 more)"
+    )
+    assert nav2_failures(lines[:2]).endswith("No valid path found (error code 206)")
+    assert nav2_failures(lines[:1]) == ""
+
+
+def test_amcl_is_read_where_its_map_to_odom_puts_the_robot():
+    watch = AmclWatch()
+    assert watch.robot() is None  # nothing heard yet
+    quarter = (0.0, 0.0, math.sin(math.pi / 4), math.cos(math.pi / 4))
+    watch.on_tf(_tf(("map", "odom", 1.0, 2.0, quarter), ("odom", "base_link", 1.0, 0.0, None)))
+    x, y = watch.robot()
+    assert math.isclose(x, 1.0, abs_tol=1e-9) and math.isclose(y, 3.0, abs_tol=1e-9)
+
+
+def _tf(*parts):
+    msg = TFMessage()
+    for parent, child, x, y, q in parts:
+        t = TransformStamped()
+        t.header.frame_id, t.child_frame_id = parent, child
+        t.transform.translation.x, t.transform.translation.y = x, y
+        if q is not None:
+            r = t.transform.rotation
+            r.x, r.y, r.z, r.w = q
+        msg.transforms.append(t)
+    return msg
 
 
 def test_finished_printed_before_the_robot_arrived():

@@ -4,7 +4,8 @@ The exercise's setup starts the office world and the navigation stack (map
 server, amcl, planner, controller, navigator, waypoint follower and their
 lifecycle manager). The probe waits until the lifecycle manager says the
 stack is active, puts the robot back at the start (the world's reset, and
-amcl told so on ``/initialpose``, as a "2D Pose Estimate" would), then
+amcl told so on ``/initialpose``, as a "2D Pose Estimate" would, until its
+``map -> odom`` on /tf puts the robot there too), then
 publishes a route of ``count`` waypoints on a latched topic
 (``nav_msgs/Path``, frame ``map``): drawn for this grading on the world's
 floor plan, each well clear of the furniture, each between ``leg_min`` and
@@ -55,6 +56,7 @@ from rclpy.node import Node
 from rclpy.publisher import Publisher
 from rclpy.qos import DurabilityPolicy, QoSProfile
 from std_srvs.srv import Trigger
+from tf2_msgs.msg import TFMessage
 
 from app.exercises.probes.base import ProbeContext, register_probe
 from app.exercises.probes.sim import (
@@ -102,7 +104,10 @@ IDLE = 12.0  # s at rest with nothing asked of the wheels: the patrol is not com
 FINISHED_SLACK = 2.0  # s
 LINGER = 15.0  # s watched at most after "Patrol finished", for the robot to come to rest
 NAV2_WAIT = 120.0  # s for the stack to come up on a busy machine
-POSE_WAIT = 5.0  # s for amcl to take the start pose
+POSE_WAIT = 5.0  # s for amcl to take the start pose, each time it is told
+POSE_TELLS = 3  # times amcl is told the start pose before the trial goes on regardless
+POSE_SETTLE = 1.0  # s (ten scans) amcl's map -> odom is watched after it took the pose
+POSE_AGREES = 0.2  # m between the start and where amcl puts the robot
 # Why a trial was lost, when a busy machine cannot be the reason.
 MOVED_NOT_DRIVEN = "moved, not driven"
 OFF_ROUTE = "a goal off the route"
@@ -240,6 +245,16 @@ def new_lines(tail: Sequence[str], lines: Sequence[str]) -> list[str]:
             if list(lines[start : start + n]) == anchor:
                 return list(lines[start + n :])
     return list(lines)  # nothing of the tail is left: all of it is new
+
+
+def nav2_failures(lines: Sequence[str]) -> str:
+    """What Nav2's navigator said of goals it could not reach (its error lines), if any:
+    the reason a robot did not set off, or stopped, is often there."""
+    failed = [line.split("]: ", 1)[-1] for line in lines if "Goal failed" in line]
+    if not failed:
+        return ""
+    more = f" (and {len(failed) - 1} more)" if len(failed) > 1 else ""
+    return f"; Nav2's navigator said: {failed[-1]}{more}"
 
 
 def goals_in(lines: Sequence[str]) -> list[Point]:
@@ -489,14 +504,15 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
     # Made first: discovery runs while the stack comes up, so the route arrives at once.
     route_pub = node.create_publisher(Path, str(p["topic"]), latched)
     pose_pub = node.create_publisher(PoseWithCovarianceStamped, "/initialpose", 10)
-    heard: list[PoseWithCovarianceStamped] = []
+    amcl = AmclWatch()
     amcl_sub = node.create_subscription(
-        PoseWithCovarianceStamped, "/amcl_pose", heard.append, latched
+        PoseWithCovarianceStamped, "/amcl_pose", amcl.heard.append, latched
     )
+    tf_sub = node.create_subscription(TFMessage, "/tf", amcl.on_tf, 100)
     try:
         with simulation(ctx, 1.0, learner_sim_time=False) as (world, recorder):
             _wait_for_nav2(ctx, world.services, str(p["manager"]))
-            trial = _Trial(ctx, p, world, recorder, route_pub, pose_pub, heard)
+            trial = _Trial(ctx, p, world, recorder, route_pub, pose_pub, amcl)
             result, spoiled = trial.run()
             if not spoiled:
                 return result
@@ -509,6 +525,7 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
                 return Result(again.name, False, detail, again.traces)
             return Result(again.name, again.passed, first + again.detail, again.traces)
     finally:
+        node.destroy_subscription(tf_sub)
         node.destroy_subscription(amcl_sub)
         node.destroy_publisher(pose_pub)
         node.destroy_publisher(route_pub)
@@ -542,7 +559,7 @@ class _Trial:
     recorder: Recorder
     route_pub: Publisher
     pose_pub: Publisher
-    heard: list[PoseWithCovarianceStamped]
+    amcl: AmclWatch
 
     def run(self) -> tuple[Result, str]:
         """The trial's result, and why it proves nothing ('' if it does)."""
@@ -558,7 +575,7 @@ class _Trial:
         navigator = str(p["navigator"])
         navigator_tail = programs.setup_output().get(navigator, [])[-TAIL:]
         t0 = release(ctx, world, recorder, (sx, sy, syaw))
-        _tell_amcl(ctx, self.pose_pub, self.heard, (sx, sy, syaw))
+        _tell_amcl(ctx, self.pose_pub, self.amcl, (sx, sy, syaw))
         self.route_pub.publish(_path(ctx.call.node, (sx, sy), route))
         tolerance, hold = float(p["tolerance"]), float(p["hold"])
         # When the script's FINISHED line was seen: the newest sample's time (which lags
@@ -599,7 +616,8 @@ class _Trial:
             return Result(name, False, f"route {shown}; {stalled}"), ""
         touch = closest_touch(world.plan, samples, t0)
         told = programs.setup_output()
-        sent = goals_in(new_lines(navigator_tail, told[navigator])) if navigator in told else None
+        logged = new_lines(navigator_tail, told[navigator]) if navigator in told else None
+        sent = goals_in(logged) if logged is not None else None
         at = None
         if finished:  # when the world was where it was as the line came, on its own clock
             at = recorder.sim_time_at(finished_wall[0])
@@ -607,7 +625,10 @@ class _Trial:
         verdict = judge(samples, t0, route, tolerance, touch, at, sent)
         traces = (distance_trace(samples, t0, route, tolerance, verdict),) if samples else ()
         spoiled = spoiled_by(recorder.silent_drives(t0), verdict, bool(finished))
-        return Result(name, verdict.passed, f"route {shown}: {verdict.text}", traces), spoiled
+        text = f"route {shown}: {verdict.text}"
+        if not verdict.passed:
+            text += nav2_failures(logged or [])
+        return Result(name, verdict.passed, text, traces), spoiled
 
 
 def _wait_for_nav2(ctx: ProbeContext, services: Services, manager: str) -> None:
@@ -631,33 +652,80 @@ def _wait_for_nav2(ctx: ProbeContext, services: Services, manager: str) -> None:
     )
 
 
+class AmclWatch:
+    """What amcl says: the poses it published on /amcl_pose, and where its ``map -> odom``
+    and the world's odometry put the robot on /tf."""
+
+    def __init__(self) -> None:
+        self.heard: list[PoseWithCovarianceStamped] = []
+        self.map_odom: tuple[float, float, float] | None = None  # the newest, from amcl
+        self.odom_base: tuple[float, float, float] | None = None  # the world's odometry
+
+    def on_tf(self, msg: TFMessage) -> None:
+        for t in msg.transforms:
+            r = t.transform.rotation
+            pose = (
+                t.transform.translation.x,
+                t.transform.translation.y,
+                math.atan2(2 * (r.w * r.z + r.x * r.y), 1 - 2 * (r.y * r.y + r.z * r.z)),
+            )
+            if (t.header.frame_id, t.child_frame_id) == ("map", "odom"):
+                self.map_odom = pose
+            elif (t.header.frame_id, t.child_frame_id) == ("odom", "base_link"):
+                self.odom_base = pose
+
+    def robot(self) -> Point | None:
+        """Where amcl's newest ``map -> odom`` puts the robot on the map."""
+        if self.map_odom is None or self.odom_base is None:
+            return None
+        (mx, my, myaw), (ox, oy, _) = self.map_odom, self.odom_base
+        return (
+            mx + ox * math.cos(myaw) - oy * math.sin(myaw),
+            my + ox * math.sin(myaw) + oy * math.cos(myaw),
+        )
+
+
 def _tell_amcl(
-    ctx: ProbeContext,
-    publisher: Publisher,
-    heard: list[PoseWithCovarianceStamped],
-    start: tuple[float, float, float],
+    ctx: ProbeContext, publisher: Publisher, amcl: AmclWatch, start: tuple[float, float, float]
 ) -> None:
-    """The robot is back at the start: say so on /initialpose, and wait until amcl agrees."""
+    """The robot is back at the start: say so on /initialpose, until amcl agrees.
+
+    amcl takes the pose with the odometry of the next scan it reads. When that scan is one
+    from before the world's reset (a busy machine delivers it late), the reset's jump in
+    odometry then reads as motion, and amcl puts the robot up to a route's length away (ci
+    of d358651: Nav2 then planned from there, and the robot never set off). So the
+    newest ``map -> odom`` is watched for a moment after, and the pose told again if amcl
+    puts the robot elsewhere: that stale scan has been read by then.
+    """
     deadline = time.monotonic() + POSE_WAIT
     while publisher.get_subscription_count() == 0 and time.monotonic() < deadline:
         ctx.call.sleep(0.1)
     msg = PoseWithCovarianceStamped()
     msg.header.frame_id = "map"
-    msg.header.stamp = ctx.call.node.get_clock().now().to_msg()
     msg.pose.pose.position.x, msg.pose.pose.position.y = start[0], start[1]
     msg.pose.pose.orientation.z = math.sin(start[2] / 2.0)
     msg.pose.pose.orientation.w = math.cos(start[2] / 2.0)
     msg.pose.covariance[0] = msg.pose.covariance[7] = 0.05**2
     msg.pose.covariance[35] = 0.05**2
-    heard.clear()
-    publisher.publish(msg)
-    while time.monotonic() < deadline:
-        if any(
-            math.hypot(h.pose.pose.position.x - start[0], h.pose.pose.position.y - start[1]) < 0.2
-            for h in heard
-        ):
+
+    def near(point: Point | None) -> bool:
+        return point is not None and math.dist(point, start[:2]) < POSE_AGREES
+
+    for _ in range(POSE_TELLS):
+        msg.header.stamp = ctx.call.node.get_clock().now().to_msg()
+        amcl.heard.clear()
+        publisher.publish(msg)
+        deadline = time.monotonic() + POSE_WAIT
+        while time.monotonic() < deadline:
+            if any(near((h.pose.pose.position.x, h.pose.pose.position.y)) for h in amcl.heard):
+                break
+            ctx.call.sleep(0.1)
+        ctx.call.sleep(POSE_SETTLE)
+        amcl.map_odom = None  # the next scan's, read after those of the settling moment
+        while amcl.map_odom is None and time.monotonic() < deadline + POSE_SETTLE:
+            ctx.call.sleep(0.1)
+        if near(amcl.robot()):
             return
-        ctx.call.sleep(0.1)
 
 
 def _path(node: Node, start: Point, route: Sequence[Point]) -> Path:
