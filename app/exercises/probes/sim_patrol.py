@@ -690,12 +690,13 @@ def _tell_amcl(
 ) -> None:
     """The robot is back at the start: say so on /initialpose, until amcl agrees.
 
-    amcl takes the pose with the odometry of the next scan it reads. When that scan is one
-    from before the world's reset (a busy machine delivers it late), the reset's jump in
-    odometry then reads as motion, and amcl puts the robot up to a route's length away (ci
-    of d358651: Nav2 then planned from there, and the robot never set off). So the
-    newest ``map -> odom`` is watched for a moment after, and the pose told again if amcl
-    puts the robot elsewhere: that stale scan has been read by then.
+    Its answer on /amcl_pose is not enough. Nav2 reads where the robot is from /tf, and
+    amcl's new ``map -> odom`` comes after, with a later scan: a route sent at once was
+    planned from the old one, up to 0.8 m off with the odometry reset to zero (seen on a
+    second route; CI of d358651 had a robot that never set off there, on a busy machine).
+    And a scan from before the reset, read late, makes the reset's jump in odometry look
+    like motion. So the newest ``map -> odom`` is read a moment after the answer, and the
+    pose told again while it puts the robot elsewhere (a stale scan is read by then).
     """
     deadline = time.monotonic() + POSE_WAIT
     while publisher.get_subscription_count() == 0 and time.monotonic() < deadline:
