@@ -12,8 +12,13 @@ a Chromium, a simulated world, a busy grading, or a module measured so)
 first takes one of ``os.cpu_count()`` slots: a lock on a file named after the
 run's namespaces file (tests/run.py), which every worker of the run shares.
 A worker whose next test is heavy waits for a slot; the cores are full then
-anyway. The kernel drops the lock when a worker dies, so a crash frees its
-slot. A run with one worker, or pytest by hand, has nothing to share.
+anyway. A few tests keep about two cores busy on their own (``takes_all``: a
+world drawn by software WebGL in a Chromium, a grading with a world and
+Nav2's seven nodes); they take every slot, in order, so no other heavy test
+runs beside them (rehearsal ci74: one of each at once held the load at 19,
+and the page answered no click on its dropdown for 30 s). The kernel drops
+the lock when a worker dies, so a crash frees its slot. A run with one
+worker, or pytest by hand, has nothing to share.
 """
 
 from __future__ import annotations
@@ -46,6 +51,11 @@ HEAVY_MODULES = (
     "tests/sim/test_sim_physics.py",
     "tests/sim/test_sim_world_ros.py",
 )
+# Measured (rehearsal ci74 and ci70, 2 cores): each of these keeps about two cores busy.
+WHOLE_MACHINE = (
+    "tests/browser/test_sim_world_view.py",
+    "tests/exercises/test_grading.py::test_grading[patrol-",
+)
 # Modules whose tests each grade an exercise or walk a lesson; a busy one takes a core.
 CASE_MODULES = ("tests/exercises/test_grading.py", "tests/integration/test_lessons_walk.py")
 POLL_S = 0.5
@@ -65,6 +75,11 @@ def is_heavy(nodeid: str, fixturenames: Any, busy: frozenset[str] | set[str]) ->
     )
 
 
+def takes_all(nodeid: str) -> bool:
+    """Whether the test keeps about two cores busy on its own: it takes every slot."""
+    return nodeid.startswith(WHOLE_MACHINE)
+
+
 def slot_files(run_file: str, cores: int) -> list[str]:
     return [f"{run_file}.heavy{number}" for number in range(max(1, cores))]
 
@@ -82,6 +97,17 @@ def take_slot(paths: list[str], sleep: Callable[[float], None] = time.sleep) -> 
         sleep(POLL_S)
 
 
+def take_all(paths: list[str]) -> list[IO[str]]:
+    """Every one of ``paths``, each waited for in their order: two workers that both want
+    them all never hold one each (and a one-slot taker never waits while holding one)."""
+    held = []
+    for path in paths:
+        handle = open(path, "a", encoding="ascii")  # held until released
+        fcntl.flock(handle, fcntl.LOCK_EX)  # blocks until this slot is free
+        held.append(handle)
+    return held
+
+
 class HeavySlots:
     """One worker's side of the run's slots: taken before a heavy test, kept while
     the next test is heavy and of the same unit (a module-scoped world lives on
@@ -90,17 +116,22 @@ class HeavySlots:
     def __init__(self, run_file: str | None, cores: int | None = None):
         self.paths = slot_files(run_file, cores or os.cpu_count() or 1) if run_file else []
         self.busy = frozenset(busy_cases())
-        self.held: IO[str] | None = None
+        self.held: list[IO[str]] = []
 
     def heavy(self, item: Any) -> bool:
         return bool(self.paths) and is_heavy(item.nodeid, item.fixturenames, self.busy)
 
     def before(self, item: Any) -> float:
-        """Take a slot for ``item`` if it is heavy; the seconds waited for it."""
-        if self.held is not None or not self.heavy(item):
+        """Take a slot for ``item`` if it is heavy (every slot if it ``takes_all``); the
+        seconds waited for it."""
+        if not self.heavy(item):
             return 0.0
+        wanted = len(self.paths) if takes_all(item.nodeid) else 1
+        if len(self.held) >= wanted:
+            return 0.0
+        self.release()  # a kept slot first: slots are only ever waited for holding none
         began = time.monotonic()
-        self.held = take_slot(self.paths)
+        self.held = take_all(self.paths) if wanted > 1 else [take_slot(self.paths)]
         return time.monotonic() - began
 
     def after(self, item: Any, nextitem: Any) -> None:
@@ -109,9 +140,17 @@ class HeavySlots:
             and self.heavy(nextitem)
             and unit_of(nextitem.nodeid) == unit_of(item.nodeid)
         )
-        if self.held is not None and not keep:
-            self.held.close()  # closing the file drops the lock
-            self.held = None
+        if not keep:
+            self.release()
+        elif not takes_all(nextitem.nodeid):
+            for handle in self.held[1:]:  # the next one needs a single slot: others may go on
+                handle.close()
+            self.held = self.held[:1]
+
+    def release(self) -> None:
+        for handle in self.held:
+            handle.close()  # closing the file drops the lock
+        self.held = []
 
 
 def for_this_worker() -> HeavySlots:

@@ -9,7 +9,17 @@ from types import SimpleNamespace
 import pytest
 
 from app import PROJECT_ROOT
-from tests.heavy_slots import HEAVY_MODULES, HeavySlots, is_heavy, slot_files, take_slot
+from tests.conftest import wait_until
+from tests.heavy_slots import (
+    HEAVY_MODULES,
+    WHOLE_MACHINE,
+    HeavySlots,
+    is_heavy,
+    slot_files,
+    take_all,
+    take_slot,
+    takes_all,
+)
 
 BUSY = frozenset({"patrol", "24_navigation"})
 
@@ -46,8 +56,72 @@ def test_what_keeps_a_core_busy_is_heavy(nodeid, fixtures, heavy):
 
 def test_every_heavy_module_or_folder_exists():
     # A renamed module would silently run beside the others again.
-    missing = [path for path in HEAVY_MODULES if not (PROJECT_ROOT / path).exists()]
+    modules = [*HEAVY_MODULES, *(prefix.split("::")[0] for prefix in WHOLE_MACHINE)]
+    missing = [path for path in modules if not (PROJECT_ROOT / path).exists()]
     assert not missing, missing
+
+
+def test_a_test_that_takes_all_waits_for_every_slot_and_holds_them_all(tmp_path):
+    run = str(tmp_path / "run.netns")
+    world = "tests/browser/test_sim_world_view.py::test_the_world"
+    assert takes_all(world) and is_heavy(world, ("browser",), BUSY)
+    assert takes_all("tests/exercises/test_grading.py::test_grading[patrol-starter]")
+    assert not takes_all("tests/exercises/test_grading.py::test_grading[patrol_x-starter]")
+    paths = slot_files(run, cores=2)
+    other = take_slot(paths[1:])  # another worker's heavy test, on the second slot
+    taker = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import time; from tests.heavy_slots import take_all, slot_files;"
+            f" held = take_all(slot_files({run!r}, 2)); print(len(held), flush=True);"
+            " time.sleep(60)",
+        ],
+        cwd=PROJECT_ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    try:
+        wait_until(lambda: _locked(paths[0]), timeout=30, what="the taker to hold slot 0")
+        with pytest.raises(Waited):  # it holds the first slot while it waits for the second
+            take_slot(paths, sleep=_refuse_to_wait)
+        other.close()
+        assert taker.stdout.readline().strip() == "2", taker.communicate(timeout=10)
+        with pytest.raises(Waited):  # no heavy test runs beside it
+            take_slot(paths, sleep=_refuse_to_wait)
+    finally:
+        taker.kill()
+        taker.wait(timeout=10)
+    take_all(paths)  # its death freed both
+
+
+def _locked(path: str) -> bool:
+    """Whether another process holds ``path``'s slot (taken and given back at once if not)."""
+    try:
+        take_slot([path], sleep=_refuse_to_wait).close()
+    except Waited:
+        return True
+    return False
+
+
+def test_all_slots_are_given_back_down_to_one_for_a_next_test_that_needs_one(tmp_path):
+    slots = HeavySlots(str(tmp_path / "run.netns"), cores=2)
+    grading = "tests/exercises/test_grading.py::test_grading"
+    patrol = _item(f"{grading}[patrol-reference]")
+    nav = _item(f"{grading}[nav_x-reference]")
+    slots.busy = frozenset({"patrol", "nav_x"})
+    slots.before(patrol)
+    assert len(slots.held) == 2
+    slots.after(patrol, nav)
+    kept = len(slots.held)
+    if kept:  # one unit (tests/worker_plan.py): one slot kept, the other free again
+        assert kept == 1
+        take_slot(slots.paths, sleep=_refuse_to_wait).close()
+        assert slots.before(nav) == 0.0
+    slots.before(patrol)  # from one slot to all: the kept one given back first
+    assert len(slots.held) == 2
+    slots.release()
 
 
 def test_a_slot_is_taken_once_and_free_again_when_given_back(tmp_path):
@@ -100,7 +174,7 @@ def test_a_slot_is_kept_through_a_one_worker_module_and_given_back_after_it(tmp_
     assert slots.before(second) == 0.0
     slots.after(second, light)
     take_slot(slots.paths, sleep=_refuse_to_wait).close()
-    assert slots.before(light) == 0.0 and slots.held is None
+    assert slots.before(light) == 0.0 and slots.held == []
 
 
 def test_two_tests_shared_out_one_by_one_each_take_the_slot_again(tmp_path):
@@ -115,4 +189,4 @@ def test_two_tests_shared_out_one_by_one_each_take_the_slot_again(tmp_path):
 def test_outside_a_run_nothing_is_shared():
     slots = HeavySlots(None)
     assert slots.before(_item("tests/browser/test_x.py::test_a", ("browser",))) == 0.0
-    assert slots.held is None
+    assert slots.held == []
