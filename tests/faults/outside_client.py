@@ -20,7 +20,9 @@ import argparse
 import importlib
 import json
 import math
+import os
 import sys
+import threading
 import time
 import uuid
 from collections import Counter
@@ -862,13 +864,39 @@ def main(argv: list[str] | None = None) -> int:
                 client.run_lifecycle(node)
         else:
             client.run_fuzz(options.nodes, options.expect_service, options.expect_action)
-        print(client.report.dump())
+        print(client.report.dump(), flush=True)
     finally:
+        _tear_down(client)
+    return 0
+
+
+TEARDOWN_LIMIT = 30.0  # s for this client's own executor, node and context to go
+
+
+def _tear_down(client: OutsideClient | None) -> None:
+    """End this client's ROS side, within TEARDOWN_LIMIT.
+
+    The verdict is printed before: a teardown that hangs is this tool's, not the nodes'
+    (rehearsal ci75: the report was complete, yet the process was still there 150 s in,
+    at load 15). It says on stderr where it hung, for the test to record, and exits.
+    """
+    stage = ["the executor's shutdown"]
+
+    def run() -> None:
         if client is not None:
             client.spinner.shutdown()
+            stage[0] = "destroying the node"
             client.destroy_node()
+        stage[0] = "rclpy's shutdown"
         rclpy.try_shutdown()
-    return 0
+        stage[0] = ""
+
+    worker = threading.Thread(target=run, name="teardown", daemon=True)
+    worker.start()
+    worker.join(TEARDOWN_LIMIT)
+    if worker.is_alive():
+        print(f"teardown hung at {stage[0]} for {TEARDOWN_LIMIT:g} s", file=sys.stderr, flush=True)
+        os._exit(0)
 
 
 if __name__ == "__main__":

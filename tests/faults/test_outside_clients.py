@@ -68,6 +68,10 @@ def run_client(env: dict[str, str], *args: str) -> dict:
     assert done.returncode == 0, done.stderr[-3000:]
     report = json.loads(done.stdout.strip().splitlines()[-1])
     report["wall_seconds"] = round(time.monotonic() - started, 1)
+    # The client's own teardown, bounded (outside_client.py _tear_down): kept in the figures.
+    report["teardown"] = next(
+        (line for line in done.stderr.splitlines() if line.startswith("teardown hung")), "clean"
+    )
     ARTIFACTS.mkdir(parents=True, exist_ok=True)  # every call, for reading after a failure
     (ARTIFACTS / f"outside-client-{args[0]}.json").write_text(json.dumps(report, indent=1))
     return report
@@ -122,6 +126,7 @@ def test_lifecycle_talker_refuses_every_invalid_transition_in_every_state(ros_en
         calls=len(calls),
         slowest_call_s=report["slowest"],
         client_wall_s=report["wall_seconds"],
+        client_teardown=report["teardown"],
     )
 
 
@@ -162,4 +167,5 @@ def test_every_interface_of_every_node_answers_hostile_requests(ros_env, supervi
         interfaces=len(targets),
         slowest_call_s=report["slowest"],
         client_wall_s=report["wall_seconds"],
+        client_teardown=report["teardown"],
     )
