@@ -857,6 +857,7 @@ def main(argv: list[str] | None = None) -> int:
     options = parser.parse_args(argv)
     rclpy.init(args=[])
     client = None
+    reported = False
     try:
         client = OutsideClient()
         if options.mode == "lifecycle":
@@ -865,20 +866,22 @@ def main(argv: list[str] | None = None) -> int:
         else:
             client.run_fuzz(options.nodes, options.expect_service, options.expect_action)
         print(client.report.dump(), flush=True)
+        reported = True
     finally:
-        _tear_down(client)
+        _tear_down(client, reported)
     return 0
 
 
 TEARDOWN_LIMIT = 30.0  # s for this client's own executor, node and context to go
 
 
-def _tear_down(client: OutsideClient | None) -> None:
+def _tear_down(client: OutsideClient | None, reported: bool) -> None:
     """End this client's ROS side, within TEARDOWN_LIMIT.
 
     The verdict is printed before: a teardown that hangs is this tool's, not the nodes'
     (rehearsal ci75: the report was complete, yet the process was still there 150 s in,
-    at load 15). It says on stderr where it hung, for the test to record, and exits.
+    at load 15). It says on stderr where it hung, for the test to record, and exits (with
+    an error when there was no report: the exception under way is lost then).
     """
     stage = ["the executor's shutdown"]
 
@@ -896,7 +899,7 @@ def _tear_down(client: OutsideClient | None) -> None:
     worker.join(TEARDOWN_LIMIT)
     if worker.is_alive():
         print(f"teardown hung at {stage[0]} for {TEARDOWN_LIMIT:g} s", file=sys.stderr, flush=True)
-        os._exit(0)
+        os._exit(0 if reported else 1)
 
 
 if __name__ == "__main__":
