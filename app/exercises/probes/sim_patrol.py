@@ -81,6 +81,7 @@ from app.lessons.checks._sim_topics import world_map
 from app.lessons.checks._world_map import WorldMap
 from app.lessons.schema import Spec
 from app.ros.errors import Ros2Error
+from app.ros.rotations import yaw_of
 
 FINISHED = "Patrol finished"  # what the script prints once the patrol is over
 # What Nav2's navigator logs for each goal it takes (bt_navigator, as Nav2's own does): the
@@ -667,7 +668,7 @@ class AmclWatch:
             pose = (
                 t.transform.translation.x,
                 t.transform.translation.y,
-                math.atan2(2 * (r.w * r.z + r.x * r.y), 1 - 2 * (r.y * r.y + r.z * r.z)),
+                yaw_of(r.x, r.y, r.z, r.w),
             )
             if (t.header.frame_id, t.child_frame_id) == ("map", "odom"):
                 self.map_odom = pose
