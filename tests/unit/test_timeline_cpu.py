@@ -8,6 +8,8 @@ import subprocess
 import sys
 import time
 
+import psutil
+
 from tests.conftest import _tree_cpu_seconds
 
 BURN = "import time\nend = time.process_time() + {s}\nwhile time.process_time() < end: pass\n"
@@ -22,16 +24,39 @@ def test_a_child_that_ran_and_was_reaped_is_counted():
 
 
 def test_a_grandchild_still_running_is_counted():
-    # A shell whose child burns: the grandchild's time is read while it lives.
+    # A shell whose child burns (the "; true" keeps the shell from exec-ing it): the grandchild's time is read while it lives. How much
+    # it burns in a wall-clock second depends on the machine's load, so the test waits
+    # for the grandchild's own clock, read apart, and compares the tree's figure to it.
     child = subprocess.Popen(
-        ["/bin/sh", "-c", f"{sys.executable} -c '{BURN.format(s=5)}'"], start_new_session=True
+        ["/bin/sh", "-c", f"{sys.executable} -c '{BURN.format(s=30)}'; true"],
+        start_new_session=True,
     )
     try:
-        before = _tree_cpu_seconds()
+        shell = psutil.Process(child.pid)
+        grandchild = _only_child(shell)
+        before, grand_before = _tree_cpu_seconds(), _cpu_of(grandchild)
         assert before is not None
-        time.sleep(1.0)
-        after = _tree_cpu_seconds()
-        assert after is not None and after - before >= 0.3, (before, after)
+        deadline = time.monotonic() + 60
+        while _cpu_of(grandchild) - grand_before < 0.5:
+            assert time.monotonic() < deadline, "the grandchild got no CPU for a minute"
+            time.sleep(0.05)
+        after, grand_after = _tree_cpu_seconds(), _cpu_of(grandchild)
+        assert after is not None
+        # The tree's figure holds the grandchild's growth, less at most a clock tick.
+        assert after - before >= (grand_after - grand_before) - 0.1, (before, after)
     finally:
         os.killpg(child.pid, signal.SIGKILL)  # the shell and the grandchild
         child.wait()
+
+
+def _only_child(shell: psutil.Process) -> psutil.Process:
+    deadline = time.monotonic() + 30
+    while not (kids := shell.children()):
+        assert time.monotonic() < deadline, "the shell started no child"
+        time.sleep(0.02)
+    return kids[0]
+
+
+def _cpu_of(proc: psutil.Process) -> float:
+    times = proc.cpu_times()
+    return times.user + times.system
