@@ -133,20 +133,21 @@ def test_latest_worker_draws_the_newest_and_skips_the_backlog():
     from app.scene.latest import LatestWorker
 
     drawn: list[int] = []
-    gate = threading.Event()
+    gate, drawing = threading.Event(), threading.Event()
 
     def draw(msg: int) -> None:
+        drawing.set()
         gate.wait(2.0)  # a slow browser update
         drawn.append(msg)
 
     worker = LatestWorker("test", draw, max_hz=1000.0)
     try:
         worker.offer(0)
-        time.sleep(0.05)
+        assert drawing.wait(10)  # the worker holds 0, however busy the machine
         for i in range(1, 50):  # arrive while 0 is still being drawn
             worker.offer(i)
         gate.set()
-        deadline = time.monotonic() + 2.0
+        deadline = time.monotonic() + 10.0
         while (not drawn or drawn[-1] != 49) and time.monotonic() < deadline:
             time.sleep(0.01)
         assert drawn == [0, 49]
