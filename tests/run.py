@@ -33,7 +33,9 @@ this; ``--workers 1`` runs pytest in one process, as before); ``--bench
 
 from __future__ import annotations
 
+import contextlib
 import fcntl
+import glob
 import os
 import shutil
 import signal
@@ -315,13 +317,24 @@ def main() -> int:
             # First this run's own file: a run inside a run must not end the outer one's
             # workers when its collection ends (it inherited the outer run's file).
             os.environ[NAMESPACES] = noted.name
-            collect_ahead(args, keeper=True)
-            return run_phases(phases, keeper=True)
+            try:
+                collect_ahead(args, keeper=True)
+                return run_phases(phases, keeper=True)
+            finally:
+                _remove_slot_files(noted.name)
     if not keeper:
         os.execv(sys.executable, command)
     with tempfile.NamedTemporaryFile("w", prefix="classroom-run-", suffix=".netns") as noted:
         os.environ[NAMESPACES] = noted.name
         return keep(command)
+
+
+def _remove_slot_files(run_file: str) -> None:
+    """The heavy-test slots (tests/heavy_slots.py) are files beside the run's own: they go
+    with it, or every run leaves a few in /tmp."""
+    for path in glob.glob(f"{glob.escape(run_file)}.heavy*"):
+        with contextlib.suppress(OSError):
+            os.unlink(path)
 
 
 if __name__ == "__main__":

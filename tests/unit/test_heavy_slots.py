@@ -190,3 +190,13 @@ def test_outside_a_run_nothing_is_shared():
     slots = HeavySlots(None)
     assert slots.before(_item("tests/browser/test_x.py::test_a", ("browser",))) == 0.0
     assert slots.held == []
+
+
+def test_the_run_removes_its_slot_files_with_its_own(tmp_path):
+    from tests.run import _remove_slot_files
+
+    run_file = str(tmp_path / "classroom-run-x.netns")
+    for path in [*slot_files(run_file, 2), f"{run_file}-other.heavy0"]:
+        open(path, "w").close()
+    _remove_slot_files(run_file)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["classroom-run-x.netns-other.heavy0"]
