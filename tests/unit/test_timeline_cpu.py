@@ -24,9 +24,10 @@ def test_a_child_that_ran_and_was_reaped_is_counted():
 
 
 def test_a_grandchild_still_running_is_counted():
-    # A shell whose child burns (the "; true" keeps the shell from exec-ing it): the grandchild's time is read while it lives. How much
-    # it burns in a wall-clock second depends on the machine's load, so the test waits
-    # for the grandchild's own clock, read apart, and compares the tree's figure to it.
+    # A shell whose child burns ("; true" keeps the shell from exec-ing it): the
+    # grandchild's time is read while it lives. How much it burns in a wall-clock second
+    # depends on the machine's load, so the test waits for the grandchild's own clock,
+    # read apart, and compares the tree's figure to it.
     child = subprocess.Popen(
         ["/bin/sh", "-c", f"{sys.executable} -c '{BURN.format(s=30)}'; true"],
         start_new_session=True,
