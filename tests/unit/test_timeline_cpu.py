@@ -41,9 +41,9 @@ def test_a_grandchild_still_running_is_counted():
         while _cpu_of(grandchild) - grand_before < 0.5:
             assert time.monotonic() < deadline, "the grandchild got no CPU for a minute"
             time.sleep(0.05)
-        after, grand_after = _tree_cpu_seconds(), _cpu_of(grandchild)
+        grand_after, after = _cpu_of(grandchild), _tree_cpu_seconds()  # the tree's last
         assert after is not None
-        # The tree's figure holds the grandchild's growth, less at most a clock tick.
+        # The tree's figure holds at least the grandchild's growth (less a clock tick).
         assert after - before >= (grand_after - grand_before) - 0.1, (before, after)
     finally:
         os.killpg(child.pid, signal.SIGKILL)  # the shell and the grandchild
