@@ -29,7 +29,7 @@ import time
 from collections.abc import Callable
 from typing import IO, Any
 
-from tests.run import NAMESPACES  # one file per run, named by its keeper
+from tests.run import NAMESPACES, SLOT_SUFFIX  # one file per run, named by its keeper
 from tests.worker_plan import busy_cases, unit_of
 
 # Measured (rehearsal ci70, 2 cores, a worker's process tree): these keep 0.6-1.3 of a
@@ -81,7 +81,7 @@ def takes_all(nodeid: str) -> bool:
 
 
 def slot_files(run_file: str, cores: int) -> list[str]:
-    return [f"{run_file}.heavy{number}" for number in range(max(1, cores))]
+    return [f"{run_file}{SLOT_SUFFIX}{number}" for number in range(max(1, cores))]
 
 
 def take_slot(paths: list[str], sleep: Callable[[float], None] = time.sleep) -> IO[str]:

@@ -57,6 +57,7 @@ MARKER = "CLASSROOM_PRIVATE_NETNS"
 KEEPER = "CLASSROOM_NETNS_KEEPER"  # set only for the process that unshare starts
 WORKER = "CLASSROOM_WORKER_NETNS"  # set only for the worker that unshare starts
 NAMESPACES = "CLASSROOM_RUN_NAMESPACES"  # the file where workers note their namespaces
+SLOT_SUFFIX = ".heavy"  # the heavy-test slots' files beside it: <file>.heavy0, .heavy1, ...
 # Three workers on two cores, measured: the whole suite in 16-17 min instead of
 # 47, a core still idle a third of the time. Four took 15 min but saturated the
 # cores: eight tests that wait on real time failed (a MuJoCo run, turtlesim). So
@@ -332,7 +333,7 @@ def main() -> int:
 def _remove_slot_files(run_file: str) -> None:
     """The heavy-test slots (tests/heavy_slots.py) are files beside the run's own: they go
     with it, or every run leaves a few in /tmp."""
-    for path in glob.glob(f"{glob.escape(run_file)}.heavy*"):
+    for path in glob.glob(f"{glob.escape(run_file)}{SLOT_SUFFIX}*"):
         with contextlib.suppress(OSError):
             os.unlink(path)
 
