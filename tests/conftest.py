@@ -335,8 +335,19 @@ def pytest_runtest_logstart(nodeid: str, location: tuple) -> None:
 
 def pytest_runtest_logfinish(nodeid: str, location: tuple) -> None:
     before, now = _cpu_at_start.pop(nodeid, None), _tree_cpu_seconds()
-    cpu = f" cpu {now - before:.1f}" if before is not None and now is not None else ""
-    _timeline(f"end   {nodeid}{cpu}")
+    _timeline(f"end   {nodeid}{_cpu_figure(before, now)}")
+
+
+def _cpu_figure(before: float | None, now: float | None) -> str:
+    """The timeline's CPU figure for a test: what the tree took between two reads. A
+    process below that worked and was then left to init (its parent ended first) takes
+    its seconds out of the tree, so the difference can fall below zero (a session's
+    last test, tearing its fixtures down): that is said, never written as a figure."""
+    if before is None or now is None:
+        return ""
+    if now < before:
+        return f" cpu unknown ({before - now:.1f} s left the tree with a process left to init)"
+    return f" cpu {now - before:.1f}"
 
 
 _cpu_at_start: dict[str, float | None] = {}

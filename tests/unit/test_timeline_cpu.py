@@ -10,7 +10,7 @@ import time
 
 import psutil
 
-from tests.conftest import _tree_cpu_seconds
+from tests.conftest import _cpu_figure, _tree_cpu_seconds
 
 BURN = "import time\nend = time.process_time() + {s}\nwhile time.process_time() < end: pass\n"
 
@@ -61,3 +61,11 @@ def _only_child(shell: psutil.Process) -> psutil.Process:
 def _cpu_of(proc: psutil.Process) -> float:
     times = proc.cpu_times()
     return times.user + times.system
+
+
+def test_a_figure_below_zero_is_said_not_written():
+    """A session's last test can see the tree lose a reparented process's seconds."""
+    assert _cpu_figure(10.0, 12.25) == " cpu 2.2"
+    assert _cpu_figure(None, 3.0) == _cpu_figure(3.0, None) == ""
+    text = _cpu_figure(450.0, 9.3)
+    assert "unknown" in text and "440.7 s" in text and "-" not in text
