@@ -3,6 +3,7 @@ and shared by workspaces in different temporary folders."""
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 import tempfile
@@ -11,22 +12,26 @@ from pathlib import Path
 import pytest
 
 from tests import run
-from tests.run import compiler_cache
+from tests.run import compiler_cache, compiler_cache_env
 
 SOURCE = '#include <stdio.h>\nint main(void) { puts("hi"); return 0; }\n'
 
 
-def test_the_cache_is_set_for_the_run_and_gone_after(monkeypatch):
+def test_the_cache_is_the_runs_and_only_the_tests_that_ask_get_it(monkeypatch):
     monkeypatch.setattr(run.shutil, "which", lambda name: f"/usr/bin/{name}")
-    env = {"CMAKE_C_COMPILER_LAUNCHER": "mine", "KEEP": "1"}
+    monkeypatch.delenv(run.COMPILER_CACHE, raising=False)
+    env = {"KEEP": "1"}
     with compiler_cache(env) as folder:
         assert folder is not None and folder.is_dir()
-        assert env["CCACHE_DIR"] == str(folder)
-        assert env["CMAKE_C_COMPILER_LAUNCHER"] == env["CMAKE_CXX_COMPILER_LAUNCHER"]
-        assert env["CMAKE_CXX_COMPILER_LAUNCHER"] == "/usr/bin/ccache"
-        assert env["CCACHE_BASEDIR"].startswith(str(Path(tempfile.gettempdir()).resolve()))
+        assert env == {"KEEP": "1", run.COMPILER_CACHE: str(folder)}
+        monkeypatch.setenv(run.COMPILER_CACHE, str(folder))
+        asked = compiler_cache_env()
+        assert asked["CCACHE_DIR"] == str(folder)
+        assert asked["CMAKE_C_COMPILER_LAUNCHER"] == asked["CMAKE_CXX_COMPILER_LAUNCHER"]
+        assert asked["CMAKE_CXX_COMPILER_LAUNCHER"] == "/usr/bin/ccache"
+        assert asked["CCACHE_BASEDIR"].startswith(str(Path(tempfile.gettempdir()).resolve()))
     assert not folder.exists()
-    assert env == {"CMAKE_C_COMPILER_LAUNCHER": "mine", "KEEP": "1"}
+    assert env == {"KEEP": "1"}
 
 
 def test_without_ccache_nothing_is_set(monkeypatch):
@@ -34,6 +39,8 @@ def test_without_ccache_nothing_is_set(monkeypatch):
     env: dict[str, str] = {}
     with compiler_cache(env) as folder:
         assert folder is None and env == {}
+    monkeypatch.setenv(run.COMPILER_CACHE, "/somewhere")
+    assert compiler_cache_env() == {}
 
 
 def test_the_same_source_in_another_workspace_is_a_hit(tmp_path):
@@ -41,8 +48,8 @@ def test_the_same_source_in_another_workspace_is_a_hit(tmp_path):
     temporary root, compiled from inside each workspace's build folder."""
     if shutil.which("ccache") is None or shutil.which("cc") is None:
         pytest.fail("ccache and a C compiler are needed: `make test` installs ccache")
-    env: dict[str, str] = {"PATH": "/usr/bin:/bin"}
-    with compiler_cache(env):
+    with compiler_cache(os.environ):
+        env = {"PATH": "/usr/bin:/bin", **compiler_cache_env()}
         assert str(tmp_path.resolve()).startswith(env["CCACHE_BASEDIR"]), (
             f"pytest's folder {tmp_path} is not under base_dir {env['CCACHE_BASEDIR']}"
         )
