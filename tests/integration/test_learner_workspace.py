@@ -417,6 +417,11 @@ def test_build_limits_time_and_disk(tmp_path):
         sup.shutdown()
 
 
+# Five programs one after another (our `pkg create`, colcon, `pkg executables`, two
+# `run`s), each starting Python, about 7 CPU-s in all: 67-115 s in the suite's runs at
+# load 12-17 on 2 cores, 132 s with a busy loop beside it (rehearsal ci78), where the
+# limit was 120 s. The limit is there for a hang, not for speed.
+@pytest.mark.timeout(420)
 def test_tutorial_sequence_in_a_terminal(tmp_path):
     """The same commands in bash: ros2-classroom pkg create, real colcon, source, run."""
     src = tmp_path / "ros2_ws" / "src"
@@ -431,7 +436,7 @@ def test_tutorial_sequence_in_a_terminal(tmp_path):
         f"{{ {classroom} run my_package no_such_node; echo exit=$?; }}"
     )
     done = subprocess.run(
-        ["bash", "-c", script], env=env, capture_output=True, text=True, timeout=120
+        ["bash", "-c", script], env=env, capture_output=True, text=True, timeout=360
     )
     assert done.returncode == 0, done.stdout + done.stderr
     lines = done.stdout.splitlines()
