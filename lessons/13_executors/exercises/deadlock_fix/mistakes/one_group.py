@@ -10,6 +10,10 @@ class RelayServer(Node):
     def __init__(self):
         super().__init__("relay_server")
         self.client = self.create_client(AddTwoInts, "add_two_ints")
+        # Offer /relay_add only once /add_two_ints can be reached, so whoever sees
+        # /relay_add gets an answer (finding another node can take seconds on a busy machine).
+        while not self.client.wait_for_service(timeout_sec=1.0):
+            self.get_logger().info("waiting for /add_two_ints ...")
         self.service = self.create_service(AddTwoInts, "relay_add", self.on_request)
 
     def on_request(self, request, response):
