@@ -23,7 +23,7 @@ FOXGLOVE_CLIENT := tests/foxglove/wsclient
 FOXGLOVE_CLIENT_STAMP := $(FOXGLOVE_CLIENT)/node_modules/.classroom-setup
 ARGS ?=
 
-.PHONY: setup run test check browser ccache sandbox lint docs bench screenshots clean render bytecode
+.PHONY: setup run test check browser sandbox lint docs bench screenshots clean render bytecode
 
 setup: $(STAMP) $(EDITOR_STAMP) $(HUB_PROXY_STAMP) $(AXE_STAMP) $(FOXGLOVE_CLIENT_STAMP) render bytecode
 
@@ -90,15 +90,6 @@ browser:
 		SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
 		$$SUDO apt-get update -q && $$SUDO apt-get install -y -q chromium; }
 
-# A compiler cache for the tests' CMake builds (tests/run.py compiler_cache): three
-# tests build the tutorial's interface package from scratch; the later two reuse the
-# first one's compiled objects. Only the tests use it, never a learner's build.
-ccache:
-	@command -v ccache >/dev/null 2>&1 || { \
-		echo "== installing Debian's ccache for the tests' CMake builds"; \
-		SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
-		$$SUDO apt-get update -q && $$SUDO apt-get install -y -q ccache; }
-
 # Headless rendering for the MuJoCo camera (nodes/sim_world.py): Mesa's EGL, and
 # OSMesa as the fallback; a GPU's own EGL driver is used where one is installed.
 render:
@@ -120,7 +111,7 @@ sandbox: setup
 # Every test runs inside a private network namespace with only loopback
 # (tests/run.py sets it up): DDS traffic cannot leave the machine. Three
 # pytest-xdist workers, each in a namespace of its own; ARGS="--workers 1" for one.
-test: setup browser ccache sandbox lint
+test: setup browser sandbox lint
 	$(VPY) tests/run.py $(ARGS)
 
 # Fast feedback for whoever changes the code: lint, types, contracts and the docs, the
@@ -133,7 +124,7 @@ SMOKE := tests/unit \
 	"tests/integration/test_lessons_walk.py::test_every_step_of_the_lesson_passes_on_real_nodes[05_topics]" \
 	"tests/exercises/test_grading.py::test_grading[counter_publisher-reference]" \
 	"tests/exercises/test_grading.py::test_grading[counter_publisher-never_increments]"
-check: setup browser ccache sandbox lint
+check: setup browser sandbox lint
 	$(VPY) tests/run.py --workers 2 $(SMOKE) $(ARGS)
 
 # Style, the layer contracts of pyproject.toml (import-linter) and types (mypy).

@@ -17,7 +17,6 @@ from app import PROJECT_ROOT
 from app.dds import configure_dds_env
 from bench import _reaper
 from tests import heavy_slots, worker_plan
-from tests.run import compiler_cache_env
 
 # pytest keeps each test module with its asserts rewritten in __pycache__, unless Python
 # is told not to write bytecode (PYTHONDONTWRITEBYTECODE, set on this project's machines):
@@ -203,11 +202,8 @@ def progress_dir(tmp_path) -> Path:
 
 
 @pytest.fixture
-def dashboard(ros_env, progress_dir, request) -> Iterator[DashboardProcess]:
-    env = ros_env
-    if request.node.get_closest_marker("cmake_builds") is not None:
-        env = {**ros_env, **compiler_cache_env()}  # the run's compiler cache (tests/run.py)
-    dash = DashboardProcess(env, free_port(), ["--progress-dir", str(progress_dir)])
+def dashboard(ros_env, progress_dir) -> Iterator[DashboardProcess]:
+    dash = DashboardProcess(ros_env, free_port(), ["--progress-dir", str(progress_dir)])
     yield dash
     dash.stop()
 

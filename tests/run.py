@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
-import getpass
 import glob
 import os
 import shutil
@@ -45,7 +44,6 @@ import struct
 import subprocess
 import sys
 import tempfile
-from collections.abc import Iterator
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # run as a script from anywhere
@@ -321,9 +319,8 @@ def main() -> int:
             # workers when its collection ends (it inherited the outer run's file).
             os.environ[NAMESPACES] = noted.name
             try:
-                with compiler_cache(os.environ):
-                    collect_ahead(args, keeper=True)
-                    return run_phases(phases, keeper=True)
+                collect_ahead(args, keeper=True)
+                return run_phases(phases, keeper=True)
             finally:
                 _remove_slot_files(noted.name)
     if not keeper:
@@ -331,59 +328,6 @@ def main() -> int:
     with tempfile.NamedTemporaryFile("w", prefix="classroom-run-", suffix=".netns") as noted:
         os.environ[NAMESPACES] = noted.name
         return keep(command)
-
-
-COMPILER_CACHE = "CLASSROOM_TEST_COMPILER_CACHE"  # the run's ccache folder, for the tests
-
-
-@contextlib.contextmanager
-def compiler_cache(env: dict[str, str] | os._Environ[str]) -> Iterator[Path | None]:
-    """One compiler cache folder (ccache, where installed) for the run, gone after.
-
-    Three tests build the tutorial's interface package from scratch, a real CMake and
-    rosidl build of about 300 CPU-s on 2 cores each (rehearsal ci76's timeline). Those
-    three ask for the cache (``compiler_cache_env``); every other process of the run,
-    contained learner code above all, never sees it.
-    """
-    if shutil.which("ccache") is None:
-        yield None
-        return
-    folder = Path(tempfile.mkdtemp(prefix="classroom-ccache-"))
-    before = env.get(COMPILER_CACHE)
-    env[COMPILER_CACHE] = str(folder)
-    try:
-        yield folder
-    finally:
-        if before is None:
-            env.pop(COMPILER_CACHE, None)
-        else:
-            env[COMPILER_CACHE] = before
-        shutil.rmtree(folder, ignore_errors=True)
-
-
-def compiler_cache_env() -> dict[str, str]:
-    """What a test's CMake builds get to share the run's compiler cache ({} without one).
-
-    The later builds get the compiler's output for the same input back instead of making
-    it again; everything else of a build (CMake, the rosidl generators, colcon, the install
-    space) runs as before. ``base_dir`` is pytest's temporary root: paths inside it (each
-    test's workspace) are made relative, so workspaces in different folders share entries;
-    the venv's paths stay absolute. CMake (3.17 on) reads the launchers from the
-    environment when it configures.
-    """
-    folder, ccache = os.environ.get(COMPILER_CACHE), shutil.which("ccache")
-    if not folder or ccache is None:
-        return {}
-    try:
-        user = getpass.getuser()
-    except (KeyError, OSError):
-        user = "unknown"  # what pytest names its folder then
-    return {
-        "CCACHE_DIR": folder,
-        "CCACHE_BASEDIR": str(Path(tempfile.gettempdir()).resolve() / f"pytest-of-{user}"),
-        "CMAKE_C_COMPILER_LAUNCHER": ccache,
-        "CMAKE_CXX_COMPILER_LAUNCHER": ccache,
-    }
 
 
 def _remove_slot_files(run_file: str) -> None:

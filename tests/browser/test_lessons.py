@@ -98,7 +98,6 @@ def test_complete_the_bags_lesson_whose_buttons_type_into_the_console(page):
 # 18 steps with three colcon builds (one of them CMake + rosidl + a compiler): ~70 s on two
 # idle cores, ~230 s when the cores are shared with another test run.
 @pytest.mark.timeout(480)
-@pytest.mark.cmake_builds
 def test_complete_the_workspace_lesson_building_and_running_the_learners_own_package(page):
     """Unit 15 by clicking: pkg create, files written, colcon build, source, ros2 run,
     'No executable found', the fix, a launch file, an interface package; real colcon."""

@@ -25,7 +25,6 @@ from app.ros.context import CallContext, Limits
 from app.ros2cli import run_text
 from app.ros2cli.pkg import setup_workspace
 from app.supervisor import Supervisor
-from tests.run import compiler_cache_env
 
 LIMITS = Limits(max_messages=3, max_seconds=6.0)
 TUTORIAL_CREATE = (
@@ -130,7 +129,7 @@ def built(tmp_path_factory):
     saved = os.environ.get(overlay.PREFIX_ENV)
     progress = tmp_path_factory.mktemp("learner") / "progress" / "ada.json"
     ws = setup_workspace(progress, remote=False)
-    sup = Supervisor({**os.environ, **compiler_cache_env()})  # the run's, for my_interfaces
+    sup = Supervisor(os.environ)
     console = Console(sup)
     src = ws.src
     log: dict[str, str] = {}

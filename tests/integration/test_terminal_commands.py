@@ -14,7 +14,6 @@ from pathlib import Path
 import pytest
 
 from app.dds import LOOPBACK_PROFILE
-from tests.run import compiler_cache_env
 
 VENV_BIN = Path(sys.executable).parent
 # What a login shell has before the project's environment is added.
@@ -29,11 +28,8 @@ PRINTS_PROFILE = (
 )
 
 
-def _shell(
-    script: str, home: Path, timeout: float = 60, extra_env: dict[str, str] | None = None
-) -> subprocess.CompletedProcess[str]:
+def _shell(script: str, home: Path, timeout: float = 60) -> subprocess.CompletedProcess[str]:
     env = {"HOME": str(home), "PATH": f"{VENV_BIN}:{PLAIN_PATH}", "LANG": "C.UTF-8"}
-    env.update(extra_env or {})
     return subprocess.run(
         ["bash", "-c", f"set -e\n{script}"],
         cwd=home,
@@ -102,8 +98,7 @@ def test_interface_package_builds_with_colcon_in_a_terminal(tmp_path):
     )
     (src / "my_package" / "my_package" / "my_node.py").write_text(PRINTS_PROFILE)
 
-    # The run's compiler cache (tests/run.py): the compiler's output for the same input.
-    built = _shell("cd ~/ros2_ws && colcon build", tmp_path, 300, compiler_cache_env())
+    built = _shell("cd ~/ros2_ws && colcon build", tmp_path, timeout=300)
     assert built.returncode == 0, built.stdout + built.stderr
     assert "Summary: 2 packages finished" in built.stdout, built.stdout
 
