@@ -190,6 +190,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     if hub_login is not None:
         hub_login.close()
     dashboard.stop()
+    editor_hub.close()  # its tasks end on viser's loop, before the loop stops
     runtime.shutdown()
     supervisor.shutdown(timeout=2.5)
     server.stop()

@@ -546,7 +546,17 @@ class EditorHub:
     def editors_open(self, slug: str) -> int:
         return sum(1 for editing in list(self._editors.values()) if editing == slug)
 
-    def close(self) -> None:
-        """End the completion worker (it also dies with this process)."""
+    def close(self, timeout: float = 1.0) -> None:
+        """End the hub's own tasks on the server's loop while it still runs, then the
+        completion worker (it also dies with this process). A task still pending when the
+        loop is dropped is logged as an error ("Task was destroyed but it is pending!"):
+        the file watcher of every dashboard whose editor had been opened did so."""
+        self._run(self._cancel_tasks(), timeout)
         if self._assist is not None:
             self._assist.close()
+
+    async def _cancel_tasks(self) -> None:
+        tasks = [t for t in (self._watcher, *self._tasks) if t is not None and not t.done()]
+        for task in tasks:
+            task.cancel()
+        await asyncio.gather(*tasks, return_exceptions=True)

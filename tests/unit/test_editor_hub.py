@@ -314,3 +314,48 @@ def test_an_editor_that_connects_before_the_panel_is_built_loses_no_save(tmp_pat
         run_with_editor(hub, test, first_load=False)
     finally:
         hub.close()
+
+
+def test_close_ends_the_hubs_tasks_while_the_servers_loop_still_runs(hub, ws, caplog):
+    """Shutdown: the file watcher an editor started ends before viser's loop stops; left
+    pending, the dropped loop logged "Task was destroyed but it is pending!" as an ERROR
+    (rehearsal ci78: 12 dashboards' logs ended so)."""
+    import gc
+    import threading
+
+    loop = asyncio.new_event_loop()
+    thread = threading.Thread(target=loop.run_forever, daemon=True)
+    thread.start()
+    connected = threading.Event()
+
+    async def serve_one_editor() -> Any:
+        async def refuse(connection: Any) -> None:
+            raise AssertionError("only the editor's socket is used here")
+
+        server = await serve(hub.wrap_handler(refuse), "127.0.0.1", 0)
+        port = server.sockets[0].getsockname()[1]
+        socket = await connect(f"ws://127.0.0.1:{port}{SOCKET_PATH}?slug=heartbeat_logger")
+        await Editor(socket).expect("load", file=None)
+        connected.set()
+        return server, socket
+
+    server, socket = asyncio.run_coroutine_threadsafe(serve_one_editor(), loop).result(30)
+    assert connected.is_set()
+    watcher = hub._watcher
+    assert watcher is not None and not watcher.done()  # an editor is open: it watches
+
+    hub.close()
+    assert watcher.done() and watcher.cancelled()
+
+    async def end() -> None:
+        await socket.close()
+        server.close()
+        await server.wait_closed()
+
+    asyncio.run_coroutine_threadsafe(end(), loop).result(30)
+    loop.call_soon_threadsafe(loop.stop)
+    thread.join(10)
+    loop.close()
+    del watcher
+    gc.collect()
+    assert "Task was destroyed" not in caplog.text
