@@ -6,7 +6,7 @@ the Python of the project's virtual environment and its prefix, where the ROS
 wheels are (the underlay). colcon loads argument parser extensions from every
 installed distribution (entry point group ``colcon_core.argument_parser``; the
 same hook colcon-mixin adds its ``cmake-args`` with), and ours appends these
-three to ``--cmake-args`` of ``colcon build``. So the Console's builds
+(and ``-Wno-deprecated``) to ``--cmake-args`` of ``colcon build``. So the Console's builds
 (``app.learner_ws.build``), a JupyterLab terminal and any shell with the
 venv's ``bin/`` on PATH (or activated) build alike, with no variable to set.
 
@@ -40,11 +40,16 @@ def cmake_args() -> list[str]:
         f"-DCMAKE_TOOLCHAIN_FILE={TOOLCHAIN}",
         f"-DPython3_EXECUTABLE={sys.executable}",  # FindPython3 could pick /usr/bin's
         f"-DCLASSROOM_UNDERLAY={sys.prefix}",  # the wheels' prefix, read by the toolchain
+        # The tutorials' cmake_minimum_required(VERSION 3.8) is fine on Jazzy's CMake 3.28;
+        # the venv's newer CMake warns about it at line 1 of every package, before any
+        # toolchain file is read, so only the command line can turn that off.
+        "-Wno-deprecated",
     ]
 
 
 def _set_by(given: list[str]) -> set[str]:
-    """The cache variables ``given`` sets (``-DNAME=v``, ``-DNAME:TYPE=v``, ``-D NAME=v``)."""
+    """The cache variables ``given`` sets (``-DNAME=v``, ``-DNAME:TYPE=v``, ``-D NAME=v``),
+    and ``-Wdeprecated`` for either switch of those warnings."""
     names: set[str] = set()
     for index, arg in enumerate(given):
         if arg == "-D" and index + 1 < len(given):
@@ -53,6 +58,8 @@ def _set_by(given: list[str]) -> set[str]:
             names.add(arg[2:].split("=", 1)[0].split(":", 1)[0])
         elif arg == "--toolchain" or arg.startswith("--toolchain="):
             names.add("CMAKE_TOOLCHAIN_FILE")
+        elif arg in ("-Wdeprecated", "-Wno-deprecated"):
+            names.add("-Wdeprecated")  # the learner's own choice of these warnings wins
     return names
 
 

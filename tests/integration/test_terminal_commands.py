@@ -126,7 +126,7 @@ def test_colcon_gives_cmake_our_toolchain_and_the_command_line_wins(tmp_path):
     pkg = tmp_path / "ws" / "src" / "plain"
     pkg.mkdir(parents=True)
     (pkg / "CMakeLists.txt").write_text(
-        "cmake_minimum_required(VERSION 3.10)\nproject(plain NONE)\n"
+        "cmake_minimum_required(VERSION 3.8)\nproject(plain NONE)\n"  # as the tutorials
         'message(STATUS "seen: ${Python3_EXECUTABLE} ${CLASSROOM_UNDERLAY} ${BUILD_TESTING}")\n'
     )
     done = _shell(
@@ -137,3 +137,5 @@ def test_colcon_gives_cmake_our_toolchain_and_the_command_line_wins(tmp_path):
     assert done.returncode == 0, done.stdout + done.stderr
     # The toolchain ran (BUILD_TESTING off), with the venv as underlay; the typed Python won.
     assert f"-- seen: /usr/bin/python3 {sys.prefix} OFF" in done.stdout.splitlines(), done.stdout
+    # VERSION 3.8 is fine on Jazzy's CMake 3.28: the venv's newer CMake says nothing either.
+    assert "CMake Warning" not in done.stdout + done.stderr, done.stdout + done.stderr

@@ -22,7 +22,4 @@ if(DEFINED CLASSROOM_UNDERLAY)
   list(APPEND CMAKE_PREFIX_PATH "${CLASSROOM_UNDERLAY}")
 endif()
 set(BUILD_TESTING OFF CACHE BOOL "ament_lint_auto has no wheel")
-# The tutorials' cmake_minimum_required(VERSION 3.8) is fine on Jazzy's CMake 3.28;
-# this newer CMake would warn about it on every build.
-set(CMAKE_WARN_DEPRECATED OFF CACHE BOOL "")
 set(CMAKE_PROJECT_INCLUDE "${CMAKE_CURRENT_LIST_DIR}/after_project.cmake" CACHE FILEPATH "")
