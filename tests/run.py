@@ -211,7 +211,10 @@ def pytest_command(args: list[str]) -> list[str]:
     if workers <= 1:
         return command
     spawn = f"{workers}*popen//python={sys.executable} {Path(__file__).resolve()} --worker"
-    return [*command, "--tx", spawn, "--dist", "loadscope"]  # scheduler: tests/worker_plan.py
+    # A worker that dies (SIGKILL) fails the run at once: a replacement worker never came up
+    # (rehearsal ci79 then waited for it until killed), and xdist replaced crash after crash.
+    restart = "--max-worker-restart=0"
+    return [*command, "--tx", spawn, "--dist", "loadscope", restart]  # tests/worker_plan.py
 
 
 def collect_ahead(args: list[str], keeper: bool) -> None:

@@ -182,3 +182,33 @@ def test_the_workers_after_the_general_ones_take_only_tests_that_wait():
     extra = {f"gw{GENERAL_WORKERS}"}
     assert workers_of[waiting] & extra, workers_of  # the extra workers did take some
     assert not workers_of[general] & extra, workers_of
+
+
+DIES = """
+import os, signal
+
+
+def test_dies():
+    os.kill(os.getpid(), signal.SIGKILL)
+"""
+
+
+@pytest.mark.timeout(NESTED_RUN_LIMIT_SEC + 60)
+def test_a_worker_that_dies_fails_the_run_at_once(tmp_path):
+    """No replacement worker: one never came up in rehearsal ci79, and the run waited for it
+    until it was killed; without the rule, xdist replaced crash after crash."""
+    (tmp_path / "test_dies.py").write_text(DIES)
+    env = {k: v for k, v in os.environ.items() if k != "CLASSROOM_PRIVATE_NETNS"}
+    command = [sys.executable, "tests/run.py", "--workers", "2", "-c", "pyproject.toml"]
+    run = subprocess.run(
+        [*command, "--rootdir", str(tmp_path), str(tmp_path / "test_dies.py")],
+        cwd=PROJECT_ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=NESTED_RUN_LIMIT_SEC,
+    )
+    out = run.stdout + run.stderr
+    assert run.returncode != 0, out
+    assert "crashed while running 'test_dies.py::test_dies'" in out, out
+    assert "worker restarting disabled" in out and "replacing crashed worker" not in out, out
