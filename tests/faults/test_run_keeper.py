@@ -145,17 +145,22 @@ def test_workers_have_namespaces_of_their_own_and_the_keeper_ends_what_they_leav
     wait_until(lambda: _gone(left), timeout=10, what=f"pid {left} to be gone")
 
 
-def _workers_of(workers: int, *paths: str) -> dict[str, set[str]]:
-    """Which workers ran each module's tests when the real run is given ``paths``."""
+def _nested_run(*args: str) -> subprocess.CompletedProcess[str]:
+    """``tests/run.py ARGS`` from the project's root, as a run of its own (own namespace)."""
     env = {k: v for k, v in os.environ.items() if k != "CLASSROOM_PRIVATE_NETNS"}
-    run = subprocess.run(
-        [sys.executable, "tests/run.py", "--workers", str(workers), *paths, "-v"],
+    return subprocess.run(
+        [sys.executable, "tests/run.py", *args],
         cwd=PROJECT_ROOT,
         env=env,
         capture_output=True,
         text=True,
         timeout=NESTED_RUN_LIMIT_SEC,
     )
+
+
+def _workers_of(workers: int, *paths: str) -> dict[str, set[str]]:
+    """Which workers ran each module's tests when the real run is given ``paths``."""
+    run = _nested_run("--workers", str(workers), *paths, "-v")
     out = run.stdout + run.stderr
     assert run.returncode == 0, out
     ran = re.findall(r"^\[(gw\d)\] .*PASSED (\S+)::", out, re.M)
@@ -198,16 +203,10 @@ def test_a_worker_that_dies_fails_the_run_at_once(tmp_path):
     """No replacement worker: one never came up in rehearsal ci79, and the run waited for it
     until it was killed; without the rule, xdist replaced crash after crash."""
     (tmp_path / "test_dies.py").write_text(DIES)
-    env = {k: v for k, v in os.environ.items() if k != "CLASSROOM_PRIVATE_NETNS"}
-    command = [sys.executable, "tests/run.py", "--workers", "2", "-c", "pyproject.toml"]
-    run = subprocess.run(
-        [*command, "--rootdir", str(tmp_path), str(tmp_path / "test_dies.py")],
-        cwd=PROJECT_ROOT,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=NESTED_RUN_LIMIT_SEC,
-    )
+    run = _nested_run(
+        "--workers", "2", "-c", "pyproject.toml", "--rootdir", str(tmp_path),
+        str(tmp_path / "test_dies.py"),
+    )  # fmt: skip
     out = run.stdout + run.stderr
     assert run.returncode != 0, out
     assert "crashed while running 'test_dies.py::test_dies'" in out, out
