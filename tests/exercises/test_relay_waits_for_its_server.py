@@ -8,11 +8,10 @@ The starter, the reference and both recorded mistakes share the constructor's wa
 
 from __future__ import annotations
 
-import time
-
 import pytest
 
 from app.exercises import runner
+from tests.conftest import wait_until
 from tests.course_data import shared_exercises
 
 pytestmark = pytest.mark.ros
@@ -21,13 +20,6 @@ SERVER = "add_two_ints_server"  # the exercise's setup node
 
 def _services(probe) -> set[str]:
     return {name for name, _types in probe.node.get_service_names_and_types()}
-
-
-def _wait(condition, seconds: float, what: str) -> None:
-    deadline = time.monotonic() + seconds
-    while not condition():
-        assert time.monotonic() < deadline, f"not within {seconds:.0f} s: {what}"
-        time.sleep(0.1)
 
 
 @pytest.mark.parametrize("which", ["reference", "starter"])
@@ -39,18 +31,24 @@ def test_relay_add_appears_only_once_add_two_ints_is_reachable(which, supervisor
     runner.start(supervisor, exercise, script)
     try:
         # Its constructor is waiting: it says so each second, and offers nothing yet.
-        _wait(
+        wait_until(
             lambda: any(
                 "waiting for /add_two_ints" in line for line in runner.output(supervisor, exercise)
             ),
-            60,
-            "the relay saying it waits for /add_two_ints",
+            timeout=60,
+            what="the relay saying it waits for /add_two_ints",
         )
-        _wait(lambda: "relay_server" in probe.node.get_node_names(), 30, "/relay_server")
+        wait_until(
+            lambda: "relay_server" in probe.node.get_node_names(), timeout=30, what="/relay_server"
+        )
         assert "/relay_add" not in _services(probe), "offered before its server is reachable"
 
         supervisor.start(SERVER)
-        _wait(lambda: "/relay_add" in _services(probe), 60, "/relay_add once the server is up")
+        wait_until(
+            lambda: "/relay_add" in _services(probe),
+            timeout=60,
+            what="/relay_add once the server is up",
+        )
         if which == "starter":
             return  # it deadlocks on a call: that is the exercise
         from tutorial_interfaces.srv import AddTwoInts
@@ -59,7 +57,7 @@ def test_relay_add_appears_only_once_add_two_ints_is_reachable(which, supervisor
         try:
             assert client.wait_for_service(timeout_sec=30)
             future = client.call_async(AddTwoInts.Request(a=20, b=22))
-            _wait(future.done, 30, "the answer of /relay_add")
+            wait_until(future.done, timeout=30, what="the answer of /relay_add")
             assert future.result().sum == 42
         finally:
             probe.node.destroy_client(client)

@@ -65,7 +65,7 @@ def _cpu_of(proc: psutil.Process) -> float:
 
 def test_a_figure_below_zero_is_said_not_written():
     """A session's last test can see the tree lose a reparented process's seconds."""
-    assert _cpu_figure(10.0, 12.25) == " cpu 2.2"
+    assert _cpu_figure(10.0, 12.5) == " cpu 2.5"
     assert _cpu_figure(None, 3.0) == _cpu_figure(3.0, None) == ""
     text = _cpu_figure(450.0, 9.3)
     assert "unknown" in text and "440.7 s" in text and "-" not in text
