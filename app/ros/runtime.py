@@ -28,7 +28,13 @@ import rclpy
 from rclpy._rclpy_pybind11 import RCLError
 from rclpy.context import Context
 from rclpy.exceptions import InvalidHandle
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.executors import (
+    ConditionReachedException,
+    Executor,
+    ExternalShutdownException,
+    ShutdownException,
+    SingleThreadedExecutor,
+)
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import try_shutdown
@@ -71,13 +77,14 @@ class RosRuntime:
         self.callback_errors = 0  # callbacks that raised; each place is told once (see _spin)
         self._reported: set[tuple[str, str, int]] = set()
         self.executor.add_node(self.node)
+        self._stopping = threading.Event()  # ends _spin with nothing destroyed under it
         self._thread = threading.Thread(target=self._spin, name=f"ros-{node_name}", daemon=True)
         self._thread.start()
 
     def _spin(self) -> None:
         while True:
             try:
-                self.executor.spin()
+                spin_until(self.executor, self._stopping)
                 return
             except (ExternalShutdownException, KeyboardInterrupt):
                 return
@@ -115,20 +122,41 @@ class RosRuntime:
     def shutdown(self, timeout: float = 2.0, teardown_sec: float = TEARDOWN_SEC) -> None:
         """Executor first, then the node, then the context: never unbounded.
 
-        The executor thread gets ``timeout`` s to leave (rclpy 7.1.6's
-        ``Executor.shutdown`` does not wait for it, so we join it). The node is
-        destroyed only once that thread is gone: destroying what it still waits
-        on is the race rclpy cannot handle. The native teardown (Fast DDS
-        deleting its readers and writers) runs with the GIL held, so no Python
-        thread could stop it if it hung: a watchdog process ends this process
-        after ``teardown_sec`` s instead, saying so on stderr.
+        The executor thread is told to stop and gets ``timeout`` s to leave; only
+        then are the executor (rclpy 7.1.6's ``Executor.shutdown`` destroys its
+        guard conditions without waiting for the spinning thread) and the node
+        destroyed: destroying what that thread still waits on is the race rclpy
+        cannot handle (a SIGSEGV of tf2_monitor on SIGTERM, CI of 2026-12-04).
+        The native teardown (Fast DDS deleting its readers and writers) runs
+        with the GIL held, so no Python thread could stop it if it hung: a
+        watchdog process ends this process after ``teardown_sec`` s instead,
+        saying so on stderr.
         """
-        self.executor.shutdown(timeout_sec=timeout)
+        self._stopping.set()
+        self.executor.wake()  # out of its wait, to see the flag
         self._thread.join(timeout)
         with process_watchdog(teardown_sec, f"ROS teardown of /{self.node.get_name()}"):
             if not self._thread.is_alive():
+                self.executor.shutdown(timeout_sec=timeout)
                 self.node.destroy_node()
             try_shutdown(context=self.context)
+
+
+def spin_until(executor: Executor, stopping: threading.Event) -> None:
+    """``executor.spin()`` until ``stopping`` is set and the executor is woken.
+
+    ``Executor.spin()`` ends only through ``Executor.shutdown()``, which destroys the
+    guard conditions the spinning thread still waits on. Raises what a callback
+    raised, and ExternalShutdownException once the context is shut down.
+    """
+    stopped = stopping.is_set  # one object: the executor reuses its wait while args are equal
+    while not stopped():
+        try:
+            handler = executor.wait_for_ready_callbacks(None, None, stopped)[0]
+        except (ConditionReachedException, ShutdownException):
+            return
+        handler()
+        handler.result()  # raises what the callback raised
 
 
 def _lost_wait(exc: RCLError) -> bool:

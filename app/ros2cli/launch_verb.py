@@ -31,7 +31,9 @@ _ARGUMENT = re.compile(r"^[A-Za-z_][\w.-]*:=[^\n\x00]*$")
 _STARTED = re.compile(r"^\[INFO\] \[(?P<label>[^\]]+)\]: process started with pid \[\d+\]$")
 _INTERRUPTED = "[WARNING] [launch]: user interrupted with ctrl-c (SIGINT)"
 # How long the verb shows a starting launch: until every process has printed a line,
-# or this long once one has (a node may stay silent until it hears something)...
+# or this long after the first one did (a node may stay silent until it hears
+# something; counted from that first line, so a slow start does not cut the others off:
+# CI of 2026-12-04 showed turtlesim2's greeting after 10 s and lost turtlesim1's)...
 STARTUP_WAIT_SEC = 10.0
 # ...or this long while none has: several rclpy nodes starting at once on a loaded
 # computer can take that long (CI of 2026-12-03: no turtlesim had greeted after 10 s).
@@ -100,6 +102,7 @@ def _show_start(
     """What ros2 launch prints while its processes start; all of it if it ends meanwhile."""
     shown = 0
     waited = 0.0
+    first_spoke_at: float | None = None  # the wait for the silent ones counts from here
     # Not a stream: the Console's limit for streams does not apply.
     while True:
         lines = programs.output(key)
@@ -113,8 +116,14 @@ def _show_start(
             return 0 if status.exit_code == 0 else 1
         labels = [m["label"] for line in lines if (m := _STARTED.match(line))]
         spoke = {label for label in labels if any(x.startswith(f"[{label}] ") for x in lines)}
-        limit = STARTUP_WAIT_SEC if spoke else SLOW_START_LIMIT_SEC
-        if (labels and len(spoke) == len(labels)) or waited >= limit:
+        if spoke and first_spoke_at is None:
+            first_spoke_at = waited
+        if labels and len(spoke) == len(labels):
+            break
+        if first_spoke_at is None:
+            if waited >= SLOW_START_LIMIT_SEC:
+                break
+        elif waited - first_spoke_at >= STARTUP_WAIT_SEC:
             break
         ctx.sleep(0.1)
         waited += 0.1

@@ -100,8 +100,13 @@ def test_camera_to_arm_chain_reaches_the_target(supervisor, probe):
         return any("unreachable" in m.data for _, m in taps["status"].recent())
 
     wait_until(reported_unreachable, timeout=30, interval=0.5, what="the unreachable report")
-    assert any("unreachable" in line for line in supervisor.output("robotic_arm")), (
-        "the arm should log a warning for the unreachable target"
+    # The warning is logged before the status is published, but it reaches us through the
+    # supervisor's reader of the arm's pipe, which a loaded machine may run later than DDS
+    # delivers the status (CI of 2026-12-04).
+    wait_until(
+        lambda: any("unreachable" in line for line in supervisor.output("robotic_arm")),
+        timeout=10,
+        what="the arm's warning for the unreachable target in its output",
     )
 
 

@@ -138,14 +138,24 @@ def main(argv: list[str] | None = None) -> int:
     rclpy.init(args=argv)
     node = Node("tf2_monitor_main")
     executor = SingleThreadedExecutor()
+    stop = threading.Event()
     spinner: threading.Thread | None = None
+
+    def spin() -> None:
+        # Executor.spin() ends only through Executor.shutdown(), which destroys the guard
+        # conditions the spinning thread still waits on; that thread then frees them while
+        # the signal's context shutdown runs, and crashed once (SIGSEGV on SIGTERM, CI of
+        # 2026-12-04). A flag of our own ends the loop with nothing destroyed under it.
+        while not stop.is_set() and executor.context.ok():
+            executor.spin_once(timeout_sec=0.2)
+
     try:
         if len(args) not in (1, 3):
             node.get_logger().info("TF_Monitor: usage: tf2_monitor framea frameb")
             return 255
         monitor = TFMonitor(node, *args[1:3])
         executor.add_node(node)
-        spinner = threading.Thread(target=executor.spin, daemon=True)
+        spinner = threading.Thread(target=spin, daemon=True)
         spinner.start()
         if monitor.specific:
             monitor.wait_for_chain()
@@ -153,12 +163,15 @@ def main(argv: list[str] | None = None) -> int:
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        executor.shutdown(timeout_sec=2.0)
-        # The node is destroyed only once nothing spins it. A SIGTERM can land between the
-        # thread's creation and its start (seen on a loaded machine): nothing to wait for then.
+        stop.set()
+        # Executor and node are destroyed only once nothing spins them. A SIGTERM can land
+        # between the thread's creation and its start (seen on a loaded machine): nothing to
+        # wait for then.
         if spinner is not None and spinner.ident is not None:
-            spinner.join(timeout=2.0)
-        node.destroy_node()
+            spinner.join(timeout=5.0)
+        if spinner is None or not spinner.is_alive():
+            executor.shutdown(timeout_sec=2.0)
+            node.destroy_node()
         rclpy.try_shutdown()
     return 0
 
