@@ -35,6 +35,10 @@ def pytest_collection_finish(session: pytest.Session) -> None:
 # their own, so two of them may serve on the same port number and would write
 # the same dashboard-<port>.log.
 ARTIFACTS = PROJECT_ROOT / "test-artifacts" / os.environ.get("PYTEST_XDIST_WORKER", "")
+# A ROS teardown watchdog that ends a worker (or a dashboard it started) says why in the
+# worker's timeline: its stderr would die with the worker's captured output. The name is
+# app.ros.runtime.WATCHDOG_LOG_VARIABLE (not imported here: that imports rclpy).
+os.environ.setdefault("CLASSROOM_WATCHDOG_LOG", str(ARTIFACTS / "timeline.txt"))
 _domain_ids = itertools.count(1 + os.getpid() % 50)
 
 

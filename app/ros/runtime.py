@@ -44,6 +44,8 @@ from nodes.common.parameter_guard import guard_parameter_services
 DASHBOARD_NODE_NAME = "classroom_dashboard"
 # The native teardown of a participant takes milliseconds; this long means it hung.
 TEARDOWN_SEC = 10.0
+# A file that a watchdog's last words are appended to as well (see process_watchdog).
+WATCHDOG_LOG_VARIABLE = "CLASSROOM_WATCHDOG_LOG"
 
 
 class RosRuntime:
@@ -177,11 +179,18 @@ def process_watchdog(seconds: float, what: str) -> Iterator[None]:
 
     The watchdog is a shell in its own session (it keeps running while native
     code holds our GIL); when the block ends in time, its whole group is killed.
+    The line also goes to the file ``$CLASSROOM_WATCHDOG_LOG`` names, if any: a
+    process whose stderr is captured in memory (a test runner's) loses it.
     """
     pid = os.getpid()
     line = f"{what} hung for {seconds:g} s: ending process {pid}"
+    also = os.environ.get(WATCHDOG_LOG_VARIABLE, "")
+    script = (
+        f'sleep {seconds:g}; echo "$1" >&2; '
+        f'[ -z "$2" ] || echo "$(date +%H:%M:%S) $1" >> "$2"; kill -KILL {pid}'
+    )
     guard = subprocess.Popen(
-        ["/bin/sh", "-c", f'sleep {seconds:g}; echo "$1" >&2; kill -KILL {pid}', "watchdog", line],
+        ["/bin/sh", "-c", script, "watchdog", line, also],
         start_new_session=True,
         stdin=subprocess.DEVNULL,
         stdout=subprocess.DEVNULL,

@@ -3,6 +3,7 @@ can pick another, and the live graph grows and shows messages moving on /chatter
 
 from __future__ import annotations
 
+import os
 import re
 import time
 
@@ -29,6 +30,9 @@ from tests.integration.core_helpers import DISCOVERY_TIMEOUT
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
 SIZES = [(1366, 768), (1920, 1080)]
+# A folder to photograph every step of the course walk into, for a person to look at
+# (`CLASSROOM_STEP_SHOTS=/tmp/steps tests/run.py ... -k every_step`); unset in CI.
+STEP_SHOTS = os.environ.get("CLASSROOM_STEP_SHOTS", "")
 
 
 def _open(browser, dashboard, size: tuple[int, int]) -> Page:
@@ -191,6 +195,10 @@ def test_every_step_in_course_order_puts_its_stage_on_with_its_text_in_view(
                 if off := stage_fills(settled_layout(page, stage), stage):
                     wrong.append(f"{where} ({stage}): {off}")
                 wrong += [f"{where}: {why}" for why in step_reads_top_down(page, lesson, index)]
+                if STEP_SHOTS:
+                    number = lessons.index(lesson) + 1
+                    name = f"{size[0]}-{number:02d}-{lesson.id}-{index + 1:02d}.png"
+                    page.screenshot(path=os.path.join(STEP_SHOTS, name))
                 if (lesson, index) != (lessons[-1], len(lesson.steps) - 1):
                     click_next(page)  # on a lesson's last step: "Next lesson: ..."
         assert not wrong, f"at {size}: " + "; ".join(wrong)

@@ -116,8 +116,12 @@ def test_a_node_whose_teardown_hangs_ends_after_ctrl_c(ros_env):
     assert TEARDOWN_SEC - 0.5 <= took <= TEARDOWN_SEC + 8, f"ended {took:.1f} s after Ctrl+C"
 
 
-def test_a_stuck_ros_runtime_teardown_ends_the_process_and_says_why(ros_env):
-    proc = _run_until_ready(STUCK_RUNTIME, ros_env)
+def test_a_stuck_ros_runtime_teardown_ends_the_process_and_says_why(ros_env, tmp_path):
+    from app.ros.runtime import WATCHDOG_LOG_VARIABLE
+
+    last_words = tmp_path / "watchdog.log"
+    env = {**ros_env, WATCHDOG_LOG_VARIABLE: str(last_words)}
+    proc = _run_until_ready(STUCK_RUNTIME, env)
     try:
         code = proc.wait(2.0 + 15)
     finally:
@@ -128,6 +132,8 @@ def test_a_stuck_ros_runtime_teardown_ends_the_process_and_says_why(ros_env):
     err, out = proc.stderr.read(), proc.stdout.read()
     assert "ROS teardown of /stuck_runtime hung for 2 s: ending process" in err, err[-2000:]
     assert "NOT REACHED" not in out
+    # ...and in the file named for it, where a captured stderr would have lost it.
+    assert "ROS teardown of /stuck_runtime hung for 2 s" in last_words.read_text()
 
 
 def test_a_ros_runtime_teardown_in_time_leaves_no_watchdog(ros_env):
