@@ -1,45 +1,24 @@
 """How long `ros2 launch` shows its starting processes, on a simulated clock.
 
-The launch's output is a script of (second, line) pairs; the verb's sleeps
-advance the clock instead of waiting.
+The launch's output is a script of (second, line) pairs, as for `ros2 run`
+(tests/unit/test_run_follow_start.py); the verb's sleeps advance the clock.
 """
 
 from __future__ import annotations
 
-import threading
-
 import pytest
 
-from app.ros.context import CONSOLE_LIMITS, CallContext
 from app.ros2cli import launch_verb
-from app.supervisor import NodeState, NodeStatus
 
-
-class ScriptedLaunch:
-    def __init__(self, lines: list[tuple[float, str]]) -> None:
-        self.lines, self.now = lines, 0.0
-
-    def output(self, _key: str, last: int | None = None) -> list[str]:
-        return [text for at, text in self.lines if at <= self.now + 1e-9]
-
-    def status(self, key: str) -> NodeStatus:
-        return NodeStatus(key, NodeState.RUNNING, pid=42)
-
-
-class SimulatedContext(CallContext):
-    def __init__(self, launch: ScriptedLaunch, written: list[str]) -> None:
-        super().__init__(None, written.append, CONSOLE_LIMITS, threading.Event())  # type: ignore[arg-type]
-        self.launch = launch
-
-    def sleep(self, seconds: float) -> None:
-        self.launch.now += seconds
+# A scripted program's output as a function of the simulated time; sleeps advance it.
+from tests.unit.test_run_follow_start import ScriptedProgram, SimulatedContext
 
 
 def show(lines: list[tuple[float, str]]) -> tuple[float, list[str]]:
     """When the verb let go (simulated seconds), and what it wrote."""
-    launch, written = ScriptedLaunch(lines), []
+    launch, written = ScriptedProgram(lines, up_at=None), []
     code = launch_verb._show_start(
-        SimulatedContext(launch, written),
+        SimulatedContext(launch, written),  # type: ignore[arg-type]
         launch,  # type: ignore[arg-type]
         "launch:turtlesim/multisim.launch.py",
         "turtlesim",
