@@ -123,6 +123,9 @@ class _TopicRow:
         self.automatic = True  # False: the row waits for the learner's pick
         self._select: Callable[[str], None] = lambda _topic: None
         self._options: tuple[str, ...] = (picker.NONE,)
+        # The topic the row follows. Not read back from the dropdown: a forged value
+        # sits there for a moment until it is put back (app.ui.loop.refuse_choice).
+        self.current = picker.NONE
         self.dropdown = gui.add_dropdown(
             label, self._options, initial_value=picker.NONE, hint=offer.hint
         )
@@ -135,22 +138,29 @@ class _TopicRow:
 
     def _picked_by_learner(self) -> None:
         self.chosen_by_learner = True
-        self._select(self.dropdown.value)
+        self.current = self.dropdown.value
+        self._select(self.current)
+
+    def follow(self, topic: str) -> None:
+        """Show and follow ``topic`` by our own choice (``picker.NONE``: nothing)."""
+        self.chosen_by_learner = False
+        self.current = topic
+        assign(self.dropdown, topic)  # posts no intent
+        self._select(topic)
 
     def refresh_options(self, graph: GraphSnapshot) -> None:
-        opts = tuple(picker.options(graph, self.offer.types, self.dropdown.value))
+        opts = tuple(picker.options(graph, self.offer.types, self.current))
         if opts != self._options:
             self._options = opts
             self.dropdown.options = opts
         if self.chosen_by_learner or not self.automatic:
             return
-        if self.dropdown.value == picker.NONE and len(opts) > 1:
+        if self.current == picker.NONE and len(opts) > 1:
             choice = next((t for t in self.offer.preferred if t in opts), None)
             if choice is None:
                 choice = next((t for t in opts[1:] if t not in self.offer.avoid), None)
             if choice is not None:
-                assign(self.dropdown, choice)  # our own choice: posts no intent
-                self._select(choice)
+                self.follow(choice)
 
 
 class ScenePanel:
@@ -315,21 +325,18 @@ class ScenePanel:
         out over a point cloud), unless the simulated world still runs.
         """
         rows = (
-            (self._cloud_row, self.clouds.select),
-            (self._scan_row, self.scan.select),
-            (self._map_row, self.map.select),
-            (self._particle_row, self.particles.select),
-            (self._path_row, self.path.select),
-            (self._image_row, self.images.select),
-            (self._marker_row, self.markers.select),
-            (self._joint_row, self._select_joints),
+            self._cloud_row,
+            self._scan_row,
+            self._map_row,
+            self._particle_row,
+            self._path_row,
+            self._image_row,
+            self._marker_row,
+            self._joint_row,
         )
-        for row, select in rows:
-            topic = str(row.dropdown.value)
-            if topic != picker.NONE and graph.publishers(topic) == 0:
-                assign(row.dropdown, picker.NONE)
-                select(picker.NONE)
-                row.chosen_by_learner = False
+        for row in rows:
+            if row.current != picker.NONE and graph.publishers(row.current) == 0:
+                row.follow(picker.NONE)
         self.stamped.forget_unpublished(graph)
         self.tf_view.forget_unpublished(graph.publishers("/robot_description") > 0)
         if not self._world_shown:
@@ -442,9 +449,8 @@ class ScenePanel:
         gives way (robots then move on TF; the hidden desk arm would only cost CPU)."""
         row = self._joint_row
         row.automatic = not paused
-        if paused and not row.chosen_by_learner and row.dropdown.value != picker.NONE:
-            assign(row.dropdown, picker.NONE)
-            self._select_joints(picker.NONE)
+        if paused and not row.chosen_by_learner and row.current != picker.NONE:
+            row.follow(picker.NONE)
 
     def _on_frame_display(self) -> None:
         self.tf_view.set_display(

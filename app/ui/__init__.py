@@ -27,6 +27,8 @@ viser (1.1.1) from each thread:
   servers built without ``make_server`` (bench/ baselines, a few tests) still do.
 - Setting an input's ``value`` runs its update callbacks at once, on the
   setter's thread (``event.client`` is None; ``UiLoop.callback`` ignores them).
+- viser takes any string a browser sends as a dropdown's value; ``UiLoop.callback``
+  puts back one the dropdown does not offer, on the pool thread, and posts nothing.
 - Browser events run plain callbacks on viser's pool (32 threads) and
   ``async def`` callbacks on the event loop thread. Blocking in the first
   holds a pool thread, in the second freezes every browser: post an intent.

@@ -9,6 +9,8 @@ from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from typing import TypeVar
 
+import viser
+
 from app.ros.errors import Ros2Error
 
 log = logging.getLogger(__name__)
@@ -23,6 +25,23 @@ def one_line(exc: BaseException) -> str:
         return str(exc)
     text = str(exc).splitlines()[0] if str(exc) else ""
     return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+def refuse_choice(dropdown: viser.GuiDropdownHandle, before: object, *, warn: bool) -> None:
+    """A browser chose a value its dropdown does not offer: a forged message, or a pick
+    that raced the server's new list. viser takes any string as the value; it goes back
+    at once, on this thread (viser's pool), to what the dropdown showed before (or its
+    first option), so no intent and (but for a moment) no refresh sees it. The first
+    refusal of each dropdown is a warning line; a flood of forged values is not."""
+    chosen = str(dropdown.value)
+    (log.warning if warn else log.debug)(
+        "a browser chose %r in the dropdown %r, which does not offer it: put back",
+        chosen[:80],
+        dropdown.label,
+    )
+    options = dropdown.options
+    if options:
+        setattr(dropdown, "value", before if before in options else options[0])  # noqa: B010 (typed read-only)
 
 
 class UiLoop:
@@ -57,13 +76,33 @@ class UiLoop:
 
         viser also runs update callbacks, synchronously, when the server itself
         assigns a value (``event.client`` is None then): the UI thread made that
-        change and already knows it, so no intent is posted for it.
+        change and already knows it, so no intent is posted for it. A dropdown's value
+        that the dropdown does not offer is refused (``refuse_choice``), never posted.
         """
 
+        # The last value of this widget that a panel knows of: what a refused choice is
+        # put back to. Any thread may write it; a list holds the one value.
+        known: list[object] = []
+        warned: list[bool] = []
+
         def on_event(event: object) -> None:
+            target = getattr(event, "target", None)
             if getattr(event, "client", True) is None:
+                known[:] = [getattr(target, "value", None)]
                 return
-            self.post(lambda: intent(*args))
+            if isinstance(target, viser.GuiDropdownHandle) and target.value not in target.options:
+                refuse_choice(target, known[0] if known else None, warn=not warned)
+                warned[:] = [True]
+                return
+            known[:] = [getattr(target, "value", None)]
+            self.post(lambda: acted_on(target))
+
+        def acted_on(target: object) -> None:
+            # A forged value may have landed since this event (viser sets it on its loop
+            # before our pool thread puts it back): the panel reads the value only now.
+            if isinstance(target, viser.GuiDropdownHandle) and target.value not in target.options:
+                return
+            intent(*args)
 
         return on_event
 

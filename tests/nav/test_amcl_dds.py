@@ -120,6 +120,13 @@ class Watcher:
         self.cmd.publish(Twist())
 
     def set_initial_pose(self, x: float, y: float, yaw: float, frame: str = "map") -> None:
+        # amcl subscribes once configured; a pose sent before discovery matched us is lost
+        # (ci84, a busy loop beside it: no amcl output for 30 s after the first one).
+        wait_until(
+            lambda: self.initial.get_subscription_count() > 0,
+            timeout=30,
+            what="amcl's /initialpose subscription",
+        )
         msg = PoseWithCovarianceStamped()
         msg.header.frame_id = frame
         msg.pose.pose.position.x, msg.pose.pose.position.y = x, y
