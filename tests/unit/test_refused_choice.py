@@ -11,6 +11,7 @@ from __future__ import annotations
 import logging
 
 from app.access import make_server
+from app.ui import set_options
 from app.ui.loop import UiLoop
 from tests.conftest import free_port, wait_until
 from tests.wire_client import WireClient
@@ -61,4 +62,25 @@ def test_a_value_the_dropdown_does_not_offer_is_put_back_and_never_acted_on(capl
         client.close()
         watcher.close()
         loop.close()
+        server.stop()
+
+
+def test_new_options_keep_the_learners_choice_but_never_a_forged_value():
+    server, _ = make_server("127.0.0.1", free_port(), None)
+    # No callback: the forged value stays, as it does for a moment before it is put back.
+    dropdown = server.gui.add_dropdown("Topic", ["/a", "/b"], initial_value="/a")
+    client = WireClient(f"http://127.0.0.1:{server.get_port()}")
+    try:
+        uuid = wait_until(lambda: client.find("Topic", "GuiDropdownMessage"), what="the dropdown")
+        client.set_value(uuid, "/b")
+        wait_until(lambda: dropdown.value == "/b", what="the learner's choice")
+        set_options(dropdown, ["/a", "/c"])  # /b went away: it stays, it may come back
+        assert dropdown.options == ("/a", "/c", "/b") and dropdown.value == "/b"
+
+        client.set_value(uuid, "rm -rf /")
+        wait_until(lambda: dropdown.value == "rm -rf /", what="the forged value")
+        set_options(dropdown, ["/a", "/c"])  # a refresh in the moment before it is put back
+        assert "rm -rf /" not in dropdown.options
+    finally:
+        client.close()
         server.stop()
