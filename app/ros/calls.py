@@ -138,6 +138,8 @@ class GoalRun:
     goal_id: str = ""
     command: str = ""  # the equivalent `ros2 action send_goal ...` line
     done: threading.Event = field(default_factory=threading.Event)
+    # The server's answer to our cancel: action_msgs' CancelGoal return code (None: none yet).
+    cancel_code: int | None = None
     _handle: ClientGoalHandle | None = None
 
     @property
@@ -150,7 +152,14 @@ class GoalRun:
         handle = self._handle
         if handle is not None and not self.done.is_set():
             self.status = "CANCELING"
-            handle.cancel_goal_async()
+            handle.cancel_goal_async().add_done_callback(self._cancel_answered)
+
+    def _cancel_answered(self, future: Future) -> None:
+        try:
+            response = future.result()
+        except Exception:  # the client went away with the goal's end: no answer
+            return
+        self.cancel_code = int(getattr(response, "return_code", -1))
 
 
 class _ResultResponse(Protocol):
