@@ -7,11 +7,12 @@ import queue
 import threading
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
-from typing import TypeVar
+from typing import TypeGuard, TypeVar
 
 import viser
 
 from app.ros.errors import Ros2Error
+from app.ui import assign
 
 log = logging.getLogger(__name__)
 
@@ -25,6 +26,11 @@ def one_line(exc: BaseException) -> str:
         return str(exc)
     text = str(exc).splitlines()[0] if str(exc) else ""
     return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+def unoffered(target: object) -> TypeGuard[viser.GuiDropdownHandle]:
+    """Whether ``target`` is a dropdown whose value it does not offer."""
+    return isinstance(target, viser.GuiDropdownHandle) and target.value not in target.options
 
 
 def refuse_choice(dropdown: viser.GuiDropdownHandle, before: object, *, warn: bool) -> None:
@@ -41,7 +47,7 @@ def refuse_choice(dropdown: viser.GuiDropdownHandle, before: object, *, warn: bo
     )
     options = dropdown.options
     if options:
-        setattr(dropdown, "value", before if before in options else options[0])  # noqa: B010 (typed read-only)
+        assign(dropdown, before if before in options else options[0])
 
 
 class UiLoop:
@@ -81,28 +87,27 @@ class UiLoop:
         """
 
         # The last value of this widget that a panel knows of: what a refused choice is
-        # put back to. Any thread may write it; a list holds the one value.
-        known: list[object] = []
-        warned: list[bool] = []
+        # put back to. Any thread may write it.
+        known: object = None
+        warned = False
 
         def on_event(event: object) -> None:
+            nonlocal known, warned
             target = getattr(event, "target", None)
-            if getattr(event, "client", True) is None:
-                known[:] = [getattr(target, "value", None)]
+            from_browser = getattr(event, "client", True) is not None
+            if from_browser and unoffered(target):
+                refuse_choice(target, known, warn=not warned)
+                warned = True
                 return
-            if isinstance(target, viser.GuiDropdownHandle) and target.value not in target.options:
-                refuse_choice(target, known[0] if known else None, warn=not warned)
-                warned[:] = [True]
-                return
-            known[:] = [getattr(target, "value", None)]
-            self.post(lambda: acted_on(target))
+            known = getattr(target, "value", None)
+            if from_browser:
+                self.post(lambda: acted_on(target))
 
         def acted_on(target: object) -> None:
             # A forged value may have landed since this event (viser sets it on its loop
             # before our pool thread puts it back): the panel reads the value only now.
-            if isinstance(target, viser.GuiDropdownHandle) and target.value not in target.options:
-                return
-            intent(*args)
+            if not unoffered(target):
+                intent(*args)
 
         return on_event
 
