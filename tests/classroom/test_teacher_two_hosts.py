@@ -71,6 +71,9 @@ DRIVER = textwrap.dedent(
             elif op == "wait_text":
                 seen = until(lambda: cmd["text"] in page.markdown(), cmd.get("timeout", 15))
                 out = {"ok": bool(seen), "t": time.monotonic(), "markdown": page.markdown()}
+                if not seen:  # was the page still connected, and still being sent frames?
+                    out["closed"] = page.closed_reason
+                    out["quiet_s"] = round(time.monotonic() - page.last_frame_at, 1)
             elif op == "wait_regex":
                 import re
                 pattern = re.compile(cmd["regex"])
@@ -353,7 +356,11 @@ def test_teacher_follows_three_learners_on_two_hosts(ros_env, two_hosts, tmp_pat
         a("set", page="teacher", label="To", value="everyone")
         a("set", page="teacher", label="Message", value="Five minutes left")
         a("click", page="teacher", label="Send")
-        assert a("wait_text", page="a2", text="Five minutes left")["ok"]
+        seen = a("wait_text", page="a2", text="Five minutes left")
+        # Once (ci86) a2 never showed it: say what the teacher page answered Send with, and if
+        # a2's page was still connected.
+        sent = re.findall(r"(?:Sent to|⚠)[^\n]*", a("markdown", page="teacher")["markdown"])
+        assert seen["ok"], (sent, seen.get("closed"), seen.get("quiet_s"), seen["markdown"][-1500:])
         assert b("wait_text", page="b1", text="Five minutes left")["ok"]
 
         # -- the teacher decides when solutions show ------------------------------------
