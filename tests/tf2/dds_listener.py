@@ -35,13 +35,25 @@ def main() -> None:
         tr, r = last.transform.translation, last.transform.rotation
         out["s11"] = [tr.x, tr.y, tr.z, r.x, r.y, r.z, r.w]
         out["s11_stamp"] = [last.header.stamp.sec, last.header.stamp.nanosec]
-        xs = []
-        for _ in range(3):
+        # Three readings of the newest pose, each at least 0.3 s after the one before by
+        # the frame's own stamps, not by this program's sleeps: on a loaded machine the
+        # listener's thread can fall behind the wall clock, and the buffer then held less
+        # than the 0.51 s the lookup in the past below needs.
+        xs: list[float] = []
+        newest = None
+        deadline = time.monotonic() + 30.0
+        while len(xs) < 3:
             moving = buffer.lookup_transform(
                 "world", "moving", Time(), timeout=Duration(seconds=10.0)
             )
-            xs.append(moving.transform.translation.x)
-            time.sleep(0.3)
+            stamp = Time.from_msg(moving.header.stamp)
+            if newest is None or stamp - newest >= Duration(seconds=0.3):
+                xs.append(moving.transform.translation.x)
+                newest = stamp
+            elif time.monotonic() > deadline:
+                raise TransformException(f"'moving' stopped at {stamp.nanoseconds} ns")
+            else:
+                time.sleep(0.05)
         out["moving_x"] = xs
         # the frame a little in the past, between two stamps: interpolated
         stamp = Time.from_msg(moving.header.stamp) - Duration(seconds=0.51)
