@@ -470,9 +470,19 @@ class TeacherPage:
         if len(text) > MAX_NOTICE:
             self._sent.show(f"⚠ At most {MAX_NOTICE} characters ({len(text)} now).")
             return
-        target = "" if to == EVERYONE else to
-        self.roster.send_notice(target, text)
+        # The box is emptied before the message leaves, not after: whoever sees it arrive and
+        # types the next one at once (ci86's two-host test did, within the loaded UI thread's
+        # pause after publishing) must never have the new words wiped by this clear.
         assign(self._text, "")
+        try:
+            self.roster.send_notice("" if to == EVERYONE else to, text)
+        except Exception as error:  # the classroom's DDS closing: the words go back in the box
+            log.exception("sending a notice failed")
+            assign(self._text, text)
+            self._sent.show(
+                f"⚠ Not sent ({type(error).__name__}): your message is back in the box."
+            )
+            return
         self._sent.show(f"Sent to {to} at {time.strftime('%H:%M:%S')}.")
 
     def _on_apply(self) -> None:
