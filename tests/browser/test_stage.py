@@ -258,7 +258,10 @@ _TIME_THE_TALKERS_BOX = """() => {
   new MutationObserver((_, watch) => {
     if (box()) { window.__boxAt = performance.now(); watch.disconnect(); }
   }).observe(document.body, {childList: true, subtree: true, attributes: true});
+  return box() !== null;  // already drawn: there would be no moment to time
 }"""
+_SECONDS_TO_THE_BOX = """() => window.__boxAt === null || window.__clickAt === null
+  ? null : (window.__boxAt - window.__clickAt) / 1000"""
 
 
 @pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
@@ -270,12 +273,13 @@ def test_the_graph_grows_and_messages_move_on_chatter(browser, dashboard, probe,
         open_tab(page, "Nodes")
         choose(page, "Catalog node", "talker")
         start = page.get_by_role("button", name="Start", exact=True)
-        page.evaluate(_TIME_THE_TALKERS_BOX)
+        assert not page.evaluate(_TIME_THE_TALKERS_BOX), "/talker on stage before its Start"
         start.click()
         # The box is on stage within a second of the click (drawn 'starting…' until DDS
         # lists the node), then stands for the node the ROS graph lists.
         expect(talker).to_be_attached(timeout=10_000)
-        grew = page.evaluate("() => (window.__boxAt - window.__clickAt) / 1000")
+        grew = page.evaluate(_SECONDS_TO_THE_BOX)
+        assert grew is not None, "the page saw no Start click, or no box appear after it"
         assert grew < 1.0, f"/talker on stage {grew:.2f} s after the Start click"
         expect(talker).to_have_attribute("data-state", "on-graph", timeout=20_000)
         # What DDS lists, as any ROS tool sees it (this probe discovers on its own time).
