@@ -23,7 +23,7 @@ from app.lessons.schema import Spec
 from app.ros.context import CONSOLE_LIMITS, CallContext
 from app.ros.graph import snapshot
 from app.ros2cli import run_text
-from tests.conftest import wait_until
+from tests.conftest import ARTIFACTS, wait_until
 from tests.course_data import shared_course
 
 pytestmark = pytest.mark.ros
@@ -169,8 +169,25 @@ def test_every_step_of_the_lesson_passes_on_real_nodes(live, world, lesson, requ
                     f"processes: {[s.describe() for s in live.supervisor.statuses().values()]}; "
                     f"graph query errors: {live.graph_errors[-3:]}; "
                     f"nodes now: {snapshot(live.node).nodes}"
+                    f"{_what_the_programs_said(live, lesson.id)}"
                 ),
             )
+
+
+def _what_the_programs_said(live: LessonRuntime, lesson_id: str) -> str:
+    """The warnings and errors of every program the walk started (a failed goal's why is
+    there: the planner's "no valid path", amcl's jumps); all their output to a file."""
+    said: list[str] = []
+    everything: list[str] = []
+    for name in live.supervisor.statuses():
+        output = live.supervisor.output(name)
+        everything += [f"== {name}", *output]
+        said += [f"{name}: {line}" for line in output if "[WARN]" in line or "[ERROR]" in line]
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    kept = ARTIFACTS / f"walk-{lesson_id}-programs.log"
+    kept.write_text("\n".join(everything) + "\n", encoding="utf-8")
+    last = "\n  ".join(said[-15:]) or "none"
+    return f"\nthe programs' last warnings and errors (all output in {kept}):\n  {last}"
 
 
 # A /clock older than this (by the world's own send time): no world runs now.

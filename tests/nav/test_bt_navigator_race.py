@@ -24,8 +24,9 @@ from geometry_msgs.msg import PoseStamped, TransformStamped
 from lifecycle_msgs.msg import Transition
 from lifecycle_msgs.srv import ChangeState
 from nav2_msgs.action import ComputePathToPose, FollowPath, NavigateToPose
+from nav2_msgs.srv import ClearEntireCostmap
 from nav_msgs.msg import Path
-from rclpy.action import ActionServer
+from rclpy.action import ActionServer, CancelResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.context import Context
 from rclpy.executors import MultiThreadedExecutor
@@ -59,7 +60,8 @@ def _path(x: float) -> Path:
 
 
 class StandIns:
-    """compute_path_to_pose and follow_path, and map -> base_link on /tf_static."""
+    """compute_path_to_pose and follow_path, the costmaps' clear services, and
+    map -> base_link on /tf_static. Subclasses change how planning and following go."""
 
     def __init__(self) -> None:
         self.context = Context()
@@ -68,6 +70,7 @@ class StandIns:
         self.plans = 0
         self.follow_goals = 0
         self.succeed = threading.Event()
+        self.events: list[str] = []  # "plan", "follow", "clear <costmap>", in order
         group = ReentrantCallbackGroup()
         self._servers = [
             ActionServer(
@@ -75,9 +78,19 @@ class StandIns:
                 callback_group=group,
             ),
             ActionServer(
-                self.node, FollowPath, "follow_path", self._follow, callback_group=group
+                self.node, FollowPath, "follow_path", self._follow, callback_group=group,
+                cancel_callback=lambda _handle: CancelResponse.ACCEPT,
             ),
         ]  # fmt: skip
+        self._clear_services = [
+            self.node.create_service(
+                ClearEntireCostmap,
+                f"{costmap}/clear_entirely_{costmap}",
+                lambda _request, response, costmap=costmap: self._clear(costmap, response),
+                callback_group=group,
+            )
+            for costmap in ("local_costmap", "global_costmap")
+        ]
         tf = TransformStamped()
         tf.header.frame_id, tf.child_frame_id = "map", "base_link"
         tf.transform.rotation.w = 1.0
@@ -93,7 +106,12 @@ class StandIns:
         self._thread = threading.Thread(target=self._executor.spin, daemon=True)
         self._thread.start()
 
+    def _clear(self, costmap: str, response: Any) -> Any:
+        self.events.append(f"clear {costmap}")
+        return response
+
     def _plan(self, handle: Any) -> ComputePathToPose.Result:
+        self.events.append("plan")
         self.plans += 1
         if self.plans == 2:  # a replan while driving: the controller finishes meanwhile
             self.succeed.set()
@@ -102,6 +120,7 @@ class StandIns:
         return ComputePathToPose.Result(path=_path(handle.request.goal.pose.position.x))
 
     def _follow(self, handle: Any) -> FollowPath.Result:
+        self.events.append("follow")
         self.follow_goals += 1
         self.succeed.wait(30.0)
         handle.succeed()
@@ -128,20 +147,25 @@ def _wait(future: Any, what: str) -> Any:
     return future.result()
 
 
+def navigate(supervisor: Any, stand_ins: StandIns, x: float = 1.0) -> Any:
+    """Start the real bt_navigator, bring it up, send one goal; its outcome."""
+    supervisor.start_program(lookup("bt_navigator"))
+    _transition(stand_ins, Transition.TRANSITION_CONFIGURE)
+    _transition(stand_ins, Transition.TRANSITION_ACTIVATE)
+    assert stand_ins.navigate.wait_for_server(timeout_sec=30)
+    goal = NavigateToPose.Goal()
+    goal.pose.header.frame_id = "map"
+    goal.pose.pose.position.x = x
+    goal.pose.pose.orientation.w = 1.0
+    handle = _wait(stand_ins.navigate.send_goal_async(goal), "navigate_to_pose's answer")
+    assert handle.accepted
+    return _wait(handle.get_result_async(), "navigate_to_pose's result")
+
+
 def test_a_success_during_a_replan_ends_the_goal_without_a_second_path(supervisor):
     stand_ins = StandIns()
     try:
-        supervisor.start_program(lookup("bt_navigator"))
-        _transition(stand_ins, Transition.TRANSITION_CONFIGURE)
-        _transition(stand_ins, Transition.TRANSITION_ACTIVATE)
-        assert stand_ins.navigate.wait_for_server(timeout_sec=30)
-        goal = NavigateToPose.Goal()
-        goal.pose.header.frame_id = "map"
-        goal.pose.pose.position.x = 1.0
-        goal.pose.pose.orientation.w = 1.0
-        handle = _wait(stand_ins.navigate.send_goal_async(goal), "navigate_to_pose's answer")
-        assert handle.accepted
-        outcome = _wait(handle.get_result_async(), "navigate_to_pose's result")
+        outcome = navigate(supervisor, stand_ins)
         assert stand_ins.plans >= 2, "the navigator never planned again while driving"
         assert outcome.status == SUCCEEDED, f"the goal ended with status {outcome.status}"
         assert stand_ins.follow_goals == 1, (

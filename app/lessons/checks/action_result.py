@@ -29,4 +29,13 @@ def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
         return CheckResult(FAIL, run.error)
     if status == c["status"]:
         return CheckResult(PASS, f"the goal {status}")
-    return CheckResult(FAIL, f"the goal {status}, expected {c['status']}")
+    return CheckResult(FAIL, f"the goal {status}, expected {c['status']}{_why(run.result)}")
+
+
+def _why(result: object) -> str:
+    """' (error CODE: message)' from a result that says why (Nav2's actions do), else ''."""
+    code = getattr(result, "error_code", 0)
+    message = str(getattr(result, "error_msg", "") or "").strip()
+    if not code and not message:
+        return ""
+    return f" (error {code}: {message})" if message else f" (error {code})"

@@ -16,10 +16,14 @@ this one runs the same steps as plain code, no behaviour tree (nor its XML,
    then the goal ends aborted with the failing server's error code and
    message (e.g. ComputePathToPose's ``GOAL_OCCUPIED`` 206, FollowPath's
    ``FAILED_TO_MAKE_PROGRESS`` 105). A first plan that fails ends the goal
-   (``NO_VALID_PATH`` 208 when an obstacle the scans saw closes the way;
-   after one more try ``recovery_wait`` later for the codes a planner
-   recovery may help with, at once for the others, e.g. ``GOAL_OCCUPIED``);
-   so do three replans in a row that fail.
+   (``NO_VALID_PATH`` 208 when an obstacle the scans saw closes the way), and
+   so do three replans in a row that fail. Each plan is one try as the tree's
+   ComputePathToPose RecoveryNode makes it: a plan that fails with a code a
+   planner recovery may help with (``NO_VALID_PATH``, ``TIMEOUT``,
+   ``UNKNOWN``) clears the global costmap (a scan taken while the robot's
+   pose was off may have drawn a wall across a door), waits
+   ``recovery_wait`` for its next update and plans once more; other codes,
+   e.g. ``GOAL_OCCUPIED``, fail at once.
 
 The recovery actions, in turn: *wait* ``recovery_wait`` (1 s: the costmaps
 take in what the scans show, so the next plan goes round a new obstacle);
@@ -77,10 +81,9 @@ PLANNER_RETRY = (
     ComputePathToPose.Result.NO_VALID_PATH,
     ComputePathToPose.Result.TIMEOUT,
 )
-COSTMAPS = (
-    "local_costmap/clear_entirely_local_costmap",
-    "global_costmap/clear_entirely_global_costmap",
-)
+LOCAL_COSTMAP = "local_costmap/clear_entirely_local_costmap"
+GLOBAL_COSTMAP = "global_costmap/clear_entirely_global_costmap"
+COSTMAPS = (LOCAL_COSTMAP, GLOBAL_COSTMAP)
 
 
 class NavigationFailed(Exception):
@@ -323,16 +326,7 @@ class BtNavigator(LifecycleNode):
         try:
             period = float(self.get_parameter("replanning_period").value)
             retries = int(self.get_parameter("number_of_retries").value)
-            try:
-                path = self.plan(goals, stop)
-            except NavigationFailed as exc:
-                # The tree plans again after a failure a recovery may mend (its costmap may
-                # hold what a scan got wrong): here once, after the costmaps' next update.
-                if exc.code not in PLANNER_RETRY or stop():
-                    raise
-                self.get_logger().warning(f"Planning failed ({exc.code}: {exc}); once more")
-                self.recover("wait", stop)
-                path = self.plan(goals, stop)
+            path = self.plan_with_recovery(goals, stop)
             follow = self.follow(path, stop, handle)
             state["path"] = [(p.pose.position.x, p.pose.position.y) for p in path.poses]
             last_plan = time.monotonic()
@@ -380,7 +374,7 @@ class BtNavigator(LifecycleNode):
                 if follow is None or time.monotonic() - last_plan >= period:
                     last_plan = time.monotonic()
                     try:
-                        path = self.plan(goals, stop)
+                        path = self.plan_with_recovery(goals, stop)
                         failures = 0
                         if follow is not None and not follow.running():
                             # It ended while the planner worked: the loop's top reads how (a
@@ -422,9 +416,14 @@ class BtNavigator(LifecycleNode):
         elif action == "back up":
             self.back_up(stop)
         else:
-            for client in self.clear_clients:
-                if client.wait_for_service(timeout_sec=1.0):
-                    wait_for(client.call_async(ClearEntireCostmap.Request()), 5.0, stop)
+            self.clear_costmaps(stop, COSTMAPS)
+
+    def clear_costmaps(self, stop: Any, which: tuple[str, ...]) -> None:
+        """Empty the obstacle layers of the costmaps named in ``which`` (of ``COSTMAPS``)."""
+        # Not strict: after a deactivation there are no clients (a goal may still be ending).
+        for name, client in zip(COSTMAPS, self.clear_clients, strict=False):
+            if name in which and client.wait_for_service(timeout_sec=1.0):
+                wait_for(client.call_async(ClearEntireCostmap.Request()), 5.0, stop)
 
     def back_up(self, stop: Any) -> None:
         """Drive backwards ``backup_dist`` at ``backup_speed`` while the costmap has room."""
@@ -494,6 +493,22 @@ class BtNavigator(LifecycleNode):
         if action is NavigateThroughPoses:
             feedback.number_of_poses_remaining = len(goals)
         handle.publish_feedback(feedback)
+
+    def plan_with_recovery(self, goals: list[PoseStamped], stop: Any) -> Path:
+        """A plan, tried a second time as the tree's ComputePathToPose RecoveryNode does:
+        after clearing the global costmap, for the codes a planner recovery may help with."""
+        try:
+            return self.plan(goals, stop)
+        except NavigationFailed as exc:
+            if exc.code not in PLANNER_RETRY or stop():
+                raise
+            self.get_logger().warning(
+                f"Planning failed ({exc.code}: {exc}); clearing the global costmap and "
+                "planning once more"
+            )
+            self.clear_costmaps(stop, (GLOBAL_COSTMAP,))
+            self.recover("wait", stop)  # the costmap's next update takes in the scans again
+            return self.plan(goals, stop)
 
     def plan(self, goals: list[PoseStamped], stop: Any) -> Path:
         """One path through ``goals`` (each leg a ComputePathToPose from the previous pose)."""
