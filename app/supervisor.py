@@ -185,6 +185,10 @@ class Supervisor:
         self._timeouts = (sigint_timeout, sigterm_timeout)
         self._lock = threading.Lock()
         self._start_lock = threading.Lock()  # check-then-spawn is one step
+        # A state change and its telling are one step, so listeners hear a program's
+        # states in the order they happened (a reap racing a Stop told STOPPED first).
+        # Reentrant: a listener may ask for a status or a stop.
+        self._told_in_order = threading.RLock()
         self._procs: dict[str, _Process] = {}
         self._ended: deque[NodeStatus] = deque(maxlen=500)  # who ended, newest last
         self._spawner = ThreadPoolExecutor(max_workers=1, thread_name_prefix="supervisor-spawn")
@@ -196,7 +200,9 @@ class Supervisor:
 
     def on_change(self, listener: Callable[[NodeStatus], None]) -> None:
         """Call ``listener`` with a program's status when it was started, asked to stop and
-        reaped (on the thread that did it): the moments its node joins or leaves the graph."""
+        reaped (on the thread that did it, in that order): the moments its node joins or
+        leaves the graph. A listener must be quick and must not start a program (a start
+        waits for the spawner thread, which may be waiting to tell)."""
         self._listeners.append(listener)
 
     def _tell(self, status: NodeStatus) -> None:
@@ -290,18 +296,20 @@ class Supervisor:
         """Ask a node to stop; the future resolves once it has been reaped."""
         self._known(name)
         future: Future[NodeStatus] = Future()
-        with self._lock:
-            proc = self._procs.get(name)
-            if proc is None or proc.state not in ACTIVE_STATES:
-                future.set_result(proc.status() if proc else NodeStatus(name, NodeState.STOPPED))
-                return future
-            proc.stop_requested = True
-            proc.state = NodeState.STOPPING
-            stopping = proc.status()
+        with self._told_in_order:
+            with self._lock:
+                proc = self._procs.get(name)
+                if proc is None or proc.state not in ACTIVE_STATES:
+                    ended = proc.status() if proc else NodeStatus(name, NodeState.STOPPED)
+                    future.set_result(ended)
+                    return future
+                proc.stop_requested = True
+                proc.state = NodeState.STOPPING
+                stopping = proc.status()
+            self._tell(stopping)
         threading.Thread(
             target=self._escalate_stop, args=(proc, future), name=f"stop-{name}", daemon=True
         ).start()
-        self._tell(stopping)
         return future
 
     def restart(self, name: str) -> NodeStatus:
@@ -363,13 +371,14 @@ class Supervisor:
             preexec_fn=die_with(os.getpid(), death_signal),
         )
         proc = _Process(entry, popen, self._max_log_lines)
-        with self._lock:
-            self._procs[entry.name] = proc
-        threading.Thread(
-            target=self._read_and_reap, args=(proc,), name=f"output-{entry.name}", daemon=True
-        ).start()
-        status = proc.status()
-        self._tell(status)
+        with self._told_in_order:  # a program that dies at once is told ended after this
+            with self._lock:
+                self._procs[entry.name] = proc
+            threading.Thread(
+                target=self._read_and_reap, args=(proc,), name=f"output-{entry.name}", daemon=True
+            ).start()
+            status = proc.status()
+            self._tell(status)
         return status
 
     def _read_and_reap(self, proc: _Process) -> None:
@@ -406,14 +415,15 @@ class Supervisor:
                 entry.after_exit(proc.popen.pid)
             except Exception:  # cleaning up after a learner's program must not stop the reap
                 logging.getLogger(__name__).exception("after_exit of %s failed", entry.name)
-        with self._lock:
-            proc.exit_code = code
-            proc.ended_at = time.time()
-            proc.state = ended_state(code, proc.stop_requested, list(proc.output)[-5:])
-            self._ended.append(proc.status())
-            ended = self._ended[-1]
-        proc.done.set()
-        self._tell(ended)
+        with self._told_in_order:
+            with self._lock:
+                proc.exit_code = code
+                proc.ended_at = time.time()
+                proc.state = ended_state(code, proc.stop_requested, list(proc.output)[-5:])
+                self._ended.append(proc.status())
+                ended = self._ended[-1]
+            proc.done.set()
+            self._tell(ended)
 
     def _escalate_stop(self, proc: _Process, future: Future[NodeStatus]) -> None:
         # SIGINT is Ctrl+C: rclpy nodes leave spin and shut down cleanly, so
