@@ -123,8 +123,7 @@ class _TopicRow:
         self.automatic = True  # False: the row waits for the learner's pick
         self._select: Callable[[str], None] = lambda _topic: None
         self._options: tuple[str, ...] = (picker.NONE,)
-        # The topic the row follows. Not read back from the dropdown: a forged value
-        # sits there for a moment until it is put back (app.ui.loop.refuse_choice).
+        # The topic the row follows: its options are built around it (app.scene.picker).
         self.current = picker.NONE
         self.dropdown = gui.add_dropdown(
             label, self._options, initial_value=picker.NONE, hint=offer.hint

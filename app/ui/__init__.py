@@ -186,12 +186,11 @@ def set_options(
 
     With ``keep_current`` the current value stays selectable even when it has
     left the list (a topic that went away may come back); otherwise a value
-    not in the list falls back to the first option. A value the dropdown never
-    offered is a browser's forged one, about to be put back (``UiLoop.callback``):
-    it is never kept.
+    not in the list falls back to the first option (a browser cannot set a value the
+    dropdown does not offer: ``app.viser_input``).
     """
     current = dropdown.value
-    if keep_current and current not in options and current in dropdown.options:
+    if keep_current and current not in options:
         options = [*options, current]
     if tuple(dropdown.options) != tuple(options):
         dropdown.options = options

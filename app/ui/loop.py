@@ -7,12 +7,9 @@ import queue
 import threading
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
-from typing import TypeGuard, TypeVar
-
-import viser
+from typing import TypeVar
 
 from app.ros.errors import Ros2Error
-from app.ui import assign
 
 log = logging.getLogger(__name__)
 
@@ -26,28 +23,6 @@ def one_line(exc: BaseException) -> str:
         return str(exc)
     text = str(exc).splitlines()[0] if str(exc) else ""
     return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
-
-
-def unoffered(target: object) -> TypeGuard[viser.GuiDropdownHandle]:
-    """Whether ``target`` is a dropdown whose value it does not offer."""
-    return isinstance(target, viser.GuiDropdownHandle) and target.value not in target.options
-
-
-def refuse_choice(dropdown: viser.GuiDropdownHandle, before: object, *, warn: bool) -> None:
-    """A browser chose a value its dropdown does not offer: a forged message, or a pick
-    that raced the server's new list. viser takes any string as the value; it goes back
-    at once, on this thread (viser's pool), to what the dropdown showed before (or its
-    first option), so no intent and (but for a moment) no refresh sees it. The first
-    refusal of each dropdown is a warning line; a flood of forged values is not."""
-    chosen = str(dropdown.value)
-    (log.warning if warn else log.debug)(
-        "a browser chose %r in the dropdown %r, which does not offer it: put back",
-        chosen[:80],
-        dropdown.label,
-    )
-    options = dropdown.options
-    if options:
-        assign(dropdown, before if before in options else options[0])
 
 
 class UiLoop:
@@ -82,32 +57,13 @@ class UiLoop:
 
         viser also runs update callbacks, synchronously, when the server itself
         assigns a value (``event.client`` is None then): the UI thread made that
-        change and already knows it, so no intent is posted for it. A dropdown's value
-        that the dropdown does not offer is refused (``refuse_choice``), never posted.
+        change and already knows it, so no intent is posted for it. A dropdown value
+        the dropdown does not offer never gets here (``app.viser_input``).
         """
 
-        # The last value of this widget that a panel knows of: what a refused choice is
-        # put back to. Any thread may write it.
-        known: object = None
-        warned = False
-
         def on_event(event: object) -> None:
-            nonlocal known, warned
-            target = getattr(event, "target", None)
-            from_browser = getattr(event, "client", True) is not None
-            if from_browser and unoffered(target):
-                refuse_choice(target, known, warn=not warned)
-                warned = True
-                return
-            known = getattr(target, "value", None)
-            if from_browser:
-                self.post(lambda: acted_on(target))
-
-        def acted_on(target: object) -> None:
-            # A forged value may have landed since this event (viser sets it on its loop
-            # before our pool thread puts it back): the panel reads the value only now.
-            if not unoffered(target):
-                intent(*args)
+            if getattr(event, "client", True) is not None:
+                self.post(lambda: intent(*args))
 
         return on_event
 
