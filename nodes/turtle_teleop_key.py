@@ -7,7 +7,10 @@ The node ``/teleop_turtle`` does what ROS 2's ``turtle_teleop_key`` does:
   ``angular.z`` = +/- ``scale_angular``; both parameters default to 2.0);
   turtlesim stops the turtle 1 s after the last one, so holding a key drives;
 - G B V C D E R T send a ``turtle1/rotate_absolute`` goal to the heading
-  0, -45, -90, -135, 180, 135, 90, 45 degrees; F cancels the last goal;
+  0, -45, -90, -135, 180, 135, 90, 45 degrees; F cancels the last goal,
+  even one whose answer has not come back yet (upstream's F then cancels
+  the goal before it, already done, and the turtle turns on: a key pressed
+  quickly, or an answer slowed by a busy machine, is not lost here);
 - Q quits (in a terminal).
 
 Two sources of keys, so it works with and without a terminal:
@@ -39,6 +42,7 @@ from rclpy.action import ActionClient
 from rclpy.action.client import ClientGoalHandle
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
+from rclpy.task import Future
 from std_msgs.msg import String
 from turtlesim.action import RotateAbsolute
 
@@ -70,6 +74,10 @@ class TeleopTurtle(Node):
         self.twist_publisher = self.create_publisher(Twist, "turtle1/cmd_vel", TOPIC_QOS)
         self.rotate_client = ActionClient(self, RotateAbsolute, "turtle1/rotate_absolute")
         self.goal_handle: ClientGoalHandle | None = None
+        # The last goal sent, until its answer comes; F meanwhile cancels it on arrival.
+        # Keys and answers are handled on the executor's one thread: no lock.
+        self.sent: Future | None = None
+        self.cancel_on_answer = False
         self.key_subscription = self.create_subscription(String, "~/_key", self.on_key, 10)
         self.quit = threading.Event()
 
@@ -96,13 +104,22 @@ class TeleopTurtle(Node):
 
     def send_goal(self, theta: float) -> None:
         future = self.rotate_client.send_goal_async(RotateAbsolute.Goal(theta=theta))
+        self.sent, self.cancel_on_answer = future, False
         future.add_done_callback(self.on_goal_response)
 
-    def on_goal_response(self, future) -> None:
+    def on_goal_response(self, future: Future) -> None:
+        if future is not self.sent:
+            return  # a later goal was sent meanwhile: F is for that one
+        self.sent = None
         self.goal_handle = future.result()
+        if self.cancel_on_answer and self.goal_handle is not None:
+            self.cancel_on_answer = False
+            self.goal_handle.cancel_goal_async()
 
     def cancel_goal(self) -> None:
-        if self.goal_handle is not None:
+        if self.sent is not None:  # the goal is on its way: cancel it once it is answered
+            self.cancel_on_answer = True
+        elif self.goal_handle is not None:
             self.goal_handle.cancel_goal_async()
 
 

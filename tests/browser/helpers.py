@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 import time
+from collections.abc import Callable
 from typing import Any
 
 import pytest
@@ -106,6 +107,33 @@ def go_to_step(page: Page, lesson, index: int) -> None:
 
 def click(page: Page, button: str) -> None:
     page.get_by_role("button", name=button, exact=True).click()
+
+
+# Records where a click's press and release landed, and where the button was then: a click
+# that did nothing (ci102: "Publish at rate", one core busy) says whether it moved under
+# the pointer, landed elsewhere, or never reached the page.
+_CLICK_RECORDER = """(name) => {
+  const found = () => [...document.querySelectorAll('button')]
+    .find(b => b.textContent.trim() === name);
+  const rect = (el) => { if (!el) return 'gone';
+    const r = el.getBoundingClientRect();
+    return `${Math.round(r.x)},${Math.round(r.y)} ${Math.round(r.width)}x${Math.round(r.height)}`
+      + (el.disabled ? ' disabled' : ''); };
+  window.__clicks = [];
+  for (const type of ['pointerdown', 'pointerup', 'click']) {
+    document.addEventListener(type, (e) => window.__clicks.push(
+      `${type} at ${Math.round(e.clientX)},${Math.round(e.clientY)} on `
+      + `${e.target.tagName} '${(e.target.textContent || '').trim().slice(0, 30)}'; `
+      + `button ${rect(found())}, t=${Math.round(performance.now())}`), true);
+  }
+}"""
+
+
+def watched_click(page: Page, button: str) -> Callable[[], str]:
+    """Click ``button``; a function that says what the page saw of that click."""
+    page.evaluate(_CLICK_RECORDER, button)
+    click(page, button)
+    return lambda: "; ".join(page.evaluate("window.__clicks || []")) or "no event at all"
 
 
 def click_next(page: Page) -> None:

@@ -7,7 +7,14 @@ import re
 import pytest
 from playwright.sync_api import Page, expect
 
-from tests.browser.helpers import choose_when_listed, click, expect_text, open_tab, start_node
+from tests.browser.helpers import (
+    choose_when_listed,
+    click,
+    expect_text,
+    open_tab,
+    start_node,
+    watched_click,
+)
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
@@ -99,8 +106,11 @@ def test_topics_echo_hz_publish_and_plot(page):
     expect_regex(page, r"^data: Hello from the browser$|data: Hello from the browser\n")
 
     field(page, "Rate (Hz)").fill("10")
-    click(page, "Publish at rate")
-    expect_regex(page, r"publishing: ([3-9]|\d\d+) sent so far")
+    seen = watched_click(page, "Publish at rate")
+    try:
+        expect_regex(page, r"publishing: ([3-9]|\d\d+) sent so far")
+    except AssertionError as exc:
+        raise AssertionError(f"the click: {seen()}") from exc
     click(page, "Stop publishing")
     expect_regex(page, r"stopped after \d+ messages")
 

@@ -98,6 +98,19 @@ def test_keys_drive_rotate_and_cancel(supervisor, probe):
     halted = wait_until(lambda: (p := watcher.pose()) and p.angular_velocity == 0 and p)
     assert -math.pi / 2 + 0.1 < halted.theta < turned.theta - 0.01  # stopped on the way
 
+    # F right after a goal key: teleop has not had the goal's answer yet (ci102, one core
+    # busy: the turtle was already turning when F came, and teleop cancelled the goal before,
+    # long done). The goal is cancelled once its answer arrives.
+    keys.publish(String(data="g"))  # to 0 degrees, over a radian away
+    keys.publish(String(data="f"))
+    wait_until(
+        lambda: "\n".join(supervisor.output("turtlesim_node")).count("Rotation goal canceled") == 2,
+        timeout=30,
+        what=lambda: f"a second cancel; turtlesim said {supervisor.output('turtlesim_node')[-4:]}",
+    )
+    stopped_early = wait_until(lambda: (p := watcher.pose()) and p.angular_velocity == 0 and p)
+    assert stopped_early.theta > 0.1, "the rotation ran to its end"
+
 
 def test_remapped_teleop_drives_a_spawned_turtle(supervisor, probe):
     """``--ros-args -r turtle1/cmd_vel:=turtle2/cmd_vel`` as the tutorials do, really applied."""
