@@ -173,7 +173,11 @@ def published_rate_of(samples: Sequence[Sample]) -> PublishedRate | None:
 
     Sequence numbers count per writer. Samples are grouped by writer (when the
     middleware names it) and cut into runs wherever a writer's sequence does
-    not go up (a restarted publisher starts again at 1). Each run sent
+    not go up (a restarted publisher starts again at 1). Where no writer is
+    named, each sample continues the run whose last sequence number is the
+    highest below its own, so two publishers' sequences are told apart; a run
+    that begins where the earlier ones have ended is a restart. More runs than
+    ``MAX_RESTARTS`` allows: the arrival rate (``INTERLEAVED``). Each run sent
     ``last - first + 1`` samples over ``last - first`` intervals of the
     publisher's clock; the rate is all intervals over the time covered by any
     run, so missed samples do not lower it, two concurrent writers add up and
@@ -193,26 +197,33 @@ def published_rate_of(samples: Sequence[Sample]) -> PublishedRate | None:
             return None
         return PublishedRate(fallback_rate, None, n, None, writers=0, fallback=reason)
 
-    # run: [first_seq, first_ns, last_seq, last_ns, received]
-    open_runs: dict[Hashable | None, list[int]] = {}
+    # run: [first_seq, first_ns, last_seq, last_ns, received, first_index, last_index]
+    open_runs: dict[Hashable | None, list[list[int]]] = {}
     runs: list[list[int]] = []
-    breaks = 0
     points: list[tuple[int, int]] = []  # (seq, stamp) of every sample, for one run's fit
-    for _arrival, _size, stamp, seq, writer in samples:
+    for index, (_arrival, _size, stamp, seq, writer) in enumerate(samples):
         if stamp <= 0 or seq is None:
             return fallback(NO_INFO)
         points.append((seq, stamp))
-        run = open_runs.get(writer)
-        if run is not None and seq > run[2] and stamp >= run[3]:
+        candidates = open_runs.setdefault(writer, [])
+        # Unnamed writers (Jazzy's rclpy names none) may be several publishers: a sample
+        # goes on the run it continues most closely. One message published from the
+        # dashboard (sequence number 1) amid a talker's 50s used to join the talker's
+        # run, which then seemed to have sent 58 samples this view never got (ci102).
+        fits = [r for r in candidates if seq > r[2] and stamp >= r[3]]
+        if fits:
+            run = max(fits, key=lambda r: r[2])
             run[2], run[3] = seq, stamp
             run[4] += 1
+            run[6] = index
             continue
-        if run is not None:
-            breaks += 1
-        run = [seq, stamp, seq, stamp, 1]
-        open_runs[writer] = run
+        run = [seq, stamp, seq, stamp, 1, index, index]
+        if writer is not None:
+            candidates.clear()  # a named writer's sequence started over: it restarted
+        candidates.append(run)
         runs.append(run)
-    if breaks > MAX_RESTARTS:
+    restarts = _restarts(runs, samples)
+    if restarts > MAX_RESTARTS or len(runs) - len(open_runs) > MAX_RESTARTS:
         return fallback(INTERLEAVED)
     intervals = sum(r[2] - r[0] for r in runs)
     covered_ns = _union_ns([(r[1], r[3]) for r in runs if r[3] > r[1]])
@@ -228,8 +239,21 @@ def published_rate_of(samples: Sequence[Sample]) -> PublishedRate | None:
         received=n,
         missed=max(0, published - n),
         writers=len(open_runs),
-        restarts=breaks,
+        restarts=restarts,
     )
+
+
+def _restarts(runs: list[list[int]], samples: Sequence[Sample]) -> int:
+    """Runs that began where the same writer's earlier runs had all ended: a publisher that
+    started its sequence again. A run that began while an earlier one went on is another
+    publisher (only where the middleware names no writer can the two look alike)."""
+    count = 0
+    for i, run in enumerate(runs):
+        writer = samples[run[5]][4]
+        earlier = [r for r in runs[:i] if samples[r[5]][4] == writer]
+        if earlier and all(r[6] < run[5] for r in earlier):
+            count += 1
+    return count
 
 
 def fitted_rate(points: Sequence[tuple[int, int]]) -> float | None:

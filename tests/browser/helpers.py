@@ -110,8 +110,9 @@ def click(page: Page, button: str) -> None:
 
 
 # Records where a click's press and release landed, and where the button was then: a click
-# that did nothing (ci102: "Publish at rate", one core busy) says whether it moved under
-# the pointer, landed elsewhere, or never reached the page.
+# that did nothing says whether it moved under the pointer, landed elsewhere, or never
+# reached the page (ci102 lost "Publish at rate": a wrong, longer Rate line above it had
+# wrapped, app/ros/monitor.py).
 _CLICK_RECORDER = """(name) => {
   const found = () => [...document.querySelectorAll('button')]
     .find(b => b.textContent.trim() === name);

@@ -125,15 +125,40 @@ def test_writers_one_after_the_other_do_not_add_up():
     assert stats.writers == 2
 
 
-def test_two_writers_without_gid_fall_back_to_arrival_times():
+def test_two_writers_without_gid_are_told_apart_by_their_sequences():
     a = stream(10.0, 50, first_seq=200)
     b = stream(10.0, 50, first_seq=3, start_sec=1_700_000_000.05)
-    samples = by_arrival(a, b)
+    stats = published_rate_of(by_arrival(a, b))
+    assert stats is not None and not stats.fallback
+    # Two publishers add up (over the time either covered: 98 intervals in 4.95 s).
+    assert stats.rate == pytest.approx(98 / 4.95, rel=1e-3)
+    assert stats.published == 100 and stats.missed == 0 and stats.restarts == 0
+
+
+def test_one_message_from_another_publisher_amid_a_stream_is_no_miss():
+    """ci102: the Topics panel's "Publish once" sent sequence number 1 amid a talker's 50s;
+    it joined the talker's run, and the panel said "this view missed 57 of 71" (a longer
+    line, which moved the Publish buttons under the pointer)."""
+    talker = stream(2.0, 14, first_seq=50)
+    once = [(talker[8][0] + 0.2, 40, talker[8][2] + 200_000_000, 1, None)]
+    stats = published_rate_of(by_arrival(talker, once))
+    assert stats is not None and not stats.fallback
+    assert stats.rate == pytest.approx(2.0, rel=0.01)
+    assert (stats.published, stats.missed, stats.restarts) == (15, 0, 0)
+    assert "none missed" in stats.summary()
+
+
+def test_many_unnamed_writers_fall_back_to_arrival_times():
+    streams = [
+        stream(10.0, 30, first_seq=first, start_sec=1_700_000_000.0 + 0.02 * i)
+        for i, first in enumerate((5, 300, 1000, 4000))
+    ]
+    samples = by_arrival(*streams)
     stats = published_rate_of(samples)
     assert stats is not None
     assert stats.fallback == INTERLEAVED
     assert stats.published is None and stats.missed is None
-    assert stats.received == 100
+    assert stats.received == 120
     assert stats.rate == pytest.approx(arrival_rate([s[0] for s in samples]))
     assert "unknown" in stats.summary() and "arrived" in stats.summary()
     assert "unknown" in stats.ros2_line()
