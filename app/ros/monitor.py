@@ -222,9 +222,9 @@ def published_rate_of(samples: Sequence[Sample]) -> PublishedRate | None:
             candidates.clear()  # a named writer's sequence started over: it restarted
         candidates.append(run)
         runs.append(run)
+        if len(runs) - len(open_runs) > MAX_RESTARTS:  # at once: a flood of runs costs n²
+            return fallback(INTERLEAVED)
     restarts = _restarts(runs, samples)
-    if restarts > MAX_RESTARTS or len(runs) - len(open_runs) > MAX_RESTARTS:
-        return fallback(INTERLEAVED)
     intervals = sum(r[2] - r[0] for r in runs)
     covered_ns = _union_ns([(r[1], r[3]) for r in runs if r[3] > r[1]])
     if intervals <= 0 or covered_ns <= 0:
