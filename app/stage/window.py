@@ -68,10 +68,20 @@ _TOAST_STYLE = (
 # Any stage but the 3D scene covers the canvas (but for a sliver beside the control
 # panel), yet viser's canvas still drew every change of the scene: with the camera and
 # arm running, 29 % of a core in the page for nothing seen (software WebGL, measured).
-# Out of the layout, viser's in-view watch stops its drawing; back, it draws at once.
-# The element hidden is viser's wrapper of three.js's canvas (data-engine="three.js ...");
-# a browser without CSS :has() (Firefox before 121) keeps drawing it, as before.
-_CANVAS_OFF_STYLE = "<style>div:has(> div > div > canvas[data-engine]){display:none}</style>"
+# Out of view, viser's in-view watch (an IntersectionObserver) stops its drawing; back,
+# it draws at once. The wrapper is moved out of the window, shrunk and made invisible,
+# not taken out of the layout: with display:none the watch missed the change on one or
+# two pages of five in about half of issue 38's soaks (the MuJoCo world starting while
+# they were open): they drew the hidden scene 400-700 times a second, Chromium's software
+# GPU process went to 130 % of a core and every page waited seconds for a frame
+# (tests/browser/test_stage.py). The element moved is viser's
+# wrapper of three.js's canvas (data-engine="three.js ..."); a browser without CSS :has()
+# (Firefox before 121) keeps drawing it, as before.
+_CANVAS_OFF_STYLE = (
+    "<style>div:has(> div > div > canvas[data-engine]){position:fixed!important;"
+    "left:-300vw!important;top:0!important;width:8px!important;height:8px!important;"
+    "visibility:hidden!important}</style>"
+)
 
 
 class StagePart(Protocol):
