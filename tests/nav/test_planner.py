@@ -11,6 +11,7 @@ from nav2_controller.regulated_pure_pursuit import (
     RPPParameters,
     closest_index,
     compute_velocity,
+    in_collision_ahead,
 )
 from nav2_costmap_2d import INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE
 from nav2_costmap_2d.costmap_2d import Costmap2D, costmap_from_grid
@@ -149,13 +150,35 @@ def test_pure_pursuit_swerves_round_a_box_close_ahead_without_entering_inscribed
     assert max(costs) < LETHAL_OBSTACLE
 
 
+def test_a_robot_already_in_inscribed_space_may_leave_it_but_not_go_deeper():
+    """ci113, one core loaded by the rest of the suite: on its way to a door a box closed,
+    the robot's centre came 0.069 m from the box. Once its own cell was inscribed, only
+    lethal cells stopped it, and a near carrot's short arc never reached one: it drove on
+    until the box was a cell away. It may still drive out, or along, but not closer."""
+    grid = np.zeros((40, 40), np.int8)
+    grid[20:, :] = 100  # a wall: everything from y = 1.0 m up
+    costmap = costmap_from_grid(grid, RES, (0.0, 0.0))
+    robot_x, robot_y = 1.0, 0.875  # 0.125 m from the wall, in an inscribed cell
+    assert costmap.get_cost(*costmap.world_to_map(robot_x, robot_y)) == INSCRIBED_INFLATED_OBSTACLE
+    params = RPPParameters()
+    north, south, east = math.pi / 2, -math.pi / 2, 0.0
+
+    def blocked(yaw: float, carrot: tuple[float, float] = (0.06, 0.0)) -> bool:
+        return in_collision_ahead((robot_x, robot_y, yaw), 0.1, 0.0, carrot, params, costmap)
+
+    assert blocked(north), "a short step towards the wall is deeper into inscribed space"
+    assert not blocked(south), "driving away from the wall leaves inscribed space"
+    assert not blocked(east, (0.3, 0.0)), "driving along the wall goes no deeper"
+    assert blocked(north, (0.3, 0.0)), "a longer arc reaches the wall itself"
+
+
 def test_a_nearer_carrot_round_a_box_turns_no_faster_than_the_controller_turns_on_the_spot():
     """Ours: when the far carrot's arc would hit a box, a nearer carrot's tight arc is taken,
     driven slower along the same arc rather than at a turn rate a base would clamp (then it
     would drive a wider arc than the one checked)."""
     res = 0.01
     grid = np.zeros((200, 200), np.int8)
-    grid[97:107, 113:117] = 100  # a box 0.13-0.17 m ahead of the robot, just right of the path
+    grid[85:95, 119:125] = 100  # a box 0.19-0.25 m ahead of the robot, 0.05-0.15 m to its right
     costmap = costmap_from_grid(grid, res, (0.0, 0.0))
     heading = 0.5  # the path leaves the robot 0.5 rad to its left, in a straight line
     path = [

@@ -130,9 +130,31 @@ def test_two_writers_without_gid_are_told_apart_by_their_sequences():
     b = stream(10.0, 50, first_seq=3, start_sec=1_700_000_000.05)
     stats = published_rate_of(by_arrival(a, b))
     assert stats is not None and not stats.fallback
-    # Two publishers add up (over the time either covered: 98 intervals in 4.95 s).
-    assert stats.rate == pytest.approx(98 / 4.95, rel=1e-3)
+    # Two publishers add up: each one's line, summed where both were publishing.
+    assert stats.rate == pytest.approx(20.0, rel=1e-3)
     assert stats.published == 100 and stats.missed == 0 and stats.restarts == 0
+
+
+def test_two_writers_add_up_when_the_view_missed_the_start_of_one():
+    """ci113: two publishers took turns at 200 Hz together, and the view matched the
+    second a moment after the first, so its first few samples never came. Dividing all
+    intervals by the time either covered counted the second as silent until then, and
+    the rate came out 2.06 % low (195.91 Hz for 200.03 sent)."""
+    a = stream(100.0, 150, first_seq=1)
+    b = stream(100.0, 150, first_seq=1, start_sec=1_700_000_000.005, keep=lambda seq: seq > 6)
+    stats = published_rate_of(by_arrival(a, b))
+    assert stats is not None and not stats.fallback
+    assert stats.rate == pytest.approx(200.0, rel=1e-3)
+    assert (stats.published, stats.missed, stats.restarts) == (294, 0, 0)
+
+
+def test_two_writers_where_one_stopped_give_the_rate_kept_longest():
+    """Two talkers for 4 s, then one for 1 s more: the rate they kept most of the window."""
+    a = stream(10.0, 50, first_seq=200)
+    b = stream(10.0, 40, first_seq=3, start_sec=1_700_000_000.05)
+    stats = published_rate_of(by_arrival(a, b))
+    assert stats is not None and not stats.fallback
+    assert stats.rate == pytest.approx(20.0, rel=1e-3)
 
 
 def test_one_message_from_another_publisher_amid_a_stream_is_no_miss():

@@ -16,7 +16,9 @@ and the turn rate ``v * curvature``. Nav2's *regulated* version then
 - checks the arc it is about to drive against the costmap for
   ``max_allowed_time_to_collision_up_to_carrot`` seconds and refuses to move
   into an obstacle ("detected collision ahead!"); ours first tries nearer
-  carrots, then turning on the spot (see ``compute_velocity``).
+  carrots, then turning on the spot (see ``compute_velocity``). A robot whose
+  own cell is already inscribed (Nav2 stops it there and recovers) may drive
+  out or along, never nearer the obstacle (``in_collision_ahead``).
 
 Defaults are Nav2's (its code's: cost regulation on, ``cost_scaling_dist``
 0.6 m) but for ``use_velocity_scaled_lookahead_dist``, on here.
@@ -29,6 +31,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
 from nav2_costmap_2d.cost_values import (
     INSCRIBED_INFLATED_OBSTACLE,
     LETHAL_OBSTACLE,
@@ -351,10 +354,14 @@ def in_collision_ahead(
     step = costmap.resolution / max(abs(linear), 0.01)
     x, y, yaw = robot
     here = costmap.world_to_map(x, y)
-    # A robot already in inscribed space may drive out of it: then only lethal cells count.
+    # A robot already in inscribed space may drive out of it, or along it, but no step may
+    # take it nearer the obstacle (ci113: with only lethal cells counting, near carrots took
+    # a robot on until its centre was 0.069 m from a box).
     wall = INSCRIBED_INFLATED_OBSTACLE
+    escape_from = math.inf
     if here is not None and costmap.get_cost(*here) == INSCRIBED_INFLATED_OBSTACLE:
         wall = LETHAL_OBSTACLE
+        escape_from = lethal_clearance(costmap, x, y, INSCRIBED_REACH)
     t, travelled = 0.0, 0.0
     while t < horizon and travelled < carrot_dist:
         t += step
@@ -368,4 +375,29 @@ def in_collision_ahead(
         cost = costmap.get_cost(*cell)
         if wall <= cost < NO_INFORMATION:
             return True
+        if cost == INSCRIBED_INFLATED_OBSTACLE and escape_from < math.inf:
+            deeper = escape_from - lethal_clearance(costmap, x, y, INSCRIBED_REACH)
+            if deeper > 0.1 * costmap.resolution:  # a tenth of a cell: along a wall is no deeper
+                return True
     return False
+
+
+INSCRIBED_REACH = 0.3  # m: beyond any robot radius a costmap here inflates as inscribed
+
+
+def lethal_clearance(costmap: Costmap2D, x: float, y: float, reach: float) -> float:
+    """Metres from (x, y) to the centre of the nearest lethal cell within ``reach``
+    (inf if none): how deep in inscribed space a point is, which its cost does not say."""
+    r = int(math.ceil(reach / costmap.resolution))
+    cx = int(math.floor((x - costmap.origin_x) / costmap.resolution))
+    cy = int(math.floor((y - costmap.origin_y) / costmap.resolution))
+    x0, x1 = max(cx - r, 0), min(cx + r + 1, costmap.size_x)
+    y0, y1 = max(cy - r, 0), min(cy + r + 1, costmap.size_y)
+    if x0 >= x1 or y0 >= y1:
+        return math.inf
+    rows, cols = np.nonzero(costmap.costs[y0:y1, x0:x1] == LETHAL_OBSTACLE)
+    if rows.size == 0:
+        return math.inf
+    px = costmap.origin_x + (cols + x0 + 0.5) * costmap.resolution
+    py = costmap.origin_y + (rows + y0 + 0.5) * costmap.resolution
+    return float(np.min(np.hypot(px - x, py - y)))
