@@ -22,6 +22,7 @@ from bisect import bisect_left
 from collections import deque
 from collections.abc import Hashable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
+from itertools import pairwise
 from typing import Generic, TypedDict, TypeVar
 
 from rclpy.node import Node
@@ -169,7 +170,7 @@ def _rate_kept_longest(spans: list[tuple[int, int, float]]) -> float:
     """
     edges = sorted({t for start, end, _rate in spans for t in (start, end)})
     stretches: list[tuple[float, int]] = []  # (summed rate, length ns)
-    for t0, t1 in zip(edges, edges[1:], strict=False):
+    for t0, t1 in pairwise(edges):
         active = [rate for start, end, rate in spans if start <= t0 and end >= t1]
         if active:
             stretches.append((sum(active), t1 - t0))

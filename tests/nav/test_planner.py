@@ -150,21 +150,23 @@ def test_pure_pursuit_swerves_round_a_box_close_ahead_without_entering_inscribed
     assert max(costs) < LETHAL_OBSTACLE
 
 
-def test_a_robot_already_in_inscribed_space_may_leave_it_but_not_go_deeper():
+@pytest.mark.parametrize("radius", [0.15, 0.35])
+def test_a_robot_already_in_inscribed_space_may_leave_it_but_not_go_deeper(radius):
     """ci113, one core loaded by the rest of the suite: on its way to a door a box closed,
     the robot's centre came 0.069 m from the box. Once its own cell was inscribed, only
     lethal cells stopped it, and a near carrot's short arc never reached one: it drove on
     until the box was a cell away. It may still drive out, or along, but not closer."""
     grid = np.zeros((40, 40), np.int8)
-    grid[20:, :] = 100  # a wall: everything from y = 1.0 m up
-    costmap = costmap_from_grid(grid, RES, (0.0, 0.0))
-    robot_x, robot_y = 1.0, 0.875  # 0.125 m from the wall, in an inscribed cell
+    grid[20:, :] = 100  # a wall: everything from y = 1.0 m up (its first cells' centres: 1.025)
+    costmap = costmap_from_grid(grid, RES, (0.0, 0.0), robot_radius=radius)
+    robot_x, robot_y = 1.0, 1.025 - radius  # a cell's centre a robot's radius from the wall's
     assert costmap.get_cost(*costmap.world_to_map(robot_x, robot_y)) == INSCRIBED_INFLATED_OBSTACLE
     params = RPPParameters()
     north, south, east = math.pi / 2, -math.pi / 2, 0.0
 
     def blocked(yaw: float, carrot: tuple[float, float] = (0.06, 0.0)) -> bool:
-        return in_collision_ahead((robot_x, robot_y, yaw), 0.1, 0.0, carrot, params, costmap)
+        robot = (robot_x, robot_y, yaw)
+        return in_collision_ahead(robot, 0.1, 0.0, carrot, params, costmap, radius)
 
     assert blocked(north), "a short step towards the wall is deeper into inscribed space"
     assert not blocked(south), "driving away from the wall leaves inscribed space"

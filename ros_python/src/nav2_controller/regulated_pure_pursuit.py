@@ -223,7 +223,7 @@ def compute_velocity(
     def free(command: Command) -> bool:
         assert costmap is not None
         turn = (command.linear, command.angular, command.carrot)
-        return not in_collision_ahead(robot, *turn, params, costmap)
+        return not in_collision_ahead(robot, *turn, params, costmap, inscribed_radius)
 
     command = at(lookahead)
     if not params.use_collision_detection or costmap is None or free(command):
@@ -345,6 +345,7 @@ def in_collision_ahead(
     carrot: tuple[float, float],
     params: RPPParameters,
     costmap: Costmap2D,
+    inscribed_radius: float = 0.15,
 ) -> bool:
     """Does the arc driven for the next second (at most to the carrot) cross a wall?"""
     if abs(linear) < 0.01 and abs(angular) < 0.01:
@@ -359,9 +360,10 @@ def in_collision_ahead(
     # a robot on until its centre was 0.069 m from a box).
     wall = INSCRIBED_INFLATED_OBSTACLE
     escape_from = math.inf
+    reach = inscribed_radius + costmap.resolution  # a point is within a cell of its centre
     if here is not None and costmap.get_cost(*here) == INSCRIBED_INFLATED_OBSTACLE:
         wall = LETHAL_OBSTACLE
-        escape_from = lethal_clearance(costmap, x, y, INSCRIBED_REACH)
+        escape_from = lethal_clearance(costmap, x, y, reach)
     t, travelled = 0.0, 0.0
     while t < horizon and travelled < carrot_dist:
         t += step
@@ -376,13 +378,10 @@ def in_collision_ahead(
         if wall <= cost < NO_INFORMATION:
             return True
         if cost == INSCRIBED_INFLATED_OBSTACLE and escape_from < math.inf:
-            deeper = escape_from - lethal_clearance(costmap, x, y, INSCRIBED_REACH)
+            deeper = escape_from - lethal_clearance(costmap, x, y, reach)
             if deeper > 0.1 * costmap.resolution:  # a tenth of a cell: along a wall is no deeper
                 return True
     return False
-
-
-INSCRIBED_REACH = 0.3  # m: beyond any robot radius a costmap here inflates as inscribed
 
 
 def lethal_clearance(costmap: Costmap2D, x: float, y: float, reach: float) -> float:
