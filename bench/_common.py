@@ -183,12 +183,17 @@ def open_dashboard(browser: Any, url: str, init_js: str | None = None) -> Any:
 def open_tool(page: Any, name: str) -> None:
     """Open a dashboard tool as a learner does: its group's tab (Run, Inspect...), then its own
     (a tab outside the groups, such as the stage window's, directly)."""
+    from playwright.sync_api import expect
+
     from app.ui import GROUP_OF
 
     group = GROUP_OF.get(name)
-    if group is not None:
-        page.get_by_role("tab", name=group, exact=True).click()
-    page.get_by_role("tab", name=name, exact=True).click()
+    for tab in (group, name) if group is not None else (name,):
+        button = page.get_by_role("tab", name=tab, exact=True)
+        button.click()
+        # A click that did not select the tab says so here, not later as a "text not
+        # visible" of whatever the test looks for next.
+        expect(button, f"the {tab} tab is open").to_have_attribute("aria-selected", "true")
 
 
 def machine() -> dict[str, Any]:

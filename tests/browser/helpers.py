@@ -109,6 +109,33 @@ def click(page: Page, button: str) -> None:
     page.get_by_role("button", name=button, exact=True).click()
 
 
+# A folder's contents slide open (viser's folders are Mantine Collapses, about 200 ms), and
+# while they do, the panel's scroll range grows and the buttons inside can still move:
+# Playwright's own check (the same box on two animation frames) passes on a slow machine.
+# cb18c3d's CI, Open in Foxglove: pressed at y 684, released 3 ms later with the button at
+# 712, and the click went to the paragraph above. Measured here at a 760 px high window, a
+# click straight after opening: the panel scrolled to the button mid-slide, and the button
+# then moved from y 693 to 712. Settled = the folder's box and its scroll area's height and
+# position the same for 300 ms.
+_FOLDER_SETTLED = """(folder) => {
+  let box = folder; while (box && getComputedStyle(box).overflowY === 'visible')
+    box = box.parentElement;
+  const r = folder.getBoundingClientRect();
+  const now = `${r.y} ${r.height} ${box ? box.scrollHeight + ' ' + box.scrollTop : ''}`;
+  const t = performance.now();
+  if (folder.__seen !== now) { folder.__seen = now; folder.__since = t; }
+  return t - folder.__since >= 300;
+}"""
+
+
+def open_folder(page: Page, label: str) -> None:
+    """Open the folder titled ``label`` (visible, closed) and wait until it has slid open."""
+    header = page.get_by_text(label, exact=True).filter(visible=True).first
+    header.click()
+    folder = header.evaluate_handle("(h) => h.parentElement")
+    page.wait_for_function(_FOLDER_SETTLED, arg=folder, polling=50, timeout=10_000)
+
+
 # Records where a click's press and release landed, and where the button was then: a click
 # that did nothing says whether it moved under the pointer, landed elsewhere, or never
 # reached the page (ci102 lost "Publish at rate": a wrong, longer Rate line above it had

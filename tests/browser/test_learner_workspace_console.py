@@ -7,7 +7,7 @@ import re
 import pytest
 from playwright.sync_api import expect
 
-from tests.browser.helpers import click, open_tab
+from tests.browser.helpers import click, open_folder, open_tab
 from tests.browser.test_ros2_panels import expect_shown, field
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -41,7 +41,7 @@ def test_workspace_files_open_edit_save_and_delete(page, progress_dir):
     )
     click(page, "Run")
     expect_shown(page, "creating ./pkg_a/pkg_a/my_node.py", timeout=60_000)
-    page.get_by_text("Workspace files (~/ros2_ws)").first.click()
+    open_folder(page, "Workspace files (~/ros2_ws)")
     expect_shown(page, "my_node.py")  # the tree shows what pkg create wrote
     field(page, "Path").fill("src/pkg_a/pkg_a/my_node.py")
     click(page, "Open")

@@ -12,6 +12,7 @@ from tests.browser.helpers import (
     click,
     click_next,
     expect_text,
+    open_folder,
     open_lesson,
     open_page,
     open_tab,
@@ -56,7 +57,7 @@ def _checks_text(page) -> str:
 def done_cells(page):
     """The outline's done marks (the outline folder starts collapsed)."""
     open_tab(page, "Lessons")
-    page.get_by_text("Course outline", exact=True).click()
+    open_folder(page, "Course outline")
     return page.get_by_role("cell", name="✓", exact=True)
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from playwright.sync_api import expect
 
-from tests.browser.helpers import open_tab, start_group
+from tests.browser.helpers import open_folder, open_tab, start_group
 from tests.browser.scene_helpers import wait_scene_points
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -47,7 +47,7 @@ def test_arm_chain_moves_the_arm_and_shows_the_target(page):
     ):
         page.wait_for_function(HAS_NODE_JS, arg=name, polling=100, timeout=30_000)
     # Moving the camera in the view sets the node's parameters.
-    page.get_by_text("Camera ↔ base transform").click()
+    open_folder(page, "Camera ↔ base transform")
     row = page.get_by_text("z (m)", exact=True).locator(
         "xpath=ancestor::div[contains(@class,'Flex-root')][1]"
     )
