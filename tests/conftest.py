@@ -10,13 +10,14 @@ import sys
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import IO
 
 import pytest
 
 from app import PROJECT_ROOT
 from app.dds import configure_dds_env
 from bench import _reaper
-from tests import heavy_slots, worker_plan
+from tests import hang_watchdog, heavy_slots, worker_plan
 
 # pytest keeps each test module with its asserts rewritten in __pycache__, unless Python
 # is told not to write bytecode (PYTHONDONTWRITEBYTECODE, set on this project's machines):
@@ -265,9 +266,31 @@ def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> 
     if waited >= 1:
         _timeline(f"waited {waited:.0f} s for a core's slot: {item.nodeid}")
     try:
-        return (yield)
+        with hang_watchdog.armed(hang_watchdog.limit_for(_own_timeout(item)), _hang_log()):
+            return (yield)
     finally:
         _HEAVY_SLOTS.after(item, nextitem)
+
+
+def _own_timeout(item: pytest.Item) -> float | None:
+    """The test's pytest-timeout limit: its mark's, else the ini's."""
+    marker = item.get_closest_marker("timeout")
+    if marker is not None and marker.args:
+        return float(marker.args[0])
+    return float(item.config.getini("timeout") or 0) or None
+
+
+_HANG_LOGS: list[IO[str]] = []  # the worker's timeline, open for faulthandler's C thread
+
+
+def _hang_log() -> IO[str]:
+    if not _HANG_LOGS:
+        try:
+            ARTIFACTS.mkdir(parents=True, exist_ok=True)
+            _HANG_LOGS.append(open(ARTIFACTS / "timeline.txt", "a", encoding="utf-8"))
+        except OSError:  # a read-only checkout: the stacks go to the worker's stderr
+            _HANG_LOGS.append(sys.__stderr__ or sys.stderr)
+    return _HANG_LOGS[0]
 
 
 # Tests that take the cores on purpose (to prove a check holds on a slow

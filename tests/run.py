@@ -48,6 +48,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # run as a script from anywhere
 from bench._reaper import end_found  # the run's reaper; it needs only the stdlib
+from tests import hang_watchdog  # stdlib only, too
 from tests.worker_plan import GENERAL_WORKERS, WAITING_WORKERS  # stdlib only, too
 
 _SIOCGIFFLAGS = 0x8913
@@ -260,6 +261,7 @@ def run_phases(commands: list[list[str]], keeper: bool) -> int:
     if not keeper and len(commands) == 1:
         os.execv(sys.executable, commands[0])
     codes: list[int] = []
+    timelines = _timeline_sizes()
     with tempfile.TemporaryDirectory(prefix="classroom-run-") as reports:
         for number, command in enumerate(commands):
             if codes and codes[-1] not in GO_ON:
@@ -269,10 +271,26 @@ def run_phases(commands: list[list[str]], keeper: bool) -> int:
             command = [*command, f"--junitxml={reports}/phase{number}.xml"]
             codes.append(keep(command) if keeper else subprocess.call(command))
         print_failures(sorted(Path(reports).glob("phase*.xml")))
+    print_hangs(timelines)
     failed = [code for code in codes if code not in (0, NO_TESTS)]
     if failed:
         return failed[0]
     return NO_TESTS if all(code == NO_TESTS for code in codes) else 0
+
+
+ARTIFACTS = Path(__file__).resolve().parent.parent / "test-artifacts"
+
+
+def _timeline_sizes() -> dict[Path, int]:
+    """Each worker's timeline and its size now: what a run appends is that run's."""
+    return {path: path.stat().st_size for path in ARTIFACTS.glob("**/timeline.txt")}
+
+
+def print_hangs(before: dict[Path, int]) -> None:
+    """The stacks tests/hang_watchdog.py wrote for a test stuck in native code."""
+    for path in sorted(ARTIFACTS.glob("**/timeline.txt")):
+        for dump in hang_watchdog.hangs_in(hang_watchdog.new_text(path, before.get(path, 0))):
+            print(f"\ntests/run.py: a test hung ({path.parent.name}):\n{dump}", flush=True)
 
 
 DIGEST_CHARS = 1200  # of each failure's message: the reason, not the whole traceback
