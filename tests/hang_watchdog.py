@@ -8,8 +8,9 @@ PDP mutex) held the grader's ``create_subscription``, and the run hung until it
 was killed 30 minutes later. faulthandler's watchdog is a C thread: once a test
 has outlived its own timeout by ``MARGIN_SEC``, it writes every Python thread's
 stack to the worker's timeline and ends the worker. xdist reports the test as
-crashed and starts a fresh worker, and tests/run.py prints the stacks with what
-failed (``hangs_in``). Stdlib only: tests/run.py imports it.
+crashed and, with ``--max-worker-restart=0``, ends the run there; tests/run.py
+prints the stacks after what failed (``hangs_in``). Stdlib only: tests/run.py
+imports it.
 """
 
 from __future__ import annotations
