@@ -80,8 +80,9 @@ $(STAMP): pyproject.toml ros_python/pyproject.toml $(INTERFACE_FILES)
 	done
 	@touch $(STAMP)
 
+# Through a keeper (app/keep_serving.py): a dashboard ended by its ROS guard starts again.
 run: setup
-	$(VENV)/bin/ros2-classroom serve $(ARGS)
+	$(VPY) -m app.keep_serving serve $(ARGS)
 
 # Debian's Chromium for the headless browser tests (never a downloaded browser).
 browser:

@@ -55,6 +55,10 @@ if TYPE_CHECKING:
     from app.teacher.roster import Roster
 
 READY_TIMEOUT_SEC = 90.0
+# A learner's dashboard ended by SIGABRT (its ROS guard, or a native crash) starts
+# again, at most this often in one session: one that keeps dying is only reported.
+RESTART_AFTER = -signal.SIGABRT
+MAX_RESTARTS = 3
 MAX_LEARNERS = 40
 LTI_URL_ENV = "CLASSROOM_LTI_URL"  # as the hub's teacher service reads it
 LTI_PORT_ENV = "CLASSROOM_LTI_PORT"  # where the LTI server listens (default: teacher page - 1)
@@ -264,38 +268,42 @@ class Classroom:
         if not self.warm:
             self.say(f"Cold start ({COLD_START_VAR}=1): each dashboard imports everything itself.")
         for learner in self.learners:
-            argv = [
-                sys.executable, "-m", "app", "serve",
-                "--host", self.host,
-                "--port", str(learner.port),
-                "--domain-id", str(learner.domain_id),
-                "--learner", learner.name,
-                "--progress-dir", str(learner.progress_dir),
-                *self._flags,
+            self.start_learner(learner)
+
+    def start_learner(self, learner: Learner) -> None:
+        """``learner``'s dashboard, warm if it can be, with its log pump and ready flag."""
+        argv = [
+            sys.executable, "-m", "app", "serve",
+            "--host", self.host,
+            "--port", str(learner.port),
+            "--domain-id", str(learner.domain_id),
+            "--learner", learner.name,
+            "--progress-dir", str(learner.progress_dir),
+            *self._flags,
+        ]  # fmt: skip
+        if learner.classroom_domain is not None:
+            argv += [
+                "--classroom-domain-id", str(learner.classroom_domain), "--site", learner.site
             ]  # fmt: skip
-            if learner.classroom_domain is not None:
-                argv += [
-                    "--classroom-domain-id", str(learner.classroom_domain), "--site", learner.site
-                ]  # fmt: skip
-            env = {**self._env, "PYTHONUNBUFFERED": "1"}
-            env.pop("CLASSROOM_TOKEN", None)
-            if learner.token:  # through the environment: a token on argv shows in `ps`
-                env["CLASSROOM_TOKEN"] = learner.token
-            proc = self._start_warm(learner, argv, env) or subprocess.Popen(
-                argv,
-                cwd=PROJECT_ROOT,
-                env=env,
-                stdin=subprocess.DEVNULL,
-                stdout=subprocess.PIPE,
-                stderr=subprocess.STDOUT,
-                start_new_session=True,  # Ctrl+C reaches us; we stop them in order
-                preexec_fn=die_with(os.getpid()),
-            )
-            self._procs[learner.name] = proc
-            self._ready[learner.name] = threading.Event()
-            threading.Thread(
-                target=self._pump, args=(learner, proc), name=f"log-{learner.name}", daemon=True
-            ).start()
+        env = {**self._env, "PYTHONUNBUFFERED": "1"}
+        env.pop("CLASSROOM_TOKEN", None)
+        if learner.token:  # through the environment: a token on argv shows in `ps`
+            env["CLASSROOM_TOKEN"] = learner.token
+        proc = self._start_warm(learner, argv, env) or subprocess.Popen(
+            argv,
+            cwd=PROJECT_ROOT,
+            env=env,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,  # Ctrl+C reaches us; we stop them in order
+            preexec_fn=die_with(os.getpid()),
+        )
+        self._procs[learner.name] = proc
+        self._ready[learner.name] = threading.Event()
+        threading.Thread(
+            target=self._pump, args=(learner, proc), name=f"log-{learner.name}", daemon=True
+        ).start()
 
     def _start_warm_parent(self) -> WarmStarter | None:
         """The warm parent, ready; None (said why) when it cannot start: everyone starts cold."""
@@ -445,10 +453,18 @@ def _serve(
         say(line)
     say("Press Ctrl+C to stop every dashboard.")
     reported: set[str] = set()
+    restarts: dict[str, int] = {}
+    learners = {learner.name: learner for learner in classroom.learners}
     while not stop_requested.wait(0.5):
         classroom.watch()
         for name, code in classroom.ended().items():
-            if name not in reported:
+            if code == RESTART_AFTER and restarts.get(name, 0) < MAX_RESTARTS:
+                # Its ROS guard ended it (a hung participant, app/ros/liveness.py) or it
+                # crashed in native code: its page comes back by itself, progress kept.
+                restarts[name] = restarts.get(name, 0) + 1
+                say(f"  {name}'s dashboard was ended by SIGABRT (see its log); starting it again")
+                classroom.start_learner(learners[name])
+            elif name not in reported:
                 reported.add(name)
                 say(f"  {name}'s dashboard ended (exit code {code}); the others keep running")
     say("Stopping the classroom…")

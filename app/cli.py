@@ -7,8 +7,10 @@ clear line and exit non-zero; they never show a traceback.
 from __future__ import annotations
 
 import argparse
+import faulthandler
 import logging
 import os
+import resource
 import socket
 import sys
 import threading
@@ -57,6 +59,9 @@ def _port(text: str) -> int:
 def _check_port_free(host: str, port: int) -> None:
     # viser silently moves to the next port when ours is taken; say so instead.
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        # As servers bind (viser's too): a browser's connection to a dashboard that just
+        # ended lingers in TIME_WAIT for a minute, and that is no reason to refuse.
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
             probe.bind((host, port))
         except OSError as exc:
@@ -115,6 +120,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     from app.exercises.panel import ExerciseSettings
     from app.exercises.workspace import Workspace
     from app.lessons.progress import DEFAULT_DIR, ProgressStore
+    from app.ros.liveness import ParticipantLiveness
     from app.ros.runtime import RosRuntime
     from app.supervisor import Supervisor
     from app.ui.base_path import BasePathPage
@@ -141,6 +147,13 @@ def cmd_serve(args: argparse.Namespace) -> int:
         server.stop()
         raise CliError(f"port {args.port} on {args.host} became busy; pick another with --port")
     runtime = RosRuntime()
+    # A hung DDS participant freezes the whole process; a guard outside it notices, and
+    # faulthandler writes every thread's stack to the log when the guard ends us.
+    faulthandler.enable()
+    # ...and no core file: dumping a few hundred MB would outlast the guard's 3 s to SIGKILL.
+    resource.setrlimit(resource.RLIMIT_CORE, (0, resource.getrlimit(resource.RLIMIT_CORE)[1]))
+    liveness = ParticipantLiveness(runtime.node)
+    liveness.start()
     # The learner's colcon workspace and the ament underlay, before the supervisor copies
     # the environment (issue 22: app/ros2cli/pkg.py). Served to other machines, builds
     # are learner code: the workspace lives in the learner's scratch folder, the one
@@ -191,6 +204,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         hub_login.close()
     dashboard.stop()
     editor_hub.close()  # its tasks end on viser's loop, before the loop stops
+    liveness.stop()
     runtime.shutdown()
     supervisor.shutdown(timeout=2.5)
     server.stop()

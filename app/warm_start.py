@@ -137,6 +137,7 @@ WARM_IMPORTS = REQUIRED_IMPORTS + (
     "app.exercises.workspace",
     "app.lessons.progress",
     "app.lessons.schema",
+    "app.ros.liveness",
     "app.ros.runtime",
     "app.supervisor",
     "app.ui.base_path",

@@ -1,7 +1,11 @@
-"""Classroom mode: three learners, each on their own port, domain and progress; isolated."""
+"""Classroom mode: three learners, each on their own port, domain and progress; isolated.
+
+A learner's dashboard that stops answering is started again; the others never notice.
+"""
 
 from __future__ import annotations
 
+import os
 import re
 import signal
 import subprocess
@@ -13,10 +17,13 @@ import psutil
 import pytest
 
 from app import PROJECT_ROOT
+from app.ros.liveness import LIMIT_VARIABLE
 from tests.conftest import free_port, wait_until
 from tests.wire_client import WireClient
 
 pytestmark = pytest.mark.ros
+
+LIVENESS_LIMIT_SEC = 6  # each dashboard's ROS guard: ended after this long without an answer
 
 
 def _graph_nodes(client: WireClient) -> list[str]:
@@ -32,7 +39,8 @@ def test_three_isolated_learners(ros_env, tmp_path):
         [sys.executable, "-m", "app", "classroom", "--learners", "3",
          "--base-port", str(base_port), "--base-domain-id", str(base_domain),
          "--progress-dir", str(tmp_path)],
-        cwd=PROJECT_ROOT, env=ros_env, stdout=subprocess.PIPE, text=True,
+        cwd=PROJECT_ROOT, env={**ros_env, LIMIT_VARIABLE: str(LIVENESS_LIMIT_SEC)},
+        stdout=subprocess.PIPE, text=True,
     )  # fmt: skip
     clients: list[WireClient] = []
     try:
@@ -66,6 +74,25 @@ def test_three_isolated_learners(ros_env, tmp_path):
         assert "/talker" not in _graph_nodes(clients[1]) + _graph_nodes(clients[2])
         descendants = psutil.Process(room.pid).children(recursive=True)
         assert len(descendants) >= 4  # three dashboards and learner1's talker
+
+        # learner2's dashboard stops answering (SIGSTOP stands in for a hung DDS
+        # participant, tests/faults/test_ros_liveness.py): its guard ends it, the
+        # classroom starts it again, and learner1's talker never notices.
+        stuck = _serving(base_port + 1)
+        os.kill(stuck, signal.SIGSTOP)
+        while "learner2's dashboard was ended by SIGABRT" not in lines[-1]:
+            line = room.stdout.readline()
+            assert line, f"classroom ended early: {lines}"
+            lines.append(line)
+        assert "starting it again" in lines[-1]
+        wait_until(lambda: _serving(base_port + 1) not in (None, stuck), timeout=60,
+                   what="learner2's new dashboard")  # fmt: skip
+        clients[1].close()
+        clients[1] = WireClient(urls[1])
+        wait_until(lambda: f"Domain id **{base_domain + 1}**" in clients[1].markdown(),
+                   what="learner2's header again")  # fmt: skip
+        assert "/talker" in _graph_nodes(clients[0])
+        descendants = psutil.Process(room.pid).children(recursive=True)
     finally:
         for client in clients:
             client.close()
@@ -76,6 +103,14 @@ def test_three_isolated_learners(ros_env, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["learner1", "learner2", "learner3"] or (
         not list(tmp_path.iterdir())  # progress is written on the first lesson action
     )
+
+
+def _serving(port: int) -> int | None:
+    """The pid listening on ``port`` (a learner's dashboard, forked warm or started cold)."""
+    for conn in psutil.net_connections("tcp"):
+        if conn.status == psutil.CONN_LISTEN and conn.laddr.port == port and conn.pid:
+            return conn.pid
+    return None
 
 
 def _busy(port: int) -> bool:
