@@ -54,6 +54,12 @@ INTRO = (
 
 
 AUTO_FIXED = "(root of the tree)"
+# Shown in the middle of the view while it draws nothing at all: a first-week learner on
+# a 3D step sees an empty grid otherwise, with no word of what should be there.
+EMPTY_HINT = (
+    "Nothing to draw yet.\nThis view shows what running nodes publish:\n"
+    "press the step's Start button in the lesson, and what it starts appears here."
+)
 
 
 class _Offer(NamedTuple):
@@ -185,6 +191,13 @@ class ScenePanel:
         self._framed_box: tuple[np.ndarray, np.ndarray] | None = None
         self._desk_shown = (True, True)  # (the desk's frames and arm, its frustum)
         self._light = scene.add_light_ambient("/sim_world_light", intensity=0.9, visible=False)
+        self._empty_hint = scene.add_label(
+            "/empty_scene_hint",
+            EMPTY_HINT,
+            position=DESK_VIEW[1],
+            anchor="center-center",
+            font_screen_scale=1.3,
+        )
 
         with gui.add_folder("Simulated world"):
             self._world_info = MarkdownView(gui)
@@ -282,6 +295,10 @@ class ScenePanel:
             self._frame_axes = gui.add_checkbox("Frame axes", True)
             self._tf_status = MarkdownView(gui)
         self.joint_sliders = JointSliders(gui, ui, node)
+        self._rows = (
+            self._cloud_row, self._scan_row, self._map_row, self._particle_row,
+            self._path_row, self._image_row, self._marker_row, self._joint_row,
+        )  # fmt: skip
 
         self.params = CameraParamSync(node)
         self._wire()
@@ -323,17 +340,7 @@ class ScenePanel:
         cameras go back to the desk view (an earlier lesson may have left them far
         out over a point cloud), unless the simulated world still runs.
         """
-        rows = (
-            self._cloud_row,
-            self._scan_row,
-            self._map_row,
-            self._particle_row,
-            self._path_row,
-            self._image_row,
-            self._marker_row,
-            self._joint_row,
-        )
-        for row in rows:
+        for row in self._rows:
             if row.current != picker.NONE and graph.publishers(row.current) == 0:
                 row.follow(picker.NONE)
         self.stamped.forget_unpublished(graph)
@@ -443,6 +450,20 @@ class ScenePanel:
         lift = np.array([0.0, 0.0, (high[2] - low[2]) / 2.0])  # ...and here at their middle
         self.drive.move_cameras(position + lift, look_at + lift)
 
+    def _draws_nothing(self) -> bool:
+        """No world, no desk, no frame on TF, nothing received for a 3D layer: only the grid.
+
+        The image row does not count: its picture shows in this panel, not in 3D (on a
+        frustum only with a frame on TF, or the desk's, and those count).
+        """
+        layers = (self.clouds, self.scan, self.map, self.particles, self.path, self.markers)
+        return (
+            not self._world_shown
+            and self._desk_shown == (False, False)
+            and not self.tf_view.frame_names()
+            and all(layer.worker.stats()[0] == 0 for layer in layers)
+        )
+
     def _pause_desk_arm(self, paused: bool) -> None:
         """The desk arm's joint row stops following /joint_states by itself while the desk
         gives way (robots then move on TF; the hidden desk arm would only cost CPU)."""
@@ -509,6 +530,9 @@ class ScenePanel:
         self._follow_world()
         self._follow_robot(graph)
         self._follow_desk(graph)
+        empty = self._draws_nothing()
+        if self._empty_hint.visible != empty:
+            self._empty_hint.visible = empty
         self.plot.flush()
         self.stamped.refresh(graph)
         frames = (AUTO_FIXED, *self.tf_view.frame_names())

@@ -1,4 +1,7 @@
-"""The 3D view: a learner picks a cloud, an image and a joint topic and sees them live."""
+"""The 3D view: a learner picks a cloud, an image and a joint topic and sees them live.
+
+An empty view says what would show there; it stops saying so once something is drawn.
+"""
 
 from __future__ import annotations
 
@@ -30,6 +33,12 @@ CLOUD_POINTS = 50_000
 # A scene node is mounted (labels register their name with a null object).
 HAS_NODE_JS = "(n) => !!window.__viserMutable && (n in window.__viserMutable.nodeRefFromName)"
 GONE_JS = "(n) => !!window.__viserMutable && !window.__viserMutable.nodeRefFromName[n]"
+# The empty scene's hint is in viser's scene tree, shown (arg true) or hidden (arg false).
+HINT_SHOWN_JS = (
+    "(shown) => { const tree = window.__viserSceneTree;"
+    " const node = tree && tree.getState()['/empty_scene_hint'];"
+    " return !!node && (node.visibility ?? true) === shown; }"
+)
 # src of the image under the "Camera image" label once it shows a picture (not the blank one).
 CAMERA_IMAGE_SRC_JS = """() => {
   const label = [...document.querySelectorAll('p')].find((e) => e.textContent === 'Camera image');
@@ -69,6 +78,8 @@ def test_point_cloud_image_and_arm_show_up_live(page, probe):
         msg.position = [math.sin(t), 0.6 + 0.3 * math.sin(t), -1.0, -0.8]
         return msg
 
+    # Nothing sent yet, so nothing drawn: the view says what should be there.
+    page.wait_for_function(HINT_SHOWN_JS, arg=True, polling=100, timeout=10_000)
     repeaters = [
         Repeater(cloud_pub, cloud, 0.2),
         Repeater(image_pub, image, 0.2),
@@ -79,6 +90,7 @@ def test_point_cloud_image_and_arm_show_up_live(page, probe):
         pick(page, "Cloud topic", "/test/cloud")
         shown = wait_scene_points(page, "/base_link/cloud", CLOUD_POINTS, timeout_ms=40_000)
         assert shown == CLOUD_POINTS
+        page.wait_for_function(HINT_SHOWN_JS, arg=False, polling=100, timeout=10_000)  # drawn
         expect(page.get_by_text(f"{CLOUD_POINTS:,} points").first).to_be_visible(timeout=10_000)
 
         pick(page, "Image topic", "/test/camera/image")
