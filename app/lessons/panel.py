@@ -9,6 +9,7 @@ from __future__ import annotations
 import base64
 import html
 import re
+from collections import Counter
 from collections.abc import Callable
 from functools import lru_cache
 from typing import Final
@@ -18,6 +19,7 @@ import viser
 from app.catalog import UnknownNodeError, lookup_group
 from app.lessons import step_code
 from app.lessons.progress import ProgressStore
+from app.lessons.registry import CheckResult
 from app.lessons.runtime import FAIL, PASS, WAITING, LessonRuntime
 from app.lessons.schema import IMAGE_TYPES, STATIC_DIR, Course, Lesson, Spec
 from app.ros.graph import GraphSnapshot
@@ -149,6 +151,19 @@ COURSE_END = "End of the course"
 # Every label Next takes but the course's end (browser tests and docs/screenshots.py find
 # the button by it).
 NEXT_LABEL = re.compile(r"^(Next|Next lesson: .+|Skip \(\d+ checks? not passed\))$")
+
+
+def check_lines(results: list[CheckResult]) -> list[str]:
+    """The step's check lines: what is left to do first, a line per check, except that
+    checks waiting on the same thing (four frames, one missing /tf) share one line that
+    says how many they are."""
+    ordered = sorted(results, key=lambda result: result.state == PASS)
+    counts = Counter((result.state, result.reason) for result in ordered)
+    lines = []
+    for state, reason in counts:  # in the order first seen
+        many = f" ({counts[state, reason]} checks)" if counts[state, reason] > 1 else ""
+        lines.append(f"- {_MARKS[state]} **{_WORDS[state]}**{many}: {reason}")
+    return lines
 
 
 def _next_label(not_passed: int, following: Lesson | None, last_step: bool) -> str:
@@ -425,15 +440,7 @@ class LessonsPanel:
         results = [(check, self._live.evaluate(check)) for check in step.checks]
         if results and all(result.state == PASS for _, result in results):
             self._progress.mark_passed(lesson.id, index)
-        # What is left to do comes first, a line per check; a reason is said once for the
-        # checks that wait on the same thing (four frames, one missing /tf).
-        ordered = sorted(results, key=lambda pair: pair[1].state == PASS)
-        lines, said = [], set()
-        for _, result in ordered:
-            key = (result.state, result.reason)
-            reason = "the same as above" if key in said else result.reason
-            said.add(key)
-            lines.append(f"- {_MARKS[result.state]} **{_WORDS[result.state]}**: {reason}")
+        lines = check_lines([result for _, result in results])
         passed = set(self._progress.lesson(lesson.id)["passed"])
         status = "✓ step done" if index in passed else ""
         not_passed = sum(result.state != PASS for _, result in results)
