@@ -12,10 +12,12 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO
 
+import psutil
 import pytest
 
 from app import PROJECT_ROOT
 from app.dds import configure_dds_env
+from app.ros.liveness import GUARD_NAME
 from bench import _reaper
 from tests import hang_watchdog, heavy_slots, worker_plan
 
@@ -154,6 +156,19 @@ def supervisor(ros_env):
     sup = Supervisor(ros_env)
     yield sup
     sup.shutdown()
+
+
+def started_by(pid: int) -> list[psutil.Process]:
+    """The processes a dashboard started: its descendants, less its ROS liveness guard
+    (app/ros/liveness.py), which every dashboard has from its start."""
+    out = []
+    for child in psutil.Process(pid).children(recursive=True):
+        try:
+            if GUARD_NAME not in child.cmdline():
+                out.append(child)
+        except psutil.NoSuchProcess:
+            continue
+    return out
 
 
 def free_port() -> int:

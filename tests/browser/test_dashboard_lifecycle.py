@@ -11,13 +11,13 @@ import pytest
 
 from app.lessons.progress import ProgressStore
 from tests.browser.helpers import choose, click, expect_text, open_tab
-from tests.conftest import wait_until
+from tests.conftest import started_by, wait_until
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
 
 def node_processes(dashboard_pid: int) -> list[psutil.Process]:
-    return psutil.Process(dashboard_pid).children(recursive=True)
+    return started_by(dashboard_pid)
 
 
 def start_chatter_group(page) -> None:

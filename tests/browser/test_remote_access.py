@@ -10,12 +10,11 @@ from __future__ import annotations
 import urllib.error
 import urllib.request
 
-import psutil
 import pytest
 from websockets.exceptions import InvalidStatus
 
 from tests.browser.helpers import expect_text, open_tab
-from tests.conftest import DashboardProcess, free_port, wait_until
+from tests.conftest import DashboardProcess, free_port, started_by, wait_until
 from tests.wire_client import WireClient
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
@@ -56,7 +55,7 @@ def test_without_the_token_nothing_is_served_or_accepted(remote_dashboard):
         assert info.value.response.status_code == 401
     with pytest.raises(InvalidStatus):  # a forged cookie is no better
         WireClient(url, headers={"Cookie": f"classroom_token_{remote_dashboard.port}=guess"})
-    assert psutil.Process(remote_dashboard.proc.pid).children(recursive=True) == []
+    assert started_by(remote_dashboard.proc.pid) == []
     # ...and the server still serves whoever has the token.
     status, headers, _body = _get(f"{url}/?token={TOKEN}")
     assert status == 200
@@ -70,7 +69,7 @@ def test_with_the_token_a_client_watches_and_controls(remote_dashboard):
         wait_until(lambda: client.find("Start", "GuiButtonMessage"), what="the Nodes panel")
         client.click("Start")  # the catalog's first node, talker
         wait_until(
-            lambda: psutil.Process(remote_dashboard.proc.pid).children(recursive=True),
+            lambda: started_by(remote_dashboard.proc.pid),
             what="the talker process",
         )
         wait_until(lambda: "Started **talker**" in client.markdown(), what="the start message")
@@ -132,4 +131,4 @@ def test_learner_code_does_not_run_on_a_served_dashboard_without_consent(browser
         expect_text(page, "learner code runs only when the teacher starts it")
     finally:
         context.close()
-    assert psutil.Process(remote_dashboard.proc.pid).children(recursive=True) == []
+    assert started_by(remote_dashboard.proc.pid) == []
