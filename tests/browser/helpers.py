@@ -299,10 +299,13 @@ _STEP_CARD_FN = """function stepCard(spec) {
   if (spec.head) return {missing, names: Object.keys(found), elements: Object.values(found)};
   for (const [name, label] of spec.buttons) want(name, button((n) => n === label));
   const line = new RegExp(spec.check_line);
+  const shared = new RegExp(spec.shared_line);  // one line for N checks waiting on one thing
   const checks = [...document.body.querySelectorAll('li')]
-    .filter((e) => line.test(fold(e.textContent)) && visible(e));
+    .filter((e) => line.test(fold(e.textContent)) && visible(e))
+    .flatMap((e) => { const m = fold(e.textContent).match(shared);
+      return Array(m ? Number(m[1]) : 1).fill(e); });
   if (checks.length !== spec.checks.length)
-    missing.push(`${spec.checks.length} check lines (${checks.length} shown)`);
+    missing.push(`${spec.checks.length} checks on their lines (${checks.length} shown)`);
   spec.checks.forEach(([name, answers], i) => {
     for (const [answer, labels] of answers) want(answer, button((n) => labels.includes(n)));
     want(name, checks[i]);
@@ -354,6 +357,7 @@ def _card_spec(lesson, index: int, head: bool) -> dict:
         "buttons": buttons,
         "checks": checks,
         "check_line": CHECK_LINE.pattern,
+        "shared_line": SHARED_LINE.pattern,
         "next": NEXT_OR_SKIP.pattern,
         "end": COURSE_END,
     }
@@ -411,6 +415,14 @@ def first_words(markdown: str, count: int = 5) -> str:
 
 
 CHECK_LINE = re.compile(r"^(✓|○|…) (pass|to do|waiting)")
+# Checks that wait on the same thing share a line that counts them (app/lessons/panel.py).
+SHARED_LINE = re.compile(r"^\S+ (?:pass|to do|waiting) \((\d+) checks\):")
+# For each visible check line, how many checks it stands for (1, or N on a shared line).
+_CHECKS_PER_LINE_JS = r"""([line, shared]) => [...document.body.querySelectorAll('li')]
+  .filter((e) => e.getClientRects().length > 0 && getComputedStyle(e).visibility !== 'hidden')
+  .map((e) => (e.textContent || '').replace(/\s+/g, ' ').trim())
+  .filter((text) => new RegExp(line).test(text))
+  .map((text) => { const m = text.match(new RegExp(shared)); return m ? Number(m[1]) : 1; })"""
 
 
 def step_controls(page: Page, lesson, index: int) -> dict[str, Locator]:
@@ -426,16 +438,28 @@ def step_controls(page: Page, lesson, index: int) -> dict[str, Locator]:
         label = action.get("label") or action.kind.replace("_", " ")
         controls[f"button {label!r}"] = page.get_by_role("button", name=label, exact=True)
     checks = page.locator("li").filter(has_text=CHECK_LINE).filter(visible=True)
-    expect(checks).to_have_count(len(step.checks))
+    line_of = _line_of_each_check(page, len(step.checks))
     for i, check in enumerate(step.checks):
         if check.kind == "quiz":
             for option in check["options"]:
                 controls[f"answer {option[:30]!r}"] = answer_button(page, option)
-        controls[f"check {i + 1}"] = checks.nth(i)
+        controls[f"check {i + 1}"] = checks.nth(line_of[i])
     controls["Back"] = page.get_by_role("button", name="Back", exact=True)
     last = page.get_by_role("button", name=COURSE_END, exact=True)  # the course's last step
     controls["Next"] = page.get_by_role("button", name=NEXT_OR_SKIP).or_(last)
     return controls
+
+
+def _line_of_each_check(page: Page, checks: int, timeout: float = 10.0) -> list[int]:
+    """Waits until the check lines stand for ``checks`` checks; the line of each."""
+    deadline = time.monotonic() + timeout
+    while True:
+        per_line = page.evaluate(_CHECKS_PER_LINE_JS, [CHECK_LINE.pattern, SHARED_LINE.pattern])
+        if sum(per_line) == checks or time.monotonic() > deadline:
+            break
+        time.sleep(0.1)
+    assert sum(per_line) == checks, f"{checks} checks on their lines, {per_line} shown"
+    return [line for line, count in enumerate(per_line) for _ in range(count)]
 
 
 def answer_button(page: Page, option: str) -> Locator:
