@@ -1,10 +1,11 @@
 """A dashboard whose ROS layer stops answering is ended by its guard and started again.
 
 The real cause (a Fast DDS 2.14.5 deadlock between two of its own threads,
-app/ros/liveness.py) cannot be made to happen on purpose. What it does to the
-dashboard can: every thread stops, the GIL with them. SIGSTOP does exactly
-that to the whole process, so it stands in for the deadlock here; the guard,
-a process of its own, is not stopped with it.
+app/ros/liveness.py) takes minutes of heavy DDS traffic to bring about
+(tools/fastdds_deadlock.py does, to study it), far too long for a test. What
+it does to the dashboard is quick to cause: every thread stops, the GIL with
+them. SIGSTOP does exactly that to the whole process, so it stands in for the
+deadlock here; the guard, a process of its own, is not stopped with it.
 
 Through ``make run``'s keeper (app/keep_serving.py), with the guard's limit
 at 6 s:
