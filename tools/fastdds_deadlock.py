@@ -17,10 +17,9 @@ moment, so short-lived writers are the risk. This tool makes that common:
 When the victim stops probing, the tool takes its native stacks with gdb (if
 installed), keeps them in a file and says whether they show the two threads of
 the cycle; then the guard ends the victim with SIGABRT and the tool starts
-another. Measured on 2
-cores: a victim deadlocked after 10-130 s (8 in 12 minutes). With the
-dashboard's real load a participant has a few readers per topic and the odds
-are far lower (one hang in about 16 test-suite runs).
+another. Measured on 2 cores: a victim deadlocked after 10-130 s (8 in 12
+minutes). With the dashboard's real load a participant has a few readers per
+topic and the odds are far lower (one hang in about 16 test-suite runs).
 
 Run it inside a private network namespace (it starts DDS participants):
 
