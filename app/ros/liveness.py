@@ -77,6 +77,7 @@ class ParticipantLiveness:
         self._guard: subprocess.Popen[bytes] | None = None
         self._thread = threading.Thread(target=self._run, name="ros-liveness", daemon=True)
         self.probes = 0
+        self.guard_pid: int | None = None  # while it runs, and after (what `ps` showed)
 
     def start(self) -> None:
         bash = shutil.which("bash")
@@ -94,13 +95,19 @@ class ParticipantLiveness:
             stdout=subprocess.DEVNULL,
             start_new_session=True,  # Ctrl+C in the terminal is the dashboard's, not the guard's
         )
+        self.guard_pid = self._guard.pid
         self._thread.start()
 
     def _run(self) -> None:
         period = self.limit / PROBES_PER_LIMIT
         while True:
-            sub = self._node.create_subscription(Empty, PROBE_TOPIC, _ignore, 1)
-            self._node.destroy_subscription(sub)
+            try:
+                sub = self._node.create_subscription(Empty, PROBE_TOPIC, _ignore, 1)
+                self._node.destroy_subscription(sub)
+            except Exception:  # an error, not a hang: never a reason to end the dashboard
+                log.exception("the ROS liveness probe failed; it stops, and so does its guard")
+                self._release_guard()
+                return
             self.probes += 1
             if not self._beat() or self._stopping.wait(period):
                 return
@@ -122,6 +129,10 @@ class ParticipantLiveness:
         self._stopping.set()
         if self._thread.is_alive():
             self._thread.join(timeout)
+        self._release_guard(timeout)
+
+    def _release_guard(self, timeout: float = 5.0) -> None:
+        """Close the guard's pipe: it leaves without ending anything."""
         guard, self._guard = self._guard, None
         if guard is None:
             return
