@@ -6,27 +6,24 @@ learner's page should come back by itself, so this runs ``python -m app
 ARGS...`` and runs it again after such an end. Any other end (Ctrl+C, an
 error at start, SIGTERM) ends this too, with the dashboard's exit status.
 
-Standard library only: this process must outlive whatever its child does.
+Standard library only (app.stop_signals is too): this process must outlive
+whatever its child does.
 Ctrl+C in the terminal reaches the dashboard directly (one process group);
 SIGTERM and SIGHUP sent here are passed on to it.
 """
 
 from __future__ import annotations
 
-import ctypes
+import os
 import signal
 import subprocess
 import sys
 import time
 
+from app.stop_signals import die_with  # standard library only, too
+
 RESTART_AFTER = -signal.SIGABRT  # Popen's returncode for "ended by SIGABRT"
 CALM_SEC = 30.0  # a dashboard that keeps dying sooner than this after its start is not restarted
-_PR_SET_PDEATHSIG = 1
-
-
-def _die_with_keeper() -> None:
-    """Between fork and exec: the dashboard ends if this keeper is killed."""
-    ctypes.CDLL(None).prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
 
 
 def main(argv: list[str]) -> int:
@@ -44,7 +41,10 @@ def main(argv: list[str]) -> int:
     quick_ends = 0
     while True:
         started = time.monotonic()
-        child = subprocess.Popen([sys.executable, "-m", "app", *argv], preexec_fn=_die_with_keeper)
+        child = subprocess.Popen(
+            [sys.executable, "-m", "app", *argv],
+            preexec_fn=die_with(os.getpid()),  # the dashboard ends if this keeper is killed
+        )
         code = child.wait()
         if code != RESTART_AFTER or interrupted:
             return code if code >= 0 else 128 - code
