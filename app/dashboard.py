@@ -205,6 +205,7 @@ class Dashboard:
                 position=position,
                 # The column's top: any tab always in it finds the column (the first group).
                 to_top=lambda: opener.scroll_to_top(next(iter(TOOL_GROUPS))),
+                atomic=self.server.atomic,
             ),
             "Exercise": lambda: ExercisePanel(
                 gui,

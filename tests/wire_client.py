@@ -105,6 +105,9 @@ class WireClient:
         # Called with each message once it is applied, under ``lock`` (on the reader thread):
         # what a test sees at the moment a message arrives, in the order they were sent.
         self.on_message: Callable[[dict[str, Any]], None] | None = None
+        # Called once a frame's messages are all applied, under ``lock``: a page draws
+        # what one frame brought at once, so this is each state a page can show.
+        self.on_frame: Callable[[], None] | None = None
         self._closing = threading.Event()
         self._reader = threading.Thread(target=self._read, name="wire-reader", daemon=True)
         self._reader.start()
@@ -125,6 +128,8 @@ class WireClient:
                         self._apply(message)
                         if self.on_message is not None:
                             self.on_message(message)
+                    if self.on_frame is not None:
+                        self.on_frame()
         except ConnectionClosed as exc:
             self.closed_reason = str(exc)
         except Exception as exc:  # reported, then the test fails on it
@@ -138,6 +143,7 @@ class WireClient:
             self.counts["cloud_frames"] += 1
         if kind.startswith("Gui") and "props" in message and uuid:
             self.gui[uuid] = {"type": kind, **dict(message["props"])}
+            self.gui[uuid]["container_uuid"] = message.get("container_uuid")  # where it sits
             if "value" in message:
                 self.gui[uuid]["value"] = message["value"]
         elif kind == "GuiUpdateMessage" and uuid in self.gui:

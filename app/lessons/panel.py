@@ -11,6 +11,7 @@ import html
 import re
 from collections import Counter
 from collections.abc import Callable
+from contextlib import AbstractContextManager, nullcontext
 from functools import lru_cache
 from typing import Final
 
@@ -206,6 +207,7 @@ class LessonsPanel:
         new_lesson: Callable[[frozenset[str]], None] = lambda _programs: None,
         position: MarkdownView | None = None,
         to_top: Callable[[], None] = lambda: None,
+        atomic: Callable[[], AbstractContextManager[object]] = nullcontext,
     ) -> None:
         """``step_card``: a folder for the step's title, buttons, checks and Back/Next (the
         dashboard puts it above its tools, so they stay in view); made here when None.
@@ -214,7 +216,8 @@ class LessonsPanel:
         (the dashboard clears what the last one left in the views). ``position``: where the
         "Lesson i of n · Step j of m" line goes (the dashboard puts it above the step card);
         made in the card when None.
-        ``to_top()``: the column back to its top, where a new step's text begins."""
+        ``to_top()``: the column back to its top, where a new step's text begins.
+        ``atomic()``: the server's ``atomic``, so a page draws a step's switch at once."""
         self._gui = gui
         self._ui = ui
         self._course = course
@@ -224,6 +227,7 @@ class LessonsPanel:
         self._show_stage = show_stage  # the stage shows what each step names (and its picture)
         self._open_tool = open_tool
         self._to_top = to_top
+        self._atomic = atomic
         self._requests = start_requests or StartRequests()  # the stage shows a Start at once
         self._new_lesson = new_lesson
         self._leftovers: list[str] = []  # nodes running when this lesson was opened
@@ -314,7 +318,14 @@ class LessonsPanel:
 
     def _select(self, lesson: Lesson, step: int, reading: bool = True) -> None:
         """Show ``step`` of ``lesson``; ``reading``: bring its text into view (a new step is
-        read first; the tool the learner has open stays open under the card)."""
+        read first; the tool the learner has open stays open under the card).
+
+        In one atomic group: a page given the new title before the new buttons drew the
+        card with none, Next moved up and back down, and a click on it was lost (ci127)."""
+        with self._atomic():
+            self._show_step(lesson, step, reading)
+
+    def _show_step(self, lesson: Lesson, step: int, reading: bool) -> None:
         step = max(0, min(step, len(lesson.steps) - 1))
         opened = lesson is not self._lesson
         if opened:  # a lesson starts clean: nothing of the last one
