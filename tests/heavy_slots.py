@@ -9,8 +9,10 @@ the load at 26 on two cores, and the page answered no click for 30 s
 
 So a test that keeps about a core busy for most of its time (``is_heavy``:
 a Chromium, a simulated world, a busy grading, or a module measured so)
-first takes one of ``os.cpu_count()`` slots: a lock on a file named after the
-run's namespaces file (tests/run.py), which every worker of the run shares.
+first takes one of as many slots as the run has free cores (the machine's, less
+those something else kept busy as the run began: tests/run.py measures them): a
+lock on a file named after the run's namespaces file (tests/run.py), which every
+worker of the run shares.
 A worker whose next test is heavy waits for a slot; the cores are full then
 anyway. A few tests keep about two cores busy on their own (``takes_all``: a
 world drawn by software WebGL in a Chromium, a grading with a world and
@@ -29,7 +31,7 @@ import time
 from collections.abc import Callable
 from typing import IO, Any
 
-from tests.run import NAMESPACES, SLOT_SUFFIX  # one file per run, named by its keeper
+from tests.run import FREE_CORES, NAMESPACES, SLOT_SUFFIX  # one file per run, by its keeper
 from tests.worker_plan import busy_cases, unit_of
 
 # Measured (rehearsal ci70, 2 cores, a worker's process tree): these keep 0.6-1.3 of a
@@ -156,4 +158,5 @@ class HeavySlots:
 def for_this_worker() -> HeavySlots:
     """The slots of the run this xdist worker belongs to; none outside a run's workers."""
     shared = os.environ.get("PYTEST_XDIST_WORKER") and os.environ.get(NAMESPACES)
-    return HeavySlots(shared or None)
+    free = os.environ.get(FREE_CORES, "")  # the keeper's: cores nothing else kept busy
+    return HeavySlots(shared or None, int(free) if free.isdigit() else None)

@@ -44,6 +44,7 @@ import struct
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # run as a script from anywhere
@@ -59,6 +60,10 @@ KEEPER = "CLASSROOM_NETNS_KEEPER"  # set only for the process that unshare start
 WORKER = "CLASSROOM_WORKER_NETNS"  # set only for the worker that unshare starts
 NAMESPACES = "CLASSROOM_RUN_NAMESPACES"  # the file where workers note their namespaces
 SLOT_SUFFIX = ".heavy"  # the heavy-test slots' files beside it: <file>.heavy0, .heavy1, ...
+# How many cores the run's heavy tests may count on (tests/heavy_slots.py): the machine's,
+# less those that something outside the run kept busy as it began (measured by the keeper).
+FREE_CORES = "CLASSROOM_FREE_CORES"
+BUSY_SAMPLE_SEC = 2.0
 # Three workers on two cores, measured: the whole suite in 16-17 min instead of
 # 47, a core still idle a third of the time. Four took 15 min but saturated the
 # cores: eight tests that wait on real time failed (a MuJoCo run, turtlesim). So
@@ -134,6 +139,29 @@ def _another_run(proc: Path) -> bool:
     prefix = f"{NAMESPACES}=".encode()
     theirs = next((v[len(prefix) :] for v in environ if v.startswith(prefix)), None)
     return theirs is not None and theirs.decode(errors="replace") != os.environ.get(NAMESPACES)
+
+
+def _cpu_ticks() -> tuple[int, int]:
+    """(busy, total) ticks of every core since boot, from /proc/stat's first line."""
+    with open("/proc/stat", encoding="ascii") as stat:
+        fields = [int(x) for x in stat.readline().split()[1:]]
+    idle = fields[3] + (fields[4] if len(fields) > 4 else 0)  # idle + iowait
+    total = sum(fields[:8])  # guest time is already counted in user time
+    return total - idle, total
+
+
+def cores_free_of_others(sample_sec: float = BUSY_SAMPLE_SEC) -> tuple[int, float]:
+    """(cores free, cores busy) as the run begins, before it has started anything: the
+    busy ones are another program's (a build, a second run, a busy loop beside it). The
+    heavy tests then share the free ones: ci128, one core kept busy by a loop while the
+    plan counted two, ran two heavy tests beside the loop at a load of 15-22, and a fuzz
+    of 22 nodes took longer than its 150 s while a talker took over 30 s to show."""
+    cores = os.cpu_count() or 1
+    busy0, total0 = _cpu_ticks()
+    time.sleep(sample_sec)
+    busy1, total1 = _cpu_ticks()
+    busy = cores * (busy1 - busy0) / max(total1 - total0, 1)
+    return max(1, cores - round(busy)), busy
 
 
 def keep(command: list[str], quiet: bool = False) -> int:
@@ -339,6 +367,14 @@ def main() -> int:
             # First this run's own file: a run inside a run must not end the outer one's
             # workers when its collection ends (it inherited the outer run's file).
             os.environ[NAMESPACES] = noted.name
+            if FREE_CORES not in os.environ:  # (set by hand: that figure)
+                free, busy = cores_free_of_others()
+                os.environ[FREE_CORES] = str(free)
+                print(
+                    f"tests/run.py: {busy:.1f} of {os.cpu_count()} cores busy before the run: "
+                    f"heavy tests share {free}",
+                    flush=True,
+                )
             try:
                 collect_ahead(args, keeper=True)
                 return run_phases(phases, keeper=True)

@@ -200,3 +200,40 @@ def test_the_run_removes_its_slot_files_with_its_own(tmp_path):
         open(path, "w").close()
     _remove_slot_files(run_file)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["classroom-run-x.netns-other.heavy0"]
+
+
+@pytest.mark.parametrize(
+    ("busy_share", "free"),
+    [(0.0, 2), (0.1, 2), (0.5, 1), (0.52, 1), (1.0, 1)],  # a busy loop on one core: 0.5
+)
+def test_the_keeper_counts_as_free_the_cores_nothing_else_kept_busy(monkeypatch, busy_share, free):
+    """Two cores: the slots the run's heavy tests share are those nothing else kept busy as
+    the run began, one at least (a machine busy throughout still runs the suite)."""
+    from tests import run
+
+    ticks = iter([(0, 1000), (int(busy_share * 1000), 2000)])  # busy, total: 1000 ticks apart
+    monkeypatch.setattr(run, "_cpu_ticks", lambda: next(ticks))
+    monkeypatch.setattr(run.os, "cpu_count", lambda: 2)
+    got, busy = run.cores_free_of_others(sample_sec=0.0)
+    assert (got, round(busy, 2)) == (free, round(2 * busy_share, 2))
+
+
+def test_a_worker_takes_as_many_slots_as_the_keeper_found_free(monkeypatch, tmp_path):
+    from tests import heavy_slots
+    from tests.run import FREE_CORES, NAMESPACES
+
+    monkeypatch.setenv("PYTEST_XDIST_WORKER", "gw0")
+    monkeypatch.setenv(NAMESPACES, str(tmp_path / "run.netns"))
+    monkeypatch.setenv(FREE_CORES, "1")
+    assert len(heavy_slots.for_this_worker().paths) == 1
+    monkeypatch.delenv(FREE_CORES)
+    assert len(heavy_slots.for_this_worker().paths) == (heavy_slots.os.cpu_count() or 1)
+
+
+def test_the_cpu_ticks_are_read_from_the_kernel():
+    from tests.run import _cpu_ticks
+
+    busy0, total0 = _cpu_ticks()
+    sum(range(2_000_000))  # some work of our own, so the counters move
+    busy1, total1 = _cpu_ticks()
+    assert 0 <= busy0 <= total0 and busy1 > busy0 and total1 > total0
