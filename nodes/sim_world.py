@@ -18,7 +18,8 @@ drivers publish, stamped with simulation time:
   really is, for lessons to compare with;
 - ``/scan`` (sensor_msgs/LaserScan, 360 rays at 10 Hz, noisy), ``/imu``
   (sensor_msgs/Imu), ``/camera/image_raw`` + ``/camera/camera_info`` (320x240
-  at 15 Hz, rendered in a thread of its own so the physics keeps time);
+  at 15 Hz, rendered in a thread of its own so the physics keeps time, and
+  only while something subscribes to the picture);
 - ``/joint_states``: the wheels, the arm's joints and its fingers;
 - ``/arm_controller/joint_trajectory`` in (trajectory_msgs/JointTrajectory)
   and ``/gripper/command`` in (std_msgs/Float64, finger opening in metres);
@@ -481,13 +482,17 @@ class SimWorld(Node):
                 if request is None:
                     continue
                 now, qpos = request
-                pixels = camera.render(qpos)
-                image = Image(height=height, width=width, encoding="rgb8", step=width * 3)
-                image.header.stamp = info.header.stamp = stamp(now)
-                image.header.frame_id = "camera_optical_frame"
-                image.data = pixels.tobytes()
-                self.image_pub.publish(image)
-                self.info_pub.publish(info)
+                info.header.stamp = stamp(now)
+                # A picture nobody reads is not drawn, as Gazebo's cameras do: software
+                # rendering is most of an idle world's CPU (a class's server holds many).
+                if self.image_pub.get_subscription_count() > 0:
+                    image = Image(height=height, width=width, encoding="rgb8", step=width * 3)
+                    image.header.stamp = info.header.stamp
+                    image.header.frame_id = "camera_optical_frame"
+                    image.data = camera.render(qpos).tobytes()
+                    self.image_pub.publish(image)
+                if self.info_pub.get_subscription_count() > 0:
+                    self.info_pub.publish(info)
         finally:
             camera.close()
 
