@@ -53,6 +53,12 @@ def pick(page, label: str, topic: str) -> None:
 
 
 def test_point_cloud_image_and_arm_show_up_live(page, probe):
+    # Nothing on the graph, so nothing drawn: the view says what would show there. Waited
+    # for before this test's publishers exist: their joint angles put the desk's arm in
+    # the view, and ci128 (a busy loop beside the run) saw the dashboard discover them
+    # first. (Waited for with them, it passed only while the dashboard had not yet.)
+    open_tab(page, "3D view")
+    page.wait_for_function(HINT_SHOWN_JS, arg=True, polling=100, timeout=10_000)
     node = probe.node
     pts, colours = synthetic_cloud_points(CLOUD_POINTS)
     cloud_pub = node.create_publisher(PointCloud2, "/test/cloud", 1)
@@ -78,15 +84,12 @@ def test_point_cloud_image_and_arm_show_up_live(page, probe):
         msg.position = [math.sin(t), 0.6 + 0.3 * math.sin(t), -1.0, -0.8]
         return msg
 
-    # Nothing sent yet, so nothing drawn: the view says what should be there.
-    page.wait_for_function(HINT_SHOWN_JS, arg=True, polling=100, timeout=10_000)
     repeaters = [
         Repeater(cloud_pub, cloud, 0.2),
         Repeater(image_pub, image, 0.2),
         Repeater(joint_pub, joints, 0.05),
     ]
     try:
-        open_tab(page, "3D view")
         pick(page, "Cloud topic", "/test/cloud")
         shown = wait_scene_points(page, "/base_link/cloud", CLOUD_POINTS, timeout_ms=40_000)
         assert shown == CLOUD_POINTS
