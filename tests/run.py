@@ -161,7 +161,8 @@ def cores_free_of_others(sample_sec: float = BUSY_SAMPLE_SEC) -> tuple[int, floa
     time.sleep(sample_sec)
     busy1, total1 = _cpu_ticks()
     busy = cores * (busy1 - busy0) / max(total1 - total0, 1)
-    return max(1, cores - round(busy)), busy
+    # A core counts as taken from three quarters busy: a busy loop is one, noise is none.
+    return max(1, cores - int(busy + 0.25)), busy
 
 
 def keep(command: list[str], quiet: bool = False) -> int:
