@@ -52,6 +52,11 @@ _ANSWER_COLOUR: Final = "gray"
 _CHOSEN_COLOUR: Final = "blue"
 
 
+def action_button_label(action: Spec) -> str:
+    """A step action's button: its own label, or its kind in words."""
+    return str(action.get("label") or action.kind.replace("_", " "))
+
+
 def answer_button_label(option: str, chosen: bool) -> str:
     """A quiz answer's button: a radio mark, then the answer's whole text."""
     return f"{'●' if chosen else '○'} {option}"
@@ -369,7 +374,7 @@ class LessonsPanel:
         statuses = self._statuses()
         with self._actions:
             for action in step.actions:
-                label = action.get("label") or f"{action.kind.replace('_', ' ')}"
+                label = action_button_label(action)
                 icon = _ACTION_ICONS.get(action.kind, viser.Icon.PLAYER_PLAY)
                 stops = _stopped_by(action)
                 button = self._gui.add_button(

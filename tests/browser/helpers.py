@@ -11,7 +11,7 @@ import pytest
 from playwright.sync_api import Locator, Page, expect
 from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
-from app.lessons.panel import COURSE_END, answer_button_label
+from app.lessons.panel import COURSE_END, action_button_label, answer_button_label
 from bench._common import open_tool
 from tests.wire_client import NEXT_OR_SKIP
 
@@ -340,7 +340,7 @@ def _card_spec(lesson, index: int, head: bool) -> dict:
     step = lesson.steps[index]
     buttons = []
     for action in step.actions:
-        label = action.get("label") or action.kind.replace("_", " ")
+        label = action_button_label(action)
         buttons.append([f"button {label!r}", label])
     checks = []
     for i, check in enumerate(step.checks):
@@ -435,7 +435,7 @@ def step_controls(page: Page, lesson, index: int) -> dict[str, Locator]:
     expect(controls["title"]).to_be_visible()
     controls["text"] = page.get_by_text(first_words(step.text)).filter(visible=True)
     for action in step.actions:
-        label = action.get("label") or action.kind.replace("_", " ")
+        label = action_button_label(action)
         controls[f"button {label!r}"] = page.get_by_role("button", name=label, exact=True)
     checks = page.locator("li").filter(has_text=CHECK_LINE).filter(visible=True)
     line_of = _line_of_each_check(page, len(step.checks))

@@ -7,6 +7,7 @@ import json
 import pytest
 from playwright.sync_api import expect
 
+from app.lessons.panel import action_button_label
 from tests.browser.helpers import (
     answer_quiz,
     click,
@@ -30,7 +31,7 @@ def complete_by_clicking(page, lesson, done_within_ms: int = 45_000) -> None:
     for index, step in enumerate(lesson.steps):
         expect_text(page, f"Step {index + 1} of {len(lesson.steps)}: {step.title}")
         for action in step.actions:
-            click(page, action.get("label") or action.kind.replace("_", " "))
+            click(page, action_button_label(action))
             page.wait_for_timeout(300)  # a learner reads the result before the next click
         for check in step.checks:
             if check.kind == "quiz":

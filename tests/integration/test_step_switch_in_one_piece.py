@@ -15,7 +15,7 @@ import re
 
 import pytest
 
-from app.lessons.panel import answer_button_label
+from app.lessons.panel import action_button_label, answer_button_label
 from tests.conftest import wait_until
 from tests.course_data import shared_course
 from tests.wire_client import NEXT_OR_SKIP, WireClient
@@ -29,7 +29,7 @@ CARD = re.compile(r"^Step (\d+) of (\d+): (.*)$")
 def _buttons(step) -> frozenset[str]:
     """The buttons the step card shows for ``step`` (app/lessons/panel.py): one per
     action, then each quiz's answers, none chosen."""
-    labels = [str(action.get("label") or action.kind.replace("_", " ")) for action in step.actions]
+    labels = [action_button_label(action) for action in step.actions]
     labels += [
         answer_button_label(option, False)
         for check in step.checks
