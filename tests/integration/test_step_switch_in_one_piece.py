@@ -7,6 +7,11 @@ rehearsal ci127 lost a click on Next so: the course walk at 125 % zoom pressed i
 3's step 2, and the page stayed there. The dashboard now sends a switch as one of viser's
 atomic groups, which a page draws at once. This test walks three lessons and looks at
 what a page would draw after each frame it is sent.
+
+A page's first load is not a switch: viser sends everything the page must show in
+windows of at most 128 messages, so a card can arrive a frame before its buttons (the
+busy CI run of 1678878 saw lesson 1's first card so). Judging starts once that first load
+shows a whole card, before the test makes its first switch.
 """
 
 from __future__ import annotations
@@ -53,7 +58,9 @@ def test_every_frame_shows_one_steps_title_with_that_steps_buttons(dashboard):
     judged: set[tuple[int, str]] = set()
     client = WireClient(dashboard.url)
 
-    def look() -> None:  # the client's reader, under its lock, after each frame
+    def judge() -> tuple[tuple[int, str], str | None] | None:
+        """The step card's key and, if its buttons are wrong, what was drawn; None when
+        there is no single card with a known title. Called under the client's lock."""
         gui = client.gui
         cards = [
             (uuid, CARD.match(str(p.get("label"))))
@@ -61,13 +68,13 @@ def test_every_frame_shows_one_steps_title_with_that_steps_buttons(dashboard):
             if p["type"] == "GuiFolderMessage" and CARD.match(str(p.get("label")))
         ]
         if len(cards) != 1:
-            return
+            return None
         card, match = cards[0]
         assert match is not None
         key = (int(match.group(2)), match.group(3))
         expected = buttons_of.get(key)
         if expected is None:
-            return  # a step of another lesson, or a title two steps share
+            return None  # a step of another lesson, or a title two steps share
         # The step's own buttons sit in an unlabelled folder of the card.
         holders = {
             uuid
@@ -81,17 +88,31 @@ def test_every_frame_shows_one_steps_title_with_that_steps_buttons(dashboard):
             for p in gui.values()
             if p["type"] == "GuiButtonMessage" and p.get("container_uuid") in holders
         }
-        judged.add(key)
-        if shown != expected:
-            wrong.append(f"{match.group(0)!r} drawn with {sorted(shown)}")
+        return key, (
+            None if shown == expected else f"{match.group(0)!r} drawn with {sorted(shown)}"
+        )
+
+    def look() -> None:  # the client's reader, under its lock, after each frame
+        verdict = judge()
+        if verdict is not None:
+            judged.add(verdict[0])
+            if verdict[1] is not None:
+                wrong.append(verdict[1])
+
+    def first_load_whole() -> bool:
+        with client.lock:
+            verdict = judge()
+            if verdict is None or verdict[1] is not None:
+                return False
+            judged.add(verdict[0])
+            client.on_frame = look  # from here on, every frame is judged
+            return True
 
     try:
         picker = wait_until(
             lambda: client.find("Lesson", "GuiDropdownMessage"), timeout=60, what="Lesson"
         )
-        with client.lock:  # what the page shows now, then after every frame
-            look()
-            client.on_frame = look
+        wait_until(first_load_whole, timeout=60, what="the first load's whole step card")
         switches = 0
         for lesson in lessons:
             assert lesson is not None
