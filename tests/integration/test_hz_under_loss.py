@@ -101,22 +101,30 @@ def test_two_publishers_on_one_topic_and_the_hz_verb(probe, ros2):
 
     view = RosRuntime("pair_view")
     try:
-        monitor = TopicMonitor(view.node, "/pair_probe", Int64, qos=10)
+        rate_hz, seconds = 200.0, 1.5
+        keep = int(rate_hz * seconds) + 1  # every sample seen, to know which ones it was
+        monitor = TopicMonitor(view.node, "/pair_probe", Int64, keep=keep, qos=10)
         pubs = [probe.node.create_publisher(Int64, "/pair_probe", 10) for _ in range(2)]
         wait_until(
             lambda: all(p.get_subscription_count() >= 1 for p in pubs), 15, what="both to match"
         )
-        sent = publish_at(pubs, 200.0, 1.5)
+        sent = publish_at(pubs, rate_hz, seconds)
         time.sleep(0.2)
         stats = monitor.published_rate()
         arrived = monitor.rate()
+        seen = [message.data for _stamp, message in monitor.recent()]
     finally:
         view.shutdown()
     assert stats is not None and arrived is not None
     # Per writer, by the publishers' clocks: named by an rclpy that gives publisher_gid, told
     # apart by their sequence numbers by Jazzy's, which does not (app.ros.monitor).
     assert not stats.fallback, stats
-    assert stats.rate == pytest.approx(true_rate(sent), rel=0.02), (stats, arrived)
+    # The line through the publishes the view received, as its estimate is (and as the
+    # starved view's test above draws it): a quiet run loses none, but a CI rehearsal at
+    # load 17 stalled 187 ms and the view missed 56 of 286, and the line through every
+    # publish (190.7 Hz) was 2.9 % below the view's 196.2.
+    truth = true_rate(sent, seen)
+    assert stats.rate == pytest.approx(truth, rel=0.02), (stats, arrived, truth)
 
     # `ros2 topic hz` keeps ros2's lines and adds the publisher's rate after them.
     pub = probe.node.create_publisher(Int64, "/hz_probe", 10)
