@@ -56,6 +56,58 @@ def wait_future(ctx: CallContext, future: Future, timeout: float, what: str) -> 
     return future.result()
 
 
+RESEND_SEC = 2.0  # a lost request of a call_again is sent again after this long
+
+
+def call_again_until_answered(
+    ctx: CallContext,
+    client: Client,
+    request: object,
+    timeout: float,
+    what: str,
+    resend: float = RESEND_SEC,
+) -> object:
+    """``client``'s answer to ``request``, which is sent again every ``resend`` s until
+    any copy is answered, at most ``timeout`` s: only for requests that may arrive twice
+    (set or get a parameter, pause, reset).
+
+    A request leaves once: if the client's writer has not matched the server's reader
+    yet, it is lost (volatile durability), and the call waits out its whole timeout. That
+    happens when a server has just restarted under the same name: the graph still lists
+    the old one, so ``service_is_ready`` says yes at once (a learner's second attempt,
+    graded while the world from the first one runs on, lost its ``use_sim_time``).
+    """
+    done = threading.Event()
+    sent: list[Future] = []
+    started = time.monotonic()
+    deadline = started + timeout
+    try:
+        while True:
+            again_at = started + len(sent) * resend
+            if time.monotonic() >= again_at and again_at < deadline:
+                future = client.call_async(request)
+                future.add_done_callback(lambda _f: done.set())
+                sent.append(future)
+            if done.wait(0.05):
+                break
+            if ctx.cancel.is_set():
+                raise Cancelled()
+            if time.monotonic() > deadline:
+                times = "twice" if len(sent) == 2 else f"{len(sent)} times"
+                also = f" (the request was sent {times})" if len(sent) > 1 else ""
+                raise NoAnswer(f"no answer from {what} within {timeout:g} s{also}")
+        answered = next(f for f in sent if f.done())
+    finally:
+        for future in sent:
+            if not future.done():  # its answer, should it come, goes nowhere
+                client.remove_pending_request(future)
+                future.cancel()
+    exc = answered.exception()
+    if exc is not None:
+        raise Ros2Error(f"{what} failed: {exc}")
+    return answered.result()
+
+
 def wait_for_server(
     ctx: CallContext, is_ready: Callable[[], bool], timeout: float, what: str
 ) -> None:
@@ -92,11 +144,12 @@ def call_service(
     The response is a ``srv_type.Response``: the caller that reads it names that type.
 
     ``resend_unanswered``: for a request that is safe to repeat (a pure function, an
-    absolute teleport), send it once more when no answer came. A new client's first
-    answer can be lost: Fast DDS drops a reply whose reader the server has not yet
-    matched ("failed to send response (timeout): client will not receive response"),
-    which happens on a loaded machine while discovery lags. The second request goes
-    out once the reply path is matched; a server that never answers still fails.
+    absolute teleport), send it once more when no answer came within ``timeout``, and
+    wait as long again. A new client's first answer can be lost: Fast DDS drops a reply
+    whose reader the server has not yet matched ("failed to send response (timeout):
+    client will not receive response"), which happens on a loaded machine while
+    discovery lags. The second request goes out once the reply path is matched; a
+    server that never answers still fails.
     """
     timeout = ctx.limits.service_timeout if timeout is None else timeout
     check_service_type(ctx, name, srv_type)
@@ -104,15 +157,9 @@ def call_service(
     what = f"service '{name}'"
     try:
         wait_for_server(ctx, client.service_is_ready, timeout, what)
-        try:
-            return wait_future(ctx, client.call_async(request), timeout, what)
-        except NoAnswer:
-            if not resend_unanswered:
-                raise
-        try:
-            return wait_future(ctx, client.call_async(request), timeout, what)
-        except NoAnswer as exc:
-            raise NoAnswer(f"{exc} (the request was sent twice)") from None
+        if resend_unanswered:
+            return call_again_until_answered(ctx, client, request, 2 * timeout, what, timeout)
+        return wait_future(ctx, client.call_async(request), timeout, what)
     finally:
         ctx.node.destroy_client(client)
 

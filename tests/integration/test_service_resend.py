@@ -13,7 +13,7 @@ import time
 import pytest
 from tutorial_interfaces.srv import AddTwoInts
 
-from app.ros.calls import call_service
+from app.ros.calls import call_again_until_answered, call_service
 from app.ros.context import CallContext
 from app.ros.errors import NoAnswer
 
@@ -71,8 +71,42 @@ def test_without_the_resend_the_late_answer_is_no_answer(probe, slow_first_answe
 def test_a_server_that_never_answers_still_fails_after_the_resend(probe, slow_first_answer):
     ctx = CallContext(probe.node)
     started = time.monotonic()
-    with pytest.raises(NoAnswer, match=r"within 1 s \(the request was sent twice\)"):
+    with pytest.raises(NoAnswer, match=r"within 2 s \(the request was sent twice\)$"):
         call_service(
             ctx, "/never_add", AddTwoInts, AddTwoInts.Request(), 1.0, resend_unanswered=True
         )
     assert 2.0 <= time.monotonic() - started < 6.0
+
+
+def test_a_repeatable_request_goes_again_every_few_seconds_until_one_copy_is_answered(
+    probe, slow_first_answer
+):
+    # As the simulation probes set a learner's use_sim_time: the first copy can be lost
+    # for good (a learner's node restarted under the same name, its old server still in
+    # the graph), so waiting out the whole timeout on it would fail the grading.
+    ctx = CallContext(probe.node)
+    client = probe.node.create_client(AddTwoInts, "/slow_add")
+    try:
+        assert client.wait_for_service(10.0)
+        started = time.monotonic()
+        response = call_again_until_answered(
+            ctx, client, AddTwoInts.Request(a=2, b=3), 10.0, "service '/slow_add'", resend=0.5
+        )
+        took = time.monotonic() - started
+    finally:
+        probe.node.destroy_client(client)
+    assert response.sum == 5
+    assert len(slow_first_answer) >= 2 and took < 2.5, (slow_first_answer, took)
+
+
+def test_repeated_copies_that_are_never_answered_say_how_many_went(probe, slow_first_answer):
+    ctx = CallContext(probe.node)
+    client = probe.node.create_client(AddTwoInts, "/never_add")
+    try:
+        assert client.wait_for_service(10.0)
+        with pytest.raises(NoAnswer, match=r"within 1\.5 s \(the request was sent 3 times\)$"):
+            call_again_until_answered(
+                ctx, client, AddTwoInts.Request(), 1.5, "service '/never_add'", resend=0.5
+            )
+    finally:
+        probe.node.destroy_client(client)

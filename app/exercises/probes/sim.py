@@ -49,7 +49,7 @@ from app.exercises.probes.base import ProbeContext, draw
 from app.lessons.checks._sim_topics import SIM_NODE, Pose, pose_of, world_map, wrap
 from app.lessons.checks._world_map import WorldMap
 from app.ros import params
-from app.ros.calls import wait_for_server, wait_future
+from app.ros.calls import call_again_until_answered, wait_for_server
 from app.ros.errors import Ros2Error
 from app.ros.monitor import MessageInfo
 
@@ -239,7 +239,8 @@ class Services:
         client = self._clients[key]
         what = f"service '{name}'"
         wait_for_server(self._ctx.call, client.service_is_ready, SERVICE_SEC, what)
-        return wait_future(self._ctx.call, client.call_async(request), SERVICE_SEC, what)
+        # Every request made here may arrive twice (parameters, pause, reset, is_active).
+        return call_again_until_answered(self._ctx.call, client, request, SERVICE_SEC, what)
 
     def get(self, node: str, names: list[str]) -> dict[str, object]:
         request = GetParameters.Request(names=names)

@@ -50,8 +50,10 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from action_msgs.srv import CancelGoal
 from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
 from nav_msgs.msg import Path
+from rclpy.action.graph import get_action_names_and_types
 from rclpy.node import Node
 from rclpy.publisher import Publisher
 from rclpy.qos import DurabilityPolicy, QoSProfile
@@ -109,6 +111,10 @@ POSE_WAIT = 5.0  # s for amcl to take the start pose, each time it is told
 POSE_TELLS = 3  # times amcl is told the start pose before the trial goes on regardless
 POSE_SETTLE = 1.0  # s (ten scans) amcl's map -> odom is watched after it took the pose
 POSE_AGREES = 0.2  # m between the start and where amcl puts the robot
+# Nav2's tasks a script starts through BasicNavigator, cancelled before each trial.
+NAV2_TASKS = ("navigate_to_pose", "navigate_through_poses", "follow_waypoints")
+STOP_WAIT = 5.0  # s at most for /cmd_vel to fall silent once they are cancelled
+STILL_FOR = 0.5  # s (simulated) of /cmd_vel asking for no motion: the stack has stopped
 # Why a trial was lost, when a busy machine cannot be the reason.
 MOVED_NOT_DRIVEN = "moved, not driven"
 OFF_ROUTE = "a goal off the route"
@@ -575,6 +581,7 @@ class _Trial:
         learner_tail = programs.learner_output()[-TAIL:]
         navigator = str(p["navigator"])
         navigator_tail = programs.setup_output().get(navigator, [])[-TAIL:]
+        _stop_navigation(ctx, world.services, recorder)
         t0 = release(ctx, world, recorder, (sx, sy, syaw))
         _tell_amcl(ctx, self.pose_pub, self.amcl, (sx, sy, syaw))
         self.route_pub.publish(_path(ctx.call.node, (sx, sy), route))
@@ -630,6 +637,20 @@ class _Trial:
         if not verdict.passed:
             text += nav2_failures(logged or [])
         return Result(name, verdict.passed, text, traces), spoiled
+
+
+def _stop_navigation(ctx: ProbeContext, services: Services, recorder: Recorder) -> None:
+    """Cancel every goal Nav2 still runs, as the Cancel of rviz's Nav2 panel does, and wait
+    until /cmd_vel asks for no motion. A goal sent by an earlier attempt's script goes on
+    after the script has ended (in Nav2 too): it would carry the robot off the start the
+    trial puts it on, and its next waypoints would be goals off this trial's route."""
+    actions = {name for name, _types in get_action_names_and_types(ctx.call.node)}
+    for task in NAV2_TASKS:
+        if f"/{task}" in actions:  # an empty request (goal id and stamp zero): every goal
+            services.call(f"/{task}/_action/cancel_goal", CancelGoal, CancelGoal.Request())
+    deadline = time.monotonic() + STOP_WAIT
+    while recorder.asked_to_move(STILL_FOR) and time.monotonic() < deadline:
+        ctx.call.sleep(0.1)
 
 
 def _wait_for_nav2(ctx: ProbeContext, services: Services, manager: str) -> None:
