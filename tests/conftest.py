@@ -8,7 +8,7 @@ import socket
 import subprocess
 import sys
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Collection, Iterator
 from pathlib import Path
 from typing import IO
 
@@ -91,6 +91,11 @@ def _same_netns(pid: int) -> bool:
         return False
 
 
+def _pid_of(entry: str) -> int:
+    """The pid in a ``leftover_node_processes`` entry: ``"nodes.talker (pid 42)"``."""
+    return int(entry.rsplit(" ", 1)[1].rstrip(")"))
+
+
 def leftover_node_processes() -> list[str]:
     """Catalog node processes still alive in this test run's network namespace."""
     import psutil
@@ -128,14 +133,19 @@ def ros_env(monkeypatch: pytest.MonkeyPatch) -> Iterator[dict[str, str]]:
     fail_on_leftover_nodes("the test")
 
 
-def fail_on_leftover_nodes(who: str) -> None:
-    """Fail (and kill them) if catalog node processes outlive ``who`` by 8 s."""
+def fail_on_leftover_nodes(who: str, kept: Collection[int] = ()) -> None:
+    """Fail (and kill them) if catalog node processes outlive ``who`` by 8 s; the pids in
+    ``kept`` are meant to run on."""
+
+    def leftover() -> list[str]:
+        return [p for p in leftover_node_processes() if _pid_of(p) not in kept]
+
     deadline = time.monotonic() + 8.0
-    while (left := leftover_node_processes()) and time.monotonic() < deadline:
+    while (left := leftover()) and time.monotonic() < deadline:
         time.sleep(0.2)
     if left:
         for entry in left:  # do not let them spoil later tests either
-            os.kill(int(entry.rsplit(" ", 1)[1].rstrip(")")), 9)
+            os.kill(_pid_of(entry), 9)
         pytest.fail(f"{who} left node processes running: {', '.join(left)}")
 
 

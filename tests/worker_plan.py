@@ -76,11 +76,24 @@ SAME_UNIT = {
 }
 
 
+# Modules whose cases are grouped by the first word of their parameter: one worker runs
+# a group in order, so what the cases of a group share is made once.
+GROUPED_BY_PARAMETER = {
+    # A unit per exercise: its cases are attempts, one after the other, on the setup
+    # (world, turtlesim, Nav2) the first one started, as a learner's are.
+    "tests/exercises/test_grading.py": "an exercise's cases share its running setup",
+}
+
+
 def unit_of(nodeid: str) -> str:
-    """The unit of work a test belongs to: its module (or its modules'), or the test alone."""
+    """The unit of work a test belongs to: its module (or its modules'), its group, or
+    the test alone."""
     module = nodeid.split("::", 1)[0]
     if module in SAME_UNIT:
         return SAME_UNIT[module]
+    if module in GROUPED_BY_PARAMETER and "[" in nodeid:
+        test, _, case = nodeid.partition("[")
+        return f"{test}[{re.split(r'-|__', case, maxsplit=1)[0]}]"
     return module if module in ONE_WORKER else nodeid
 
 
@@ -132,8 +145,8 @@ LONG_UNITS = (
     "tests/integration/test_terminal_commands.py::test_interface_package_builds",
     "tests/faults/test_sigterm_stops.py",
     "tests/integration/test_lessons_walk.py::test_every_step_of_the_lesson_passes_on_real_nodes[24_",
-    "tests/exercises/test_grading.py::test_grading[wall_follower-reference]",
-    "tests/exercises/test_grading.py::test_grading[wall_follower-cheat]",
+    "tests/exercises/test_grading.py::test_grading[wall_follower]",
+    "tests/exercises/test_grading.py::test_grading[patrol]",
 )
 
 

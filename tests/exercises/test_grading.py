@@ -6,14 +6,23 @@ example) fail, and a mistake's failure names what is wrong.
 One ROS participant and one supervisor serve the whole module (each exercise
 runs as a real process, as the Run button starts it). Exercises use distinct
 node names, and every learner process is stopped after its case.
+
+The exercise's setup (the world, turtlesim, Nav2...) runs on from one case to the next
+of the same exercise, as it does for a learner between two attempts (the grader starts
+it if it is not running and leaves it on); it is stopped when the next case is another
+exercise's. So a grading is tried both on a fresh setup and on one an earlier attempt
+left as it was (a Nav2 goal still driving, a turtle the last program spawned), and the
+module does not start the same world a few times over.
 """
 
 from __future__ import annotations
 
+import contextlib
 import re
 import shutil
 from pathlib import Path
 
+import psutil
 import pytest
 
 from app.exercises import runner
@@ -55,6 +64,38 @@ def grading_env(tmp_path_factory):
         # Every grading recorded, as the dashboard does: each attempt is read back below.
         attempts = AttemptStore(tmp_path_factory.mktemp("attempts"))
         yield Grader(node, supervisor, attempts), supervisor, tmp_path_factory.mktemp("code")
+        _stop_setup(supervisor)
+
+
+# The exercise whose setup the module's supervisor runs now (see the module's docstring).
+_setup_of: list[Exercise] = []
+
+
+def _stop_setup(supervisor) -> None:
+    """Stop the running setup (each node still Ctrl+C, then escalated), all at once."""
+    if _setup_of:
+        stopping = [supervisor.stop(name) for name in _setup_of.pop().setup]
+        for future in stopping:
+            future.result()
+
+
+def _switch_to(exercise: Exercise, supervisor) -> None:
+    """Another exercise's case: the last one's setup stops first, and leaves nothing."""
+    if _setup_of and _setup_of[-1] is not exercise:
+        _stop_setup(supervisor)
+        fail_on_leftover_nodes("the last exercise's setup")
+    _setup_of[:] = [exercise]
+
+
+def _setup_pids(supervisor, exercise: Exercise) -> set[int]:
+    """The running setup's processes and theirs (a launch file's nodes)."""
+    pids: set[int] = set()
+    for status in supervisor.statuses().values():
+        if status.name in exercise.setup and status.active and status.pid:
+            pids.add(status.pid)
+            with contextlib.suppress(psutil.Error):
+                pids.update(c.pid for c in psutil.Process(status.pid).children(recursive=True))
+    return pids
 
 
 def _read_back(report: Report, ran: bool = True) -> Report:
@@ -101,24 +142,24 @@ PNG = b"\x89PNG\r\n\x1a\n"
 
 def _grade(grading_env, exercise: Exercise, code: str) -> Report:
     grader, supervisor, scratch = grading_env
+    _switch_to(exercise, supervisor)
     script = scratch / f"{exercise.slug}.py"
     script.write_text(code, encoding="utf-8")
     runner.start(supervisor, exercise, script)
     try:
         return _read_back(grader.grade(exercise, script, seed=7))
     finally:
-        # The verdict is in: the learner's program and the setup nodes are stopped at once
-        # (each still Ctrl+C, then escalated), not one after the other's reap.
-        stopping = [supervisor.stop(name) for name in exercise.setup]
+        # The verdict is in: the learner's program ends, as a learner's Stop ends it;
+        # the setup runs on for the next attempt.
         runner.stop(supervisor, exercise)
-        for future in stopping:
-            future.result()
-        fail_on_leftover_nodes("this case")  # e.g. the nodes a launch file started
+        # Nothing else left running, e.g. the nodes a launch file started.
+        fail_on_leftover_nodes("this case", kept=_setup_pids(supervisor, exercise))
 
 
 def _grade_package(grading_env, exercise: Exercise, folder: Path) -> Report:
     """A package exercise: the grader builds the folder with colcon, then runs or launches it."""
-    grader, _supervisor, scratch = grading_env
+    grader, supervisor, scratch = grading_env
+    _switch_to(exercise, supervisor)
     try:
         return _read_back(grade_package(grader, exercise, folder, scratch, seed=7), ran=False)
     finally:

@@ -56,6 +56,16 @@ def test_a_one_worker_module_is_one_unit_and_other_tests_are_their_own():
     assert unit_of("tests/unit/test_cli.py::test_a") == "tests/unit/test_cli.py::test_a"
 
 
+def test_an_exercises_grading_cases_are_one_unit_whoever_wrote_them():
+    grading = "tests/exercises/test_grading.py::test_grading"
+    cases = ("patrol-reference", "patrol-swaps_x_and_y", "patrol__goto_each", "patrol-cheat")
+    assert {unit_of(f"{grading}[{case}]") for case in cases} == {f"{grading}[patrol]"}
+    assert unit_of(f"{grading}[wall_stop-reference]") == f"{grading}[wall_stop]"
+    # A unit that waits stays one unless its exercise takes a core.
+    assert waits(f"{grading}[heartbeat_logger]", busy=set())
+    assert not waits(f"{grading}[patrol]", busy={"patrol"})
+
+
 def test_a_one_worker_module_stays_whole_and_in_its_written_order():
     hub = [f"{HUB}::test_{name}" for name in ("spawn", "refuse", "teacher")]
     order = spread([*_ids("browser", 4), *hub, *_ids("unit", 6)], nodeid_of=str)
