@@ -61,3 +61,18 @@ def settled_layout(page: Page, stage: str, timeout: float = 10.0) -> dict:
         if (on and not stage_fills(layout, stage)) or time.monotonic() > deadline:
             return layout
         page.wait_for_timeout(200)
+
+
+MIN_TEXT_PX = 11  # the graph is drawn at its natural size: never shrunk below readable
+
+
+def stage_problem(page: Page, stage: str) -> str:
+    """'' when ``stage``, once settled, is all the room left of the column and (the graph)
+    its text is readable on screen; else what is wrong (issue 37's one layout)."""
+    layout = settled_layout(page, stage)
+    if off := stage_fills(layout, stage):
+        return f"{off}; {layout}"
+    smallest = layout["smallest_text"]
+    if stage == "graph" and (smallest is None or smallest < MIN_TEXT_PX - 0.01):
+        return f"graph text {smallest} px on screen"
+    return ""

@@ -26,6 +26,7 @@ from tests.browser.helpers import (
     open_tab,
     step_reads_top_down,
 )
+from tests.browser.stage_layout import stage_problem
 from tests.conftest import ARTIFACTS, DashboardProcess, fail_on_leftover_nodes, free_port
 from tests.course_data import shared_course
 from tests.outside_report import private_dds_env
@@ -118,10 +119,10 @@ def test_at_125_percent_zoom_each_step_reads_top_down_and_every_control_is_reach
         hidden = []
         for lesson, index in places:
             go_to_step(page, lesson, index)
-            hidden += [
-                f"{lesson.id} step {index + 1}: {why}"
-                for why in step_reads_top_down(page, lesson, index)
-            ]
+            stage = lesson.steps[index].stage or lesson.stage
+            whys = [off] if (off := stage_problem(page, stage)) else []  # as at 100 %
+            whys += step_reads_top_down(page, lesson, index)
+            hidden += [f"{lesson.id} step {index + 1}: {why}" for why in whys]
         assert not hidden, "; ".join(hidden)
     finally:
         page.screenshot(path=str(ARTIFACTS / "accessibility-zoom-125.png"))

@@ -23,7 +23,7 @@ from tests.browser.helpers import (
     start_node,
     step_reads_top_down,
 )
-from tests.browser.stage_layout import settled_layout, stage_fills
+from tests.browser.stage_layout import stage_problem
 from tests.conftest import ARTIFACTS, DashboardProcess, free_port, wait_until
 from tests.course_data import shared_course
 from tests.integration.core_helpers import DISCOVERY_TIMEOUT
@@ -151,14 +151,19 @@ def test_every_lesson_puts_its_stage_on_and_the_learner_can_switch(browser, dash
     page = _open(browser, dashboard, size)
     try:
         _wait_side_by_side(page, size)
-        # The course as the dashboard loaded it (lessons are being written in this tree).
-        for lesson in shared_course().lessons:
+        # The course as the dashboard loaded it (lessons are being written in this tree),
+        # then the first lesson again: its graph after the last lesson's 3D scene.
+        lessons = shared_course().lessons
+        for lesson in [*lessons, lessons[0]]:
             open_lesson(page, lesson)
-            _wait_stage(page, lesson.steps[0].stage or lesson.stage)
-            # The card reads top to bottom: title and text in view, the text before the
+            stage = lesson.steps[0].stage or lesson.stage
+            _wait_stage(page, stage)
+            # The stage is all the room left of the column, whichever came before, and
+            # the card reads top to bottom: title and text in view, the text before the
             # buttons and answers, every control whole once scrolled to.
-            wrong = step_reads_top_down(page, lesson, 0)
-            assert not wrong, f"{lesson.id} at {size}: " + "; ".join(wrong)
+            wrong = [off] if (off := stage_problem(page, stage)) else []
+            wrong += step_reads_top_down(page, lesson, 0)
+            assert not wrong, f"{lesson.id} ({stage}) at {size}: " + "; ".join(wrong)
         for name, label in STAGES.items():  # the learner's own choice
             choose(page, "On stage", label)
             _wait_stage(page, name)
@@ -193,7 +198,7 @@ def test_every_step_in_course_order_puts_its_stage_on_with_its_text_in_view(
                     _wait_stage(page, stage)
                 except AssertionError as exc:
                     wrong.append(f"{where}: {exc}")
-                if off := stage_fills(settled_layout(page, stage), stage):
+                if off := stage_problem(page, stage):
                     wrong.append(f"{where} ({stage}): {off}")
                 wrong += [f"{where}: {why}" for why in step_reads_top_down(page, lesson, index)]
                 if STEP_SHOTS:
@@ -475,21 +480,35 @@ def test_the_plot_stage_shows_the_executor_demo_starved_then_not(browser, dashbo
         page.context.close()  # the dashboard ends its nodes with it
 
 
-# The draw calls three.js makes on the page's 3D canvas in 1.5 s (-1: no WebGL canvas).
-_DRAWS_JS = """async () => {
+# Counting the draw calls three.js makes on a page's 3D canvas: COUNT wraps the canvas's
+# draw functions with a counter (-1: no WebGL canvas), READ unwraps them and says how many.
+_COUNT_DRAWS_JS = """() => {
   const canvas = document.querySelector('canvas[data-engine]');
   const gl = canvas && (canvas.getContext('webgl2') || canvas.getContext('webgl'));
-  if (!gl) return -1;
   const names = ['drawElements', 'drawArrays', 'drawElementsInstanced', 'drawArraysInstanced'];
-  let draws = 0;
+  window.__draws = {gl, names, n: gl ? 0 : -1};
+  if (!gl) return;
   for (const name of names) {
     const own = gl[name];
-    if (own) gl[name] = function (...args) { draws++; return own.apply(this, args); };
+    if (own) gl[name] = function (...args) { window.__draws.n++; return own.apply(this, args); };
   }
-  await new Promise((resolve) => setTimeout(resolve, 1500));
-  for (const name of names) delete gl[name];
-  return draws;
 }"""
+_READ_DRAWS_JS = """() => {
+  const {gl, names, n} = window.__draws;
+  if (gl) for (const name of names) delete gl[name];  // the prototype's own come back
+  return n;
+}"""
+
+
+def _draws_on(pages: list[Page], seconds: float = 1.5) -> list[int]:
+    """Each page's draw calls over the same ``seconds``, counted on every page at once (one
+    after the other, the pages drawing the scene on the shared software GPU took 4x as long)."""
+    for page in pages:
+        page.evaluate(_COUNT_DRAWS_JS)
+    pages[0].wait_for_timeout(seconds * 1000)
+    return [page.evaluate(_READ_DRAWS_JS) for page in pages]
+
+
 PAGES_AT_ONCE = 4
 
 
@@ -511,11 +530,11 @@ def test_a_3d_scene_behind_another_stage_is_not_drawn(browser, dashboard, probe)
             what="the arm's /joint_states in the probe's graph",
         )
         pages[0].wait_for_timeout(2000)  # the pipeline's first pictures reach the scene
-        hidden = [page.evaluate(_DRAWS_JS) for page in pages]
+        hidden = _draws_on(pages)
         choose(pages[0], "On stage", STAGES["scene"])
         for page in pages:
             _wait_stage(page, "scene")
-        shown = [page.evaluate(_DRAWS_JS) for page in pages]
+        shown = _draws_on(pages)
         # Each count can fail: -1 (no canvas), a hidden canvas drawn, a shown one still.
         assert hidden == [0] * PAGES_AT_ONCE and all(n > 0 for n in shown), (hidden, shown)
     finally:
