@@ -1,21 +1,24 @@
-"""Recording: raw subscriptions feed one writer thread that owns the bag.
+"""Recording: one writer thread takes the messages and owns the bag.
 
 Messages are never deserialized here. Each subscription is raw (the
-middleware's CDR bytes) and its callback, on the ROS executor thread, only
-queues the bytes with the time the middleware received them; the writer
-thread is the single owner of the rosbags ``Writer`` and writes each batch
-in receive-time order. Topics are added by the thread that drives the
-recording (``poll``), through the same queue, so a topic's connection always
-exists before its first message arrives.
+middleware's CDR bytes) and belongs to the recording's own node, which no
+executor spins: every ``BATCH_PAUSE_SEC`` the writer thread takes whatever
+waits on each subscription (the public ``Subscription.handle.take_message``
+an executor uses), stamped with the time the middleware received it, and
+writes the batch in receive-time order. Topics are added by the thread that
+drives the recording (``poll``) through a queue the writer reads first, so a
+topic's connection always exists before its first message is taken.
 
-Throughput: rclpy's executor rebuilds its wait set for every message, which
-caps a plain subscriber near 10k small messages a second. The callback
-therefore also takes whatever else already waits on its subscription (the
-public ``Subscription.handle.take_message`` the executor itself uses), and
-the writer drains the queue in batches every ``BATCH_PAUSE_SEC`` so that the
-two threads hand the GIL over rarely. Measured side by side (bench/bag_record.py):
-on a loaded machine this recorder lost 0 of 50,150 messages where a plain
-rosbags writer fed by plain subscribers lost 17,196.
+Why no executor: rclpy's executor rebuilds its wait set, every waitable of
+every node it spins included, for each message it hands over. A recording of
+every topic of the simulated world (some 600 messages a second at twice real
+time) on the grader's node made that node's executor wake for each one: a
+third of the grading process's CPU (measured on the wall_follower gradings).
+Taken in batches, a topic waits at most one pause in its queue
+(``SUBSCRIPTION_DEPTH`` deep: a 1 kHz topic survives a writer held up for a
+second). Measured side by side (bench/bag_record.py): on a loaded machine
+this recorder lost 0 of 50,150 messages where a plain rosbags writer fed by
+plain subscribers lost 17,196.
 
 Durability: every ``flush_interval`` the writer closes the current MCAP
 chunk and hands it to the kernel (sqlite3: commits), so a SIGKILL of the
@@ -51,7 +54,6 @@ from app.bags.definitions import definition
 from app.bags.errors import BagError
 from app.bags.repair import reindex, stamp_distro, truncate_storage
 from app.ros.convert import ConversionError, import_type
-from app.ros.monitor import MessageInfo
 from app.ros.names import QUIET_TOPICS, is_internal_topic
 from app.ros.qos import matching_qos
 
@@ -60,10 +62,11 @@ COMPRESSION_MODES = {"none": CompressionMode.NONE, "file": CompressionMode.FILE}
 COMPRESSION_MODES["message"] = CompressionMode.MESSAGE
 # Deep enough that a 1 kHz topic survives a slow writer moment without drops.
 SUBSCRIPTION_DEPTH = 1000
-BATCH_PAUSE_SEC = 0.02  # the writer lets messages gather this long between batches
+BATCH_PAUSE_SEC = 0.02  # the writer lets messages gather this long between batches...
+IDLE_PAUSE_SEC = 0.1  # ...or this long after a batch that found none (a quiet recording)
 SUBSCRIBED = "Subscribed to topic"  # rosbag2's words, the line a learner waits for
-DRAIN_MAX = 100  # messages taken per callback beyond the one it was called with
-MAX_BATCH = 20_000
+TAKE_MAX = 5_000  # messages taken from one subscription in one batch (then the next topic)
+READER_NAME = "rosbag2_recorder"  # the recording's own node, as `ros2 bag record` names it
 BAG_VERSION: Literal[9] = 9  # Jazzy's rosbag2 metadata version
 # Writing errors that end a recording: the disk, the file size limit, sqlite's own.
 WRITE_ERRORS = (OSError, sqlite3.Error, WriterError)
@@ -102,26 +105,29 @@ class _NewTopic:
     msgdef: str
     rihs01: str
     offered: list[Qos]
+    subscription: Subscription
+    py_type: type
 
 
-_Item = tuple[int, int, bytes] | _NewTopic | None
+_Message = tuple[int, int, bytes]  # (topic key, receive time in ns, CDR bytes)
+_Item = _NewTopic | None  # what the driving thread hands the writer: a topic, or stop
 
 
-def _in_time_order(batch: list[_Item]) -> list[_Item]:
-    """Messages by receive time (topics arrive in per-topic runs), other items first.
+def _in_time_order(batch: list[_Message]) -> list[_Message]:
+    """Messages by receive time (they are taken in per-topic runs).
 
     Writing in time order keeps each MCAP chunk's time range apart from the
     next one's, which readers (rosbags' among them) need to replay smoothly.
-    New topics stay ahead of their messages and the stop marker stays last.
     """
-    messages = sorted((i for i in batch if isinstance(i, tuple)), key=_stamp)
-    topics: list[_Item] = [i for i in batch if isinstance(i, _NewTopic)]
-    stop: list[_Item] = [None] if None in batch else []
-    return [*topics, *messages, *stop]
+    return sorted(batch, key=_stamp)
 
 
-def _stamp(item: tuple[int, int, bytes]) -> int:
+def _stamp(item: _Message) -> int:
     return item[1]
+
+
+def _never_called(_message: object) -> None:
+    """The callback rclpy asks for; no executor spins the recording's node."""
 
 
 class Recorder:
@@ -139,9 +145,12 @@ class Recorder:
         compression_format: str = "zstd",
         flush_interval: float = 1.0,
         skip_types: frozenset[str] = frozenset(),
+        reader_name: str = READER_NAME,
     ) -> None:
-        """``skip_types``: message types ``all_topics`` leaves out (a topic named in
-        ``topics`` is recorded whatever its type)."""
+        """``node`` looks at the graph; the subscriptions are on a node of the recording's
+        own, ``reader_name``, in ``node``'s context and namespace. ``skip_types``: message types
+        ``all_topics`` leaves out (a topic named in ``topics`` is recorded whatever its
+        type)."""
         if storage not in STORAGES:
             raise BagError(f"unknown storage '{storage}' (choose {' or '.join(STORAGES)})")
         if compression_mode not in COMPRESSION_MODES:
@@ -157,6 +166,7 @@ class Recorder:
         self._skip_types = skip_types
         self._flush_interval = flush_interval
         self._queue: queue.SimpleQueue[_Item] = queue.SimpleQueue()
+        self._stopping = threading.Event()
         self._subs: dict[str, Subscription] = {}
         self._topics: list[tuple[str, str]] = []  # by key: (topic, type)
         self._skipped: set[str] = set()
@@ -170,11 +180,23 @@ class Recorder:
         self._started = time.monotonic()
         if path.exists():
             raise BagError(f"cannot record into {path}: it already exists")
-        self._writer = Writer(path, version=BAG_VERSION, storage_plugin=STORAGES[storage])
-        if compression_mode != "none":
-            self._writer.set_compression(
-                COMPRESSION_MODES[compression_mode], CompressionFormat.ZSTD
-            )
+        # No executor spins it: the writer thread takes its messages (see the docstring).
+        self._reader = Node(
+            reader_name,
+            namespace=node.get_namespace(),
+            context=node.context,
+            start_parameter_services=False,
+            enable_rosout=False,
+        )
+        try:
+            self._writer = Writer(path, version=BAG_VERSION, storage_plugin=STORAGES[storage])
+            if compression_mode != "none":
+                self._writer.set_compression(
+                    COMPRESSION_MODES[compression_mode], CompressionFormat.ZSTD
+                )
+        except BaseException:
+            self._reader.destroy_node()
+            raise
         self._good_end = 0
         # The writer thread opens the bag itself: sqlite3 connections belong to one thread.
         self._opened = threading.Event()
@@ -183,7 +205,7 @@ class Recorder:
         self._thread.start()
         self._opened.wait()
         if self._open_error:
-            raise BagError(self._open_error)
+            raise BagError(self._open_error)  # the writer thread has ended the reader
 
     # ------------------------------------------------------------ driving thread
 
@@ -212,6 +234,8 @@ class Recorder:
             except BagError as exc:
                 self._skipped.add(topic)
                 lines.append(f"[WARN] cannot record {topic}: {exc}")
+            except InvalidHandle:  # a failed write ended the recording (and its node) meanwhile
+                break
         return lines
 
     def missing_topics(self) -> list[str]:
@@ -232,39 +256,17 @@ class Recorder:
         with self._lock:
             self._counts.append(0)
             self._sizes.append(0)
-        self._queue.put(_NewTopic(key, topic, msgtype, msgdef, rihs01, offered))
-        put = self._queue.put
-        subscription: list[Subscription] = []
-
-        def on_message(data: bytes, info: MessageInfo) -> None:
-            # Executor thread: hand over; the writer thread does the rest. The
-            # stamp is when the middleware received the message (as rosbag2
-            # records it), not when this busy thread got round to it.
-            if not self._accepting:
-                return
-            put((key, info.get("received_timestamp") or time.time_ns(), data))
-            # Take what else already waits on this subscription, as the executor
-            # would, but without rebuilding its wait set for every message: that
-            # rebuild is most of rclpy's cost per message at kHz rates.
-            sub = subscription[0] if subscription else None
-            for _ in range(DRAIN_MAX if sub is not None else 0):
-                try:
-                    with sub.handle:  # type: ignore[union-attr]
-                        taken = sub.handle.take_message(py_type, True)  # type: ignore[union-attr]
-                except InvalidHandle:  # destroyed by stop() meanwhile
-                    return
-                if taken is None:
-                    return
-                put((key, taken[1].get("received_timestamp") or time.time_ns(), taken[0]))
-
-        self._subs[topic] = self._node.create_subscription(
+        subscription = self._reader.create_subscription(
             py_type,
             topic,
-            on_message,  # type: ignore[arg-type]  # rclpy passes (message, info) to two parameters
+            _never_called,
             matching_qos(self._node, topic, depth=SUBSCRIPTION_DEPTH),
             raw=True,
         )
-        subscription.append(self._subs[topic])
+        self._subs[topic] = subscription
+        self._queue.put(
+            _NewTopic(key, topic, msgtype, msgdef, rihs01, offered, subscription, py_type)
+        )
         return f"{SUBSCRIBED} '{topic}'"
 
     def status(self) -> RecordingStatus:
@@ -296,12 +298,11 @@ class Recorder:
         self._writer.set_custom_data(key, value)
 
     def stop(self, timeout: float = 30.0) -> RecordingStatus:
-        """End the recording: no more messages, the writer drains and closes the bag."""
+        """End the recording: the writer takes what has arrived, closes the bag and ends
+        the recording's node."""
         self._accepting = False
-        for sub in self._subs.values():
-            self._node.destroy_subscription(sub)
-        self._subs.clear()
         self._queue.put(None)
+        self._stopping.set()  # no pause: the writer takes what is there and closes now
         self._thread.join(timeout)
         if self._thread.is_alive():
             with self._lock:
@@ -334,70 +335,96 @@ class Recorder:
         return self._open_error is None
 
     def _write_loop(self) -> None:
-        if not self._open():
+        try:
+            if self._open():
+                self._write_until_stopped()
+        finally:
+            self._end_reader()
             with self._lock:
                 self._finished = True
-            return
+
+    def _write_until_stopped(self) -> None:
         connections: dict[int, Connection] = {}
+        taking: list[_NewTopic] = []  # each topic's subscription, once its connection exists
         next_flush = time.monotonic() + self._flush_interval
         try:
+            pause = BATCH_PAUSE_SEC
             while True:
-                batch: list[_Item] = []
-                with contextlib.suppress(queue.Empty):
-                    batch.append(self._queue.get(timeout=0.1))
-                # Let messages pile up for a moment and take them in one go: fewer
-                # GIL hand-overs, so the executor thread keeps taking samples.
-                time.sleep(BATCH_PAUSE_SEC)
-                while len(batch) < MAX_BATCH:
+                # Let messages gather for a moment and take them in one go.
+                self._stopping.wait(pause)
+                news: list[_Item] = []
+                while True:
                     try:
-                        batch.append(self._queue.get_nowait())
+                        news.append(self._queue.get_nowait())
                     except queue.Empty:
                         break
-                done = self._write_batch(_in_time_order(batch), connections)
-                if done:
+                stopping = None in news
+                self._add_topics(news, connections, taking)
+                batch = self._take(taking)
+                self._write_batch(_in_time_order(batch), connections)
+                pause = BATCH_PAUSE_SEC if batch or news else IDLE_PAUSE_SEC
+                if stopping:
                     self._writer.close()
                     with contextlib.suppress(OSError, KeyError, TypeError, yaml.YAMLError):
                         stamp_distro(self.path)  # a bag without it is still a good bag
                     with self._lock:
                         self._flushed = sum(self._counts)
-                    break
+                    return
                 if time.monotonic() >= next_flush:
                     self._flush()
                     next_flush = time.monotonic() + self._flush_interval
         except WRITE_ERRORS as exc:
             self._fail(exc)
-        finally:
-            with self._lock:
-                self._finished = True
 
-    def _write_batch(self, batch: list[_Item], connections: dict[int, Connection]) -> bool:
-        """Write what arrived; True when the stop marker was among it."""
+    def _add_topics(
+        self, news: list[_Item], connections: dict[int, Connection], taking: list[_NewTopic]
+    ) -> None:
+        for item in news:
+            if isinstance(item, _NewTopic):
+                connections[item.key] = self._writer.add_connection(
+                    item.topic,
+                    item.msgtype,
+                    msgdef=item.msgdef,
+                    rihs01=item.rihs01,
+                    offered_qos_profiles=item.offered,
+                )
+                taking.append(item)
+
+    @staticmethod
+    def _take(taking: list[_NewTopic]) -> list[_Message]:
+        """Everything that waits on the subscriptions."""
+        batch: list[_Message] = []
+        for topic in taking:
+            handle = topic.subscription.handle
+            for _ in range(TAKE_MAX):
+                with handle:
+                    taken = handle.take_message(topic.py_type, True)
+                if taken is None:
+                    break
+                data, info = taken
+                batch.append((topic.key, info.get("received_timestamp") or time.time_ns(), data))
+        return batch
+
+    def _end_reader(self) -> None:
+        """The recording's node and its subscriptions go with the writer thread that took
+        from them (no other thread touches them after the constructor and ``poll``)."""
+        with contextlib.suppress(InvalidHandle):
+            self._reader.destroy_node()
+
+    def _write_batch(self, batch: list[_Message], connections: dict[int, Connection]) -> None:
+        """Write the messages taken."""
         counts: dict[int, int] = {}
         sizes: dict[int, int] = {}
-        stop = False
         try:
-            for item in batch:
-                if item is None:
-                    stop = True
-                elif isinstance(item, _NewTopic):
-                    connections[item.key] = self._writer.add_connection(
-                        item.topic,
-                        item.msgtype,
-                        msgdef=item.msgdef,
-                        rihs01=item.rihs01,
-                        offered_qos_profiles=item.offered,
-                    )
-                else:
-                    key, stamp, data = item
-                    self._writer.write(connections[key], stamp, data)
-                    counts[key] = counts.get(key, 0) + 1
-                    sizes[key] = sizes.get(key, 0) + len(data)
+            for key, stamp, data in batch:
+                self._writer.write(connections[key], stamp, data)
+                counts[key] = counts.get(key, 0) + 1
+                sizes[key] = sizes.get(key, 0) + len(data)
         finally:
             with self._lock:
                 for key, n in counts.items():
                     self._counts[key] += n
                     self._sizes[key] += sizes[key]
-        return stop
 
     def _flush(self) -> None:
         """Hand everything written so far to the kernel, as complete chunks/transactions."""

@@ -52,6 +52,7 @@ from app.exercises.attempt_folders import (
 )
 from app.exercises.model import package_files
 from app.exercises.report import Report
+from app.ros.names import ATTEMPT_RECORDER_NODE
 
 log = logging.getLogger(__name__)
 
@@ -137,7 +138,13 @@ class AttemptRecording:
         self._poller: threading.Thread | None = None
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
-            self._recorder = Recorder(node, path, all_topics=True, skip_types=LEFT_OUT_TYPES)
+            self._recorder = Recorder(
+                node,
+                path,
+                all_topics=True,
+                skip_types=LEFT_OUT_TYPES,
+                reader_name=ATTEMPT_RECORDER_NODE,
+            )
         except (OSError, BagError) as exc:
             self._failure = f"cannot record into {path.parent}: {exc}"
             return

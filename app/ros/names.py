@@ -8,6 +8,18 @@ ACTION_MARKER = "/_action/"
 QUIET_TOPICS = ("/rosout", "/parameter_events")
 
 
+# The hidden node that records a graded attempt (app/exercises/attempts.py). It subscribes
+# to every topic, as the grader's own reader: a check or probe that counts who listens to a
+# topic leaves it out, as it leaves out its own node (``own_nodes``).
+ATTEMPT_RECORDER_NODE = "_classroom_attempt_recorder"
+
+
+def own_nodes(name: str, namespace: str) -> frozenset[tuple[str, str]]:
+    """The (name, namespace) pairs of a grader's or dashboard's node ``name`` and of its
+    attempt's recording, which sits in the same namespace: readers that are not a learner's."""
+    return frozenset({(name, namespace), (ATTEMPT_RECORDER_NODE, namespace)})
+
+
 def split_node_name(fqn: str) -> tuple[str, str]:
     """'/ns/name' -> ('name', '/ns'); 'name' -> ('name', '/')."""
     if not fqn.startswith("/"):

@@ -156,3 +156,43 @@ def test_latched_topic_latches_again_on_replay_from_sqlite(probe, tmp_path):
         thread.join(30)
         player.shutdown()
     assert played["out"][0] == 0, played  # type: ignore[index]
+
+
+def test_a_recording_subscribes_as_its_own_node_as_ros2_bag_record_does(
+    supervisor, probe, tmp_path
+):
+    """`ros2 bag record` joins the graph as /rosbag2_recorder, which holds its subscriptions
+    and goes when it ends; the node that runs the verb (the dashboard's) holds none. (On
+    the dashboard's node, every message the recording took woke that node's executor: a
+    recording of the simulated world cost the grading process a third of a core.)"""
+    supervisor.start("talker")
+    runner = RosRuntime("bag_verb_runner")
+    out: list[tuple[int, list[str]]] = []
+    recording = threading.Thread(
+        target=lambda: out.append(
+            ros2(runner.node, f"ros2 bag record /chatter -o {tmp_path / 'b'} --max-duration 4")
+        )
+    )
+    try:
+        recording.start()
+
+        def readers() -> set[str]:
+            infos = probe.node.get_subscriptions_info_by_topic("/chatter")
+            return {info.node_name for info in infos}
+
+        wait_until(lambda: "rosbag2_recorder" in readers(), timeout=30, what="the recorder")
+        assert "bag_verb_runner" not in readers()
+        recording.join(timeout=30)
+        assert out and out[0][0] == 0, out
+        wait_until(
+            lambda: (
+                "rosbag2_recorder"
+                not in {n for n, _ns in probe.node.get_node_names_and_namespaces()}
+            ),
+            timeout=15,
+            what="the recorder's node gone",
+        )
+    finally:
+        recording.join(timeout=30)
+        runner.shutdown()
+        supervisor.stop("talker").result(timeout=15)

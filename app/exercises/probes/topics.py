@@ -13,7 +13,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile
 
 from app.exercises.probes.base import ProbeContext, same
 from app.ros.monitor import TopicMonitor
-from app.ros.names import node_fqn
+from app.ros.names import node_fqn, own_nodes
 from app.ros.qos import matching_qos
 
 if TYPE_CHECKING:
@@ -53,14 +53,16 @@ def listen(ctx: ProbeContext, topic: str, msg_type: type[M]) -> TopicMonitor[M]:
 
 
 def others_subscribed(node: Node, publisher: Publisher, topic: str) -> int:
-    """Readers matched by ``publisher`` other than ``node``'s own (the grader's recording of
-    the attempt subscribes to every topic: it is not the learner's node listening)."""
-    ours = sum(
+    """Readers matched by ``publisher`` other than the grader's own: ``node``'s, and the
+    recording of the attempt's (it subscribes to every topic: it is not the learner's node
+    listening)."""
+    ours = own_nodes(node.get_name(), node.get_namespace())
+    counted = sum(
         1
         for info in node.get_subscriptions_info_by_topic(topic)
-        if info.node_name == node.get_name() and info.node_namespace == node.get_namespace()
+        if (info.node_name, info.node_namespace) in ours
     )
-    return max(0, int(publisher.get_subscription_count()) - ours)
+    return max(0, int(publisher.get_subscription_count()) - counted)
 
 
 def wait_subscribed(ctx: ProbeContext, publisher: Publisher, topic: str) -> str:

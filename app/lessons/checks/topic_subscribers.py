@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from app.lessons.registry import FAIL, PASS, CheckResult, register_check
+from app.ros.names import own_nodes
 
 if TYPE_CHECKING:
     from app.lessons.runtime import LessonRuntime
@@ -17,9 +18,11 @@ if TYPE_CHECKING:
     words="enough nodes (not the dashboard) subscribe to the topic",
 )
 def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
-    # Count the learner's subscribers, not the dashboard's own taps.
+    # Count the learner's subscribers, not the dashboard's own taps (nor the grader's, and
+    # its recording of the attempt, when an exercise's check runs).
     infos = rt.node.get_subscriptions_info_by_topic(c["topic"])
-    count = sum(1 for info in infos if info.node_name != rt.node.get_name())
+    ours = own_nodes(rt.node.get_name(), rt.node.get_namespace())
+    count = sum(1 for info in infos if (info.node_name, info.node_namespace) not in ours)
     if count >= c["at_least"]:
         return CheckResult(PASS, f"{count} {_subscribers(count)} on {c['topic']}")
     wanted = c["at_least"]
