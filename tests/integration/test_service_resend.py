@@ -13,8 +13,8 @@ import time
 import pytest
 from tutorial_interfaces.srv import AddTwoInts
 
-from app.ros.calls import call_again_until_answered, call_service
-from app.ros.context import CallContext
+from app.ros.calls import GoalRun, call_again_until_answered, call_service, send_goal
+from app.ros.context import CallContext, Limits
 from app.ros.errors import NoAnswer
 
 
@@ -110,3 +110,68 @@ def test_repeated_copies_that_are_never_answered_say_how_many_went(probe, slow_f
             )
     finally:
         probe.node.destroy_client(client)
+
+
+@pytest.fixture
+def goal_server_deaf_to_first(probe):
+    """/deaf_fibonacci: the first goal request is never answered (its goal callback waits
+    until the test ends), as a request lost on its way; later copies are served at once."""
+    import rclpy
+    from rclpy.action import ActionServer, GoalResponse
+    from rclpy.callback_groups import ReentrantCallbackGroup
+    from rclpy.executors import MultiThreadedExecutor
+    from tutorial_interfaces.action import Fibonacci
+
+    node = rclpy.create_node("deaf_fibonacci", context=probe.node.context)
+    requests: list[float] = []
+    release = threading.Event()
+
+    def on_goal(_goal):
+        requests.append(time.monotonic())
+        if len(requests) == 1:
+            release.wait(15.0)
+        return GoalResponse.ACCEPT
+
+    def execute(goal_handle):
+        goal_handle.succeed()
+        return Fibonacci.Result(sequence=[0, 1, 1])
+
+    group = ReentrantCallbackGroup()
+    server = ActionServer(
+        node, Fibonacci, "/deaf_fibonacci", execute, goal_callback=on_goal, callback_group=group
+    )
+    executor = MultiThreadedExecutor(num_threads=4, context=probe.node.context)
+    executor.add_node(node)
+    spinner = threading.Thread(target=executor.spin, daemon=True)
+    spinner.start()
+    yield requests
+    release.set()
+    executor.shutdown()
+    spinner.join(5.0)
+    server.destroy()
+    node.destroy_node()
+
+
+def _fibonacci_run() -> GoalRun:
+    from tutorial_interfaces.action import Fibonacci
+
+    return GoalRun(
+        "/deaf_fibonacci", "tutorial_interfaces/action/Fibonacci", Fibonacci.Goal(order=2)
+    )
+
+
+def test_a_lost_goal_request_is_sent_again_with_the_same_goal_id(probe, goal_server_deaf_to_first):
+    # A learner's action server restarted under the same name: the grader's first goal
+    # went to the old one's endpoints (a 2-worker run: "no answer ... within 5 s").
+    ctx = CallContext(probe.node, limits=Limits(service_timeout=6.0))
+    run = send_goal(ctx, _fibonacci_run(), resend_unanswered=True)
+    assert run.status == "SUCCEEDED", run
+    assert list(run.result.sequence) == [0, 1, 1]
+    assert len(goal_server_deaf_to_first) == 2
+
+
+def test_without_the_resend_a_lost_goal_request_is_no_answer(probe, goal_server_deaf_to_first):
+    ctx = CallContext(probe.node, limits=Limits(service_timeout=3.0))
+    with pytest.raises(NoAnswer, match=r"no answer from action server '/deaf_fibonacci'"):
+        send_goal(ctx, _fibonacci_run())
+    assert len(goal_server_deaf_to_first) == 1

@@ -28,7 +28,7 @@ def _drive(ctx: ProbeContext, goal_run: GoalRun, cancel_after: int | None) -> No
         if cancel_after and len(goal_run.feedback) == cancel_after:
             goal_run.cancel()
 
-    send_goal(ctx.call, goal_run, on_feedback)
+    send_goal(ctx.call, goal_run, on_feedback, resend_unanswered=True)
 
 
 def _cancel_came_too_late(goal_run: GoalRun) -> bool:

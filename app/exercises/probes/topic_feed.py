@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 
 from rclpy.qos import QoSProfile
 
@@ -12,6 +13,8 @@ from app.exercises.report import Result
 from app.lessons.schema import Spec
 from app.ros.convert import fill, import_type, to_plain
 from app.ros.monitor import TopicMonitor
+
+LOST_AT_START = 2  # answers to the first inputs that may not reach us (see run)
 
 
 @register_probe(
@@ -50,26 +53,45 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
         monitor.wait_for_count(before + len(want), p.get("settle", 2.0))
         field = p["field"]
         got = [to_plain(getattr(msg, field)) for _, msg in monitor.messages_since(before)]
-        if len(got) < len(want):
-            return Result(
-                name,
-                False,
-                f"published {inputs} on {in_topic}; {out_topic} gave {got}, expected {want}",
-            )
-        tail = got[-len(want) :]
-        tolerance = p.get("tolerance", 1e-6)
-        wrong = [
-            i for i, (a, b) in enumerate(zip(tail, want, strict=True)) if not same(a, b, tolerance)
-        ]
-        if not wrong:
-            return Result(name, True, f"published {inputs}; {out_topic} gave {tail}")
-        return Result(
-            name,
-            False,
-            f"published {inputs} on {in_topic}; {out_topic} gave {tail}, expected {want} "
-            f"(first difference at message {wrong[0] + 1}: {tail[wrong[0]]!r}, "
-            f"expected {want[wrong[0]]!r})",
-        )
+        passed, detail = judge(inputs, in_topic, out_topic, got, want, p.get("tolerance", 1e-6))
+        return Result(name, passed, detail)
     finally:
         monitor.close()
         node.destroy_publisher(publisher)
+
+
+def judge(
+    inputs: Sequence[object],
+    in_topic: str,
+    out_topic: str,
+    got: Sequence[object],
+    want: Sequence[object],
+    tolerance: float,
+) -> tuple[bool, str]:
+    """Whether the answers ``got`` are the formula's ``want``, and the result's words.
+
+    The answers line up with the last inputs. The first ones may not have come: the
+    node's writer can match our reader a moment after the graph shows it (a restarted
+    node: its last run's writer is still matched), so the node answered before we could
+    hear it. Up to LOST_AT_START of them may be missing.
+    """
+    lost = max(0, len(want) - len(got))
+    if not got or lost > LOST_AT_START:
+        return (
+            False,
+            f"published {inputs} on {in_topic}; {out_topic} gave {got}, expected {want}",
+        )
+    tail, wanted = got[-(len(want) - lost) :], want[lost:]
+    wrong = [
+        i for i, (a, b) in enumerate(zip(tail, wanted, strict=True)) if not same(a, b, tolerance)
+    ]
+    first = "the first answer" if lost == 1 else f"the first {lost} answers"
+    unheard = f" ({first} did not reach the grader)" if lost else ""
+    if not wrong:
+        return True, f"published {inputs}; {out_topic} gave {tail}{unheard}"
+    at = wrong[0]
+    return False, (
+        f"published {inputs} on {in_topic}; {out_topic} gave {tail}, expected {want} "
+        f"(first difference at message {lost + at + 1}: {tail[at]!r}, "
+        f"expected {wanted[at]!r}){unheard}"
+    )
