@@ -60,6 +60,13 @@ def wait_future(ctx: CallContext, future: Future, timeout: float, what: str) -> 
 RESEND_SEC = 2.0  # a lost request of a call_again is sent again after this long
 
 
+def _no_answer(what: str, timeout: float, copies: int, sent: str) -> NoAnswer:
+    """'no answer from WHAT within T s', and how often ``sent`` went if more than once."""
+    times = "twice" if copies == 2 else f"{copies} times"
+    also = f" ({sent} was sent {times})" if copies > 1 else ""
+    return NoAnswer(f"no answer from {what} within {timeout:g} s{also}")
+
+
 def call_again_until_answered(
     ctx: CallContext,
     client: Client,
@@ -94,9 +101,7 @@ def call_again_until_answered(
             if ctx.cancel.is_set():
                 raise Cancelled()
             if time.monotonic() > deadline:
-                times = "twice" if len(sent) == 2 else f"{len(sent)} times"
-                also = f" (the request was sent {times})" if len(sent) > 1 else ""
-                raise NoAnswer(f"no answer from {what} within {timeout:g} s{also}")
+                raise _no_answer(what, timeout, len(sent), "the request")
         answered = next(f for f in sent if f.done())
     finally:
         for future in sent:
@@ -350,9 +355,7 @@ def _goal_answer(
             if ctx.cancel.is_set():
                 raise Cancelled()
             if time.monotonic() > deadline:
-                times = "twice" if len(sent) == 2 else f"{len(sent)} times"
-                also = f" (the goal was sent {times})" if len(sent) > 1 else ""
-                raise NoAnswer(f"no answer from {what} within {timeout:g} s{also}")
+                raise _no_answer(what, timeout, len(sent), "the goal")
             ctx.sleep(0.05)
     finally:
         for future in sent:

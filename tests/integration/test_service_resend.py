@@ -7,6 +7,7 @@ past the deadline instead, which the client cannot tell from a dropped one.
 
 from __future__ import annotations
 
+import contextlib
 import threading
 import time
 
@@ -18,12 +19,28 @@ from app.ros.context import CallContext, Limits
 from app.ros.errors import NoAnswer
 
 
+@contextlib.contextmanager
+def _spun(node):
+    """``node`` spun by four threads while the block runs; then ended, node and all."""
+    from rclpy.executors import MultiThreadedExecutor
+
+    executor = MultiThreadedExecutor(num_threads=4, context=node.context)
+    executor.add_node(node)
+    spinner = threading.Thread(target=executor.spin, daemon=True)
+    spinner.start()
+    try:
+        yield
+    finally:
+        executor.shutdown()
+        spinner.join(5.0)
+        node.destroy_node()
+
+
 @pytest.fixture
 def slow_first_answer(probe):
     """/slow_add: answers a + b, but its first answer comes after 2.5 s; /never_add never."""
     import rclpy
     from rclpy.callback_groups import ReentrantCallbackGroup
-    from rclpy.executors import MultiThreadedExecutor
 
     node = rclpy.create_node("slow_adder", context=probe.node.context)
     calls: list[float] = []
@@ -43,15 +60,9 @@ def slow_first_answer(probe):
     group = ReentrantCallbackGroup()
     node.create_service(AddTwoInts, "/slow_add", add, callback_group=group)
     node.create_service(AddTwoInts, "/never_add", hang, callback_group=group)
-    executor = MultiThreadedExecutor(num_threads=4, context=probe.node.context)
-    executor.add_node(node)
-    spinner = threading.Thread(target=executor.spin, daemon=True)
-    spinner.start()
-    yield calls
-    never.set()
-    executor.shutdown()
-    spinner.join(5.0)
-    node.destroy_node()
+    with _spun(node):
+        yield calls
+        never.set()
 
 
 def test_the_unanswered_request_is_sent_again_and_its_answer_taken(probe, slow_first_answer):
@@ -119,7 +130,6 @@ def goal_server_deaf_to_first(probe):
     import rclpy
     from rclpy.action import ActionServer, GoalResponse
     from rclpy.callback_groups import ReentrantCallbackGroup
-    from rclpy.executors import MultiThreadedExecutor
     from tutorial_interfaces.action import Fibonacci
 
     node = rclpy.create_node("deaf_fibonacci", context=probe.node.context)
@@ -137,19 +147,12 @@ def goal_server_deaf_to_first(probe):
         return Fibonacci.Result(sequence=[0, 1, 1])
 
     group = ReentrantCallbackGroup()
-    server = ActionServer(
+    ActionServer(
         node, Fibonacci, "/deaf_fibonacci", execute, goal_callback=on_goal, callback_group=group
     )
-    executor = MultiThreadedExecutor(num_threads=4, context=probe.node.context)
-    executor.add_node(node)
-    spinner = threading.Thread(target=executor.spin, daemon=True)
-    spinner.start()
-    yield requests
-    release.set()
-    executor.shutdown()
-    spinner.join(5.0)
-    server.destroy()
-    node.destroy_node()
+    with _spun(node):
+        yield requests
+        release.set()
 
 
 def _fibonacci_run() -> GoalRun:
