@@ -140,6 +140,7 @@ def goal_server_deaf_to_first(probe):
         requests.append(time.monotonic())
         if len(requests) == 1:
             release.wait(15.0)
+            return GoalResponse.REJECT  # the lost request: its answer never counts
         return GoalResponse.ACCEPT
 
     def execute(goal_handle):
