@@ -29,6 +29,7 @@ from app.ros.names import (
     is_hidden_node,
     is_internal_topic,
     node_fqn,
+    own_nodes,
     split_node_name,
 )
 
@@ -119,6 +120,15 @@ def _endpoint_nodes(node: Node, topic: str, *, publishers: bool) -> list[tuple[s
     with node.handle:
         found = query(node.handle, topic, False)
     return [(e["node_name"], e["node_namespace"]) for e in found]
+
+
+def subscriptions_ours_and_others(node: Node, topic: str) -> tuple[int, int]:
+    """Subscriptions on ``topic``: (``node``'s and its attempt's recording's, everyone
+    else's). Checks and probes count a learner's readers without their own."""
+    ours = own_nodes(node.get_name(), node.get_namespace())
+    owners = [(i.node_name, i.node_namespace) for i in node.get_subscriptions_info_by_topic(topic)]
+    mine = sum(owner in ours for owner in owners)
+    return mine, len(owners) - mine
 
 
 def _live_and_ghosts(node: Node, owners: set[str]) -> tuple[list[str], list[str]]:

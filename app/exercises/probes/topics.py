@@ -12,8 +12,9 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile
 
 from app.exercises.probes.base import ProbeContext, same
+from app.ros.graph import subscriptions_ours_and_others
 from app.ros.monitor import TopicMonitor
-from app.ros.names import node_fqn, own_nodes
+from app.ros.names import node_fqn
 from app.ros.qos import matching_qos
 
 if TYPE_CHECKING:
@@ -56,12 +57,7 @@ def others_subscribed(node: Node, publisher: Publisher, topic: str) -> int:
     """Readers matched by ``publisher`` other than the grader's own: ``node``'s, and the
     recording of the attempt's (it subscribes to every topic: it is not the learner's node
     listening)."""
-    ours = own_nodes(node.get_name(), node.get_namespace())
-    counted = sum(
-        1
-        for info in node.get_subscriptions_info_by_topic(topic)
-        if (info.node_name, info.node_namespace) in ours
-    )
+    counted, _others = subscriptions_ours_and_others(node, topic)
     return max(0, int(publisher.get_subscription_count()) - counted)
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from app.lessons.registry import FAIL, PASS, CheckResult, register_check
-from app.ros.names import own_nodes
+from app.ros.graph import subscriptions_ours_and_others
 
 if TYPE_CHECKING:
     from app.lessons.runtime import LessonRuntime
@@ -20,9 +20,7 @@ if TYPE_CHECKING:
 def evaluate(rt: LessonRuntime, c: Spec) -> CheckResult:
     # Count the learner's subscribers, not the dashboard's own taps (nor the grader's, and
     # its recording of the attempt, when an exercise's check runs).
-    infos = rt.node.get_subscriptions_info_by_topic(c["topic"])
-    ours = own_nodes(rt.node.get_name(), rt.node.get_namespace())
-    count = sum(1 for info in infos if (info.node_name, info.node_namespace) not in ours)
+    _ours, count = subscriptions_ours_and_others(rt.node, c["topic"])
     if count >= c["at_least"]:
         return CheckResult(PASS, f"{count} {_subscribers(count)} on {c['topic']}")
     wanted = c["at_least"]
