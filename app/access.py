@@ -34,7 +34,7 @@ import websockets.asyncio.server as ws_server
 from websockets.asyncio.server import ServerConnection
 from websockets.http11 import Request, Response
 
-from app import viser_icons, viser_input, viser_threads
+from app import viser_icons, viser_input, viser_threads, ws_handshake_log
 
 TOKEN_ENV = "CLASSROOM_TOKEN"
 TOKEN_HEADER = "X-Classroom-Token"
@@ -188,6 +188,7 @@ def make_server(
     viser_threads.install()
     viser_icons.install()
     viser_input.install()
+    ws_handshake_log.install()
     if token is None and extension is None and gate is None:
         return viser.ViserServer(host=host, port=port, verbose=False), None
     if token is not None:
