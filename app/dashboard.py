@@ -13,7 +13,7 @@ import threading
 import time
 from collections.abc import Callable
 from functools import partial
-from typing import cast
+from typing import TYPE_CHECKING, cast
 
 import viser
 
@@ -28,24 +28,11 @@ from app.lessons.panel import LessonsPanel
 from app.lessons.progress import ProgressStore
 from app.lessons.runtime import LessonRuntime
 from app.lessons.schema import load_course
-from app.panels.actions_panel import ActionsPanel
-from app.panels.bags_panel import BagsPanel
-from app.panels.echo_panel import EchoPanel
-from app.panels.graph_panel import GraphPanel
-from app.panels.lifecycle_panel import LifecyclePanel
-from app.panels.logs_panel import LogsPanel
-from app.panels.nodes_panel import NodesPanel
-from app.panels.parameters_panel import ParametersPanel
 from app.panels.scene_panel import ScenePanel
-from app.panels.services_panel import ServicesPanel
-from app.panels.tf_panel import TfPanel
-from app.panels.topics_panel import TopicsPanel
-from app.panels.turtlesim_panel import TurtlesimPanel
 from app.ros.graph import GraphSnapshot, snapshot
 from app.ros.rates import SharedRates
 from app.ros.rosout import RosoutLog
 from app.ros.runtime import RosRuntime
-from app.ros2cli.console_panel import ConsolePanel
 from app.scene.grid import add_floor_grid
 from app.scene.point_shader import keep_point_shader
 from app.stage.window import Stage
@@ -59,7 +46,16 @@ from app.ui.shown_tools import ShownTools
 from app.ui.starting import StartRequests
 from app.ui.tab_opener import TabOpener
 
+if TYPE_CHECKING:
+    from app.ros2cli.console_panel import ConsolePanel
+
 log = logging.getLogger(__name__)
+
+# Tools built as the dashboard starts: the one a page opens on, the exercise (its code
+# sits beside the lesson's) and the 3D view, which draws into the scene every page
+# shows. The others are built when a page first shows them (app.ui.shown_tools) or the
+# dashboard opens them: a first page then carries 123 fewer widgets (204 of 327).
+EAGER_TOOLS = frozenset({"Lessons", "Exercise", "3D view"})
 
 UI_PERIOD_SEC = 0.2  # panels refresh at 5 Hz
 # ...and within 20 ms of a node joining or leaving when this dashboard started or
@@ -132,14 +128,19 @@ class Dashboard:
         self._lesson_since = time.time()  # when the current lesson was opened (UI thread)
         self._lesson_programs: frozenset[str] = frozenset()  # what its buttons start
         self.graph = GraphSnapshot()
-        self._tools: dict[str, Panel] = {}
+        self._tools: dict[str, Panel] = {}  # the tools built so far, by tab name
+        self._tool_tabs: dict[str, viser.GuiTabHandle] = {}
+        self._placeholders: dict[str, viser.GuiMarkdownHandle] = {}  # until a tool is built
+        self._tools_failed: set[str] = set()
+        self._inspected: tuple[str, str, str] | None = None  # the box last clicked on stage
+        self._panels: list[Panel] = []  # what the UI thread refreshes: the stage, built tools
         # What the pages show: the first group's first tool until a page says.
         first = next(iter(TOOL_GROUPS.values()))[0]
         self._shown = ShownTools([*TOOL_GROUPS, *TAB_NAMES], frozenset({first}), self.ui.wake)
-        self._panels: list[Panel] = self._build_gui()
+        self._build_gui()
         self._ui_thread = threading.Thread(target=self._ui_loop, name="ui-refresh", daemon=True)
 
-    def _build_gui(self) -> list[Panel]:
+    def _build_gui(self) -> None:
         gui, ui, node = self.server.gui, self.ui, self.runtime.node
         gui.configure_theme(
             titlebar_content=None, control_width="large", show_share_button=False, show_logo=False
@@ -180,10 +181,11 @@ class Dashboard:
             starting=self._starting_nodes,
             program_output=self._program_output,
             inspect=self._inspect,
-            open_tool=opener.open,
+            open_tool=self._open_tool,
         )
         stage.follow_window(self.server)
         self._stage = stage
+        self._panels.append(stage)
         # The current step, read top to bottom: its text, buttons, checks, Back and Next;
         # above the tools, so it stays where it is whichever tool is open.
         position = MarkdownView(gui)  # "Lesson 4 of 22 · Step 1 of 6", above the card
@@ -199,7 +201,7 @@ class Dashboard:
                 self._exercise_marks,
                 stage.show_step,
                 step_card=step_card,
-                open_tool=opener.open,
+                open_tool=self._open_tool,
                 start_requests=self.start_requests,
                 new_lesson=self._new_lesson,
                 position=position,
@@ -220,38 +222,161 @@ class Dashboard:
                 open_code=lambda: stage.show("code"),
                 watch=stage.watch,
             ),
-            "Nodes": lambda: NodesPanel(gui, ui, self.supervisor, self.start_requests),
-            "Turtlesim": lambda: TurtlesimPanel(gui, ui, node, self.supervisor, self.page_links),
-            "Graph": lambda: GraphPanel(gui, node, self._rates.client()),
-            "Echo": lambda: EchoPanel(gui, node),
             "3D view": lambda: ScenePanel(self.server, ui, node),
-            "TF": lambda: TfPanel(gui, ui, node, self.supervisor),
-            "Topics": lambda: TopicsPanel(gui, ui, node),
-            "Parameters": lambda: ParametersPanel(gui, ui, node, self.rosout),
-            "Console": lambda: ConsolePanel(gui, ui, node, self.supervisor),
-            "Services": lambda: ServicesPanel(gui, ui, node),
-            "Actions": lambda: ActionsPanel(gui, ui, node),
-            "Lifecycle": lambda: LifecyclePanel(gui, ui, node, self.rosout, self.page_links),
-            "Logs": lambda: LogsPanel(gui, self.rosout),
-            "Bags": lambda: BagsPanel(gui, ui, node),
+            **self._lazy_builders(),
         }
         assert set(builders) == set(TAB_NAMES), "every tool lessons may name has a panel"
+        self._builders = builders
         # Tools grouped as a learner thinks of them: a tab per group, a tab per tool inside.
+        # The tools of EAGER_TOOLS are built now; the others when first shown or used.
         groups = gui.add_tab_group()
-        built: dict[str, Panel] = {}
         for group, declared in TOOLS.items():
             with groups.add_tab(group, declared.icon):
                 tools = gui.add_tab_group()
                 for name, icon in declared.tools.items():
-                    with tools.add_tab(name, icon):
-                        built[name] = builders[name]()
-        panels = [built[name] for name in TAB_NAMES]
-        self._tools = built
+                    tab = tools.add_tab(name, icon)
+                    self._tool_tabs[name] = tab
+                    if name not in EAGER_TOOLS:
+                        with tab:
+                            self._placeholders[name] = gui.add_markdown(f"*Opening {name}…*")
+        self._opener = opener
+        for name in TAB_NAMES:
+            if name in EAGER_TOOLS:
+                self._tool(name)
         # A lesson's `console` buttons type their command into the Console tab.
-        console = next(p for p in panels if isinstance(p, ConsolePanel))
-        self.lessons.console = console.run_for_lesson
+        self.lessons.console = lambda command: self._console().run_for_lesson(command)
         self._open_from_address(opener)
-        return [stage, *panels]
+
+    def _lazy_builders(self) -> dict[str, Callable[[], Panel]]:
+        """How to build each tool that waits until a page shows it. Each imports its module
+        only then (the warm parent of app.warm_start imports them all ahead)."""
+        gui, ui, node = self.server.gui, self.ui, self.runtime.node
+
+        def nodes() -> Panel:
+            from app.panels.nodes_panel import NodesPanel
+
+            return NodesPanel(gui, ui, self.supervisor, self.start_requests)
+
+        def console() -> Panel:
+            from app.ros2cli.console_panel import ConsolePanel
+
+            return ConsolePanel(gui, ui, node, self.supervisor)
+
+        def turtlesim() -> Panel:
+            from app.panels.turtlesim_panel import TurtlesimPanel
+
+            return TurtlesimPanel(gui, ui, node, self.supervisor, self.page_links)
+
+        def graph() -> Panel:
+            from app.panels.graph_panel import GraphPanel
+
+            return GraphPanel(gui, node, self._rates.client())
+
+        def tf() -> Panel:
+            from app.panels.tf_panel import TfPanel
+
+            return TfPanel(gui, ui, node, self.supervisor)
+
+        def topics() -> Panel:
+            from app.panels.topics_panel import TopicsPanel
+
+            return TopicsPanel(gui, ui, node)
+
+        def echo() -> Panel:
+            from app.panels.echo_panel import EchoPanel
+
+            return EchoPanel(gui, node)
+
+        def logs() -> Panel:
+            from app.panels.logs_panel import LogsPanel
+
+            return LogsPanel(gui, self.rosout)
+
+        def services() -> Panel:
+            from app.panels.services_panel import ServicesPanel
+
+            return ServicesPanel(gui, ui, node)
+
+        def actions() -> Panel:
+            from app.panels.actions_panel import ActionsPanel
+
+            return ActionsPanel(gui, ui, node)
+
+        def parameters() -> Panel:
+            from app.panels.parameters_panel import ParametersPanel
+
+            return ParametersPanel(gui, ui, node, self.rosout)
+
+        def lifecycle() -> Panel:
+            from app.panels.lifecycle_panel import LifecyclePanel
+
+            return LifecyclePanel(gui, ui, node, self.rosout, self.page_links)
+
+        def bags() -> Panel:
+            from app.panels.bags_panel import BagsPanel
+
+            return BagsPanel(gui, ui, node)
+
+        return {
+            "Nodes": nodes,
+            "Console": console,
+            "Turtlesim": turtlesim,
+            "Graph": graph,
+            "TF": tf,
+            "Topics": topics,
+            "Echo": echo,
+            "Logs": logs,
+            "Services": services,
+            "Actions": actions,
+            "Parameters": parameters,
+            "Lifecycle": lifecycle,
+            "Bags": bags,
+        }
+
+    def _tool(self, name: str) -> Panel:
+        """The tool ``name``, built in its tab now if it was not yet (UI thread only)."""
+        built = self._tools.get(name)
+        if built is not None:
+            return built
+        started = time.monotonic()
+        # In one piece: a page sees none of its widgets before all have their callbacks
+        # (a click on a Start sent the moment it arrived was lost, under load).
+        with self.server.atomic():
+            with self._tool_tabs[name]:
+                panel = self._builders[name]()
+            placeholder = self._placeholders.pop(name, None)
+            if placeholder is not None:
+                placeholder.remove()
+        self._tools[name] = panel
+        self._panels.append(panel)
+        if isinstance(panel, Inspector) and self._inspected is not None:
+            # What the learner last clicked on the stage, once the tool knows the graph.
+            panel.refresh(self.graph)
+            panel.inspect(*self._inspected)
+        log.debug("built the %s tool in %.3f s", name, time.monotonic() - started)
+        return panel
+
+    def _console(self) -> ConsolePanel:
+        return cast("ConsolePanel", self._tool("Console"))
+
+    def _open_tool(self, name: str) -> None:
+        """Open a tool's tab on the pages (UI thread): built here, before the page asks."""
+        if name in self._builders:
+            self._tool(name)
+        self._opener.open(name)
+
+    def _build_asked_tools(self) -> None:
+        """Build every tool a page has shown and that is not built yet (UI thread)."""
+        asked = self._shown.asked()
+        for name in TAB_NAMES:
+            if name in self._tools or name in self._tools_failed:
+                continue
+            if name in asked:
+                try:
+                    self._tool(name)
+                except Exception:  # one tool's bug leaves the others (and its tab) working
+                    log.exception("building the %s tool failed", name)
+                    self._tools_failed.add(name)
 
     def _open_from_address(self, opener: TabOpener) -> None:
         """A link into the course opens where it points: ``?lesson=ID`` the lesson (Learn ›
@@ -309,6 +434,7 @@ class Dashboard:
     def _inspect(self, kind: str, name: str, type_text: str) -> None:
         """A box clicked on the stage: every tool that shows more of such a thing picks
         it (UI thread); each tool says which kinds it shows."""
+        self._inspected = (kind, name, type_text)  # a tool built later picks it too
         for tool in self._tools.values():
             if isinstance(tool, Inspector):
                 tool.inspect(kind, name, type_text)
@@ -363,6 +489,7 @@ class Dashboard:
                 check = max(0.0, min(UI_PERIOD_SEC, due - time.monotonic()))
             woken = self.ui.wait(check)
             applied = self.ui.apply_pending()
+            self._build_asked_tools()
             try:
                 nodes = self.runtime.node.get_node_names_and_namespaces()
             except Exception:  # the graph may be unreadable for a moment

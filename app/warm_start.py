@@ -127,7 +127,23 @@ COLD_START_VAR = "CLASSROOM_COLD_START"  # "1": every dashboard starts cold (a c
 
 # What a learner's dashboard imports by the time it is ready (measured on a cold
 # `serve`): the command, what `cmd_serve` imports when it runs, what the page's
-# build imports, and the message type support its first subscriptions load.
+# build imports, and the message type support its first subscriptions load. And the
+# tools a page opens later (app/dashboard.py builds them then): paid once here, a
+# learner's first click on one imports nothing.
+TOOL_MODULES = (
+    "actions",
+    "bags",
+    "echo",
+    "graph",
+    "lifecycle",
+    "logs",
+    "nodes",
+    "parameters",
+    "services",
+    "tf",
+    "topics",
+    "turtlesim",
+)
 REQUIRED_IMPORTS = ("numpy", "rclpy", "rclpy.node", "viser", "app.cli", "app.dashboard")
 WARM_IMPORTS = REQUIRED_IMPORTS + (
     "app.access",
@@ -137,6 +153,8 @@ WARM_IMPORTS = REQUIRED_IMPORTS + (
     "app.exercises.workspace",
     "app.lessons.progress",
     "app.lessons.schema",
+    *(f"app.panels.{name}_panel" for name in TOOL_MODULES),
+    "app.ros2cli.console_panel",
     "app.ros.liveness",
     "app.ros.runtime",
     "app.supervisor",

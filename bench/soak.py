@@ -82,12 +82,15 @@ async ([group, name]) => {
   const visible = (el) => !!el && el.getClientRects().length > 0;
   const tab = (label) => [...document.querySelectorAll('[role=tab]')]
     .find((t) => t.textContent.trim() === label && visible(t));
-  const shown = (t) => {
+  // Shown: selected, its panel on screen, and built (a tool's first opening shows
+  // "Opening <name>…" until the dashboard has built it: app/dashboard.py).
+  const shown = (t, built = false) => {
     if (!t || t.getAttribute('aria-selected') !== 'true') return false;
     const id = t.getAttribute('aria-controls');
     if (!id) return true;
     const panel = document.getElementById(id);
-    return !!panel && visible(panel);
+    return !!panel && visible(panel) &&
+      !(built && panel.textContent.includes(`Opening ${name}…`));
   };
   const until = (pred, ms) => new Promise((resolve) => {
     if (pred()) return resolve(true);
@@ -115,7 +118,7 @@ async ([group, name]) => {
   }
   if (!await until(() => (t = tab(name)), 5000)) return -3;
   press(t);
-  if (!await until(() => shown(t), 5000)) return -4;
+  if (!await until(() => shown(t, true), 5000)) return -4;
   await frame();
   return performance.now() - t0;
 }

@@ -9,12 +9,16 @@ real page never would.
 
 from __future__ import annotations
 
+import html
 import re
 import threading
 import time
+import urllib.request
+import uuid as uuid_module
 from collections import Counter
 from collections.abc import Callable, Iterator
 from typing import Any
+from urllib.parse import urljoin, urlsplit
 
 import msgspec
 import viser
@@ -23,6 +27,8 @@ from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import ClientConnection, connect
 
 from app.lessons.panel import NEXT_LABEL
+from app.ui import TAB_NAMES
+from app.ui.shown_tools import SCRIPT_TITLE as SHOWN_SCRIPT_TITLE
 
 # The step card's Next: until the step's checks pass it says what it would skip.
 NEXT_OR_SKIP = NEXT_LABEL
@@ -41,6 +47,9 @@ CAMERA_REPORT = {
     "up_direction": (0.0, 0.0, 1.0),
 }
 
+
+# What a tool's tab holds until the dashboard has built it (app/dashboard.py).
+PLACEHOLDER = re.compile(r"\*Opening .+…\*")
 
 # How often a reader looks up from its socket to see whether it should close it.
 READ_POLL_SEC = 0.05
@@ -85,9 +94,20 @@ class WireClient:
     """Connects, reads every frame in a thread, and keeps the GUI state it was sent."""
 
     def __init__(
-        self, url: str, *, headers: dict[str, str] | None = None, open_timeout: float = 10.0
+        self,
+        url: str,
+        *,
+        headers: dict[str, str] | None = None,
+        open_timeout: float = 10.0,
+        open_every_tool: bool = True,
     ) -> None:
+        """``open_every_tool``: report every tool shown once, as a page that had opened
+        them all, so a dashboard builds the tools it builds only when shown
+        (app.ui.shown_tools); then report none, so they refresh as tools nobody looks at."""
         self.url = url.replace("http://", "ws://", 1)
+        self._headers = dict(headers or {})
+        self._open_every_tool = open_every_tool
+        self.tools_asked = threading.Event()  # set once every tool was asked for
         self.ws: ClientConnection = connect_quietly(
             self.url,
             subprotocols=[f"viser-v{viser.__version__}"],  # type: ignore[list-item]
@@ -143,6 +163,8 @@ class WireClient:
             self.counts["cloud_frames"] += 1
         if kind.startswith("Gui") and "props" in message and uuid:
             self.gui[uuid] = {"type": kind, **dict(message["props"])}
+            if kind == "GuiHtmlMessage" and self._open_every_tool:
+                self._maybe_ask_for_tools(str(self.gui[uuid].get("content", "")))
             self.gui[uuid]["container_uuid"] = message.get("container_uuid")  # where it sits
             if "value" in message:
                 self.gui[uuid]["value"] = message["value"]
@@ -152,6 +174,48 @@ class WireClient:
             self.counts["cloud_frames"] += 1  # a new cloud drawn in place of the old one
         elif kind == "GuiRemoveMessage" and uuid:
             self.gui.pop(uuid, None)
+
+    def _maybe_ask_for_tools(self, content: str) -> None:
+        """The dashboard's shown-tools script: ask for every tool, off the reader thread."""
+        if self.tools_asked.is_set() or f'title="{SHOWN_SCRIPT_TITLE}"' not in content:
+            return
+        link = re.search(r'data-link="([^"]*)"', content)
+        names = re.search(r'data-names="([^"]*)"', content)
+        if link is None or names is None:
+            return
+        # The tools' indices only (a report has room for 64 characters; groups need none).
+        listed = html.unescape(names.group(1)).split(",")
+        every = ".".join(str(i) for i, name in enumerate(listed) if name in TAB_NAMES)
+        href = html.unescape(link.group(1))
+        threading.Thread(
+            target=self._ask_for_tools, args=(href, every), name="wire-tools", daemon=True
+        ).start()
+
+    def _ask_for_tools(self, href: str, every: str) -> None:
+        page = f"w{uuid_module.uuid4().hex[:6]}"
+        base = urlsplit(self.url.replace("ws://", "http://", 1))
+        # The link is relative to the page, which is the folder the websocket opened at.
+        folder = base._replace(query="", path=base.path.rstrip("/") + "/").geturl()
+        for value in (every, "none"):
+            target = urlsplit(urljoin(folder, f"{href}/{page}-{value}"))
+            request = urllib.request.Request(
+                target._replace(query=base.query).geturl(), headers=self._headers
+            )
+            try:
+                with urllib.request.urlopen(request, timeout=10) as answer:
+                    answer.read()
+            except OSError as exc:  # the test then misses a tool's labels, and says which
+                self.closed_reason = self.closed_reason or f"could not ask for the tools: {exc}"
+                return
+        self.tools_asked.set()
+
+    def wait_for_every_tool(self, timeout: float = 30.0) -> None:
+        """Until every tool's widgets have come: asked for, and no tab says "Opening ..."."""
+        deadline = time.monotonic() + timeout
+        assert self.tools_asked.wait(timeout), self.closed_reason or "never asked for the tools"
+        while any(PLACEHOLDER.fullmatch(line) for line in self.markdown().splitlines()):
+            assert time.monotonic() < deadline, "a tool was still not built"
+            time.sleep(0.05)
 
     # -- queries -------------------------------------------------------------
 

@@ -9,8 +9,14 @@ open is not) to a page link whenever they change, and again every
 
 The dashboard refreshes a tool no page shows far less often
 (``app/dashboard.py``): it still keeps up, but nobody waits for it. A page
-that never reports (a client without JavaScript, the benchmarks' wire
-client) counts as showing what a page opens on: the first group's first tool.
+that never reports (a client without JavaScript) counts as showing what a
+page opens on: the first group's first tool.
+
+Most tools are built only once a page has shown them (``asked()``: every
+tool ever reported, even by a page that has gone), so a page's first load
+carries only what it opens on. The tests' and benchmarks' wire client
+(``tests/wire_client.py``) reports every tool once, as a page that had opened
+them all; it finds where to report in the script frame's ``data-link``.
 """
 
 from __future__ import annotations
@@ -25,6 +31,8 @@ from app.ui.page_script import listen_on_page, page_script
 REPORT_SEC = 10.0  # a page sends what it shows at least this often...
 KEEP_SEC = 3 * REPORT_SEC  # ...and what it sent counts for this long (a closed page's ends)
 MAX_PAGES = 256  # pages kept at once: a forged flood of page names pushes out the oldest
+
+SCRIPT_TITLE = "shown tools"  # the script frame's title, where a wire client finds it
 
 _SCRIPT = """
 const names = %s;
@@ -91,6 +99,7 @@ class ShownTools:
         self._clock = clock
         self._lock = threading.Lock()
         self._reports: dict[str, tuple[frozenset[str], float]] = {}  # page -> shown, when
+        self._asked: set[str] = set(default)  # every name any page has shown
 
     def report(self, value: str) -> None:
         parsed = parse_report(value, self.names)
@@ -102,6 +111,7 @@ class ShownTools:
             self._reports[page] = (shown, self._clock())  # the newest last
             if len(self._reports) > MAX_PAGES:
                 del self._reports[next(iter(self._reports))]
+            self._asked |= shown
         if before is None or before[0] != shown:
             self._on_change()
 
@@ -115,6 +125,11 @@ class ShownTools:
                 return self._default
             return frozenset().union(*(shown for shown, _ in self._reports.values()))
 
+    def asked(self) -> frozenset[str]:
+        """Every name a page has shown since the start (and the default): what to build."""
+        with self._lock:
+            return frozenset(self._asked)
+
     def script_html(self, href: str) -> str:
         """The page script that reports to ``href`` (a value link of ``app.ui.page_links``)."""
         script = _SCRIPT % (
@@ -124,4 +139,4 @@ class ShownTools:
             listen_on_page("__classroomShownClick", "click", "soon", capture=True),
             listen_on_page("__classroomShownKey", "keydown", "soon", capture=True),
         )
-        return page_script(script, "shown tools")
+        return page_script(script, SCRIPT_TITLE, link=href, names=",".join(self.names))

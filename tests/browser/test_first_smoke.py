@@ -9,6 +9,8 @@ import pytest
 from playwright.sync_api import expect
 
 from tests.browser.helpers import choose, click, expect_text, open_tab, start_node
+from tests.conftest import wait_until
+from tests.wire_client import WireClient
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
@@ -68,3 +70,23 @@ def test_crashed_node_shows_exit_code_and_restarts(page):
     expect(page.get_by_text(re.compile(r"(starting|running) \(pid \d+\)")).first).to_be_visible(
         timeout=15_000
     )
+
+
+def test_a_tool_is_built_when_the_learner_first_opens_it(page, dashboard):
+    """The first page carries the tools it opens on; the others come with their first
+    click (app/dashboard.py EAGER_TOOLS), in their place. What the dashboard sends is
+    watched by a wire client that asks for no tool itself."""
+    watcher = WireClient(dashboard.url, open_every_tool=False)
+    try:
+        wait_until(lambda: "Opening Nodes…" in watcher.markdown(), what="the placeholders")
+        assert watcher.find("Catalog node") is None, "Nodes was built before any page opened it"
+        open_tab(page, "Nodes")
+        expect(page.get_by_label("Catalog node").filter(visible=True).first).to_be_visible(
+            timeout=10_000
+        )
+        expect(page.get_by_text("Opening Nodes…")).to_have_count(0)
+        assert watcher.find("Catalog node") is not None
+        assert "Opening Nodes…" not in watcher.markdown()
+        assert "Opening Bags…" in watcher.markdown()  # never opened: still not built
+    finally:
+        watcher.close()

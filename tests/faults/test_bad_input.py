@@ -76,8 +76,7 @@ def test_forged_widget_values_never_reach_a_process_or_the_page(dashboard):
     client = WireClient(dashboard.url)
     sent = 0
     try:
-        wait_until(lambda: client.find("Start", "GuiButtonMessage"), what="the page")
-        time.sleep(0.5)
+        client.wait_for_every_tool()  # every tool's inputs, not only the first page's
         with client.lock:
             inputs = {
                 uuid: props["type"]

@@ -50,3 +50,17 @@ def test_a_flood_of_page_names_keeps_only_the_newest() -> None:
     for i in range(MAX_PAGES):
         shown.report(f"p{i}-2")
     assert shown.shown() == {"Lessons"}  # the first page's Echo was pushed out
+
+
+def test_what_to_build_is_everything_ever_shown_even_by_a_page_that_left() -> None:
+    clock = Clock()
+    shown = ShownTools(NAMES, frozenset({"Lessons"}), clock=clock)
+    assert shown.asked() == {"Lessons"}  # what a page opens on is built at once
+    shown.report("w1-3.4")  # a wire client asks for Echo and Graph...
+    shown.report("w1-none")  # ...then shows none: they stay asked for
+    assert shown.shown() == frozenset()
+    assert shown.asked() == {"Lessons", "Echo", "Graph"}
+    clock.now += KEEP_SEC + 1
+    assert shown.asked() == {"Lessons", "Echo", "Graph"}  # built tools are never unbuilt
+    shown.report("x-9")  # a forged report asks for nothing
+    assert shown.asked() == {"Lessons", "Echo", "Graph"}
