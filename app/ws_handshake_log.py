@@ -44,7 +44,7 @@ def client_left_early(record: logging.LogRecord) -> bool:
     return any(isinstance(error, _GONE) for error in _causes(record.exc_info[1]))
 
 
-class _ClientLeftEarly(logging.Filter):
+class ClientLeftEarly(logging.Filter):
     def filter(self, record: logging.LogRecord) -> bool:
         if client_left_early(record):
             error = _causes(record.exc_info[1] if record.exc_info else None)[-1]
@@ -58,5 +58,5 @@ def install() -> None:
     """Add the filter to websockets' server logger (idempotent)."""
     logger = logging.getLogger(LOGGER_NAME)
     with _LOCK:
-        if not any(isinstance(f, _ClientLeftEarly) for f in logger.filters):
-            logger.addFilter(_ClientLeftEarly())
+        if not any(isinstance(f, ClientLeftEarly) for f in logger.filters):
+            logger.addFilter(ClientLeftEarly())
