@@ -108,6 +108,7 @@ class WireClient:
         self._headers = dict(headers or {})
         self._open_every_tool = open_every_tool
         self.tools_asked = threading.Event()  # set once every tool was asked for
+        self.tools_error: str | None = None  # why asking for them failed
         self.ws: ClientConnection = connect_quietly(
             self.url,
             subprotocols=[f"viser-v{viser.__version__}"],  # type: ignore[list-item]
@@ -204,15 +205,16 @@ class WireClient:
             try:
                 with urllib.request.urlopen(request, timeout=10) as answer:
                     answer.read()
-            except OSError as exc:  # the test then misses a tool's labels, and says which
-                self.closed_reason = self.closed_reason or f"could not ask for the tools: {exc}"
+            except OSError as exc:  # wait_for_every_tool says so; a lookup misses a label
+                self.tools_error = f"could not ask for the tools: {exc}"
                 return
         self.tools_asked.set()
 
     def wait_for_every_tool(self, timeout: float = 30.0) -> None:
         """Until every tool's widgets have come: asked for, and no tab says "Opening ..."."""
         deadline = time.monotonic() + timeout
-        assert self.tools_asked.wait(timeout), self.closed_reason or "never asked for the tools"
+        asked = self.tools_asked.wait(timeout)
+        assert asked, self.tools_error or self.closed_reason or "never asked for the tools"
         while any(PLACEHOLDER.fullmatch(line) for line in self.markdown().splitlines()):
             assert time.monotonic() < deadline, "a tool was still not built"
             time.sleep(0.05)
