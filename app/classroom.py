@@ -31,10 +31,12 @@ teacher's gradebook behind the teacher's token.
 from __future__ import annotations
 
 import os
+import shutil
 import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from collections.abc import Callable, Mapping
@@ -45,6 +47,7 @@ from urllib.parse import urlsplit
 
 from app import PROJECT_ROOT
 from app.dds import MAX_DOMAIN_ID
+from app.restart_rule import GuardMark, ended_for_a_restart
 from app.stop_signals import die_with
 from app.warm_start import COLD_START_VAR, WarmChild, WarmStarter, WarmStartError, cold_start_asked
 
@@ -55,9 +58,8 @@ if TYPE_CHECKING:
     from app.teacher.roster import Roster
 
 READY_TIMEOUT_SEC = 90.0
-# A learner's dashboard ended by SIGABRT (its ROS guard, or a native crash) starts
-# again, at most this often in one session: one that keeps dying is only reported.
-RESTART_AFTER = -signal.SIGABRT
+# A learner's dashboard ended by its ROS guard or a native crash (app/restart_rule.py)
+# starts again, at most this often in one session: one that keeps dying is only reported.
 MAX_RESTARTS = 3
 MAX_LEARNERS = 40
 LTI_URL_ENV = "CLASSROOM_LTI_URL"  # as the hub's teacher service reads it
@@ -262,8 +264,11 @@ class Classroom:
         self.warm_starter: WarmStarter | None = None
         self._procs: dict[str, Process] = {}
         self._ready: dict[str, threading.Event] = {}
+        self._marks_dir: Path | None = None  # each dashboard's guard mark, while it runs
+        self._marks: dict[str, GuardMark] = {}
 
     def start(self) -> None:
+        self._marks_dir = Path(tempfile.mkdtemp(prefix="classroom-guard-marks-"))
         self.warm_starter = self._start_warm_parent() if self.warm else None
         if not self.warm:
             self.say(f"Cold start ({COLD_START_VAR}=1): each dashboard imports everything itself.")
@@ -286,6 +291,9 @@ class Classroom:
                 "--classroom-domain-id", str(learner.classroom_domain), "--site", learner.site
             ]  # fmt: skip
         env = {**self._env, "PYTHONUNBUFFERED": "1"}
+        if self._marks_dir is not None:
+            mark = self._marks[learner.name] = GuardMark(self._marks_dir, learner.name)
+            env.update(mark.env())
         env.pop("CLASSROOM_TOKEN", None)
         if learner.token:  # through the environment: a token on argv shows in `ps`
             env["CLASSROOM_TOKEN"] = learner.token
@@ -372,6 +380,13 @@ class Classroom:
         codes = {name: p.poll() for name, p in self._procs.items()}
         return {name: code for name, code in codes.items() if code is not None}
 
+    def restart_reason(self, name: str, code: int) -> str | None:
+        """Why ``name``'s dashboard, ended with ``code``, starts again; None: it stays ended."""
+        mark = self._marks.get(name)
+        if mark is None:
+            return None
+        return ended_for_a_restart(code, mark)
+
     def pids(self) -> dict[str, int]:
         return {name: proc.pid for name, proc in self._procs.items()}
 
@@ -389,6 +404,8 @@ class Classroom:
                 proc.wait()
         if self.warm_starter is not None:
             self.warm_starter.close()
+        if self._marks_dir is not None:
+            shutil.rmtree(self._marks_dir, ignore_errors=True)
 
 
 def run(
@@ -458,11 +475,11 @@ def _serve(
     while not stop_requested.wait(0.5):
         classroom.watch()
         for name, code in classroom.ended().items():
-            if code == RESTART_AFTER and restarts.get(name, 0) < MAX_RESTARTS:
-                # Its ROS guard ended it (a hung participant, app/ros/liveness.py) or it
-                # crashed in native code: its page comes back by itself, progress kept.
+            why = classroom.restart_reason(name, code)
+            if why is not None and restarts.get(name, 0) < MAX_RESTARTS:
+                # Its page comes back by itself, progress kept.
                 restarts[name] = restarts.get(name, 0) + 1
-                say(f"  {name}'s dashboard was ended by SIGABRT (see its log); starting it again")
+                say(f"  {name}'s dashboard ended ({why}); starting it again")
                 classroom.start_learner(learners[name])
             elif name not in reported:
                 reported.add(name)

@@ -15,7 +15,9 @@ a session of its own. When no line has come for ``limit`` seconds, the guard
 says why on the dashboard's stderr and ends it with SIGABRT (faulthandler then
 writes every thread's stack to the log), then SIGKILL. The nodes the dashboard
 started end with it (their parent-death signal), progress is saved as it
-goes, and ``make run`` starts the dashboard again (app/keep_serving.py).
+goes, and ``make run`` and the classroom start the dashboard again: the guard
+leaves a mark for them first, since its SIGKILL would read as anyone's
+(app/restart_rule.py).
 When the dashboard stops or dies, the guard reads the end of its pipe and
 leaves quietly.
 """
@@ -31,6 +33,8 @@ import threading
 from rclpy.node import Node
 from std_msgs.msg import Empty
 
+from app.restart_rule import MARK_VARIABLE
+
 LIMIT_VARIABLE = "CLASSROOM_LIVENESS_LIMIT_SEC"  # tests set a few seconds
 # Creating a reader takes milliseconds; a whole minute without one is a hang, even
 # on two cores busy with a test suite.
@@ -38,7 +42,8 @@ DEFAULT_LIMIT_SEC = 60.0
 PROBES_PER_LIMIT = 12  # a probe every 5 s with the default limit
 PROBE_TOPIC = "/_classroom_liveness"  # hidden (leading underscore), and nobody publishes on it
 GUARD_NAME = "classroom-ros-liveness"  # the guard's $0: what `ps` shows
-# $1 the dashboard's pid, $2 the limit in seconds, $3 what to say when it fires.
+# $1 the dashboard's pid, $2 the limit in seconds, $3 what to say when it fires, $4 the
+# mark to create first (empty: none).
 # `read -t` ends with a status above 128 on its time limit, and 1 at the end of
 # the pipe (the dashboard stopped or died): only the first is a hang.
 _GUARD_SCRIPT = """
@@ -48,6 +53,7 @@ while :; do
   [ "$status" -eq 0 ] && continue
   [ "$status" -gt 128 ] || exit 0
   echo "$3" >&2
+  [ -z "$4" ] || : 2>/dev/null > "$4"
   kill -ABRT "$1" 2>/dev/null; kill -CONT "$1" 2>/dev/null
   for _ in 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15; do
     sleep 0.2; kill -0 "$1" 2>/dev/null || exit 0
@@ -65,6 +71,26 @@ def limit_from_env() -> float:
         return max(1.0, float(os.environ.get(LIMIT_VARIABLE) or DEFAULT_LIMIT_SEC))
     except ValueError:
         return DEFAULT_LIMIT_SEC
+
+
+def start_guard(bash: str, pid: int, limit: float, line: str) -> subprocess.Popen[bytes]:
+    """The guard of process ``pid``: fed a line on its stdin at least every ``limit`` s,
+    or it says ``line`` and ends ``pid`` (after leaving the restarter's mark, if any)."""
+    return subprocess.Popen(
+        [
+            bash,
+            "-c",
+            _GUARD_SCRIPT,
+            GUARD_NAME,
+            str(pid),
+            f"{limit:g}",
+            line,
+            os.environ.get(MARK_VARIABLE, ""),
+        ],  # fmt: skip
+        stdin=subprocess.PIPE,
+        stdout=subprocess.DEVNULL,
+        start_new_session=True,  # Ctrl+C in the terminal is the dashboard's, not the guard's
+    )
 
 
 class ParticipantLiveness:
@@ -89,12 +115,7 @@ class ParticipantLiveness:
             "(most likely Fast DDS 2.14's deadlock, eProsima/Fast-DDS#6502): ending it with "
             "SIGABRT so that it starts again (`make run` and `classroom` do); progress is kept"
         )
-        self._guard = subprocess.Popen(
-            [bash, "-c", _GUARD_SCRIPT, GUARD_NAME, str(os.getpid()), f"{self.limit:g}", line],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.DEVNULL,
-            start_new_session=True,  # Ctrl+C in the terminal is the dashboard's, not the guard's
-        )
+        self._guard = start_guard(bash, os.getpid(), self.limit, line)
         self.guard_pid = self._guard.pid
         self._thread.start()
 

@@ -80,11 +80,13 @@ def test_three_isolated_learners(ros_env, tmp_path):
         # classroom starts it again, and learner1's talker never notices.
         stuck = _serving(base_port + 1)
         os.kill(stuck, signal.SIGSTOP)
-        while "learner2's dashboard was ended by SIGABRT" not in lines[-1]:
+        while "learner2's dashboard ended" not in lines[-1]:
             line = room.stdout.readline()
             assert line, f"classroom ended early: {lines}"
             lines.append(line)
-        assert "starting it again" in lines[-1]
+        # However the guard's end came (SIGABRT, or SIGKILL when the abort took too long
+        # on a loaded machine: CI), the classroom knows the guard did it, and restarts.
+        assert "its guard ended it" in lines[-1] and "starting it again" in lines[-1], lines
         wait_until(lambda: _serving(base_port + 1) not in (None, stuck), timeout=60,
                    what="learner2's new dashboard")  # fmt: skip
         clients[1].close()
