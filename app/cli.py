@@ -213,7 +213,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     print(f"Stopped in {time.monotonic() - started:.1f} s{steps.slow()}.", flush=True)
     # All this process owns has stopped; Python's exit is left (joining worker threads,
     # freeing ROS objects). Should that stall, every thread's stack goes to the log
-    # first: a CI run's dashboard said "Stopped in 2.9 s" and was still there 7 s later.
+    # first: a rehearsal's dashboard said "Stopped in 2.9 s" and was there 5 s later.
     faulthandler.dump_traceback_later(EXIT_STALL_SEC)
     return 0
 

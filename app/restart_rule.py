@@ -6,8 +6,9 @@ Two ends bring a dashboard back by itself, its progress kept:
   answering. The guard ends it with SIGABRT, so that faulthandler writes every
   thread's stack to the log, and with SIGKILL when the abort has not ended it
   within a few seconds. On a machine whose cores are busy the abort can take
-  that long (a CI run's classroom: the dashboard ended by SIGKILL, was taken
-  for one killed on purpose and never came back).
+  that long, and the restarters, which waited for SIGABRT alone, took such a
+  dashboard for one killed on purpose: it never came back (the likely end of
+  a rehearsal's classroom whose learner was never restarted, at load 14).
 
 A SIGKILL alone cannot tell the guard from someone's ``kill -9``, so the
 guard says it fired: before its first signal it creates a file, the *mark*,
