@@ -84,8 +84,8 @@ def test_three_isolated_learners(ros_env, tmp_path):
             line = room.stdout.readline()
             assert line, f"classroom ended early: {lines}"
             lines.append(line)
-        # However the guard's end came (SIGABRT, or SIGKILL when the abort took too long
-        # on a loaded machine: CI), the classroom knows the guard did it, and restarts.
+        # However the guard's end came (SIGABRT, or SIGKILL when the abort takes too long
+        # on a loaded machine), the classroom knows the guard did it, and restarts.
         assert "its guard ended it" in lines[-1] and "starting it again" in lines[-1], lines
         wait_until(lambda: _serving(base_port + 1) not in (None, stuck), timeout=60,
                    what="learner2's new dashboard")  # fmt: skip

@@ -4,9 +4,9 @@ The guard (app/ros/liveness.py) aborts a dashboard that stopped answering and
 kills it when the abort has not ended it within a few seconds. The restarters
 waited for SIGABRT alone, so they took that SIGKILL for a deliberate one and
 left the dashboard ended (most likely what a rehearsal's classroom met at load
-14: its learner was never restarted). Here a process that
-ignores SIGABRT stands in for an abort too slow to finish, and a real guard
-ends it (no DDS: the guard is a bash process fed on its stdin).
+14: its learner was never restarted). Here a process that ignores SIGABRT
+stands in for an abort too slow to finish, and a real guard ends it (no DDS:
+the guard is a bash process fed on its stdin).
 """
 
 from __future__ import annotations
