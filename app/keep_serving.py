@@ -52,9 +52,10 @@ def main(argv: list[str]) -> int:
                 preexec_fn=die_with(os.getpid()),  # the dashboard ends if this keeper is killed
             )
             code = child.wait()
+            status = code if code >= 0 else 128 - code  # a shell's status for a signal's end
             why = ended_for_a_restart(code, mark)
             if why is None or interrupted:
-                return code if code >= 0 else 128 - code
+                return status
             quick_ends = quick_ends + 1 if time.monotonic() - started < CALM_SEC else 0
             if quick_ends >= 3:
                 print(
@@ -62,7 +63,7 @@ def main(argv: list[str]) -> int:
                     file=sys.stderr,
                     flush=True,
                 )
-                return code if code >= 0 else 128 - code
+                return status
             print(f"== the dashboard ended ({why}): starting it again", file=sys.stderr, flush=True)
 
 
