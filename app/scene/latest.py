@@ -45,6 +45,13 @@ class LatestWorker(Generic[M]):
             self._last_arrival = now
         self._wake.set()
 
+    def poke(self, token: M) -> None:
+        """Draw ``token`` as soon as the throttle allows, not counted as a message: the
+        layer's own "look again" (the 3D view's empty-scene hint reads the count)."""
+        with self._lock:
+            self._pending = token
+        self._wake.set()
+
     def reset(self) -> None:
         """Forget counters and any pending message (a new topic was picked)."""
         with self._lock:

@@ -205,7 +205,7 @@ class MarkerLayer(OneTopicLayer):
         with self._lock:
             self._queue.clear()
             self._clear_pending = True  # the worker removes the old topic's markers
-        self.worker.offer(True)
+        self.worker.poke(True)
 
     def _on_message(self, msg: Marker | MarkerArray) -> None:
         markers = msg.markers if isinstance(msg, MarkerArray) else [msg]

@@ -60,6 +60,20 @@ def test_point_cloud_image_and_arm_show_up_live(page, probe):
     open_tab(page, "3D view")
     page.wait_for_function(HINT_SHOWN_JS, arg=True, polling=100, timeout=10_000)
     node = probe.node
+    # A marker topic that only has a listener (as a lesson check's on /cam/camera_pose):
+    # the Markers row follows it, and the scene, which still draws nothing, keeps its hint.
+    # (Taking the old topic's markers away counted as a message received, so the hint went
+    # for good: lessons 22 to 24 showed a bare grid.)
+    listener = node.create_subscription(MarkerArray, "/test/markers_nobody_sends", lambda _m: 0, 1)
+    try:
+        expect(page.get_by_label("Marker topic", exact=True)).to_have_value(
+            "/test/markers_nobody_sends", timeout=20_000
+        )
+        expect(page.get_by_text("Markers shown: none yet")).to_be_visible(timeout=10_000)
+        page.wait_for_timeout(1000)  # five more refreshes: the hint would have gone by now
+        assert page.evaluate(HINT_SHOWN_JS, True), "the hint went with nothing drawn"
+    finally:
+        node.destroy_subscription(listener)
     pts, colours = synthetic_cloud_points(CLOUD_POINTS)
     cloud_pub = node.create_publisher(PointCloud2, "/test/cloud", 1)
     image_pub = node.create_publisher(Image, "/test/camera/image", 1)

@@ -117,3 +117,20 @@ def test_close_unsubscribes_and_stops_the_worker():
     follower.close()
     assert not node.live and follower.topic == NONE
     assert "scene-test-follow-close" not in [t.name for t in threading.enumerate()]
+
+
+def test_a_poke_is_drawn_but_is_not_a_message_received():
+    """A layer's own "look again" (the marker layer takes an old topic's markers away on a
+    switch) is drawn, but it must not read as a message: the 3D view's empty-scene hint
+    goes once any layer has received one."""
+    drawn = threading.Event()
+    worker = LatestWorker("test-poke", lambda _token: drawn.set(), 1000.0)
+    try:
+        worker.poke(True)
+        assert drawn.wait(5.0), "the poke was never drawn"
+        received, _drawn, rate, since = worker.stats()
+        assert (received, rate, since) == (0, None, None)
+        worker.offer(True)
+        assert worker.stats()[0] == 1
+    finally:
+        worker.stop()
