@@ -19,6 +19,7 @@ import viser
 
 from app.catalog import UnknownNodeError, lookup_group
 from app.lessons import step_code
+from app.lessons.checks.quiz import answer_order
 from app.lessons.progress import ProgressStore
 from app.lessons.registry import CheckResult
 from app.lessons.runtime import FAIL, PASS, WAITING, LessonRuntime
@@ -398,7 +399,7 @@ class LessonsPanel:
                 self._dynamic.append(question)
                 chosen = self._live.quiz_answers.get(check.key)
                 answers = []
-                for option in check["options"]:
+                for option in answer_order(check):
                     answer = self._gui.add_button(
                         answer_button_label(option, option == chosen),
                         color=_CHOSEN_COLOUR if option == chosen else _ANSWER_COLOUR,
