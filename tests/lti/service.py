@@ -265,3 +265,12 @@ def wait_for(what: Callable[[], bool], timeout: float = 10.0, why: str = "") -> 
         if time.monotonic() > deadline:
             raise AssertionError(f"not within {timeout} s: {why}")
         time.sleep(0.02)
+
+
+def wait_delivered(lti: LtiService, why: str, timeout: float = 10.0) -> None:
+    """Until the tool has the LMS's answer to a score: its outbox says delivered.
+
+    The LMS holds a score a moment before the tool hears back, and the teacher's pages
+    say "✓ sent" only then (a rehearsal at load 12.7 read a page in between).
+    """
+    wait_for(lambda: any(e.status == "delivered" for e in lti.tool.outbox.entries()), timeout, why)

@@ -25,7 +25,7 @@ from app.lti.routes import ToolUrls
 from app.teacher.record import LearnerRecord
 from tests.conftest import free_port
 from tests.lti.platform import TestPlatform
-from tests.lti.service import Answer, request, wait_for
+from tests.lti.service import Answer, request, wait_delivered, wait_for
 from tests.lti.test_service import (
     EXERCISE,
     INSTRUCTOR,
@@ -198,6 +198,7 @@ def test_a_cell_of_the_gradebook_opens_the_seats_attempts_read_from_its_folder(
     keep_attempt(attempts, "20261129-102500.recording", [])  # a grading under way
     room.records.append(seat_record("learner1", passed=True))
     wait_for(lambda: bool(platform.scores["11"]), why="Ada's score")
+    wait_delivered(room.server.lti, why="the LMS's answer to Ada's score")
     # No dashboard runs here at all: the attempts are read from the seat's folder, and
     # the time the seat's dashboard counted from the file it keeps beside its progress.
     totals = {"version": 1, "seconds": {f"exercise:{EXERCISE}": 754}}

@@ -25,7 +25,7 @@ from app.lti import claims
 from app.lti.learners import hub_user_name
 from app.teacher.record import GradedAttempt
 from tests.lti.platform import TestPlatform
-from tests.lti.service import PREFIX, Answer, ServiceUnderTest, request, wait_for
+from tests.lti.service import PREFIX, Answer, ServiceUnderTest, request, wait_delivered, wait_for
 from tests.lti.test_service import (
     EXERCISE,
     LESSON,
@@ -258,6 +258,7 @@ def test_a_cell_opens_the_learners_graded_attempts_with_their_seeds_and_the_lms_
     record = replace(exercise_record(name, passed=True), exercise_history=tried)
     assert service.report(record).status == 200
     wait_for(lambda: bool(platform.scores["11"]), why="the score")
+    wait_delivered(service.lti, why="the LMS's answer to the score")
     # Then moves on to another exercise: its history stays in the gradebook.
     later = replace(exercise_record(name, passed=False, slug="wall_stop"), exercise_history=())
     assert service.report(later).status == 200
