@@ -166,6 +166,10 @@ def test_a_recording_subscribes_as_its_own_node_as_ros2_bag_record_does(
     the dashboard's node, every message the recording took woke that node's executor: a
     recording of the simulated world cost the grading process a third of a core.)"""
     supervisor.start("talker")
+    # The talker on the graph first: a recording with nothing to subscribe to counts its
+    # four seconds from its start, and a talker slow to start on a busy machine (a CI run)
+    # came after the recording had ended, so the recorder never subscribed.
+    wait_until(lambda: probe.node.count_publishers("/chatter") > 0, timeout=30, what="the talker")
     runner = RosRuntime("bag_verb_runner")
     out: list[tuple[int, list[str]]] = []
     recording = threading.Thread(
@@ -180,7 +184,11 @@ def test_a_recording_subscribes_as_its_own_node_as_ros2_bag_record_does(
             infos = probe.node.get_subscriptions_info_by_topic("/chatter")
             return {info.node_name for info in infos}
 
-        wait_until(lambda: "rosbag2_recorder" in readers(), timeout=30, what="the recorder")
+        wait_until(
+            lambda: "rosbag2_recorder" in readers(),
+            timeout=30,
+            what=lambda: f"the recorder (the verb printed {out})",
+        )
         assert "bag_verb_runner" not in readers()
         recording.join(timeout=30)
         assert out and out[0][0] == 0, out
