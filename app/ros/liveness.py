@@ -24,9 +24,11 @@ leaves quietly.
 
 from __future__ import annotations
 
+import ctypes
 import logging
 import os
 import shutil
+import signal
 import subprocess
 import threading
 
@@ -36,6 +38,9 @@ from std_msgs.msg import Empty
 from app.restart_rule import MARK_VARIABLE
 
 LIMIT_VARIABLE = "CLASSROOM_LIVENESS_LIMIT_SEC"  # tests set a few seconds
+# Tests only: with this set to 1, SIGUSR2 freezes the dashboard as the deadlock does
+# (see freeze_on_sigusr2_for_tests).
+FREEZE_VARIABLE = "CLASSROOM_LIVENESS_TEST_FREEZE"
 # Creating a reader takes milliseconds; a whole minute without one is a hang, even
 # on two cores busy with a test suite.
 DEFAULT_LIMIT_SEC = 60.0
@@ -118,6 +123,8 @@ class ParticipantLiveness:
         self._guard = start_guard(bash, os.getpid(), self.limit, line)
         self.guard_pid = self._guard.pid
         self._thread.start()
+        if os.environ.get(FREEZE_VARIABLE) == "1":
+            freeze_on_sigusr2_for_tests()
 
     def _run(self) -> None:
         period = self.limit / PROBES_PER_LIMIT
@@ -164,6 +171,25 @@ class ParticipantLiveness:
         except subprocess.TimeoutExpired:
             guard.kill()
             guard.wait()
+
+
+def freeze_on_sigusr2_for_tests() -> None:
+    """Fault injection for tests/faults/test_ros_liveness.py (main thread only): SIGUSR2
+    puts the process in the state the deadlock leaves it in.
+
+    The handler blocks in native code and keeps the GIL (ctypes.PyDLL calls do not
+    release it, like rclpy's calls into rcl), so every other Python thread stops where it
+    waits for the GIL: between two bytecodes or in a call that released it. SIGSTOP stops
+    the threads too, but anywhere, even halfway through building a Python frame, and
+    faulthandler's dump of all threads then read that frame and crashed (a fresh-clone
+    run: "File ???, line 0" and a segmentation fault before the probe's stack)."""
+    signal.signal(signal.SIGUSR2, _hold_the_gil_for_ever)
+
+
+def _hold_the_gil_for_ever(_signum: int, _frame: object) -> None:
+    pause = ctypes.PyDLL(None).pause  # returns only when a signal is caught: wait again
+    while True:
+        pause()
 
 
 def _ignore(_msg: Empty) -> None:

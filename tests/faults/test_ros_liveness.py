@@ -3,9 +3,13 @@
 The real cause (a Fast DDS 2.14.5 deadlock between two of its own threads,
 app/ros/liveness.py) takes minutes of heavy DDS traffic to bring about
 (tools/fastdds_deadlock.py does, to study it), far too long for a test. What
-it does to the dashboard is quick to cause: every thread stops, the GIL with
-them. SIGSTOP does exactly that to the whole process, so it stands in for the
-deadlock here; the guard, a process of its own, is not stopped with it.
+it does to the dashboard is quick to cause: a thread blocks for good in native
+code holding the GIL, and every other Python thread stops waiting for it. The
+dashboard does exactly that on SIGUSR2 when the test asks for it
+(``FREEZE_VARIABLE``), so that stands in for the deadlock here; the guard, a
+process of its own, is not stopped with it. (SIGSTOP, used before, stops a
+thread anywhere, even halfway through building a frame, and faulthandler's
+dump then crashed on that frame, before the probe's stack.)
 
 Through ``make run``'s keeper (app/keep_serving.py), with the guard's limit
 at 6 s:
@@ -31,7 +35,7 @@ import psutil
 import pytest
 
 from app import PROJECT_ROOT
-from app.ros.liveness import GUARD_NAME, LIMIT_VARIABLE
+from app.ros.liveness import FREEZE_VARIABLE, GUARD_NAME, LIMIT_VARIABLE
 from tests.conftest import ARTIFACTS, free_port, wait_until
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(180)]
@@ -71,7 +75,7 @@ def test_a_dashboard_that_stops_answering_is_ended_and_started_again(ros_env, tm
     port = free_port()
     log_path = ARTIFACTS / f"liveness-{port}.log"
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
-    env = {**ros_env, "PYTHONUNBUFFERED": "1", LIMIT_VARIABLE: str(LIMIT_SEC)}
+    env = {**ros_env, "PYTHONUNBUFFERED": "1", LIMIT_VARIABLE: str(LIMIT_SEC), FREEZE_VARIABLE: "1"}
     argv = ["serve", "--port", str(port), "--progress-dir", str(tmp_path / "progress")]
     with open(log_path, "wb") as log_file:
         keeper = subprocess.Popen(
@@ -94,7 +98,7 @@ def test_a_dashboard_that_stops_answering_is_ended_and_started_again(ros_env, tm
         assert "stopped answering" not in log()
         assert _page_answers(port)
 
-        os.kill(first, signal.SIGSTOP)  # every thread stops, as in the deadlock
+        os.kill(first, signal.SIGUSR2)  # the GIL held in native code, as in the deadlock
         stopped_at = time.monotonic()
         wait_until(lambda: not psutil.pid_exists(first), timeout=LIMIT_SEC + 15,
                    what="the guard to end the stopped dashboard")  # fmt: skip
@@ -103,6 +107,8 @@ def test_a_dashboard_that_stops_answering_is_ended_and_started_again(ros_env, tm
         assert f"stopped answering for {LIMIT_SEC} s" in text, text
         assert "Fatal Python error: Aborted" in text, "faulthandler's stacks are in the log"
         assert "Thread 0x" in text and "liveness.py" in text, "the probe thread's stack too"
+        # The main thread, frozen by the test, is the last one faulthandler writes.
+        assert "_hold_the_gil_for_ever" in text, "the dump reached every thread"
         assert ended_after < LIMIT_SEC + 8, f"ended {ended_after:.1f} s after it stopped"
 
         wait_until(lambda: log().count("is ready") == 2, timeout=60, what="the restart")
