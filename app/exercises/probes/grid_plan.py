@@ -27,7 +27,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from app.exercises.probes.base import ProbeContext, draw, register_probe
-from app.exercises.probes.topics import wait_subscribed
+from app.exercises.probes.topics import wait_delivered, wait_subscribed
 from app.exercises.report import Result
 from app.exercises.trace import Trace
 from app.lessons.schema import Spec
@@ -463,7 +463,11 @@ def run(ctx: ProbeContext, p: Spec) -> Result:
         waited = wait_subscribed(ctx, publisher, topic)
         if waited:
             return Result(name, False, waited)
-        ctx.call.sleep(0.5)  # the latched map reaches the node's subscription
+        # The node answers from the map it holds, so the requests wait for its subscription
+        # to acknowledge the latched map (a loaded machine once took over 1.8 s: "no map
+        # yet" on the first request and on its retry), then a little for its callback.
+        wait_delivered(ctx, publisher)
+        ctx.call.sleep(0.5)
         told = (
             f"map {width} x {height} cells of {frame.resolution:g} m, origin "
             f"({frame.x:.2f}, {frame.y:.2f})"

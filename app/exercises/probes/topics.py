@@ -8,6 +8,7 @@ import time
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Protocol, TypeVar
 
+from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile
 
@@ -70,6 +71,21 @@ def wait_subscribed(ctx: ProbeContext, publisher: Publisher, topic: str) -> str:
         ctx.call.sleep(0.05)
     ctx.call.sleep(0.3)  # let the learner's publisher find our reader too
     return ""
+
+
+def wait_delivered(
+    ctx: ProbeContext, publisher: Publisher, timeout: float = MATCH_WAIT_SEC
+) -> bool:
+    """Whether every reliable subscription matched to ``publisher`` acknowledged all it
+    sent, a latched message included: True as soon as they did, False after ``timeout``.
+    Polled with a zero wait each time: a long wait sits in native code, which may keep
+    the GIL from the dashboard's other threads (the grader runs in its process)."""
+    deadline = time.monotonic() + timeout
+    while not publisher.wait_for_all_acked(Duration(seconds=0)):
+        if time.monotonic() > deadline:
+            return False
+        ctx.call.sleep(0.05)
+    return True
 
 
 def wait_matched(ctx: ProbeContext, ours: Sequence[tuple[Publisher, str]], theirs: str) -> str:
