@@ -31,6 +31,8 @@ from collections import Counter, defaultdict
 from dataclasses import dataclass
 from pathlib import Path
 
+import psutil
+
 # struct acct_v3 (linux/acct.h): flag, version, tty, exit code, uid, gid, pid, ppid,
 # start (epoch s), elapsed (float), then eight comp_t (utime, stime, ...) and the name.
 RECORD = struct.Struct("<BBHIIIIIIf8H16s")
@@ -170,39 +172,33 @@ def report(out: Path, kinds: bool = False) -> str:
     total = sum(by_kind.values())
     if total <= 0:
         return "no process of the run ended with CPU time on record"
+    group = {kind: group_of(kind) for kind in by_kind}
     by_group: Counter[str] = Counter()
     for kind, cpu in by_kind.items():
-        by_group[group_of(kind)] += cpu
+        by_group[group[kind]] += cpu
     lines = [f"{total:,.0f} CPU-s in {sum(count.values()):,} processes", "", "CPU s     %  group"]
-    for group, cpu in by_group.most_common():
-        lines.append(f"{cpu:6,.0f} {100 * cpu / total:5.1f}  {group}")
+    for name, cpu in by_group.most_common():
+        lines.append(f"{cpu:6,.0f} {100 * cpu / total:5.1f}  {name}")
         if kinds:
             for kind, kind_cpu in by_kind.most_common():
-                if group_of(kind) == group and kind_cpu >= 0.005 * total:
+                if group[kind] == name and kind_cpu >= 0.005 * total:
                     lines.append(f"{'':13}{kind_cpu:6,.0f}  {kind} ({count[kind]} processes)")
     return "\n".join(lines)
 
 
 def _sample(path: Path, stop: threading.Event) -> None:
     """Each second, the command line of every process not noted yet (by pid and start)."""
-    boot = float(Path("/proc/stat").read_text().split("btime ")[1].split()[0])
-    ticks = os.sysconf("SC_CLK_TCK")
-    noted: dict[str, int] = {}
+    noted: dict[int, float] = {}
     with open(path, "a", encoding="utf-8") as out:
         while not stop.wait(1.0):
-            for pid in filter(str.isdigit, os.listdir("/proc")):
-                try:
-                    stat = Path(f"/proc/{pid}/stat").read_bytes()
-                    start = int(stat[stat.rindex(b")") + 2 :].split()[19])
-                    if noted.get(pid) == start:
-                        continue
-                    raw = Path(f"/proc/{pid}/cmdline").read_bytes()[:400]
-                except (OSError, ValueError, IndexError):
-                    continue  # ended meanwhile
-                command = re.sub(r"\s+", " ", raw.replace(b"\0", b" ").decode(errors="replace"))
-                if command.strip():  # (kernel threads and zombies have none)
-                    noted[pid] = start
-                    out.write(f"{pid}\t{boot + start / ticks:.2f}\t{command.strip()}\n")
+            for proc in psutil.process_iter(["cmdline", "create_time"]):
+                started, words = proc.info["create_time"], proc.info["cmdline"]
+                # (kernel threads, zombies and processes gone meanwhile have no words)
+                if not words or started is None or noted.get(proc.pid) == started:
+                    continue
+                noted[proc.pid] = started
+                command = re.sub(r"\s+", " ", " ".join(words))[:400].strip()
+                out.write(f"{proc.pid}\t{started:.2f}\t{command}\n")
             out.flush()
 
 
