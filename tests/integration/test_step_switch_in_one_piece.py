@@ -8,10 +8,15 @@ rehearsal ci127 lost a click on Next so: the course walk at 125 % zoom pressed i
 atomic groups, which a page draws at once. This test walks three lessons and looks at
 what a page would draw after each frame it is sent.
 
-A page's first load is not a switch: viser sends everything the page must show in
-windows of at most 128 messages, so a card can arrive a frame before its buttons (the
+A page's first load is not a switch: viser sent everything the page must show in
+windows of at most 128 messages, so a card could arrive a frame before its buttons (the
 busy CI run of 1678878 saw lesson 1's first card so). Judging starts once that first load
 shows a whole card, before the test makes its first switch.
+
+The same cap cut a switch queued behind a burst (the busy rehearsal ci150: step 2's title
+with step 1's buttons, while the tools this client asks for were being built); our
+servers now send what waits in one window (app/viser_threads.py,
+tests/faults/test_viser_atomic.py).
 """
 
 from __future__ import annotations
