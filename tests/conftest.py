@@ -38,6 +38,10 @@ def pytest_collection_finish(session: pytest.Session) -> None:
 # their own, so two of them may serve on the same port number and would write
 # the same dashboard-<port>.log.
 ARTIFACTS = PROJECT_ROOT / "test-artifacts" / os.environ.get("PYTEST_XDIST_WORKER", "")
+# The browser tests' Chromium: Debian's headless shell (`make browser`), the same build as
+# its full browser without the windows, whose every new page also loaded the omnibox's
+# web page in a renderer of its own (bench/results/findings.md).
+BROWSER_EXECUTABLE = "/usr/lib/chromium/chromium-headless-shell"
 # A ROS teardown watchdog that ends a worker (or a dashboard it started) says why in the
 # worker's timeline: its stderr would die with the worker's captured output. The name is
 # app.ros.runtime.WATCHDOG_LOG_VARIABLE (not imported here: that imports rclpy).
@@ -242,14 +246,14 @@ def dashboard(ros_env, progress_dir) -> Iterator[DashboardProcess]:
 def browser():
     from playwright.sync_api import sync_playwright
 
-    executable = "/usr/bin/chromium"
-    if not Path(executable).exists():
+    if not Path(BROWSER_EXECUTABLE).exists():
         pytest.fail(
-            "Debian's chromium is missing: `make test` installs it (apt-get install chromium)"
+            "Debian's chromium-headless-shell is missing: `make test` installs it "
+            "(apt-get install chromium-headless-shell)"
         )
     with sync_playwright() as playwright:
         browser = playwright.chromium.launch(
-            executable_path=executable,
+            executable_path=BROWSER_EXECUTABLE,
             args=[
                 "--no-sandbox",
                 "--disable-dev-shm-usage",

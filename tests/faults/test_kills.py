@@ -18,7 +18,7 @@ from app import PROJECT_ROOT
 from app.panels.nodes_panel import STALE_NOTE
 from app.supervisor import NodeState
 from tests.browser.helpers import expect_text, open_page, open_tab
-from tests.conftest import wait_until
+from tests.conftest import BROWSER_EXECUTABLE, wait_until
 from tests.faults.helpers import live_children, overview, record
 from tests.wire_client import WireClient
 
@@ -111,7 +111,7 @@ def test_supervisor_knows_which_pids_ended(supervisor, probe):
 def test_a_killed_browser_leaves_the_server_serving(browser, dashboard):
     marker = f"--classroom-test-{uuid.uuid4().hex}"
     doomed = browser.browser_type.launch(
-        executable_path="/usr/bin/chromium",
+        executable_path=BROWSER_EXECUTABLE,
         args=["--no-sandbox", "--disable-dev-shm-usage", marker],
     )
     page = doomed.new_page()
@@ -119,7 +119,7 @@ def test_a_killed_browser_leaves_the_server_serving(browser, dashboard):
     open_tab(page, "Nodes")
     expect_text(page, "Catalog node")
     tagged = [p for p in psutil.process_iter(["cmdline"]) if marker in (p.info["cmdline"] or [])]
-    # Debian's /usr/bin/chromium is a wrapper script: kill it, the browser and its helpers.
+    # Kill the browser and its helpers (renderers, GPU process) at once.
     main = {p.pid: p for p in tagged}
     for proc in tagged:
         main.update({c.pid: c for c in proc.children(recursive=True)})
