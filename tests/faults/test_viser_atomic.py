@@ -14,12 +14,9 @@ from __future__ import annotations
 
 import random
 import re
-from collections.abc import Iterator
 
-import pytest
 import viser
 
-from app.access import make_server
 from tests.conftest import wait_until
 from tests.wire_client import WireClient
 
@@ -30,22 +27,13 @@ TITLE = re.compile(r"^group (\d+)$")
 BUTTON = re.compile(r"^(\d+)-\d+$")
 
 
-@pytest.fixture
-def server() -> Iterator[viser.ViserServer]:
-    server, _ = make_server("127.0.0.1", 0, None)
-    try:
-        yield server
-    finally:
-        server.stop()
-
-
-def test_a_group_behind_a_burst_arrives_in_one_frame(server: viser.ViserServer):
-    others = [server.gui.add_markdown(f"other {n}") for n in range(BURST[1])]
-    title = server.gui.add_markdown("group 0")
-    holder = server.gui.add_folder("buttons")
+def test_a_group_behind_a_burst_arrives_in_one_frame(bare_server: viser.ViserServer):
+    others = [bare_server.gui.add_markdown(f"other {n}") for n in range(BURST[1])]
+    title = bare_server.gui.add_markdown("group 0")
+    holder = bare_server.gui.add_folder("buttons")
     with holder:
-        buttons = [server.gui.add_button(f"0-{n}") for n in range(BUTTONS)]
-    client = WireClient(f"http://127.0.0.1:{server.get_port()}", open_every_tool=False)
+        buttons = [bare_server.gui.add_button(f"0-{n}") for n in range(BUTTONS)]
+    client = WireClient(f"http://127.0.0.1:{bare_server.get_port()}", open_every_tool=False)
     wrong: list[str] = []
     frames: list[int] = []
 
@@ -78,12 +66,12 @@ def test_a_group_behind_a_burst_arrives_in_one_frame(server: viser.ViserServer):
         for group in range(1, GROUPS + 1):
             for n, other in enumerate(others[: rng.randint(*BURST)]):
                 other.content = f"other {n}: {group}"
-            with server.atomic():
+            with bare_server.atomic():
                 title.content = f"group {group}"
                 for button in buttons:
                     button.remove()
                 with holder:
-                    buttons = [server.gui.add_button(f"{group}-{n}") for n in range(BUTTONS)]
+                    buttons = [bare_server.gui.add_button(f"{group}-{n}") for n in range(BUTTONS)]
             wait_until(lambda g=group: settled_on(g), timeout=30, what=f"group {group}")
     finally:
         client.close()

@@ -17,13 +17,12 @@ import threading
 import time
 import traceback
 from collections import Counter
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from typing import Any
 
 import pytest
 import viser
 
-from app.access import make_server
 from tests.conftest import wait_until
 from tests.faults.helpers import record
 from tests.wire_client import CAMERA_REPORT, WireClient
@@ -50,15 +49,6 @@ SWITCH_INTERVAL = 1e-5
 # threads at that switch interval shared the GIL with the server's loop. A loop that
 # hangs still fails: its handshakes outlast this, and the churner's thread its join.
 HANDSHAKE_TIMEOUT = 40.0
-
-
-@pytest.fixture
-def server() -> Iterator[viser.ViserServer]:
-    server, _ = make_server("127.0.0.1", 0, None)
-    try:
-        yield server
-    finally:
-        server.stop()
 
 
 def _markdown_updater(server: viser.ViserServer, n: int) -> Callable[[int], None]:
@@ -97,8 +87,8 @@ def _scene_updater(server: viser.ViserServer, n: int) -> Callable[[int], None]:
 KINDS = (_markdown_updater, _number_updater, _scene_updater)
 
 
-def test_handles_set_from_many_threads_while_clients_come_and_go(server: viser.ViserServer):
-    url = f"ws://127.0.0.1:{server.get_port()}"
+def test_handles_set_from_many_threads_while_clients_come_and_go(bare_server: viser.ViserServer):
+    url = f"ws://127.0.0.1:{bare_server.get_port()}"
     errors: list[str] = []
     errors_lock = threading.Lock()
     stop = threading.Event()
@@ -117,8 +107,8 @@ def test_handles_set_from_many_threads_while_clients_come_and_go(server: viser.V
         detail = "".join(traceback.format_exception(exc)) if exc else ""
         fail(f"event loop: {context.get('message')}\n{detail}")
 
-    server.get_event_loop().set_exception_handler(on_loop_error)
-    steps = [KINDS[n % len(KINDS)](server, n) for n in range(UPDATERS)]
+    bare_server.get_event_loop().set_exception_handler(on_loop_error)
+    steps = [KINDS[n % len(KINDS)](bare_server, n) for n in range(UPDATERS)]
     steady: list[WireClient] = []
     pushes = [0] * UPDATERS
     connects = [0] * CHURNERS
@@ -188,7 +178,7 @@ def test_handles_set_from_many_threads_while_clients_come_and_go(server: viser.V
             with client.lock:
                 updates = client.counts["GuiUpdateMessage"], client.counts["SetPositionMessage"]
             assert min(updates) > 100, updates
-        markdown = server.gui.add_markdown("calm")
+        markdown = bare_server.gui.add_markdown("calm")
         sent = time.monotonic()
         markdown.content = "the last word"
         wait_until(
@@ -215,7 +205,7 @@ def test_handles_set_from_many_threads_while_clients_come_and_go(server: viser.V
 
 
 def test_a_test_client_closes_with_one_thread_joining_its_reader(
-    server: viser.ViserServer, monkeypatch: pytest.MonkeyPatch
+    bare_server: viser.ViserServer, monkeypatch: pytest.MonkeyPatch
 ):
     """CI once lost a churner to CPython 3.11's race between two joiners of one thread.
 
@@ -240,7 +230,7 @@ def test_a_test_client_closes_with_one_thread_joining_its_reader(
                 joining[id(thread)] -= 1
 
     monkeypatch.setattr(threading.Thread, "join", counted_join)
-    url = f"ws://127.0.0.1:{server.get_port()}"
+    url = f"ws://127.0.0.1:{bare_server.get_port()}"
     for _ in range(5):
         client = WireClient(url)
         wait_until(lambda c=client: c.frames > 0, timeout=10, what="the client's first frame")
