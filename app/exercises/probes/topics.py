@@ -5,7 +5,7 @@ for its subscription, sending one input and reading the answer to it, and why no
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Protocol, TypeVar
 
 from rclpy.duration import Duration
@@ -62,13 +62,20 @@ def others_subscribed(node: Node, publisher: Publisher, topic: str) -> int:
     return max(0, int(publisher.get_subscription_count()) - counted)
 
 
+def _within(ctx: ProbeContext, timeout: float, done: Callable[[], object]) -> bool:
+    """Whether ``done()`` turned true within ``timeout`` seconds, asked every 50 ms."""
+    deadline = time.monotonic() + timeout
+    while not done():
+        if time.monotonic() > deadline:
+            return False
+        ctx.call.sleep(0.05)
+    return True
+
+
 def wait_subscribed(ctx: ProbeContext, publisher: Publisher, topic: str) -> str:
     """'' once someone subscribes to ``topic``, else why not."""
-    deadline = time.monotonic() + MATCH_WAIT_SEC
-    while not others_subscribed(ctx.call.node, publisher, topic):
-        if time.monotonic() > deadline:
-            return f"nothing subscribes to {topic} (waited {MATCH_WAIT_SEC:g} s)"
-        ctx.call.sleep(0.05)
+    if not _within(ctx, MATCH_WAIT_SEC, lambda: others_subscribed(ctx.call.node, publisher, topic)):
+        return f"nothing subscribes to {topic} (waited {MATCH_WAIT_SEC:g} s)"
     ctx.call.sleep(0.3)  # let the learner's publisher find our reader too
     return ""
 
@@ -80,12 +87,7 @@ def wait_delivered(
     sent, a latched message included: True as soon as they did, False after ``timeout``.
     Polled with a zero wait each time: a long wait sits in native code, which may keep
     the GIL from the dashboard's other threads (the grader runs in its process)."""
-    deadline = time.monotonic() + timeout
-    while not publisher.wait_for_all_acked(Duration(seconds=0)):
-        if time.monotonic() > deadline:
-            return False
-        ctx.call.sleep(0.05)
-    return True
+    return _within(ctx, timeout, lambda: publisher.wait_for_all_acked(Duration(seconds=0)))
 
 
 def wait_matched(ctx: ProbeContext, ours: Sequence[tuple[Publisher, str]], theirs: str) -> str:
@@ -93,17 +95,13 @@ def wait_matched(ctx: ProbeContext, ours: Sequence[tuple[Publisher, str]], their
     up to a second more for its publisher on ``theirs`` to show (it may have none: the
     grading then says so), and a little for its writer to match our reader."""
     node = ctx.call.node
-    deadline = time.monotonic() + MATCH_WAIT_SEC
-    while True:
-        missing = [topic for pub, topic in ours if not others_subscribed(node, pub, topic)]
-        if not missing:
-            break
-        if time.monotonic() > deadline:
-            return f"nothing subscribes to {missing[0]} (waited {MATCH_WAIT_SEC:g} s)"
-        ctx.call.sleep(0.05)
-    deadline = time.monotonic() + 1.0
-    while not node.count_publishers(theirs) and time.monotonic() < deadline:
-        ctx.call.sleep(0.05)
+
+    def missing() -> list[str]:
+        return [topic for pub, topic in ours if not others_subscribed(node, pub, topic)]
+
+    if not _within(ctx, MATCH_WAIT_SEC, lambda: not missing()) and (still := missing()):
+        return f"nothing subscribes to {still[0]} (waited {MATCH_WAIT_SEC:g} s)"
+    _within(ctx, 1.0, lambda: node.count_publishers(theirs))
     ctx.call.sleep(0.1)
     return ""
 
@@ -113,9 +111,7 @@ def wait_answering(ctx: ProbeContext, monitor: TopicMonitor, timeout: float = 3.
     may have none: the grading then says so), then a little for its writer to match us in
     turn. The ROS graph shows a publisher well before that on a loaded machine, and what
     it sends before is lost (CI: the first three of seven answers)."""
-    deadline = time.monotonic() + timeout
-    while not monitor.matched_publishers() and time.monotonic() < deadline:
-        ctx.call.sleep(0.05)
+    _within(ctx, timeout, monitor.matched_publishers)
     ctx.call.sleep(ANSWER_MATCH_SEC)
 
 
