@@ -8,8 +8,10 @@ past the deadline instead, which the client cannot tell from a dropped one.
 from __future__ import annotations
 
 import contextlib
+import re
 import threading
 import time
+from dataclasses import dataclass, field
 
 import pytest
 from tutorial_interfaces.srv import AddTwoInts
@@ -36,14 +38,23 @@ def _spun(node):
         node.destroy_node()
 
 
+@dataclass
+class Arrivals:
+    """When each request reached /slow_add and /never_add (time.monotonic())."""
+
+    slow: list[float] = field(default_factory=list)
+    never: list[float] = field(default_factory=list)
+
+
 @pytest.fixture
-def slow_first_answer(probe):
+def servers(probe):
     """/slow_add: answers a + b, but its first answer comes after 2.5 s; /never_add never."""
     import rclpy
     from rclpy.callback_groups import ReentrantCallbackGroup
 
     node = rclpy.create_node("slow_adder", context=probe.node.context)
-    calls: list[float] = []
+    arrivals = Arrivals()
+    calls = arrivals.slow
     never = threading.Event()
 
     def add(request, response):
@@ -54,6 +65,7 @@ def slow_first_answer(probe):
         return response
 
     def hang(request, response):
+        arrivals.never.append(time.monotonic())
         never.wait(8.0)
         return response
 
@@ -61,25 +73,25 @@ def slow_first_answer(probe):
     node.create_service(AddTwoInts, "/slow_add", add, callback_group=group)
     node.create_service(AddTwoInts, "/never_add", hang, callback_group=group)
     with _spun(node):
-        yield calls
+        yield arrivals
         never.set()
 
 
-def test_the_unanswered_request_is_sent_again_and_its_answer_taken(probe, slow_first_answer):
+def test_the_unanswered_request_is_sent_again_and_its_answer_taken(probe, servers):
     ctx = CallContext(probe.node)
     request = AddTwoInts.Request(a=20, b=22)
     response = call_service(ctx, "/slow_add", AddTwoInts, request, 1.5, resend_unanswered=True)
     assert response.sum == 42
-    assert len(slow_first_answer) == 2  # the first request was served, its answer was late
+    assert len(servers.slow) == 2  # the first request was served, its answer was late
 
 
-def test_without_the_resend_the_late_answer_is_no_answer(probe, slow_first_answer):
+def test_without_the_resend_the_late_answer_is_no_answer(probe, servers):
     ctx = CallContext(probe.node)
     with pytest.raises(NoAnswer, match=r"no answer from service '/slow_add' within 1\.5 s$"):
         call_service(ctx, "/slow_add", AddTwoInts, AddTwoInts.Request(a=1, b=2), 1.5)
 
 
-def test_a_server_that_never_answers_still_fails_after_the_resend(probe, slow_first_answer):
+def test_a_server_that_never_answers_still_fails_after_the_resend(probe, servers):
     ctx = CallContext(probe.node)
     started = time.monotonic()
     with pytest.raises(NoAnswer, match=r"within 2 s \(the request was sent twice\)$"):
@@ -90,7 +102,7 @@ def test_a_server_that_never_answers_still_fails_after_the_resend(probe, slow_fi
 
 
 def test_a_repeatable_request_goes_again_every_few_seconds_until_one_copy_is_answered(
-    probe, slow_first_answer
+    probe, servers
 ):
     # As the simulation probes set a learner's use_sim_time: the first copy can be lost
     # for good (a learner's node restarted under the same name, its old server still in
@@ -107,20 +119,36 @@ def test_a_repeatable_request_goes_again_every_few_seconds_until_one_copy_is_ans
     finally:
         probe.node.destroy_client(client)
     assert response.sum == 5
-    assert len(slow_first_answer) >= 2 and took < 2.5, (slow_first_answer, took)
+    assert len(servers.slow) >= 2 and took < 2.5, (servers.slow, took)
 
 
-def test_repeated_copies_that_are_never_answered_say_how_many_went(probe, slow_first_answer):
+def test_repeated_copies_that_are_never_answered_say_how_many_went(probe, servers):
+    # How many copies fit in the time depends on when the calling thread runs: a busy
+    # rehearsal (load 4 on 2 cores) held it past a 0.5 s mark, and two copies went
+    # where three were due. The count must be what really went, whatever it is.
     ctx = CallContext(probe.node)
     client = probe.node.create_client(AddTwoInts, "/never_add")
     try:
         assert client.wait_for_service(10.0)
-        with pytest.raises(NoAnswer, match=r"within 1\.5 s \(the request was sent 3 times\)$"):
+        started = time.monotonic()
+        with pytest.raises(NoAnswer, match=r"within 2 s \(the request was sent") as raised:
             call_again_until_answered(
-                ctx, client, AddTwoInts.Request(), 1.5, "service '/never_add'", resend=0.5
+                ctx, client, AddTwoInts.Request(), 2.0, "service '/never_add'", resend=0.5
             )
     finally:
         probe.node.destroy_client(client)
+    said = re.search(r"sent (twice|\d+) times?\)$", str(raised.value))
+    assert said, raised.value
+    went = 2 if said[1] == "twice" else int(said[1])
+    limit = time.monotonic() + 5.0  # copies still on their way to the server
+    while len(servers.never) < went and time.monotonic() < limit:
+        time.sleep(0.05)
+    time.sleep(0.2)  # and none beyond them
+    assert len(servers.never) == went, (str(raised.value), servers.never)
+    assert 2 <= went <= 4, went  # one copy each half second of the two: 0, 0.5, 1, 1.5 s
+    # None before its time: copy k leaves 0.5 k s after the call began, at the earliest.
+    due = [started + 0.5 * k for k in range(went)]
+    assert all(came >= at for came, at in zip(sorted(servers.never), due, strict=True))
 
 
 @pytest.fixture
