@@ -113,19 +113,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
     configure_this_process(domain_id=args.domain_id, network=args.network)
     _check_port_free(args.host, args.port)
 
-    # Heavy imports only for the command that needs them.
-    from app.access import make_server
     from app.bags import folder as bag_folder
-    from app.dashboard import Dashboard
-    from app.exercises.editor_server import EditorHub
-    from app.exercises.panel import ExerciseSettings
-    from app.exercises.workspace import Workspace
     from app.lessons.progress import DEFAULT_DIR, ProgressStore
-    from app.ros.liveness import ParticipantLiveness
-    from app.ros.runtime import RosRuntime
-    from app.supervisor import Supervisor
-    from app.ui.base_path import BasePathPage
-    from app.ui.page_links import PageLinks
 
     # Tracebacks behind the one-line errors of the page go to this process's log.
     logging.basicConfig(
@@ -140,6 +129,15 @@ def cmd_serve(args: argparse.Namespace) -> int:
     stop_requested = threading.Event()
     set_on_signals(stop_requested)
 
+    # The web server first, with only what it needs (viser, no rclpy): a browser opened at
+    # the address said next loads viser's client while the rest is imported and built,
+    # and is sent the dashboard as it is built (app/ui/opening.py).
+    from app.access import make_server
+    from app.exercises.editor_server import EditorHub
+    from app.ui.base_path import BasePathPage
+    from app.ui.opening import Opening
+    from app.ui.page_links import PageLinks
+
     editor_hub = EditorHub()
     # Extra routes on viser's server: links, then the page's base-path shim, then the editor.
     page_links = PageLinks(BasePathPage(editor_hub))
@@ -147,6 +145,19 @@ def cmd_serve(args: argparse.Namespace) -> int:
     if server.get_port() != args.port:
         server.stop()
         raise CliError(f"port {args.port} on {args.host} became busy; pick another with --port")
+    opening = Opening(server)
+    query = f"/?token={token}" if token else _hub_path(hub_login)
+    address = f"http://{args.host}:{args.port}{query}"
+    print(f"ROS 2 Classroom is starting: {address}  (the page fills in as it starts)", flush=True)
+
+    # The heavy imports, only for the command that needs them.
+    from app.dashboard import Dashboard
+    from app.exercises.panel import ExerciseSettings
+    from app.exercises.workspace import Workspace
+    from app.ros.liveness import ParticipantLiveness
+    from app.ros.runtime import RosRuntime
+    from app.supervisor import Supervisor
+
     runtime = RosRuntime()
     # A hung DDS participant freezes the whole process; a guard outside it notices, and
     # faulthandler writes every thread's stack to the log when the guard ends us.
@@ -185,14 +196,14 @@ def cmd_serve(args: argparse.Namespace) -> int:
         server, runtime, supervisor, progress, editor_hub, workspace, settings, page_links
     )
     dashboard.start()
+    opening.done()
     beacon = _progress_beacon(args, dashboard)
     domain = os.environ.get("ROS_DOMAIN_ID", "0")
     scope = "network (opt-in)" if args.network else "loopback only"
-    query = f"/?token={token}" if token else _hub_path(hub_login)
     if remote:
         print(_containment_line(args.allow_learner_code), flush=True)
     print(
-        f"ROS 2 Classroom is ready: http://{args.host}:{args.port}{query}  "
+        f"ROS 2 Classroom is ready: {address}  "
         f"(ROS domain {domain}, DDS {scope}). Press Ctrl+C to stop.",
         flush=True,
     )

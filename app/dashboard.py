@@ -39,6 +39,7 @@ from app.stage.window import Stage
 from app.supervisor import NodeState, Supervisor
 from app.ui import GROUP_OF, TAB_NAMES, TOOL_GROUPS, TOOLS, Inspector, MarkdownView, Panel
 from app.ui.loop import FullPasses, HiddenPasses, UiLoop
+from app.ui.opening import configure_theme
 from app.ui.page_fixes import page_fixes_html
 from app.ui.page_links import PageLinks, link_sender_html
 from app.ui.page_script import page_script
@@ -142,9 +143,7 @@ class Dashboard:
 
     def _build_gui(self) -> None:
         gui, ui, node = self.server.gui, self.ui, self.runtime.node
-        gui.configure_theme(
-            titlebar_content=None, control_width="large", show_share_button=False, show_logo=False
-        )
+        configure_theme(gui)  # as the page serve shows while this is built (app.ui.opening)
         gui.add_html(page_fixes_html())  # contrast and button names viser leaves out
         gui.add_html(link_sender_html())  # clicks on links in drawings (graph, lifecycle)
         gui.add_html(  # which tools the page shows: the others are refreshed less often

@@ -38,6 +38,7 @@ import urllib.request
 from pathlib import Path
 from typing import Any
 
+from app.ui.opening import OPENING_WORDS
 from bench._common import (
     LOGS,
     configure_dds,
@@ -98,7 +99,12 @@ def _ready_one(url: str, started: float, deadline: float, out: dict[str, Any]) -
                 if time.monotonic() > deadline:
                     raise
                 time.sleep(POLL_SEC)
-        while not ("Domain id" in (text := client.markdown()) and "ros2" in text):
+        # The whole dashboard: serve's page answers while it is still being built.
+        while not (
+            "Domain id" in (text := client.markdown())
+            and "ros2" in text
+            and OPENING_WORDS not in text
+        ):
             if time.monotonic() > deadline:
                 raise TimeoutError("the dashboard never sent its page")
             time.sleep(0.02)

@@ -45,6 +45,7 @@ import threading
 import time
 from typing import Any
 
+from app.ui.opening import OPENING_WORDS
 from bench._common import LOGS, configure_dds, percentile, require_private_netns, rounded, sample
 
 SETTLE_SEC = 4.0
@@ -82,7 +83,8 @@ def _ready_one(hub: Any, user: str, started: float, out: dict[str, Any]) -> None
             except TimeoutError:
                 if time.monotonic() > deadline:
                     raise
-        while "ros2" not in client.markdown():
+        # The whole dashboard: serve's page answers while it is still being built.
+        while "ros2" not in (text := client.markdown()) or OPENING_WORDS in text:
             if time.monotonic() > deadline:
                 raise TimeoutError("the dashboard never sent its GUI")
             time.sleep(0.05)

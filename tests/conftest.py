@@ -194,8 +194,15 @@ def free_port() -> int:
 class DashboardProcess:
     """``ros2-classroom serve`` as a real child process."""
 
-    def __init__(self, env: dict[str, str], port: int, extra: list[str] | None = None):
+    def __init__(
+        self,
+        env: dict[str, str],
+        port: int,
+        extra: list[str] | None = None,
+        until: str = "is ready",  # "is starting": once the page answers (app/ui/opening.py)
+    ):
         self.port = port
+        self._until = until
         self.url = f"http://127.0.0.1:{port}"
         self.log_path = ARTIFACTS / f"dashboard-{port}.log"
         ARTIFACTS.mkdir(parents=True, exist_ok=True)
@@ -213,7 +220,7 @@ class DashboardProcess:
     def _ready(self) -> bool:
         if self.proc.poll() is not None:
             pytest.fail(f"dashboard exited early ({self.proc.returncode}):\n{self.log()}")
-        return "is ready" in self.log()
+        return self._until in self.log()
 
     def log(self) -> str:
         return Path(self.log_path).read_text(errors="replace")

@@ -100,6 +100,7 @@ class WireClient:
         headers: dict[str, str] | None = None,
         open_timeout: float = 10.0,
         open_every_tool: bool = True,
+        on_message: Callable[[dict[str, Any]], None] | None = None,
     ) -> None:
         """``open_every_tool``: report every tool shown once, as a page that had opened
         them all, so a dashboard builds the tools it builds only when shown
@@ -125,7 +126,8 @@ class WireClient:
         self.closed_reason: str | None = None
         # Called with each message once it is applied, under ``lock`` (on the reader thread):
         # what a test sees at the moment a message arrives, in the order they were sent.
-        self.on_message: Callable[[dict[str, Any]], None] | None = None
+        # (Given here, it sees the first message too.)
+        self.on_message: Callable[[dict[str, Any]], None] | None = on_message
         # Called once a frame's messages are all applied, under ``lock``: a page draws
         # what one frame brought at once, so this is each state a page can show.
         self.on_frame: Callable[[], None] | None = None

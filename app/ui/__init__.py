@@ -42,11 +42,12 @@ viser (1.1.1) from each thread:
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Protocol, TypeVar, runtime_checkable
+from typing import TYPE_CHECKING, Protocol, TypeVar, runtime_checkable
 
 import viser
 
-from app.ros.graph import GraphSnapshot
+if TYPE_CHECKING:  # at run time only a name in an annotation: serve's page comes up
+    from app.ros.graph import GraphSnapshot  # before rclpy is imported (app/cli.py)
 
 
 # The dashboard's tools, grouped as a learner thinks of them: what I learn with, what I
