@@ -283,6 +283,14 @@ ROWS: tuple[tuple[str, str, str, str, str, Any], ...] = (
         lambda v: v <= 1.1,
     ),
     (
+        "Start-up ratio, cold `serve` against the bare app also written address first",
+        "startup",
+        "startup_ratio_against_address_first",
+        "x",
+        "",
+        None,
+    ),
+    (
         "Class of 20 at once (`classroom`, warm start): every dashboard ready p50",
         "class_ready",
         "class_ready_p50_s",
