@@ -194,6 +194,8 @@ def free_port() -> int:
 class DashboardProcess:
     """``ros2-classroom serve`` as a real child process."""
 
+    _until = "is ready"  # also for subclasses with their own __init__ (test_kill_restart)
+
     def __init__(
         self,
         env: dict[str, str],
