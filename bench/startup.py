@@ -52,15 +52,8 @@ from bench._common import (
     wait_for_text,
 )
 
-BARE_APP = """
-import sys, threading
-import rclpy, viser
-from rclpy.node import Node
-rclpy.init()
-node = Node("bench_bare_app")
-server = viser.ViserServer(host="127.0.0.1", port=int(sys.argv[1]), verbose=False)
-server.gui.add_markdown("bare app")
-print("bare app is ready", flush=True)
+# How both bare apps end: they serve until stopped.
+_SERVE_UNTIL_STOPPED = """
 try:
     threading.Event().wait()
 except KeyboardInterrupt:
@@ -70,11 +63,26 @@ finally:
     rclpy.try_shutdown()
 """
 
+BARE_APP = (
+    """
+import sys, threading
+import rclpy, viser
+from rclpy.node import Node
+rclpy.init()
+node = Node("bench_bare_app")
+server = viser.ViserServer(host="127.0.0.1", port=int(sys.argv[1]), verbose=False)
+server.gui.add_markdown("bare app")
+print("bare app is ready", flush=True)
+"""
+    + _SERVE_UNTIL_STOPPED
+)
+
 
 # The same bare app written as `serve` now is: its web server and address first, then
 # rclpy and its node while a browser loads the page. Not the issue's baseline; timed
 # beside it so the note can say how much of the dashboard's gain any app could have.
-BARE_APP_ADDRESS_FIRST = """
+BARE_APP_ADDRESS_FIRST = (
+    """
 import sys, threading
 import viser
 server = viser.ViserServer(host="127.0.0.1", port=int(sys.argv[1]), verbose=False)
@@ -84,14 +92,9 @@ from rclpy.node import Node
 rclpy.init()
 node = Node("bench_bare_app")
 server.gui.add_markdown("bare app")
-try:
-    threading.Event().wait()
-except KeyboardInterrupt:
-    pass
-finally:
-    server.stop()
-    rclpy.try_shutdown()
 """
+    + _SERVE_UNTIL_STOPPED
+)
 
 KINDS = ("baseline", "dashboard", "warm", "baseline_address_first")
 
