@@ -6,9 +6,14 @@ and how long each took from ``publish()`` to the page (p50, p95):
 
 - **dashboard**: the real ``ros2-classroom serve`` process with the 3D view
   following the topic (decode, decimate to the point budget, viser update).
-  A frame counts when the panel's status line with that frame's
-  ``header.stamp`` reaches the page's main thread; it is sent right after the
-  points, in order, so the points have arrived by then.
+  A frame counts when its points reach the page's main thread. The points
+  themselves say which frame they are: the publisher writes each cloud's
+  ``header.stamp`` into the colours of the first points the dashboard keeps
+  (``stamp_in_colours``), and the page reads it back from viser's update of
+  the cloud. (Until 2026-12-08 a frame counted when the panel's status line
+  with its stamp arrived; that line is refreshed by the UI thread at 5 Hz,
+  not right after the points, so the figure was at most 5 frames a second and
+  late by up to 200 ms whatever the points did.)
   The same frame is also timed inside viser's websocket worker, when it has
   arrived in the browser and been decoded (``dashboard_worker_*``): headless
   Chromium here has no GPU, and while software WebGL draws, the page's main
@@ -34,6 +39,7 @@ import argparse
 import asyncio
 import http
 import json
+import math
 import os
 import statistics
 import struct
@@ -57,6 +63,7 @@ from bench._common import (
     wait_for_text,
 )
 
+POINT_STEP, RGB_OFFSET = 16, 12  # xyz_to_pointcloud2's layout: x, y, z, then rgb
 DASH_TOPIC = "/bench/cloud_dash"
 BASE_TOPIC = "/bench/cloud_base"
 CASES = ((100_000, 10), (100_000, 20), (1_000_000, 10), (1_000_000, 20))
@@ -65,8 +72,8 @@ MEASURE_SEC = 3.0
 ROUNDS = 2
 TAIL_SEC = 0.8
 
-# The dashboard page, timed at two places for each cloud status line (which
-# viser sends right after the points, in order):
+# The dashboard page, timed at two places for each cloud (the points and colours of one
+# frame come in one update of the cloud, which says its stamp):
 # - "worker": viser's websocket worker has received and decoded the batch and
 #   hands it to the page. Measured inside that worker (its script is wrapped
 #   so its postMessage time-stamps batches), so it does not wait for the page.
@@ -74,22 +81,34 @@ TAIL_SEC = 0.8
 #   thread can stall for hundreds of ms while software WebGL (SwiftShader)
 #   draws, so both are reported; the stalls themselves are logged in
 #   window.__stalls (gaps of more than 50 ms in a 10 ms interval timer).
-DASHBOARD_PROBE_JS = r"""
+# The stamp a cloud's points carry in their first colours (see ``stamp_in_colours``), read
+# from viser's message that creates or updates the cloud: [sec, nanosec as 9 digits] or null.
+_STAMP_OF_JS = r"""(m) => {
+  const x = (m.type === 'SceneNodeUpdateMessage' && m.updates && m.updates.colors)
+    || (m.props && m.props.colors);
+  if (!x || !(ArrayBuffer.isView(x) || Array.isArray(x)) || x.length < 8) return null;
+  const c = ArrayBuffer.isView(x) ? new Uint8Array(x.buffer, x.byteOffset, 8) : x;
+  const u32 = (i) => (c[i] | (c[i + 1] << 8) | (c[i + 2] << 16) | (c[i + 3] << 24)) >>> 0;
+  return [String(u32(0)), String(u32(4)).padStart(9, '0')];
+}"""
+
+DASHBOARD_PROBE_JS = (
+    r"""
 window.__frames = []; window.__workerFrames = []; window.__stalls = [];
-const STAMP = /stamp (\d+)\.(\d{9})/;
+const stampOf = """
+    + _STAMP_OF_JS
+    + r""";
 const WORKER_PREFIX = `(() => {
   const channel = new BroadcastChannel('__bench_probe');
+  const stampOf = ${stampOf.toString()};
   const post = self.postMessage.bind(self);
   self.postMessage = (message, transfer) => {
     try {
       if (message && message.type === 'message_batch') {
         const t = performance.timeOrigin + performance.now();
         for (const m of message.messages) {
-          if (m.type !== 'GuiUpdateMessage' || !m.updates) continue;
-          for (const v of Object.values(m.updates)) {
-            const r = typeof v === 'string' && /stamp (\\d+)\\.(\\d{9})/.exec(v);
-            if (r) channel.postMessage([r[1], r[2], t]);
-          }
+          const stamp = stampOf(m);
+          if (stamp) channel.postMessage([stamp[0], stamp[1], t]);
         }
       }
     } catch (e) {}
@@ -121,17 +140,14 @@ window.Worker = class extends OrigWorker {
       if (!data || data.type !== 'message_batch') return;
       const t = performance.timeOrigin + performance.now();
       for (const m of data.messages) {
-        if (m.type !== 'GuiUpdateMessage' || !m.updates) continue;
-        for (const v of Object.values(m.updates)) {
-          if (typeof v !== 'string') continue;
-          const r = STAMP.exec(v);
-          if (r) window.__frames.push([r[1], r[2], t]);
-        }
+        const stamp = stampOf(m);
+        if (stamp) window.__frames.push([stamp[0], stamp[1], t]);
       }
     });
   }
 };
 """
+)
 
 BASELINE_PAGE = """<!doctype html><html><body><p id="s">baseline</p><script>
 window.__frames = []; window.__ready = false;
@@ -249,8 +265,15 @@ def serve_baseline(port: int) -> None:
 # --------------------------------------------------------------------------- the benchmark
 
 
+# Clouds of each size, built ahead and published in turn: each frame's points differ from
+# the last one's, as a sensor's do. (One cloud published again and again is sent to a page
+# once: viser sends a property only when it changed.)
+CLOUDS_PER_SIZE = 3
+
+
 class CloudPublisher:
-    """Pre-built clouds (the decode side is what we measure); only the stamp changes."""
+    """Pre-built clouds (the decode side is what we measure), taken in turn; the stamp is
+    each frame's own, in the header and in the first points' colours."""
 
     def __init__(self) -> None:
         from rclpy.qos import QoSProfile, ReliabilityPolicy
@@ -270,14 +293,19 @@ class CloudPublisher:
         for size, _hz in CASES:
             if size in self.messages:
                 continue
-            pts = rng.uniform(-1.0, 1.0, size=(size, 3)).astype(np.float32)
-            pts[:, 2] = np.abs(pts[:, 2]) * 0.5
-            cols = rng.integers(0, 255, size=(size, 3), dtype=np.uint8)
-            self.messages[size] = encode_cloud(pts, cols, frame_id="base_link")
+            self.messages[size] = []
+            for _ in range(CLOUDS_PER_SIZE):
+                pts = rng.uniform(-1.0, 1.0, size=(size, 3)).astype(np.float32)
+                pts[:, 2] = np.abs(pts[:, 2]) * 0.5
+                cols = rng.integers(0, 255, size=(size, 3), dtype=np.uint8)
+                self.messages[size].append(encode_cloud(pts, cols, frame_id="base_link"))
 
     def run(self, topic: str, size: int, hz: float, duration: float) -> list[tuple[int, int]]:
         """Publish at ``hz`` for ``duration`` s; returns the (sec, nanosec) stamps sent."""
-        pub, msg = self.publishers[topic], self.messages[size]
+        pub, clouds = self.publishers[topic], self.messages[size]
+        from app.scene.pointclouds import DEFAULT_BUDGET
+
+        stride = math.ceil(size / DEFAULT_BUDGET)  # the points the dashboard keeps
         period = 1.0 / hz
         sent: list[tuple[int, int]] = []
         start_t = time.perf_counter()
@@ -289,8 +317,10 @@ class CloudPublisher:
                 break
             if due > now:
                 time.sleep(due - now)
+            msg = clouds[k % len(clouds)]
             wall = time.time_ns()
             msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(wall, 1_000_000_000)
+            stamp_in_colours(msg, stride)
             pub.publish(msg)
             sent.append((msg.header.stamp.sec, msg.header.stamp.nanosec))
             k += 1
@@ -298,6 +328,18 @@ class CloudPublisher:
 
     def close(self) -> None:
         self.runtime.shutdown()
+
+
+def stamp_in_colours(msg: Any, stride: int) -> None:
+    """Write ``msg``'s stamp (sec, nanosec: 8 little-endian bytes) into the colours of its
+    first three points that a viewer keeping every ``stride``-th point draws, as R, G, B.
+    The cloud is ``xyz_to_pointcloud2``'s: 16 bytes a point, its rgb packed at byte 12 as
+    B, G, R (the page reads the stamp back, ``_STAMP_OF_JS``)."""
+    stamp = struct.pack("<II", msg.header.stamp.sec, msg.header.stamp.nanosec) + b"\0"
+    for j in range(3):
+        r, g, b = stamp[3 * j : 3 * j + 3]
+        at = j * stride * POINT_STEP + RGB_OFFSET
+        msg.data[at], msg.data[at + 1], msg.data[at + 2] = b, g, r
 
 
 def window_arrivals(frames: list[list[Any]], sent: list[tuple[int, int]]) -> dict[int, float]:
@@ -493,7 +535,9 @@ def run_bench(cases: tuple[tuple[int, int], ...]) -> dict[str, Any]:
         publisher.close()
         stop(baseline)
         stop(dashboard)
-    results["dashboard_point_budget"] = 200_000
+    from app.scene.pointclouds import DEFAULT_BUDGET
+
+    results["dashboard_point_budget"] = DEFAULT_BUDGET
     if "dashboard_fps_100k_20hz" in results:
         fps_ok = (results["fps_ratio_100k_20hz"] or 0) >= 0.8
         results["aim_met_100k_20hz"] = bool(results["dashboard_p95_ms_100k_20hz"] < 100 and fps_ok)
