@@ -63,7 +63,6 @@ from bench._common import (
     wait_for_text,
 )
 
-POINT_STEP, RGB_OFFSET = 16, 12  # xyz_to_pointcloud2's layout: x, y, z, then rgb
 DASH_TOPIC = "/bench/cloud_dash"
 BASE_TOPIC = "/bench/cloud_base"
 CASES = ((100_000, 10), (100_000, 20), (1_000_000, 10), (1_000_000, 20))
@@ -302,9 +301,9 @@ class CloudPublisher:
 
     def run(self, topic: str, size: int, hz: float, duration: float) -> list[tuple[int, int]]:
         """Publish at ``hz`` for ``duration`` s; returns the (sec, nanosec) stamps sent."""
-        pub, clouds = self.publishers[topic], self.messages[size]
         from app.scene.pointclouds import DEFAULT_BUDGET
 
+        pub, clouds = self.publishers[topic], self.messages[size]
         stride = math.ceil(size / DEFAULT_BUDGET)  # the points the dashboard keeps
         period = 1.0 / hz
         sent: list[tuple[int, int]] = []
@@ -333,12 +332,13 @@ class CloudPublisher:
 def stamp_in_colours(msg: Any, stride: int) -> None:
     """Write ``msg``'s stamp (sec, nanosec: 8 little-endian bytes) into the colours of its
     first three points that a viewer keeping every ``stride``-th point draws, as R, G, B.
-    The cloud is ``xyz_to_pointcloud2``'s: 16 bytes a point, its rgb packed at byte 12 as
-    B, G, R (the page reads the stamp back, ``_STAMP_OF_JS``)."""
+    Its rgb field is packed little-endian, as ``xyz_to_pointcloud2`` writes it: B, G, R
+    (the page reads the stamp back, ``_STAMP_OF_JS``)."""
+    rgb = next(field.offset for field in msg.fields if field.name == "rgb")
     stamp = struct.pack("<II", msg.header.stamp.sec, msg.header.stamp.nanosec) + b"\0"
     for j in range(3):
         r, g, b = stamp[3 * j : 3 * j + 3]
-        at = j * stride * POINT_STEP + RGB_OFFSET
+        at = j * stride * msg.point_step + rgb
         msg.data[at], msg.data[at + 1], msg.data[at + 2] = b, g, r
 
 
